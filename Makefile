@@ -1,0 +1,38 @@
+# proxima: the two commands of the README.
+#   make run   builds in release and runs the main job
+#   make test  installs what is missing, builds, runs every test (release + sanitizers)
+JOBS ?= $(shell nproc)
+
+.PHONY: all run test setup release asan dev bench clean
+
+all: release
+
+setup:
+	@bash scripts/setup
+
+release: setup
+	cmake --preset release >/dev/null
+	cmake --build --preset release -j $(JOBS)
+
+asan: setup
+	cmake --preset asan >/dev/null
+	cmake --build --preset asan -j $(JOBS)
+
+dev: setup
+	cmake --preset dev >/dev/null
+	cmake --build --preset dev -j $(JOBS)
+
+run: release
+	./build/release/cli/proxima demo
+
+test: release asan
+	@echo "== unit tests, release build =="
+	ctest --preset release -j $(JOBS)
+	@echo "== unit tests, ASan + UBSan build =="
+	ctest --preset asan -j $(JOBS)
+
+bench: release
+	@for b in build/release/bench/*_bench; do echo "== $$b =="; $$b; done
+
+clean:
+	rm -rf build out

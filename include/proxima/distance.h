@@ -1,0 +1,28 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 6: the query API.
+//
+//   proxima::ConvexPolytope a(points_a), b(points_b);
+//   proxima::DistanceCache cache;                 // cold
+//   auto r = proxima::distance(a, pose_a, b, pose_b, {}, &cache);
+//   // ... next step, bodies moved a little: pass the same cache (tracking)
+//
+// Thread safety: polytopes are immutable and may be shared between threads.
+// A DistanceCache belongs to one pair at a time and must not be used by two
+// threads at once; distinct caches may be used concurrently.
+#pragma once
+
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
+namespace proxima {
+
+// Minimum distance, closest points and closest features of the two hulls
+// placed at pose_a and pose_b. Throws InvalidInput for a non-finite pose.
+// `cache` may be null (a cold query).
+DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                        const Pose& pose_b, const DistanceOptions& options = {},
+                        DistanceCache* cache = nullptr);
+
+}  // namespace proxima

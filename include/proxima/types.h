@@ -1,0 +1,155 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 1: the vocabulary every other layer speaks. Eigen aliases, poses,
+// feature ids, statuses and the error type for bad input.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace proxima {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Quat = Eigen::Quaterniond;
+using Isometry3 = Eigen::Isometry3d;
+
+// Unit roundoff of double, u = 2^-53. The accuracy standard of DESIGN.md is
+// written in units of u times the largest coordinate magnitude R.
+inline constexpr double kUnitRoundoff = 0x1p-53;
+
+// A rigid motion. Accepts an Eigen isometry or a (quaternion, translation)
+// pair; the quaternion is normalized on construction so that a caller's
+// slightly denormalized input does not scale the body.
+struct Pose {
+  Mat3 rotation = Mat3::Identity();
+  Vec3 translation = Vec3::Zero();
+
+  Pose() = default;
+  Pose(const Mat3& r, const Vec3& t) : rotation(r), translation(t) {}
+  Pose(const Quat& q, const Vec3& t) : rotation(q.normalized().toRotationMatrix()), translation(t) {}
+  Pose(const Isometry3& iso) : rotation(iso.linear()), translation(iso.translation()) {}  // NOLINT(google-explicit-constructor)
+
+  static Pose identity() { return {}; }
+  static Pose from_translation(const Vec3& t) { return {Mat3::Identity(), t}; }
+
+  Vec3 apply(const Vec3& p) const { return rotation * p + translation; }
+  Pose inverse() const { return {Mat3(rotation.transpose()), Vec3(-(rotation.transpose() * translation))}; }
+  // (this * other).apply(p) == this->apply(other.apply(p))
+  Pose operator*(const Pose& other) const {
+    return {Mat3(rotation * other.rotation), Vec3(rotation * other.translation + translation)};
+  }
+  bool is_finite() const { return rotation.allFinite() && translation.allFinite(); }
+};
+
+// Which kind of boundary piece of a hull realizes a closest point.
+enum class FeatureType : std::uint8_t { vertex, edge, face };
+
+// A witness feature on one hull: its type, the hull vertex ids that span the
+// closest point (one for a vertex, two for an edge, up to three of a face's
+// vertices for a face) and, for a face, the hull's face id.
+struct Feature {
+  FeatureType type = FeatureType::vertex;
+  std::array<std::int32_t, 3> vertices = {-1, -1, -1};
+  std::int32_t face = -1;
+
+  int vertex_count() const { return vertices[2] >= 0 ? 3 : vertices[1] >= 0 ? 2 : vertices[0] >= 0 ? 1 : 0; }
+};
+
+enum class Status : std::uint8_t {
+  separated,      // distance > 64 u R: the hulls do not touch
+  touching,       // distance <= 64 u R: in contact at machine precision
+  intersecting,   // the hulls overlap; distance reported as 0
+  iteration_cap,  // the loop stopped at options.max_iterations; bounds still valid
+};
+
+inline const char* to_string(Status s) {
+  switch (s) {
+    case Status::separated: return "separated";
+    case Status::touching: return "touching";
+    case Status::intersecting: return "intersecting";
+    case Status::iteration_cap: return "iteration_cap";
+  }
+  return "unknown";
+}
+
+inline const char* to_string(FeatureType t) {
+  switch (t) {
+    case FeatureType::vertex: return "vertex";
+    case FeatureType::edge: return "edge";
+    case FeatureType::face: return "face";
+  }
+  return "unknown";
+}
+
+// Which algorithm answers a distance query. All three run behind the same
+// call so that every comparison is side by side.
+enum class Algorithm : std::uint8_t {
+  hybrid,        // the paper: feature pairs, closed-form local distances, support updates
+  gjk,           // classic GJK, brute-force support, cold simplex
+  enhanced_gjk,  // Cameron's: hill-climbing support, last simplex as warm start
+};
+
+inline const char* to_string(Algorithm a) {
+  switch (a) {
+    case Algorithm::hybrid: return "hybrid";
+    case Algorithm::gjk: return "gjk";
+    case Algorithm::enhanced_gjk: return "enhanced_gjk";
+  }
+  return "unknown";
+}
+
+struct DistanceOptions {
+  Algorithm algorithm = Algorithm::hybrid;
+  // Re of the paper's eq. 19: stop when distance - lower_bound <= Re * distance.
+  double relative_tolerance = 1e-12;
+  // Ae of eq. 19, added to the machine-precision contact band 64 u R: a
+  // distance at or below it is reported as touching.
+  double absolute_tolerance = 0.0;
+  // Hard cap on iterations; a query that reaches it says so in its status.
+  int max_iterations = 64;
+};
+
+// Coherence between queries of one pair, owned by the caller (Box2D's
+// b2SimplexCache habit). Default-constructed means cold. Passing the same
+// cache to the next query of the same pair is tracking. Ids are hull vertex
+// ids; a cache from another pair or a stale one is range-checked and at worst
+// makes a query slower, never wrong.
+struct DistanceCache {
+  // The feature pair of the last answer (hybrid) or the last simplex's
+  // vertex pairs (GJK family), -1 where unused.
+  std::array<std::int32_t, 4> vertices_a = {-1, -1, -1, -1};
+  std::array<std::int32_t, 4> vertices_b = {-1, -1, -1, -1};
+  // Support hints: the last support vertex on each body.
+  std::int32_t hint_a = -1;
+  std::int32_t hint_b = -1;
+
+  bool is_cold() const { return vertices_a[0] < 0 && hint_a < 0; }
+  void reset() { *this = DistanceCache{}; }
+};
+
+struct DistanceResult {
+  Status status = Status::separated;
+  double distance = 0.0;     // upper bound: |point_a - point_b|
+  double lower_bound = 0.0;  // certified: lower_bound <= exact distance (up to rounding)
+  Vec3 point_a = Vec3::Zero();  // closest point on A, world frame
+  Vec3 point_b = Vec3::Zero();  // closest point on B, world frame
+  Vec3 normal = Vec3::UnitX();  // unit, from A towards B
+  Feature feature_a;
+  Feature feature_b;
+  int iterations = 0;
+};
+
+// Thrown for bad input (no points, NaN coordinates, non-finite poses). The
+// message names what is wrong and where (e.g. the vertex index).
+class InvalidInput : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+}  // namespace proxima
