@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -44,7 +45,15 @@ struct Pose {
   Pose operator*(const Pose& other) const {
     return {Mat3(rotation * other.rotation), Vec3(rotation * other.translation + translation)};
   }
-  bool is_finite() const { return rotation.allFinite() && translation.allFinite(); }
+  bool is_finite() const {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(translation[i])) return false;
+      for (int j = 0; j < 3; ++j) {
+        if (!std::isfinite(rotation(i, j))) return false;
+      }
+    }
+    return true;
+  }
 };
 
 // Which kind of boundary piece of a hull realizes a closest point.

@@ -1,0 +1,377 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// The paper's hybrid algorithm (sections 4-5), as DESIGN.md reads it.
+//
+// State: a feature pair (FA, FB), each one to three hull vertices. The local
+// method gives the closest points XA in conv(FA) and XB in conv(FB) in closed
+// form, with barycentric coefficients; vertices whose coefficient is zero are
+// dropped, so the pair is always the minimal one realizing d = |XB - XA|.
+//
+// With w = XB - XA, the support points a* = argmax_A w.x and
+// b* = argmin_B w.y bound the distance from below:
+//     lower = (w.b* - w.a*) / |w|   (the slab between the two support planes)
+// and d is an upper bound. We stop when d - lower <= Re d (+ rounding), when
+// d falls in the contact band, or when no support point can improve the pair
+// any more (the answer is at machine precision).
+//
+// Otherwise one body is updated at a time: its support point joins its
+// feature, the local distance is recomputed and the pair reduced. Moving XA
+// towards a* decreases |w| at first order whenever w.(a* - XA) > 0, so an
+// accepted update strictly decreases d; a pair is never visited twice (the
+// paper's recycling) because d only decreases, and a hard cap bounds the loop.
+//
+// Everything happens in A's frame: B's vertices are mapped on demand, the
+// direction is rotated into B's frame for B's support search.
+#include "proxima/hybrid.h"
+
+#include "proxima/closest_point.h"
+#include "proxima/support.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace proxima {
+namespace {
+
+// Degenerate-feature threshold in units of u * R: an edge shorter than this,
+// or a triangle flatter than this (height over its longest edge), is reduced
+// (edge -> point, triangle -> edge). At a few ulps of R the feature is
+// indistinguishable from its reduction, so the reduction costs no accuracy;
+// pinned by the paper's stress tests (tetrahedra of edge 1e-23, cubes of
+// edge 1e-15 scaled by 1e39) in distance_accuracy_test.
+constexpr double kDegenerateUlps = 4.0;
+
+// Rounding slack of the termination test, in units of u * R: the support
+// values w.a* and w.b* each carry an error of a few u |w| R, so the computed
+// gap d - lower cannot be resolved below this. Well inside the 64 u R of the
+// accuracy standard.
+constexpr double kGapUlps = 16.0;
+
+// A feature of one body: up to three hull vertex ids (a fourth slot for the
+// support point being added), with their positions in A's frame.
+struct FeatureSet {
+  std::array<std::int32_t, 4> id{};
+  std::array<Vec3, 4> p;
+  int n = 0;
+
+  bool contains(std::int32_t v) const {
+    for (int i = 0; i < n; ++i) {
+      if (id[static_cast<std::size_t>(i)] == v) return true;
+    }
+    return false;
+  }
+  void push(std::int32_t v, const Vec3& x) {
+    id[static_cast<std::size_t>(n)] = v;
+    p[static_cast<std::size_t>(n)] = x;
+    ++n;
+  }
+  // Keeps the vertices whose bit is set in `active`, in order.
+  void reduce(std::uint8_t active) {
+    int k = 0;
+    for (int i = 0; i < n; ++i) {
+      if (active & (1u << i)) {
+        id[static_cast<std::size_t>(k)] = id[static_cast<std::size_t>(i)];
+        p[static_cast<std::size_t>(k)] = p[static_cast<std::size_t>(i)];
+        ++k;
+      }
+    }
+    n = k;
+  }
+};
+
+struct Local {
+  double distance_squared;
+  Vec3 xa, xb;
+  std::uint8_t active_a, active_b;
+};
+
+Local from_kernel(const ClosestPoints<double>& c) {
+  return {c.distance_squared, c.point_a, c.point_b, c.active_a, c.active_b};
+}
+
+// Closest points of conv(fa) and conv(fb). Sizes 1..3 go to the closed-form
+// kernels. A fourth vertex only appears on the side that just received its
+// support point (index 3): the feature is then a tetrahedron whose closest
+// point to the other feature lies on one of the three triangles through the
+// new vertex (the old triangle was the previous answer, which the new vertex
+// improves on), so the minimum over those three is the answer.
+Local local_distance(const FeatureSet& fa, const FeatureSet& fb, const KernelTolerance<double>& tol) {
+  if (fa.n <= 3 && fb.n <= 3) {
+    return from_kernel(closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol));
+  }
+  const bool on_a = fa.n == 4;
+  const FeatureSet& four = on_a ? fa : fb;
+  const FeatureSet& other = on_a ? fb : fa;
+  static constexpr std::array<std::array<int, 3>, 3> kTriangles = {{{0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
+  Local best{};
+  bool have = false;
+  for (const auto& tri : kTriangles) {
+    const std::array<Vec3, 3> pts = {four.p[static_cast<std::size_t>(tri[0])], four.p[static_cast<std::size_t>(tri[1])],
+                                     four.p[static_cast<std::size_t>(tri[2])]};
+    const ClosestPoints<double> c =
+        on_a ? closest_points<double>(pts.data(), 3, other.p.data(), other.n, tol)
+             : closest_points<double>(other.p.data(), other.n, pts.data(), 3, tol);
+    if (have && c.distance_squared >= best.distance_squared) continue;
+    const std::uint8_t tri_bits = on_a ? c.active_a : c.active_b;
+    std::uint8_t mapped = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (tri_bits & (1u << i)) mapped = static_cast<std::uint8_t>(mapped | (1u << tri[static_cast<std::size_t>(i)]));
+    }
+    best = from_kernel(c);
+    if (on_a) {
+      best.active_a = mapped;
+    } else {
+      best.active_b = mapped;
+    }
+    have = true;
+  }
+  return best;
+}
+
+bool valid_id(std::int32_t id, int count) { return id >= 0 && id < count; }
+
+// Loads a cached feature (ids range-checked, duplicates dropped). Returns
+// false when nothing usable is cached.
+template <class MapPoint>
+bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f, MapPoint map_point) {
+  f.n = 0;
+  for (int i = 0; i < 3; ++i) {
+    const std::int32_t v = cached[static_cast<std::size_t>(i)];
+    if (!valid_id(v, count) || f.contains(v)) continue;
+    f.push(v, map_point(v));
+  }
+  return f.n > 0;
+}
+
+// The minimal hull feature containing the points spanned by `f`: a vertex, an
+// edge if the two vertices are adjacent, else a face holding all of them (for
+// a polygon, the side facing `toward`).
+Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& toward) {
+  Feature out;
+  for (int i = 0; i < f.n && i < 3; ++i) out.vertices[static_cast<std::size_t>(i)] = f.id[static_cast<std::size_t>(i)];
+  if (f.n <= 1) {
+    out.type = FeatureType::vertex;
+    return out;
+  }
+  const std::int32_t v0 = f.id[0];
+  const auto nbrs = poly.neighbors(v0);
+  if (f.n == 2 && std::find(nbrs.begin(), nbrs.end(), f.id[1]) != nbrs.end()) {
+    out.type = FeatureType::edge;
+    return out;
+  }
+  out.type = FeatureType::face;
+  const auto faces = poly.adjacency_faces();
+  const auto begin = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v0)]);
+  double best_alignment = -2.0;
+  for (std::size_t k = begin; k < begin + nbrs.size(); ++k) {
+    const std::int32_t face = faces[k];
+    if (face < 0) continue;
+    const auto verts = poly.face(face);
+    bool holds_all = true;
+    for (int i = 1; i < f.n; ++i) {
+      holds_all = holds_all && std::find(verts.begin(), verts.end(), f.id[static_cast<std::size_t>(i)]) != verts.end();
+    }
+    if (!holds_all) continue;
+    const double alignment = poly.face_plane(face).normal.dot(toward);
+    if (alignment > best_alignment) {
+      best_alignment = alignment;
+      out.face = face;
+    }
+  }
+  return out;
+}
+
+// Touching or intersecting, once the local distance fell into the contact
+// band. By the separating axis theorem, two convex polytopes in contact are
+// only touching when some plane through the contact separates them, and such
+// a plane is parallel to a face of one body or to an edge of each. A plane
+// through the contact point supports both bodies there, so its face or edges
+// are incident to the contact features: the faces around FA's and FB's
+// vertices and the crosses of the edges leaving them are the candidates.
+// Touching when one of them separates the bodies to within the band.
+class ContactClassifier {
+ public:
+  ContactClassifier(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                    std::int32_t hint_a, std::int32_t hint_b, double tolerance)
+      : a_(a), b_(b), rot_(b_in_a.rotation), tr_(b_in_a.translation),
+        hint_a_(hint_a), hint_b_(hint_b), tolerance_(tolerance) {}
+
+  bool touching(const FeatureSet& fa, const FeatureSet& fb, const Vec3& last_direction) {
+    if (separates(last_direction)) return true;
+    for (int i = 0; i < fa.n; ++i) {
+      if (any_face_separates(a_, fa.id[static_cast<std::size_t>(i)], Mat3::Identity(), 1.0)) return true;
+    }
+    for (int i = 0; i < fb.n; ++i) {
+      if (any_face_separates(b_, fb.id[static_cast<std::size_t>(i)], rot_, -1.0)) return true;
+    }
+    for (int i = 0; i < fa.n; ++i) {
+      for (std::int32_t na : a_.neighbors(fa.id[static_cast<std::size_t>(i)])) {
+        const Vec3 ea = a_.vertex(na) - fa.p[static_cast<std::size_t>(i)];
+        for (int j = 0; j < fb.n; ++j) {
+          const std::int32_t vb = fb.id[static_cast<std::size_t>(j)];
+          for (std::int32_t nb : b_.neighbors(vb)) {
+            const Vec3 eb = rot_ * (b_.vertex(nb) - b_.vertex(vb));
+            const Vec3 n = ea.cross(eb);
+            const double len = n.norm();
+            if (!(len > 0.0)) continue;
+            if (separates(n / len) || separates(-n / len)) return true;
+          }
+        }
+      }
+    }
+    return false;
+  }
+
+ private:
+  // min over B of n.y - max over A of n.x >= -tolerance, for unit n.
+  bool separates(const Vec3& n) {
+    hint_a_ = support_hill_climb(a_, n, hint_a_);
+    hint_b_ = support_hill_climb(b_, -(rot_.transpose() * n), hint_b_);
+    const double gap = n.dot(rot_ * b_.vertex(hint_b_) + tr_) - n.dot(a_.vertex(hint_a_));
+    return gap >= -tolerance_;
+  }
+  // Faces around vertex v of `poly` (whose frame maps to A's by `to_a`); the
+  // outward normal times `sign` is the candidate direction from A to B.
+  bool any_face_separates(const ConvexPolytope& poly, std::int32_t v, const Mat3& to_a, double sign) {
+    const auto faces = poly.adjacency_faces();
+    const auto begin = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v)]);
+    const auto end = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v) + 1]);
+    for (std::size_t k = begin; k < end; ++k) {
+      if (faces[k] < 0) continue;
+      if (separates(Vec3(sign * (to_a * poly.face_plane(faces[k]).normal)))) return true;
+    }
+    return false;
+  }
+
+  const ConvexPolytope& a_;
+  const ConvexPolytope& b_;
+  const Mat3& rot_;
+  const Vec3& tr_;
+  std::int32_t hint_a_;
+  std::int32_t hint_b_;
+  double tolerance_;
+};
+
+}  // namespace
+
+DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                               const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
+  const Mat3& rot = b_in_a.rotation;
+  const Vec3& tr = b_in_a.translation;
+  const auto b_point = [&](std::int32_t v) -> Vec3 { return rot * b.vertex(v) + tr; };
+  const auto a_point = [&](std::int32_t v) -> Vec3 { return a.vertex(v); };
+
+  // R in A's frame: B's coordinates are bounded by |t| + |y| <= |t|_inf + sqrt(3) scale_B per axis.
+  const double r_local = std::max(a.scale(), tr.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
+  const double ulp_r = kUnitRoundoff * r_local;
+  KernelTolerance<double> tol;
+  tol.min_length_squared = (kDegenerateUlps * ulp_r) * (kDegenerateUlps * ulp_r);
+
+  std::int32_t hint_a = valid_id(cache.hint_a, a.vertex_count()) ? cache.hint_a : 0;
+  std::int32_t hint_b = valid_id(cache.hint_b, b.vertex_count()) ? cache.hint_b : 0;
+
+  FeatureSet fa;
+  FeatureSet fb;
+  const bool warm = load_feature(cache.vertices_a, a.vertex_count(), fa, a_point) &&
+                    load_feature(cache.vertices_b, b.vertex_count(), fb, b_point);
+  if (!warm) {
+    // Cold start: the support points along the line of centres.
+    const Vec3 towards_b = rot * b.centroid() + tr - a.centroid();
+    const Vec3 dir = towards_b.squaredNorm() > 0.0 ? towards_b : Vec3::UnitX();
+    hint_a = support_hill_climb(a, dir, hint_a);
+    hint_b = support_hill_climb(b, -(rot.transpose() * dir), hint_b);
+    fa = FeatureSet{};
+    fb = FeatureSet{};
+    fa.push(hint_a, a_point(hint_a));
+    fb.push(hint_b, b_point(hint_b));
+  }
+
+  Local loc = local_distance(fa, fb, tol);
+  fa.reduce(loc.active_a);
+  fb.reduce(loc.active_b);
+
+  DistanceResult result;
+  double lower = 0.0;
+  Vec3 last_direction = Vec3::UnitX();
+  int iterations = 0;
+  bool contact = false;
+  for (;;) {
+    const double d = std::sqrt(loc.distance_squared);
+    if (d <= contact_tolerance) {
+      contact = true;
+      break;
+    }
+    const Vec3 w = loc.xb - loc.xa;  // from A towards B, |w| = d > 0
+    last_direction = w / d;
+    hint_a = support_hill_climb(a, w, hint_a);
+    hint_b = support_hill_climb(b, -(rot.transpose() * w), hint_b);
+    const Vec3 pa = a_point(hint_a);
+    const Vec3 pb = b_point(hint_b);
+    const double wa = w.dot(pa);
+    const double wb = w.dot(pb);
+    lower = std::max(lower, (wb - wa) / d);
+    if (d - lower <= options.relative_tolerance * d + kGapUlps * ulp_r) break;
+    if (iterations >= options.max_iterations) {
+      result.status = Status::iteration_cap;
+      break;
+    }
+    ++iterations;
+
+    // Try the body whose support point is further out first, then the other.
+    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.xa);
+    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.xb) - wb;
+    bool improved = false;
+    for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
+      const bool use_a = (attempt == 0) == (gain_a >= gain_b);
+      if ((use_a ? gain_a : gain_b) <= 0.0) continue;
+      FeatureSet na = fa;
+      FeatureSet nb = fb;
+      if (use_a) {
+        na.push(hint_a, pa);
+      } else {
+        nb.push(hint_b, pb);
+      }
+      const Local next = local_distance(na, nb, tol);
+      if (!(next.distance_squared < loc.distance_squared)) continue;  // unstable: no progress at this precision
+      na.reduce(next.active_a);
+      nb.reduce(next.active_b);
+      fa = na;
+      fb = nb;
+      loc = next;
+      improved = true;
+    }
+    if (!improved) break;  // the pair is optimal at machine precision
+  }
+
+  const double d = std::sqrt(loc.distance_squared);
+  result.iterations = iterations;
+  result.point_a = loc.xa;
+  result.point_b = loc.xb;
+  result.distance = d;
+  result.lower_bound = std::min(std::max(lower, 0.0), d);
+  result.normal = d > 0.0 ? Vec3((loc.xb - loc.xa) / d) : last_direction;
+  if (contact) {
+    ContactClassifier classifier(a, b, b_in_a, hint_a, hint_b, contact_tolerance);
+    result.status = classifier.touching(fa, fb, last_direction) ? Status::touching : Status::intersecting;
+    result.lower_bound = 0.0;
+    if (result.status == Status::intersecting) {
+      result.distance = 0.0;
+      result.point_a = result.point_b = Vec3(0.5 * (loc.xa + loc.xb));
+    }
+  } else if (result.status != Status::iteration_cap) {
+    result.status = Status::separated;
+  }
+  result.feature_a = witness(a, fa, result.normal);
+  result.feature_b = witness(b, fb, Vec3(-(rot.transpose() * result.normal)));
+
+  cache.vertices_a = {-1, -1, -1, -1};
+  cache.vertices_b = {-1, -1, -1, -1};
+  for (int i = 0; i < fa.n && i < 3; ++i) cache.vertices_a[static_cast<std::size_t>(i)] = fa.id[static_cast<std::size_t>(i)];
+  for (int i = 0; i < fb.n && i < 3; ++i) cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
+  cache.hint_a = hint_a;
+  cache.hint_b = hint_b;
+  return result;
+}
+
+}  // namespace proxima
