@@ -1,0 +1,1052 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 3: ConvexPolytope, built once from a point list.
+//
+// The build runs in four steps:
+//   1. validate (finite coordinates) and drop exact duplicates;
+//   2. find the affine dimension with exact orientation predicates, so that
+//      points that are coplanar (or collinear, or equal) as doubles give a
+//      polygon (a segment, a point) at any scale, without Qhull's joggling;
+//   3. build the boundary: the two extreme points of a segment, a strict 2D
+//      hull for a polygon, Qhull's merged facets for a solid;
+//   4. clean a solid's facets with exact predicates (merge exactly coplanar
+//      neighbours, drop vertices that lie inside an edge) and derive the
+//      vertex adjacency, in rotational order, from the face cycles.
+#include "proxima/polytope.h"
+
+#include <boost/multiprecision/cpp_int.hpp>
+#include <libqhull_r/qhull_ra.h>
+
+#include <algorithm>
+#include <cfenv>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <utility>
+
+namespace proxima {
+namespace {
+
+using Index = std::int32_t;
+
+// ---------------------------------------------------------------------------
+// Exact orientation predicates
+// ---------------------------------------------------------------------------
+//
+// orient2d(a, b, c) = (a - c).x * (b - c).y - (a - c).y * (b - c).x, positive
+// when a, b, c turn counter-clockwise. side3d(a, b, c, d) = ((b - a) x (c - a))
+// . (d - a), positive when d lies on the side the right-hand normal of the
+// triangle a, b, c points to. Both are evaluated first in double with
+// Shewchuk's forward error bound ("Adaptive precision floating-point
+// arithmetic and fast robust geometric predicates", 1997, the A-level bounds
+// ccwerrboundA and o3derrboundA): if |det| exceeds the bound times the
+// permanent (the same expression with every term replaced by its absolute
+// value), the sign of the rounded determinant is the exact sign. Otherwise the
+// determinant is recomputed exactly in integers: every double is m * 2^e with
+// a 53-bit integer m, so shifting all inputs of one predicate to their
+// smallest exponent turns the determinant into an integer polynomial.
+//
+// Shewchuk's bound assumes no overflow and no underflow. Inputs larger than
+// kFilterMaxMagnitude skip the filter (a cubic term could overflow), and an
+// absolute slack kUnderflowSlack covers products that underflowed (each loses
+// at most 2^-1075, later multiplied by factors below 2^302).
+
+constexpr double kEpsilon = 0x1p-53;
+// Shewchuk's ccwerrboundA: relative error bound of the rounded orient2d.
+constexpr double kOrient2dErrorBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+// Shewchuk's o3derrboundA: relative error bound of the rounded orient3d.
+constexpr double kOrient3dErrorBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+// Largest coordinate magnitude for which the double filter cannot overflow:
+// differences stay below 2^301 and a product of three below 2^903.
+constexpr double kFilterMaxMagnitude = 0x1p300;
+// Absolute error that underflowed products can add to a filtered determinant
+// (far above the worst case 2^-1075 * 2^302 * 6, far below any determinant
+// the filter must certify in practice).
+constexpr double kUnderflowSlack = 0x1p-700;
+
+using BigInt = boost::multiprecision::cpp_int;
+
+// Turns doubles into integers sharing one power-of-two scale, exactly.
+template <std::size_t N>
+std::array<BigInt, N> to_common_integers(const std::array<double, N>& x) {
+  std::array<std::int64_t, N> mantissa{};
+  std::array<int, N> exponent{};
+  int smallest = INT_MAX;
+  for (std::size_t i = 0; i < N; ++i) {
+    if (x[i] == 0.0) continue;
+    int e = 0;
+    const double f = std::frexp(x[i], &e);  // x = f * 2^e, 0.5 <= |f| < 1
+    mantissa[i] = static_cast<std::int64_t>(std::ldexp(f, 53));  // exact: f has 53 bits
+    exponent[i] = e - 53;
+    smallest = std::min(smallest, exponent[i]);
+  }
+  std::array<BigInt, N> out;
+  for (std::size_t i = 0; i < N; ++i) {
+    if (mantissa[i] == 0) continue;
+    BigInt magnitude = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
+    magnitude <<= static_cast<unsigned>(exponent[i] - smallest);
+    out[i] = mantissa[i] < 0 ? BigInt(-magnitude) : magnitude;
+  }
+  return out;
+}
+
+int sign_of(const BigInt& v) { return v.sign(); }
+
+int orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {
+  const auto q = to_common_integers<6>({ax, ay, bx, by, cx, cy});
+  const BigInt det = (q[0] - q[4]) * (q[3] - q[5]) - (q[1] - q[5]) * (q[2] - q[4]);
+  return sign_of(det);
+}
+
+// Sign of orient2d: +1 counter-clockwise, -1 clockwise, 0 collinear (exact).
+int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
+  const double m = std::max({std::abs(ax), std::abs(ay), std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
+  if (m <= kFilterMaxMagnitude) {
+    const double left = (ax - cx) * (by - cy);
+    const double right = (ay - cy) * (bx - cx);
+    const double det = left - right;
+    const double bound = kOrient2dErrorBound * (std::abs(left) + std::abs(right)) + kUnderflowSlack;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return orient2d_exact(ax, ay, bx, by, cx, cy);
+}
+
+int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const auto q = to_common_integers<12>({a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()});
+  const BigInt adx = q[0] - q[9], ady = q[1] - q[10], adz = q[2] - q[11];
+  const BigInt bdx = q[3] - q[9], bdy = q[4] - q[10], bdz = q[5] - q[11];
+  const BigInt cdx = q[6] - q[9], cdy = q[7] - q[10], cdz = q[8] - q[11];
+  const BigInt det = adx * (bdy * cdz - bdz * cdy) + bdx * (cdy * adz - cdz * ady) + cdx * (ady * bdz - adz * bdy);
+  return sign_of(det);
+}
+
+// Sign of side3d (see above): +1 when d is on the normal side of triangle abc.
+int side3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double m = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff(),
+                             d.cwiseAbs().maxCoeff()});
+  if (m <= kFilterMaxMagnitude) {
+    // Shewchuk's orient3d(a, b, c, d), which is -side3d(a, b, c, d).
+    const double adx = a.x() - d.x(), ady = a.y() - d.y(), adz = a.z() - d.z();
+    const double bdx = b.x() - d.x(), bdy = b.y() - d.y(), bdz = b.z() - d.z();
+    const double cdx = c.x() - d.x(), cdy = c.y() - d.y(), cdz = c.z() - d.z();
+    const double bdycdz = bdy * cdz, bdzcdy = bdz * cdy;
+    const double cdyadz = cdy * adz, cdzady = cdz * ady;
+    const double adybdz = ady * bdz, adzbdy = adz * bdy;
+    const double det = adx * (bdycdz - bdzcdy) + bdx * (cdyadz - cdzady) + cdx * (adybdz - adzbdy);
+    const double permanent = (std::abs(bdycdz) + std::abs(bdzcdy)) * std::abs(adx) +
+                             (std::abs(cdyadz) + std::abs(cdzady)) * std::abs(bdx) +
+                             (std::abs(adybdz) + std::abs(adzbdy)) * std::abs(cdx);
+    const double bound = kOrient3dErrorBound * permanent + kUnderflowSlack;
+    if (det > bound) return -1;
+    if (-det > bound) return 1;
+  }
+  return -orient3d_exact(a, b, c, d);
+}
+
+// a, b, c on one line (exactly): (b - a) x (c - a) == 0, i.e. all three
+// coordinate projections are collinear.
+bool collinear3d(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return orient2d(a.x(), a.y(), b.x(), b.y(), c.x(), c.y()) == 0 &&
+         orient2d(a.y(), a.z(), b.y(), b.z(), c.y(), c.z()) == 0 &&
+         orient2d(a.z(), a.x(), b.z(), b.x(), c.z(), c.x()) == 0;
+}
+
+// ---------------------------------------------------------------------------
+// Scaling helpers: heuristics (farthest points, Newell sums) run on copies
+// scaled by a power of two so that no square overflows whatever the input's
+// magnitude. Exact decisions always use the original doubles.
+// ---------------------------------------------------------------------------
+
+// The exponent e with max|x| < 2^e (0 for an all-zero input).
+int magnitude_exponent(double max_abs) {
+  if (max_abs == 0.0) return 0;
+  int e = 0;
+  std::frexp(max_abs, &e);
+  return e;
+}
+
+double max_abs_coordinate(std::span<const Vec3> pts) {
+  double m = 0.0;
+  for (const Vec3& p : pts) m = std::max(m, p.cwiseAbs().maxCoeff());
+  return m;
+}
+
+// ---------------------------------------------------------------------------
+// Affine frame: dimension and well-spread base points
+// ---------------------------------------------------------------------------
+
+struct Frame {
+  int dimension = 0;
+  // Indices into the unique point list: p0, p1 (dimension >= 1), p2 (>= 2).
+  std::array<Index, 3> base = {0, 0, 0};
+};
+
+// Exact affine dimension of `pts` (distinct points). p1 is the point farthest
+// from p0 and p2 the point farthest from the line p0 p1 (both measured in
+// double, only to keep the later projections well conditioned); the decisions
+// "collinear" and "coplanar" are exact.
+Frame find_frame(std::span<const Vec3> pts, std::span<const Vec3> scaled) {
+  Frame frame;
+  const auto n = static_cast<Index>(pts.size());
+  if (n == 1) return frame;
+  const Vec3& s0 = scaled[0];
+  Index i1 = 1;
+  double best = -1.0;
+  for (Index i = 1; i < n; ++i) {
+    const double d = (scaled[static_cast<std::size_t>(i)] - s0).squaredNorm();
+    if (d > best) best = d, i1 = i;
+  }
+  frame.dimension = 1;
+  frame.base[1] = i1;
+  const Vec3& p0 = pts[0];
+  const Vec3& p1 = pts[static_cast<std::size_t>(i1)];
+  const Vec3 line = scaled[static_cast<std::size_t>(i1)] - s0;
+  Index i2 = -1;
+  best = -1.0;
+  for (Index i = 1; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (collinear3d(p0, p1, pts[k])) continue;
+    const double d = line.cross(scaled[k] - s0).squaredNorm();
+    if (d > best) best = d, i2 = i;
+  }
+  if (i2 < 0) return frame;
+  frame.dimension = 2;
+  frame.base[2] = i2;
+  const Vec3& p2 = pts[static_cast<std::size_t>(i2)];
+  for (Index i = 1; i < n; ++i) {
+    if (side3d(p0, p1, p2, pts[static_cast<std::size_t>(i)]) != 0) {
+      frame.dimension = 3;
+      break;
+    }
+  }
+  return frame;
+}
+
+// ---------------------------------------------------------------------------
+// Lower-dimensional hulls
+// ---------------------------------------------------------------------------
+
+// The extreme points of exactly collinear, distinct points: along the line,
+// any coordinate in which p0 and p1 differ is strictly monotone, so the
+// smallest and largest values of that coordinate are the ends.
+std::vector<Index> segment_ends(std::span<const Vec3> pts, const Frame& frame) {
+  const Vec3 d = pts[static_cast<std::size_t>(frame.base[1])] - pts[0];
+  int axis = 0;
+  d.cwiseAbs().maxCoeff(&axis);  // nonzero: p1 != p0 exactly, and the largest |d_k| > 0
+  Index lo = 0, hi = 0;
+  for (Index i = 1; i < static_cast<Index>(pts.size()); ++i) {
+    const double v = pts[static_cast<std::size_t>(i)][axis];
+    if (v < pts[static_cast<std::size_t>(lo)][axis]) lo = i;
+    if (v > pts[static_cast<std::size_t>(hi)][axis]) hi = i;
+  }
+  return {lo, hi};
+}
+
+// Which coordinate to drop when projecting the plane of p0, p1, p2: one where
+// the normal has a nonzero component, checked exactly, preferring the largest
+// (best conditioned). Projecting onto the other two axes, in cyclic order
+// (k+1, k+2), is then a bijection of the plane that maps counter-clockwise
+// (about the normal with positive k component) to counter-clockwise.
+int projection_axis(std::span<const Vec3> pts, std::span<const Vec3> scaled, const Frame& frame) {
+  const auto& b = frame.base;
+  const Vec3 normal = (scaled[static_cast<std::size_t>(b[1])] - scaled[static_cast<std::size_t>(b[0])])
+                          .cross(scaled[static_cast<std::size_t>(b[2])] - scaled[static_cast<std::size_t>(b[0])]);
+  std::array<int, 3> order = {0, 1, 2};
+  std::sort(order.begin(), order.end(), [&](int l, int r) { return std::abs(normal[l]) > std::abs(normal[r]); });
+  for (const int k : order) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const Vec3& a = pts[static_cast<std::size_t>(b[0])];
+    const Vec3& c = pts[static_cast<std::size_t>(b[1])];
+    const Vec3& e = pts[static_cast<std::size_t>(b[2])];
+    if (orient2d(a[i], a[j], c[i], c[j], e[i], e[j]) != 0) return k;
+  }
+  return order[0];  // unreachable for a non-collinear base triangle
+}
+
+// Strict convex hull (extreme points only), counter-clockwise in the
+// projection that drops `axis`, by Andrew's monotone chain with the exact
+// orient2d. Exact for coplanar points; for points that are only nearly
+// coplanar (the Qhull fallback) it is the hull of their projection.
+std::vector<Index> polygon_hull(std::span<const Vec3> pts, int axis) {
+  const int i = (axis + 1) % 3, j = (axis + 2) % 3;
+  std::vector<Index> order(pts.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](Index v) {
+    const Vec3& p = pts[static_cast<std::size_t>(v)];
+    return std::pair<double, double>(p[i], p[j]);
+  };
+  std::sort(order.begin(), order.end(), [&](Index l, Index r) {
+    const auto kl = key(l), kr = key(r);
+    return kl != kr ? kl < kr : l < r;
+  });
+  // Points that project to one 2D point (only when not exactly coplanar):
+  // keep the first.
+  order.erase(std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }),
+              order.end());
+  const auto turns_left = [&](Index a, Index b, Index c) {
+    const Vec3& pa = pts[static_cast<std::size_t>(a)];
+    const Vec3& pb = pts[static_cast<std::size_t>(b)];
+    const Vec3& pc = pts[static_cast<std::size_t>(c)];
+    return orient2d(pa[i], pa[j], pb[i], pb[j], pc[i], pc[j]) > 0;
+  };
+  std::vector<Index> hull;
+  hull.reserve(order.size() + 1);
+  for (int pass = 0; pass < 2; ++pass) {  // lower chain, then upper chain
+    const std::size_t floor = hull.size();
+    for (const Index v : order) {
+      while (hull.size() >= floor + 2 && !turns_left(hull[hull.size() - 2], hull.back(), v)) hull.pop_back();
+      hull.push_back(v);
+    }
+    hull.pop_back();  // the last point starts the other chain
+    std::reverse(order.begin(), order.end());
+  }
+  return hull;
+}
+
+// ---------------------------------------------------------------------------
+// Half-edges over face cycles
+// ---------------------------------------------------------------------------
+
+// Face cycles in CSR form over vertex ids 0 .. vertex_count-1.
+struct Cycles {
+  std::vector<Index> offsets{0};
+  std::vector<Index> vertices;
+
+  Index count() const { return static_cast<Index>(offsets.size()) - 1; }
+  Index size(Index f) const { return offsets[static_cast<std::size_t>(f) + 1] - offsets[static_cast<std::size_t>(f)]; }
+  Index at(Index f, Index i) const {
+    return vertices[static_cast<std::size_t>(offsets[static_cast<std::size_t>(f)] + i)];
+  }
+  template <class Range>
+  void add(const Range& cycle) {
+    vertices.insert(vertices.end(), cycle.begin(), cycle.end());
+    offsets.push_back(static_cast<Index>(vertices.size()));
+  }
+};
+
+// Half-edge h of face f at position i runs at(f, i) -> at(f, i + 1); face f
+// is on its left. Half-edges are indexed by their slot in Cycles::vertices.
+// They are also sorted by (source, target) in `by_source` for lookups.
+class HalfEdges {
+ public:
+  HalfEdges(const Cycles& cycles, Index vertex_count) : cycles_(cycles) {
+    const auto h_count = cycles.vertices.size();
+    face_.resize(h_count);
+    next_.resize(h_count);
+    prev_.resize(h_count);
+    for (Index f = 0; f < cycles.count(); ++f) {
+      const Index b = cycles.offsets[static_cast<std::size_t>(f)], n = cycles.size(f);
+      for (Index i = 0; i < n; ++i) {
+        const auto h = static_cast<std::size_t>(b + i);
+        face_[h] = f;
+        next_[h] = b + (i + 1) % n;
+        prev_[h] = b + (i + n - 1) % n;
+      }
+    }
+    // Counting sort by source, then by target within a source.
+    source_offsets_.assign(static_cast<std::size_t>(vertex_count) + 1, 0);
+    for (const Index v : cycles.vertices) ++source_offsets_[static_cast<std::size_t>(v) + 1];
+    std::partial_sum(source_offsets_.begin(), source_offsets_.end(), source_offsets_.begin());
+    by_source_.resize(h_count);
+    std::vector<Index> fill(source_offsets_.begin(), source_offsets_.end() - 1);
+    for (std::size_t h = 0; h < h_count; ++h) {
+      by_source_[static_cast<std::size_t>(fill[static_cast<std::size_t>(cycles.vertices[h])]++)] = static_cast<Index>(h);
+    }
+    for (Index v = 0; v < vertex_count; ++v) {
+      auto first = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v)];
+      auto last = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v) + 1];
+      std::sort(first, last, [&](Index l, Index r) { return target(l) < target(r); });
+      for (auto it = first; it != last && it + 1 != last; ++it) {
+        if (target(*it) == target(*(it + 1))) consistent_ = false;  // a directed edge twice
+      }
+    }
+    for (std::size_t h = 0; h < h_count && consistent_; ++h) {
+      if (find(target(static_cast<Index>(h)), source(static_cast<Index>(h))) < 0) consistent_ = false;  // no twin
+    }
+  }
+
+  // False when some directed edge appears twice or has no reverse: the
+  // cycles do not bound a closed oriented surface.
+  bool consistent() const { return consistent_; }
+
+  Index source(Index h) const { return cycles_.vertices[static_cast<std::size_t>(h)]; }
+  Index target(Index h) const { return cycles_.vertices[static_cast<std::size_t>(next_[static_cast<std::size_t>(h)])]; }
+  Index face(Index h) const { return face_[static_cast<std::size_t>(h)]; }
+  Index prev(Index h) const { return prev_[static_cast<std::size_t>(h)]; }
+  Index twin(Index h) const { return find(target(h), source(h)); }
+
+  // The half-edge v -> w, or -1.
+  Index find(Index v, Index w) const {
+    const auto first = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v)];
+    const auto last = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v) + 1];
+    const auto it = std::lower_bound(first, last, w, [&](Index h, Index t) { return target(h) < t; });
+    return it != last && target(*it) == w ? *it : -1;
+  }
+
+  std::span<const Index> outgoing(Index v) const {
+    const auto b = static_cast<std::size_t>(source_offsets_[static_cast<std::size_t>(v)]);
+    const auto e = static_cast<std::size_t>(source_offsets_[static_cast<std::size_t>(v) + 1]);
+    return std::span<const Index>(by_source_).subspan(b, e - b);
+  }
+
+ private:
+  const Cycles& cycles_;
+  std::vector<Index> face_, next_, prev_;
+  std::vector<Index> source_offsets_, by_source_;
+  bool consistent_ = true;
+};
+
+struct Adjacency {
+  std::vector<Index> offsets, neighbors, faces;
+};
+
+// Vertex adjacency from face cycles, each vertex's neighbours in
+// counter-clockwise order seen from outside. Rotation: if v -> w is in face F
+// and u -> v precedes it in F, then v -> u is the next edge counter-clockwise
+// about v (for a counter-clockwise polygon the interior angle at v sweeps
+// from the outgoing to the incoming edge), and it lies in the face across
+// u -> v. Returns false if the cycles are not a closed surface whose every
+// vertex has one disk of faces around it.
+bool build_adjacency(const Cycles& cycles, Index vertex_count, Adjacency& out) {
+  const HalfEdges he(cycles, vertex_count);
+  if (!he.consistent()) return false;
+  out.offsets.assign(1, 0);
+  out.neighbors.clear();
+  out.faces.clear();
+  out.neighbors.reserve(cycles.vertices.size());
+  out.faces.reserve(cycles.vertices.size());
+  for (Index v = 0; v < vertex_count; ++v) {
+    const auto outgoing = he.outgoing(v);
+    if (outgoing.empty()) return false;  // a vertex on no face
+    const Index start = outgoing.front();
+    Index h = start;
+    for (std::size_t step = 0; step < outgoing.size(); ++step) {
+      if (step > 0 && h == start) return false;  // more than one fan around v
+      out.neighbors.push_back(he.target(h));
+      out.faces.push_back(he.face(h));
+      h = he.find(v, he.source(he.prev(h)));
+      if (h < 0) return false;
+    }
+    if (h != start) return false;
+    out.offsets.push_back(static_cast<Index>(out.neighbors.size()));
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Solids: Qhull, then exact cleaning
+// ---------------------------------------------------------------------------
+
+// Qhull's arithmetic may raise invalid or divide-by-zero flags internally; a
+// caller with those exceptions trapped must not see them. Non-stop mode for
+// the duration, then the caller's environment back, flags included.
+class FloatingPointHold {
+ public:
+  FloatingPointHold() { feholdexcept(&saved_); }
+  ~FloatingPointHold() { fesetenv(&saved_); }
+  FloatingPointHold(const FloatingPointHold&) = delete;
+  FloatingPointHold& operator=(const FloatingPointHold&) = delete;
+
+ private:
+  fenv_t saved_{};
+};
+
+// Collects Qhull's messages (errors, precision warnings) instead of letting
+// them reach stderr.
+class MessageBuffer {
+ public:
+  MessageBuffer() : file_(open_memstream(&data_, &size_)) {}
+  ~MessageBuffer() {
+    if (file_ != nullptr) std::fclose(file_);
+    std::free(data_);
+  }
+  MessageBuffer(const MessageBuffer&) = delete;
+  MessageBuffer& operator=(const MessageBuffer&) = delete;
+
+  FILE* file() const { return file_; }
+  std::string text() {
+    if (file_ == nullptr) return {};
+    std::fflush(file_);
+    return data_ == nullptr ? std::string() : std::string(data_, size_);
+  }
+
+ private:
+  char* data_ = nullptr;
+  std::size_t size_ = 0;
+  FILE* file_ = nullptr;
+};
+
+struct QhullOutcome {
+  int exit_code = 0;
+  std::string message;
+  Cycles faces;  // over unique-point ids, counter-clockwise seen from outside
+};
+
+template <class T>
+std::span<T* const> set_elements(setT* set) {
+  if (set == nullptr) return {};
+  std::size_t n = 0;
+  while (set->e[n].p != nullptr) ++n;
+  return {reinterpret_cast<T* const*>(&set->e[0].p), n};
+}
+
+// The vertex cycle of one Qhull facet, in Qhull's point ids. A simplicial
+// facet lists its three vertices; a merged one has explicit ridges (vertex
+// pairs in 3-d) that chain into its boundary. Oriented so that Newell's normal
+// agrees with the facet's outward normal. Empty on an inconsistent facet.
+std::vector<Index> facet_cycle(qhT* qh, facetT* facet) {
+  std::vector<vertexT*> cycle;
+  if (facet->simplicial) {
+    for (vertexT* v : set_elements<vertexT>(facet->vertices)) cycle.push_back(v);
+  } else {
+    std::vector<std::pair<vertexT*, vertexT*>> ridges;
+    for (ridgeT* r : set_elements<ridgeT>(facet->ridges)) {
+      const auto rv = set_elements<vertexT>(r->vertices);
+      if (rv.size() != 2) return {};
+      ridges.emplace_back(rv[0], rv[1]);
+    }
+    if (ridges.size() < 3) return {};
+    std::vector<bool> used(ridges.size(), false);
+    cycle.push_back(ridges[0].first);
+    vertexT* current = ridges[0].second;
+    used[0] = true;
+    while (current != cycle.front()) {
+      cycle.push_back(current);
+      bool found = false;
+      for (std::size_t k = 0; k < ridges.size() && !found; ++k) {
+        if (used[k]) continue;
+        if (ridges[k].first == current || ridges[k].second == current) {
+          used[k] = true;
+          current = ridges[k].first == current ? ridges[k].second : ridges[k].first;
+          found = true;
+        }
+      }
+      if (!found) return {};
+    }
+    if (cycle.size() != ridges.size()) return {};
+  }
+  if (cycle.size() < 3) return {};
+  // Newell's normal in Qhull's own coordinates, against the facet normal.
+  double newell[3] = {0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < cycle.size(); ++i) {
+    const double* p = cycle[i]->point;
+    const double* q = cycle[(i + 1) % cycle.size()]->point;
+    newell[0] += (p[1] - q[1]) * (p[2] + q[2]);
+    newell[1] += (p[2] - q[2]) * (p[0] + q[0]);
+    newell[2] += (p[0] - q[0]) * (p[1] + q[1]);
+  }
+  const double agreement = newell[0] * facet->normal[0] + newell[1] * facet->normal[1] + newell[2] * facet->normal[2];
+  if (agreement < 0.0) std::reverse(cycle.begin(), cycle.end());
+  std::vector<Index> ids;
+  ids.reserve(cycle.size());
+  for (vertexT* v : cycle) ids.push_back(static_cast<Index>(qh_pointid(qh, v->point)));
+  return ids;
+}
+
+// Runs Qhull on `coordinates` (x, y, z per point) with the given options and
+// returns its facets as vertex cycles. Qhull prints nothing: messages go to
+// the returned string.
+QhullOutcome run_qhull(std::vector<double> coordinates, const char* options) {
+  QhullOutcome outcome;
+  MessageBuffer messages;
+  if (messages.file() == nullptr) {
+    outcome.exit_code = qh_ERRother;
+    outcome.message = "cannot open a buffer for Qhull's messages";
+    return outcome;
+  }
+  const FloatingPointHold hold;
+  qhT qh_storage;
+  qhT* qh = &qh_storage;
+  qh_zero(qh, messages.file());
+  std::string command = std::string("qhull ") + options;
+  outcome.exit_code = qh_new_qhull(qh, 3, static_cast<int>(coordinates.size() / 3), coordinates.data(), False,
+                                   command.data(), nullptr, messages.file());
+  if (outcome.exit_code == 0) {
+    for (facetT* facet = qh->facet_list; facet != nullptr && facet->next != nullptr; facet = facet->next) {
+      const std::vector<Index> cycle = facet_cycle(qh, facet);
+      if (cycle.empty()) {
+        outcome.exit_code = qh_ERRqhull;
+        outcome.message = "a Qhull facet has no consistent vertex cycle";
+        break;
+      }
+      outcome.faces.add(cycle);
+    }
+  }
+  qh_freeqhull(qh, !qh_ALL);
+  int current_long = 0, total_long = 0;
+  qh_memfreeshort(qh, &current_long, &total_long);
+  if (outcome.message.empty()) outcome.message = messages.text();
+  return outcome;
+}
+
+// Union-find over faces.
+class Groups {
+ public:
+  explicit Groups(Index n) : parent_(static_cast<std::size_t>(n)) { std::iota(parent_.begin(), parent_.end(), 0); }
+  Index find(Index f) {
+    while (parent_[static_cast<std::size_t>(f)] != f) {
+      parent_[static_cast<std::size_t>(f)] = parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(f)])];
+      f = parent_[static_cast<std::size_t>(f)];
+    }
+    return f;
+  }
+  void unite(Index a, Index b) {
+    a = find(a), b = find(b);
+    if (a != b) parent_[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+  }
+
+ private:
+  std::vector<Index> parent_;
+};
+
+// Three vertices of face f that are not collinear (exactly), or nothing.
+// Spread out (farthest-point choice in double) to keep the filter effective.
+bool face_triangle(const Cycles& faces, Index f, std::span<const Vec3> pts, std::span<const Vec3> scaled,
+                   std::array<Index, 3>& tri) {
+  const Index n = faces.size(f);
+  const Index a = faces.at(f, 0);
+  const Vec3& sa = scaled[static_cast<std::size_t>(a)];
+  Index b = faces.at(f, 1);
+  double best = -1.0;
+  for (Index i = 1; i < n; ++i) {
+    const Index v = faces.at(f, i);
+    const double d = (scaled[static_cast<std::size_t>(v)] - sa).squaredNorm();
+    if (d > best) best = d, b = v;
+  }
+  const Vec3 line = scaled[static_cast<std::size_t>(b)] - sa;
+  Index c = -1;
+  best = -1.0;
+  for (Index i = 1; i < n; ++i) {
+    const Index v = faces.at(f, i);
+    if (v == b || collinear3d(pts[static_cast<std::size_t>(a)], pts[static_cast<std::size_t>(b)],
+                              pts[static_cast<std::size_t>(v)])) {
+      continue;
+    }
+    const double d = line.cross(scaled[static_cast<std::size_t>(v)] - sa).squaredNorm();
+    if (d > best) best = d, c = v;
+  }
+  if (c < 0) return false;
+  tri = {a, b, c};
+  return true;
+}
+
+// Exact cleaning of Qhull's facets, in the coordinates of the given doubles:
+//  - neighbouring facets that are exactly coplanar become one face (Qhull
+//    merges coplanar facets within its roundoff estimate; this catches what
+//    it leaves);
+//  - a vertex on exactly two faces and exactly collinear with its two
+//    neighbours along them lies inside an edge: it is not an extreme point and
+//    is dropped from both cycles (a cube's edge midpoints).
+// A vertex strictly inside a face disappears with the merge, because it is on
+// no boundary cycle any more.
+Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts, std::span<const Vec3> scaled) {
+  const Index face_count = raw.count();
+  Groups groups(face_count);
+  {
+    const HalfEdges he(raw, point_count);
+    std::vector<std::array<Index, 3>> tri(static_cast<std::size_t>(face_count));
+    std::vector<bool> has_tri(static_cast<std::size_t>(face_count), false);
+    for (Index f = 0; f < face_count; ++f) {
+      has_tri[static_cast<std::size_t>(f)] = face_triangle(raw, f, pts, scaled, tri[static_cast<std::size_t>(f)]);
+    }
+    for (Index h = 0; h < static_cast<Index>(raw.vertices.size()); ++h) {
+      const Index t = he.twin(h);
+      if (t < 0) continue;
+      const Index f = he.face(h), g = he.face(t);
+      if (f >= g || !has_tri[static_cast<std::size_t>(f)] || groups.find(f) == groups.find(g)) continue;
+      const auto& [a, b, c] = tri[static_cast<std::size_t>(f)];
+      bool coplanar = true;
+      for (Index i = 0; i < raw.size(g) && coplanar; ++i) {
+        coplanar = side3d(pts[static_cast<std::size_t>(a)], pts[static_cast<std::size_t>(b)],
+                          pts[static_cast<std::size_t>(c)], pts[static_cast<std::size_t>(raw.at(g, i))]) == 0;
+      }
+      if (coplanar) groups.unite(f, g);
+    }
+  }
+
+  // Boundary cycle of each group: its half-edges whose twin lies in another
+  // group, chained head to tail. A group that does not chain into one simple
+  // cycle keeps its facets unmerged.
+  std::vector<std::vector<Index>> members(static_cast<std::size_t>(face_count));
+  for (Index f = 0; f < face_count; ++f) members[static_cast<std::size_t>(groups.find(f))].push_back(f);
+  std::vector<std::vector<Index>> cycles;
+  {
+    const HalfEdges he(raw, point_count);
+    for (Index root = 0; root < face_count; ++root) {
+      const auto& group = members[static_cast<std::size_t>(root)];
+      if (group.empty()) continue;
+      const auto own_cycle = [&](Index f) {
+        std::vector<Index> c(static_cast<std::size_t>(raw.size(f)));
+        for (Index i = 0; i < raw.size(f); ++i) c[static_cast<std::size_t>(i)] = raw.at(f, i);
+        return c;
+      };
+      if (group.size() == 1) {
+        cycles.push_back(own_cycle(root));
+        continue;
+      }
+      std::vector<std::pair<Index, Index>> boundary;  // (source, target)
+      for (const Index f : group) {
+        for (Index i = 0; i < raw.size(f); ++i) {
+          const Index h = raw.offsets[static_cast<std::size_t>(f)] + i;
+          const Index t = he.twin(h);
+          if (t < 0 || groups.find(he.face(t)) != root) boundary.emplace_back(he.source(h), he.target(h));
+        }
+      }
+      std::sort(boundary.begin(), boundary.end());
+      bool simple = boundary.size() >= 3;
+      for (std::size_t k = 1; k < boundary.size() && simple; ++k) simple = boundary[k].first != boundary[k - 1].first;
+      std::vector<Index> merged;
+      if (simple) {
+        const auto next_of = [&](Index v) {
+          const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair<Index, Index>(v, INT32_MIN));
+          return it != boundary.end() && it->first == v ? it->second : -1;
+        };
+        Index v = boundary.front().first;
+        do {
+          merged.push_back(v);
+          v = next_of(v);
+        } while (v >= 0 && v != boundary.front().first && merged.size() <= boundary.size());
+        simple = v == boundary.front().first && merged.size() == boundary.size();
+      }
+      if (simple) {
+        cycles.push_back(std::move(merged));
+      } else {
+        for (const Index f : group) cycles.push_back(own_cycle(f));
+      }
+    }
+  }
+
+  // Drop vertices inside edges. Cycles as doubly linked lists over nodes.
+  std::vector<Index> node_vertex, node_next, node_prev, node_cycle;
+  std::vector<Index> cycle_size;
+  std::vector<std::vector<Index>> occurrences(static_cast<std::size_t>(point_count));
+  for (const auto& c : cycles) {
+    const auto base = static_cast<Index>(node_vertex.size());
+    const auto n = static_cast<Index>(c.size());
+    for (Index i = 0; i < n; ++i) {
+      node_vertex.push_back(c[static_cast<std::size_t>(i)]);
+      node_next.push_back(base + (i + 1) % n);
+      node_prev.push_back(base + (i + n - 1) % n);
+      node_cycle.push_back(static_cast<Index>(cycle_size.size()));
+      occurrences[static_cast<std::size_t>(c[static_cast<std::size_t>(i)])].push_back(base + i);
+    }
+    cycle_size.push_back(n);
+  }
+  std::vector<bool> alive(node_vertex.size(), true);
+  std::vector<Index> work;
+  for (Index v = 0; v < point_count; ++v) {
+    if (occurrences[static_cast<std::size_t>(v)].size() == 2) work.push_back(v);
+  }
+  const auto vertex_at = [&](Index node) { return node_vertex[static_cast<std::size_t>(node)]; };
+  while (!work.empty()) {
+    const Index v = work.back();
+    work.pop_back();
+    const auto& occ = occurrences[static_cast<std::size_t>(v)];
+    if (occ.size() != 2 || !alive[static_cast<std::size_t>(occ[0])]) continue;
+    const Index n0 = occ[0], n1 = occ[1];
+    const Index u = vertex_at(node_prev[static_cast<std::size_t>(n0)]);
+    const Index w = vertex_at(node_next[static_cast<std::size_t>(n0)]);
+    // The other face must run w -> v -> u: v sits on one edge of both.
+    if (vertex_at(node_prev[static_cast<std::size_t>(n1)]) != w || vertex_at(node_next[static_cast<std::size_t>(n1)]) != u) {
+      continue;
+    }
+    if (cycle_size[static_cast<std::size_t>(node_cycle[static_cast<std::size_t>(n0)])] <= 3 ||
+        cycle_size[static_cast<std::size_t>(node_cycle[static_cast<std::size_t>(n1)])] <= 3) {
+      continue;
+    }
+    if (!collinear3d(pts[static_cast<std::size_t>(u)], pts[static_cast<std::size_t>(v)], pts[static_cast<std::size_t>(w)])) {
+      continue;
+    }
+    for (const Index node : {n0, n1}) {
+      const Index p = node_prev[static_cast<std::size_t>(node)], q = node_next[static_cast<std::size_t>(node)];
+      node_next[static_cast<std::size_t>(p)] = q;
+      node_prev[static_cast<std::size_t>(q)] = p;
+      alive[static_cast<std::size_t>(node)] = false;
+      --cycle_size[static_cast<std::size_t>(node_cycle[static_cast<std::size_t>(node)])];
+    }
+    occurrences[static_cast<std::size_t>(v)].clear();
+    work.push_back(u);  // their neighbours changed: check them again
+    work.push_back(w);
+  }
+
+  Cycles out;
+  for (std::size_t c = 0, base = 0; c < cycles.size(); base += cycles[c].size(), ++c) {
+    std::vector<Index> cycle;
+    Index start = static_cast<Index>(base);
+    while (!alive[static_cast<std::size_t>(start)]) ++start;  // some node of the cycle survives (size >= 3)
+    Index node = start;
+    do {
+      cycle.push_back(node_vertex[static_cast<std::size_t>(node)]);
+      node = node_next[static_cast<std::size_t>(node)];
+    } while (node != start);
+    out.add(cycle);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// The build
+// ---------------------------------------------------------------------------
+
+// A built boundary before renumbering: hull vertices as unique-point ids and
+// face cycles over them.
+struct Boundary {
+  int dimension = 0;
+  std::vector<Index> vertices;  // unique-point ids, in hull order
+  Cycles faces;                 // over unique-point ids
+};
+
+Boundary polygon_boundary(std::vector<Index> ccw) {
+  Boundary b;
+  b.dimension = 2;
+  b.faces.add(ccw);
+  std::vector<Index> back(ccw.rbegin(), ccw.rend());
+  std::rotate(back.begin(), back.end() - 1, back.end());  // start at the same vertex
+  b.faces.add(back);
+  b.vertices = std::move(ccw);
+  return b;
+}
+
+Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled, const Frame& frame) {
+  // Qhull sees the points centred and scaled by a power of two, so that its
+  // own roundoff estimates and squared distances stay far from overflow and
+  // underflow at any input magnitude. Only its combinatorics are used; every
+  // later decision is exact on the original doubles.
+  Vec3 lo = scaled[0], hi = scaled[0];
+  for (const Vec3& s : scaled) lo = lo.cwiseMin(s), hi = hi.cwiseMax(s);
+  const Vec3 centre = 0.5 * lo + 0.5 * hi;
+  const double extent = (hi - lo).maxCoeff();
+  const double unscale = std::ldexp(1.0, -magnitude_exponent(extent));
+  std::vector<double> coordinates;
+  coordinates.reserve(3 * scaled.size());
+  for (const Vec3& s : scaled) {
+    for (int k = 0; k < 3; ++k) coordinates.push_back((s[k] - centre[k]) * unscale);
+  }
+  const auto point_count = static_cast<Index>(pts.size());
+  // Default options merge coplanar facets (C-0). On a precision or flatness
+  // error ("the initial simplex is flat", QH6154, for a box 1e-30 thin),
+  // retry with every axis scaled to [-1, 1] (QbB), which makes an
+  // axis-aligned thin box well shaped; then give up on the third dimension.
+  std::string last_message;
+  bool flat = false;
+  for (const char* options : {"", "QbB"}) {
+    QhullOutcome outcome = run_qhull(coordinates, options);
+    if (outcome.exit_code == 0) {
+      Cycles faces = clean_faces(outcome.faces, point_count, pts, scaled);
+      Boundary b;
+      b.dimension = 3;
+      std::vector<bool> used(pts.size(), false);
+      for (const Index v : faces.vertices) used[static_cast<std::size_t>(v)] = true;
+      for (Index v = 0; v < point_count; ++v) {
+        if (used[static_cast<std::size_t>(v)]) b.vertices.push_back(v);
+      }
+      b.faces = std::move(faces);
+      return b;
+    }
+    last_message = outcome.message;
+    flat = outcome.exit_code == qh_ERRsingular || outcome.exit_code == qh_ERRprec ||
+           outcome.exit_code == qh_ERRwide || outcome.exit_code == qh_ERRtopology;
+    if (!flat) break;
+  }
+  if (flat) {
+    // Flat to Qhull even after scaling: the points lie within roundoff of the
+    // plane of the frame. Their hull is, to that precision, the polygon of
+    // their projection.
+    return polygon_boundary(polygon_hull(pts, projection_axis(pts, scaled, frame)));
+  }
+  const auto first_line = last_message.substr(0, last_message.find('\n'));
+  throw InvalidInput("ConvexPolytope: Qhull failed on " + std::to_string(pts.size()) + " distinct points: " +
+                     (first_line.empty() ? std::string("unknown error") : first_line));
+}
+
+const char* axis_name(int k) { return k == 0 ? "x" : k == 1 ? "y" : "z"; }
+
+void validate(std::span<const Vec3> points) {
+  if (points.empty()) throw InvalidInput("ConvexPolytope: no points given (need at least one)");
+  if (points.size() > static_cast<std::size_t>(std::numeric_limits<Index>::max())) {
+    throw InvalidInput("ConvexPolytope: too many points (" + std::to_string(points.size()) + ")");
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const double c = points[i][k];
+      if (std::isnan(c)) {
+        throw InvalidInput("ConvexPolytope: input point " + std::to_string(i) + " has a NaN " + axis_name(k) +
+                           " coordinate");
+      }
+      if (std::isinf(c)) {
+        throw InvalidInput("ConvexPolytope: input point " + std::to_string(i) + " has an infinite " + axis_name(k) +
+                           " coordinate");
+      }
+    }
+  }
+}
+
+// Input indices of the distinct points, the first occurrence of each.
+std::vector<Index> distinct_points(std::span<const Vec3> points) {
+  std::vector<Index> order(points.size());
+  std::iota(order.begin(), order.end(), 0);
+  const auto key = [&](Index i) {
+    const Vec3& p = points[static_cast<std::size_t>(i)];
+    return std::array<double, 3>{p.x(), p.y(), p.z()};
+  };
+  std::sort(order.begin(), order.end(), [&](Index l, Index r) {
+    const auto kl = key(l), kr = key(r);
+    return kl != kr ? kl < kr : l < r;
+  });
+  order.erase(std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }), order.end());
+  std::sort(order.begin(), order.end());
+  return order;
+}
+
+}  // namespace
+
+ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
+  validate(points);
+  const std::vector<Index> distinct = distinct_points(points);
+  std::vector<Vec3> pts;
+  pts.reserve(distinct.size());
+  for (const Index i : distinct) pts.push_back(points[static_cast<std::size_t>(i)]);
+  const double unscale = std::ldexp(1.0, -magnitude_exponent(max_abs_coordinate(pts)));
+  std::vector<Vec3> scaled;
+  scaled.reserve(pts.size());
+  for (const Vec3& p : pts) scaled.push_back(p * unscale);
+
+  const Frame frame = find_frame(pts, scaled);
+  Boundary boundary;
+  boundary.dimension = frame.dimension;
+  switch (frame.dimension) {
+    case 0: boundary.vertices = {0}; break;
+    case 1: boundary.vertices = segment_ends(pts, frame); break;
+    case 2: boundary = polygon_boundary(polygon_hull(pts, projection_axis(pts, scaled, frame))); break;
+    default: boundary = solid_boundary(pts, scaled, frame); break;
+  }
+
+  // Renumber: unique-point ids -> hull vertex ids.
+  dimension_ = boundary.dimension;
+  const auto vertex_count = static_cast<Index>(boundary.vertices.size());
+  std::vector<Index> local(pts.size(), -1);
+  vertices_.reserve(boundary.vertices.size());
+  input_index_.reserve(boundary.vertices.size());
+  for (Index v = 0; v < vertex_count; ++v) {
+    const Index u = boundary.vertices[static_cast<std::size_t>(v)];
+    local[static_cast<std::size_t>(u)] = v;
+    vertices_.push_back(pts[static_cast<std::size_t>(u)]);
+    input_index_.push_back(distinct[static_cast<std::size_t>(u)]);
+  }
+  Cycles faces;
+  faces.offsets = std::move(boundary.faces.offsets);
+  faces.vertices.reserve(boundary.faces.vertices.size());
+  for (const Index u : boundary.faces.vertices) faces.vertices.push_back(local[static_cast<std::size_t>(u)]);
+
+  if (dimension_ == 1) {
+    adjacency_offsets_ = {0, 1, 2};
+    adjacency_ = {1, 0};
+    adjacency_faces_ = {-1, -1};
+  } else if (dimension_ == 0) {
+    adjacency_offsets_ = {0, 0};
+  } else {
+    Adjacency adjacency;
+    if (!build_adjacency(faces, vertex_count, adjacency)) {
+      throw InvalidInput("ConvexPolytope: the hull of " + std::to_string(points.size()) +
+                         " points is not a closed surface after cleaning (inconsistent Qhull output)");
+    }
+    adjacency_offsets_ = std::move(adjacency.offsets);
+    adjacency_ = std::move(adjacency.neighbors);
+    adjacency_faces_ = std::move(adjacency.faces);
+    face_offsets_ = std::move(faces.offsets);
+    face_vertices_ = std::move(faces.vertices);
+  }
+  for (auto* v : {&input_index_, &adjacency_offsets_, &adjacency_, &adjacency_faces_, &face_offsets_, &face_vertices_}) {
+    v->shrink_to_fit();
+  }
+  vertices_.shrink_to_fit();
+
+  // Centroid and radius on power-of-two scaled copies: exact scaling, and no
+  // sum or square can overflow near the largest doubles.
+  const int exponent = magnitude_exponent(max_abs_coordinate(vertices_));
+  const double down = std::ldexp(1.0, -exponent);
+  Vec3 sum = Vec3::Zero();
+  for (const Vec3& v : vertices_) sum += v * down;
+  const Vec3 mean = sum / static_cast<double>(vertices_.size());
+  double radius = 0.0;
+  for (const Vec3& v : vertices_) radius = std::max(radius, (v * down - mean).norm());
+  centroid_ = mean * std::ldexp(1.0, exponent);
+  bounding_radius_ = radius * std::ldexp(1.0, exponent);
+  scale_ = max_abs_coordinate(vertices_);
+  interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
+}
+
+// Newell's normal: for a planar polygon, sum over edges (p_i x p_(i+1)) is
+// twice the area times the unit normal, and for a slightly non-planar one it
+// is the normal of the best-fitting plane in the sense of projected areas.
+// Vertices are taken relative to the first one (less cancellation) and scaled
+// by a power of two of the face's magnitude (no overflow, exact scaling).
+// The offset is taken at the mean of the face's vertices.
+Plane ConvexPolytope::face_plane(int f) const {
+  const auto cycle = face(f);
+  double max_abs = 0.0;
+  for (const Index v : cycle) max_abs = std::max(max_abs, vertex(v).cwiseAbs().maxCoeff());
+  const int exponent = magnitude_exponent(max_abs);
+  const double down = std::ldexp(1.0, -exponent);
+  const Vec3 origin = vertex(cycle[0]) * down;
+  Vec3 normal = Vec3::Zero();
+  Vec3 sum = Vec3::Zero();
+  for (std::size_t i = 0; i < cycle.size(); ++i) {
+    const Vec3 p = vertex(cycle[i]) * down - origin;
+    const Vec3 q = vertex(cycle[(i + 1) % cycle.size()]) * down - origin;
+    normal += p.cross(q);
+    sum += p;
+  }
+  const double length = normal.norm();
+  if (!(length > 0.0)) return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
+  normal /= length;
+  const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
+  return {normal, normal.dot(mean) * std::ldexp(1.0, exponent)};
+}
+
+std::vector<std::array<std::int32_t, 3>> ConvexPolytope::triangles() const {
+  std::vector<std::array<std::int32_t, 3>> out;
+  out.reserve(face_vertices_.size());
+  for (int f = 0; f < face_count(); ++f) {
+    const auto c = face(f);
+    for (std::size_t i = 1; i + 1 < c.size(); ++i) out.push_back({c[0], c[i], c[i + 1]});
+  }
+  return out;
+}
+
+std::vector<std::int32_t> ConvexPolytope::triangle_face() const {
+  std::vector<std::int32_t> out;
+  out.reserve(face_vertices_.size());
+  for (int f = 0; f < face_count(); ++f) {
+    const auto n = face(f).size();
+    out.insert(out.end(), n >= 2 ? n - 2 : 0, f);
+  }
+  return out;
+}
+
+std::vector<std::array<std::int32_t, 2>> ConvexPolytope::edges() const {
+  std::vector<std::array<std::int32_t, 2>> out;
+  out.reserve(adjacency_.size() / 2);
+  for (int v = 0; v < vertex_count(); ++v) {
+    for (const std::int32_t w : neighbors(v)) {
+      if (v < w) out.push_back({v, w});
+    }
+  }
+  return out;
+}
+
+std::size_t ConvexPolytope::memory_bytes() const {
+  const auto index_bytes = [](const std::vector<std::int32_t>& v) { return v.capacity() * sizeof(std::int32_t); };
+  return sizeof(*this) + vertices_.capacity() * sizeof(Vec3) + index_bytes(input_index_) +
+         index_bytes(adjacency_offsets_) + index_bytes(adjacency_) + index_bytes(adjacency_faces_) +
+         index_bytes(face_offsets_) + index_bytes(face_vertices_);
+}
+
+}  // namespace proxima
