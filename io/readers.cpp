@@ -818,7 +818,7 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
       property.name = std::string(name);
       header.elements.back().properties.push_back(std::move(property));
     } else {
-      src.fail_line(at, "unknown PLY header keyword " + quote(word));
+      src.fail_line(at, "unknown PLY header keyword " + quote(word) + " (is end_header missing?)");
     }
   }
   if (!ended) src.fail_line(header.lines, "PLY header has no end_header line");
@@ -982,7 +982,7 @@ class PlyBinaryReader {
 class PlyTextReader {
  public:
   PlyTextReader(const Source& src, std::string_view bytes, std::size_t pos, std::int64_t line)
-      : src_(src), bytes_(bytes), pos_(pos), line_(line + 1) {}
+      : src_(src), bytes_(bytes), pos_(pos), line_(line + 1), last_line_(line) {}
 
   std::size_t left() const { return bytes_.size() - pos_; }
 
@@ -1027,10 +1027,11 @@ class PlyTextReader {
       ++pos_;
     }
     if (pos_ == bytes_.size()) {
-      src_.fail_line(line_, "the ASCII PLY data ends inside '" + element.name + "' element " + std::to_string(index) +
+      src_.fail_line(last_line_, "the ASCII PLY data ends inside '" + element.name + "' element " + std::to_string(index) +
                                 " (0-based) of the " + std::to_string(element.count) + " the header announces");
     }
     const std::size_t b = pos_;
+    last_line_ = line_;
     while (pos_ < bytes_.size() && std::string_view(" \t\v\f\r\n", 6).find(bytes_[pos_]) == std::string_view::npos &&
            bytes_[pos_] != '\0') {
       ++pos_;
@@ -1051,7 +1052,8 @@ class PlyTextReader {
   const Source& src_;
   std::string_view bytes_;
   std::size_t pos_;
-  std::int64_t line_;
+  std::int64_t line_;       // the line at pos_
+  std::int64_t last_line_;  // the line of the last token: where a short file is reported to end
 };
 
 PointCloud read_ply(const Source& src, std::string_view bytes) {
