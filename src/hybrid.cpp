@@ -34,14 +34,6 @@
 namespace proxima {
 namespace {
 
-// Degenerate-feature threshold in units of u * R: an edge shorter than this,
-// or a triangle flatter than this (height over its longest edge), is reduced
-// (edge -> point, triangle -> edge). At a few ulps of R the feature is
-// indistinguishable from its reduction, so the reduction costs no accuracy;
-// pinned by the paper's stress tests (tetrahedra of edge 1e-23, cubes of
-// edge 1e-15 scaled by 1e39) in distance_accuracy_test.
-constexpr double kDegenerateUlps = 4.0;
-
 // Rounding slack of the termination test, in units of u * R: the support
 // values w.a* and w.b* each carry an error of a few u |w| R, so the computed
 // gap d - lower cannot be resolved below this. Well inside the 64 u R of the
@@ -173,6 +165,12 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
       holds_all = holds_all && std::find(verts.begin(), verts.end(), f.id[static_cast<std::size_t>(i)]) != verts.end();
     }
     if (!holds_all) continue;
+    // In a solid, two faces share at most one edge, so the face holding a
+    // triangle or a diagonal is unique. A polygon has two, one per side.
+    if (poly.dimension() == 3) {
+      out.face = face;
+      break;
+    }
     const double alignment = poly.face_plane(face).normal.dot(toward);
     if (alignment > best_alignment) {
       best_alignment = alignment;
@@ -265,8 +263,8 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
   // R in A's frame: B's coordinates are bounded by |t| + |y| <= |t|_inf + sqrt(3) scale_B per axis.
   const double r_local = std::max(a.scale(), tr.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
   const double ulp_r = kUnitRoundoff * r_local;
-  KernelTolerance<double> tol;
-  tol.min_length_squared = (kDegenerateUlps * ulp_r) * (kDegenerateUlps * ulp_r);
+  // Features shorter or flatter than a few u R are reduced (closest_point.h).
+  const KernelTolerance<double> tol = kernel_tolerance(r_local);
 
   std::int32_t hint_a = valid_id(cache.hint_a, a.vertex_count()) ? cache.hint_a : 0;
   std::int32_t hint_b = valid_id(cache.hint_b, b.vertex_count()) ? cache.hint_b : 0;
