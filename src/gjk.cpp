@@ -222,6 +222,8 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
 // and vol = C0 + C1 + C2 + C3. The origin is strictly inside exactly when all
 // C_m have the sign of vol; otherwise the closest point is on a face opposite
 // a vertex with a wrong-signed (or zero) C_m.
+constexpr std::array<std::array<int, 3>, 4> kOppositeFace = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
+
 Reduction solve_tetrahedron(const Points& p) {
   const Vec3& w0 = p[0].w;
   const Vec3& w1 = p[1].w;
@@ -240,26 +242,29 @@ Reduction solve_tetrahedron(const Points& p) {
     r.encloses_origin = true;
     return r;
   }
-  static constexpr std::array<std::array<int, 3>, 4> kOpposite = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
   Reduction best;
   for (int m = 0; m < 4; ++m) {
     if (same_sign(vol, c[idx(m)])) continue;
-    const auto& f = kOpposite[idx(m)];
+    const auto& f = kOppositeFace[idx(m)];
     const Reduction r = solve_triangle(p, f[0], f[1], f[2]);
     if (r.vv < best.vv) best = r;
   }
   return best;
 }
 
-// Replaces the simplex by the sub-simplex realizing its closest point.
-void solve(Simplex& s) {
-  Reduction r;
-  switch (s.size) {
-    case 1: r = single(s.p, 0); break;
-    case 2: r = solve_segment(s.p, 0, 1); break;
-    case 3: r = solve_triangle(s.p, 0, 1, 2); break;
-    default: r = solve_tetrahedron(s.p); break;
+// The closest point of a tetrahedron's boundary: for a tetrahedron around
+// the origin, the nearest face (the projection onto the nearest face plane of
+// an interior point lies in that face).
+Reduction nearest_face(const Points& p) {
+  Reduction best;
+  for (const auto& f : kOppositeFace) {
+    const Reduction r = solve_triangle(p, f[0], f[1], f[2]);
+    if (r.vv < best.vv) best = r;
   }
+  return best;
+}
+
+void apply(Simplex& s, const Reduction& r) {
   const Points old = s.p;
   for (int k = 0; k < r.count; ++k) {
     s.p[idx(k)] = old[idx(r.index[idx(k)])];
@@ -269,6 +274,16 @@ void solve(Simplex& s) {
   s.v = r.v;
   s.vv = r.vv;
   s.encloses_origin = r.encloses_origin;
+}
+
+// Replaces the simplex by the sub-simplex realizing its closest point.
+void solve(Simplex& s) {
+  switch (s.size) {
+    case 1: apply(s, single(s.p, 0)); break;
+    case 2: apply(s, solve_segment(s.p, 0, 1)); break;
+    case 3: apply(s, solve_triangle(s.p, 0, 1, 2)); break;
+    default: apply(s, solve_tetrahedron(s.p)); break;
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -602,7 +617,15 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
   }
 
   Status status = Status::separated;
-  if (contact) status = classify_contact(simplex, tol, support, iterations);
+  if (contact) {
+    status = classify_contact(simplex, tol, support, iterations);
+    // A touching contact whose tetrahedron encloses the origin (by rounding,
+    // or within the band): the origin is within tol of a face of it (else
+    // the classification would have certified depth), so that face's
+    // closest points are the witnesses. Its barycentric weights of the
+    // origin would only give rounding noise from a sliver tetrahedron.
+    if (status == Status::touching && simplex.encloses_origin) apply(simplex, nearest_face(simplex.p));
+  }
 
   // Closest points from the original coordinates (the weights are
   // unit-free): sums of hull points with weights summing to one.

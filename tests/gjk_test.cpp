@@ -1,0 +1,799 @@
+// Tests of the GJK baselines (gjk.h), called directly in A's frame:
+//   - hand-computed cases with their witness features (cubes apart along an
+//     axis and a diagonal, a point against each region of a tetrahedron,
+//     parallel faces, crossing edges), touching and intersecting contacts;
+//   - seeded random polytopes (points on spheres, 4..500 vertices, and a few
+//     polygons, segments and points) against a brute force over all
+//     vertex/edge/triangle pairs written here, with a check that the random
+//     set really contains vertex-face and edge-edge answers;
+//   - optimality certificates: the closest points' difference is a
+//     separating direction, and lower_bound <= distance;
+//   - Enhanced GJK equal to classic GJK along a motion with a tracking cache,
+//     and with caches from another pair or full of garbage ids;
+//   - the iteration cap, and scale (1e-23 .. 1e120) without NaN or inf.
+#include "proxima/gjk.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace proxima {
+namespace {
+
+using Rng = std::mt19937_64;
+
+// Portable draws (std::*_distribution algorithms are implementation-defined):
+// a uniform double from 53 random bits.
+double uniform(Rng& rng, double lo, double hi) {
+  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1p-53);
+}
+int uniform_int(Rng& rng, int lo, int hi) {
+  return lo + static_cast<int>(rng() % static_cast<std::uint64_t>(hi - lo + 1));
+}
+Vec3 random_unit(Rng& rng) {
+  for (;;) {
+    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const double n2 = p.squaredNorm();
+    if (n2 > 1e-4 && n2 <= 1.0) return p / std::sqrt(n2);
+  }
+}
+Mat3 random_rotation(Rng& rng) {
+  for (;;) {
+    const Quat q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0) return q.normalized().toRotationMatrix();
+  }
+}
+
+std::vector<Vec3> box(const Vec3& lo, const Vec3& hi) {
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 8; ++i) {
+    pts.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  }
+  return pts;
+}
+std::vector<Vec3> unit_cube() { return box(Vec3::Zero(), Vec3::Ones()); }
+
+std::vector<Vec3> sphere_points(Rng& rng, int n, double radius) {
+  std::vector<Vec3> pts;
+  for (int i = 0; i < n; ++i) pts.push_back(radius * random_unit(rng));
+  return pts;
+}
+
+// A random body: mostly points on a sphere (4..500 of them, small counts
+// more often), sometimes a polygon (points on a circle), a segment or a
+// point, so that lower-dimensional hulls are exercised too.
+std::vector<Vec3> random_body(Rng& rng, int max_vertices) {
+  const int kind = uniform_int(rng, 0, 19);
+  if (kind == 0) return {random_unit(rng)};
+  if (kind == 1) return {random_unit(rng), random_unit(rng)};
+  const int n = std::min(max_vertices, kind < 12 ? uniform_int(rng, 4, 16) : uniform_int(rng, 4, max_vertices));
+  std::vector<Vec3> pts = sphere_points(rng, n, uniform(rng, 0.3, 1.5));
+  if (kind == 2 || kind == 3) {
+    for (Vec3& p : pts) p.z() = 0.0;  // a polygon
+  }
+  return pts;
+}
+
+// The contact band of the accuracy standard, with R taken exactly (B's
+// vertices mapped into A's frame, here in the test only).
+double largest_coordinate(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a) {
+  double r = 0.0;
+  for (const Vec3& x : a.vertices()) r = std::max(r, x.cwiseAbs().maxCoeff());
+  for (const Vec3& y : b.vertices()) r = std::max(r, b_in_a.apply(y).cwiseAbs().maxCoeff());
+  return r;
+}
+double contact_band(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a) {
+  return 64.0 * kUnitRoundoff * largest_coordinate(a, b, b_in_a);
+}
+
+// ---------------------------------------------------------------------------
+// The slow, obvious twin: the minimum over all vertex/edge/triangle pairs of
+// both hulls. Disjoint convex hulls are closest at a vertex-face or edge-edge
+// pair (lower ones included); a polygon is its fan triangles, a segment its
+// edge. Each primitive distance is the minimum over the closed pieces, which
+// keeps every case explicit.
+// ---------------------------------------------------------------------------
+double point_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 e = b - a;
+  const double ee = e.squaredNorm();
+  const double t = ee > 0.0 ? std::clamp((p - a).dot(e) / ee, 0.0, 1.0) : 0.0;
+  return (a + t * e - p).norm();
+}
+
+double point_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  double best = std::min({point_segment(p, a, b), point_segment(p, b, c), point_segment(p, c, a)});
+  const Vec3 n = (b - a).cross(c - a);
+  const double nn = n.squaredNorm();
+  if (nn > 0.0) {
+    const Vec3 q = p - n * (n.dot(p - a) / nn);  // projection onto the plane
+    const bool inside = n.dot((b - a).cross(q - a)) >= 0.0 && n.dot((c - b).cross(q - b)) >= 0.0 &&
+                        n.dot((a - c).cross(q - c)) >= 0.0;
+    if (inside) best = std::min(best, (p - q).norm());
+  }
+  return best;
+}
+
+// The minimum over the unit square of |p + s d1 - q - t d2| is at the
+// interior critical point (when it exists and is inside) or on the square's
+// boundary, i.e. an endpoint against the other segment.
+double segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+  double best = std::min({point_segment(p0, q0, q1), point_segment(p1, q0, q1), point_segment(q0, p0, p1),
+                          point_segment(q1, p0, p1)});
+  const Vec3 d1 = p1 - p0;
+  const Vec3 d2 = q1 - q0;
+  const Vec3 r = p0 - q0;
+  const double a = d1.dot(d1);
+  const double b = d1.dot(d2);
+  const double c = d2.dot(d2);
+  const double d = d1.dot(r);
+  const double e = d2.dot(r);
+  const double den = a * c - b * b;
+  if (den > 1e-14 * a * c) {
+    const double s = (b * e - c * d) / den;
+    const double t = (a * e - b * d) / den;
+    if (s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0) best = std::min(best, (r + s * d1 - t * d2).norm());
+  }
+  return best;
+}
+
+struct Pieces {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<Vec3, 2>> edges;
+  std::vector<std::array<Vec3, 3>> triangles;
+};
+
+Pieces pieces(const ConvexPolytope& p, const Pose& pose) {
+  Pieces out;
+  for (const Vec3& v : p.vertices()) out.vertices.push_back(pose.apply(v));
+  for (const auto& e : p.edges()) out.edges.push_back({pose.apply(p.vertex(e[0])), pose.apply(p.vertex(e[1]))});
+  for (const auto& t : p.triangles()) {
+    out.triangles.push_back({pose.apply(p.vertex(t[0])), pose.apply(p.vertex(t[1])), pose.apply(p.vertex(t[2]))});
+  }
+  return out;
+}
+
+double brute_force_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a) {
+  const Pieces pa = pieces(a, Pose::identity());
+  const Pieces pb = pieces(b, b_in_a);
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& x : pa.vertices) {
+    for (const Vec3& y : pb.vertices) best = std::min(best, (x - y).norm());
+    for (const auto& e : pb.edges) best = std::min(best, point_segment(x, e[0], e[1]));
+    for (const auto& t : pb.triangles) best = std::min(best, point_triangle(x, t[0], t[1], t[2]));
+  }
+  for (const Vec3& y : pb.vertices) {
+    for (const auto& e : pa.edges) best = std::min(best, point_segment(y, e[0], e[1]));
+    for (const auto& t : pa.triangles) best = std::min(best, point_triangle(y, t[0], t[1], t[2]));
+  }
+  for (const auto& e : pa.edges) {
+    for (const auto& f : pb.edges) best = std::min(best, segment_segment(e[0], e[1], f[0], f[1]));
+  }
+  return best;
+}
+
+// How far x is outside the hull (0 inside): the largest face-plane
+// violation of a solid; for lower-dimensional hulls the distance to the
+// pieces (the polygon's fan triangles, the segment, the point).
+double outside_by(const ConvexPolytope& p, const Pose& pose, const Vec3& x) {
+  if (p.dimension() == 3) {
+    double worst = 0.0;
+    for (int f = 0; f < p.face_count(); ++f) {
+      const Plane pl = p.face_plane(f);
+      const Vec3 n = pose.rotation * pl.normal;
+      worst = std::max(worst, n.dot(x) - (pl.offset + n.dot(pose.translation)));
+    }
+    return worst;
+  }
+  const Pieces pc = pieces(p, pose);
+  double best = std::numeric_limits<double>::infinity();
+  for (const Vec3& v : pc.vertices) best = std::min(best, (x - v).norm());
+  for (const auto& e : pc.edges) best = std::min(best, point_segment(x, e[0], e[1]));
+  for (const auto& t : pc.triangles) best = std::min(best, point_triangle(x, t[0], t[1], t[2]));
+  return best;
+}
+
+// How deep x is inside a solid hull (negative outside).
+double depth(const ConvexPolytope& p, const Pose& pose, const Vec3& x) {
+  double d = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < p.face_count(); ++f) {
+    const Plane pl = p.face_plane(f);
+    const Vec3 n = pose.rotation * pl.normal;
+    d = std::min(d, pl.offset + n.dot(pose.translation) - n.dot(x));
+  }
+  return d;
+}
+
+int vertex_at(const ConvexPolytope& p, const Vec3& x) {
+  for (int i = 0; i < p.vertex_count(); ++i) {
+    if (p.vertex(i) == x) return i;
+  }
+  return -1;
+}
+
+void expect_finite(const DistanceResult& r) {
+  EXPECT_TRUE(std::isfinite(r.distance));
+  EXPECT_TRUE(std::isfinite(r.lower_bound));
+  EXPECT_TRUE(r.point_a.allFinite());
+  EXPECT_TRUE(r.point_b.allFinite());
+  EXPECT_TRUE(r.normal.allFinite());
+  EXPECT_NEAR(r.normal.norm(), 1.0, 1e-12);
+  EXPECT_GE(r.lower_bound, 0.0);
+  EXPECT_LE(r.lower_bound, r.distance);
+}
+
+// Every vertex id of the feature is valid, and the feature is well formed:
+// a vertex has one id, an edge two adjacent ids, a face the hull face id
+// whose polygon holds its ids.
+void expect_well_formed(const ConvexPolytope& p, const Feature& f) {
+  const int n = f.vertex_count();
+  ASSERT_GE(n, 1);
+  for (int i = 0; i < n; ++i) {
+    EXPECT_GE(f.vertices[static_cast<std::size_t>(i)], 0);
+    EXPECT_LT(f.vertices[static_cast<std::size_t>(i)], p.vertex_count());
+  }
+  switch (f.type) {
+    case FeatureType::vertex: EXPECT_EQ(n, 1); break;
+    case FeatureType::edge: {
+      ASSERT_EQ(n, 2);
+      const auto nb = p.neighbors(f.vertices[0]);
+      EXPECT_NE(std::find(nb.begin(), nb.end(), f.vertices[1]), nb.end());
+      break;
+    }
+    case FeatureType::face: {
+      ASSERT_GE(f.face, 0);
+      ASSERT_LT(f.face, p.face_count());
+      const auto poly = p.face(f.face);
+      for (int i = 0; i < n; ++i) {
+        EXPECT_NE(std::find(poly.begin(), poly.end(), f.vertices[static_cast<std::size_t>(i)]), poly.end());
+      }
+      break;
+    }
+  }
+}
+
+DistanceOptions gjk_options() {
+  DistanceOptions o;
+  o.algorithm = Algorithm::gjk;
+  return o;
+}
+
+// ---------------------------------------------------------------------------
+// Hand cases.
+// ---------------------------------------------------------------------------
+
+TEST(Gjk, UnitCubesApartAlongX) {
+  const ConvexPolytope cube(unit_cube());
+  const Pose b_in_a = Pose::from_translation(Vec3(3, 0, 0));
+  for (const bool enhanced : {false, true}) {
+    DistanceCache cache;
+    const DistanceResult r = enhanced ? enhanced_gjk_distance(cube, cube, b_in_a, gjk_options(), 1e-14, cache)
+                                      : gjk_distance(cube, cube, b_in_a, gjk_options(), 1e-14);
+    expect_finite(r);
+    EXPECT_EQ(r.status, Status::separated);
+    EXPECT_NEAR(r.distance, 2.0, 1e-15);
+    EXPECT_NEAR(r.lower_bound, 2.0, 1e-12);
+    EXPECT_NEAR(r.point_a.x(), 1.0, 1e-15);
+    EXPECT_NEAR(r.point_b.x(), 3.0, 1e-15);
+    EXPECT_NEAR(r.point_a.y(), r.point_b.y(), 1e-15);
+    EXPECT_NEAR(r.point_a.z(), r.point_b.z(), 1e-15);
+    EXPECT_NEAR(r.normal.x(), 1.0, 1e-15);
+    // Parallel faces: any witness within the facing faces is right.
+    expect_well_formed(cube, r.feature_a);
+    expect_well_formed(cube, r.feature_b);
+    for (int i = 0; i < r.feature_a.vertex_count(); ++i) EXPECT_EQ(cube.vertex(r.feature_a.vertices[static_cast<std::size_t>(i)]).x(), 1.0);
+    for (int i = 0; i < r.feature_b.vertex_count(); ++i) EXPECT_EQ(cube.vertex(r.feature_b.vertices[static_cast<std::size_t>(i)]).x(), 0.0);
+    if (r.feature_a.type == FeatureType::face) {
+      EXPECT_NEAR(cube.face_plane(r.feature_a.face).normal.x(), 1.0, 1e-15);
+    }
+    if (r.feature_b.type == FeatureType::face) {
+      EXPECT_NEAR(cube.face_plane(r.feature_b.face).normal.x(), -1.0, 1e-15);
+    }
+  }
+}
+
+TEST(Gjk, UnitCubesApartAlongDiagonal) {
+  const ConvexPolytope cube(unit_cube());
+  const Pose b_in_a = Pose::from_translation(Vec3(2, 2, 2));
+  const DistanceResult r = gjk_distance(cube, cube, b_in_a, gjk_options(), 1e-14);
+  expect_finite(r);
+  EXPECT_EQ(r.status, Status::separated);
+  EXPECT_NEAR(r.distance, std::sqrt(3.0), 1e-15);
+  EXPECT_NEAR(r.lower_bound, std::sqrt(3.0), 1e-12);
+  EXPECT_TRUE(r.point_a.isApprox(Vec3(1, 1, 1), 1e-15));
+  EXPECT_TRUE(r.point_b.isApprox(Vec3(2, 2, 2), 1e-15));
+  EXPECT_TRUE(r.normal.isApprox(Vec3(1, 1, 1).normalized(), 1e-15));
+  EXPECT_EQ(r.feature_a.type, FeatureType::vertex);
+  EXPECT_EQ(r.feature_a.vertices[0], vertex_at(cube, Vec3(1, 1, 1)));
+  EXPECT_EQ(r.feature_b.type, FeatureType::vertex);
+  EXPECT_EQ(r.feature_b.vertices[0], vertex_at(cube, Vec3(0, 0, 0)));
+}
+
+TEST(Gjk, PointAgainstEachRegionOfATetrahedron) {
+  const ConvexPolytope tet(std::vector<Vec3>{Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)});
+  const int o = vertex_at(tet, Vec3(0, 0, 0));
+  const int x = vertex_at(tet, Vec3(1, 0, 0));
+  const int y = vertex_at(tet, Vec3(0, 1, 0));
+  const int z = vertex_at(tet, Vec3(0, 0, 1));
+  struct Case {
+    Vec3 point;
+    double distance;
+    Vec3 closest;
+    FeatureType type;
+    std::array<int, 3> ids;  // sorted, -1 unused
+  };
+  const auto sorted = [](std::array<int, 3> v) {
+    std::sort(v.begin(), v.begin() + (v[2] >= 0 ? 3 : v[1] >= 0 ? 2 : 1));
+    return v;
+  };
+  const Case cases[] = {
+      {Vec3(1, 1, 1), 2.0 / std::sqrt(3.0), Vec3::Constant(1.0 / 3.0), FeatureType::face, sorted({x, y, z})},
+      {Vec3(-1, -1, -1), std::sqrt(3.0), Vec3::Zero(), FeatureType::vertex, {o, -1, -1}},
+      {Vec3(0.5, -1, -1), std::sqrt(2.0), Vec3(0.5, 0, 0), FeatureType::edge, sorted({o, x, -1})},
+      {Vec3(0.25, 0.25, -2), 2.0, Vec3(0.25, 0.25, 0), FeatureType::face, sorted({o, x, y})},
+      {Vec3(3, 0, 0), 2.0, Vec3(1, 0, 0), FeatureType::vertex, {x, -1, -1}},
+  };
+  for (const Case& c : cases) {
+    const ConvexPolytope point(std::vector<Vec3>{Vec3::Zero()});
+    // The point is body A at the origin; the tetrahedron is B, placed so
+    // that in A's frame it sits at its given coordinates.
+    const Pose b_in_a = Pose::from_translation(-c.point);
+    for (const bool enhanced : {false, true}) {
+      DistanceCache cache;
+      const DistanceResult r = enhanced ? enhanced_gjk_distance(point, tet, b_in_a, gjk_options(), 1e-14, cache)
+                                        : gjk_distance(point, tet, b_in_a, gjk_options(), 1e-14);
+      expect_finite(r);
+      EXPECT_EQ(r.status, Status::separated);
+      EXPECT_NEAR(r.distance, c.distance, 1e-15);
+      EXPECT_TRUE(r.point_b.isApprox(c.closest - c.point, 1e-15)) << r.point_b.transpose();
+      EXPECT_EQ(r.feature_a.type, FeatureType::vertex);
+      EXPECT_EQ(r.feature_a.vertices[0], 0);
+      EXPECT_EQ(r.feature_b.type, c.type) << to_string(r.feature_b.type);
+      std::array<int, 3> got = {r.feature_b.vertices[0], r.feature_b.vertices[1], r.feature_b.vertices[2]};
+      EXPECT_EQ(got, c.ids);
+      expect_well_formed(tet, r.feature_b);
+    }
+  }
+}
+
+TEST(Gjk, ParallelFacesOverlappingInProjection) {
+  const ConvexPolytope a(unit_cube());
+  const ConvexPolytope b(box(Vec3(0, 0, 0), Vec3(2, 0.5, 1)));
+  const Pose b_in_a = Pose::from_translation(Vec3(0.5, 0.3, 1.5));
+  const DistanceResult r = gjk_distance(a, b, b_in_a, gjk_options(), 1e-14);
+  expect_finite(r);
+  EXPECT_EQ(r.status, Status::separated);
+  EXPECT_NEAR(r.distance, 0.5, 1e-15);
+  EXPECT_NEAR(r.point_a.z(), 1.0, 1e-15);
+  EXPECT_NEAR(r.point_b.z(), 1.5, 1e-15);
+  // The witnesses lie where the facing faces overlap: x in [0.5, 1], y in [0.3, 0.8].
+  EXPECT_GE(r.point_a.x(), 0.5 - 1e-15);
+  EXPECT_LE(r.point_a.x(), 1.0 + 1e-15);
+  EXPECT_GE(r.point_a.y(), 0.3 - 1e-15);
+  EXPECT_LE(r.point_a.y(), 0.8 + 1e-15);
+  EXPECT_TRUE(r.normal.isApprox(Vec3::UnitZ(), 1e-15));
+  for (int i = 0; i < r.feature_a.vertex_count(); ++i) EXPECT_EQ(a.vertex(r.feature_a.vertices[static_cast<std::size_t>(i)]).z(), 1.0);
+  for (int i = 0; i < r.feature_b.vertex_count(); ++i) EXPECT_EQ(b.vertex(r.feature_b.vertices[static_cast<std::size_t>(i)]).z(), 0.0);
+  expect_well_formed(a, r.feature_a);
+  expect_well_formed(b, r.feature_b);
+}
+
+// Two prisms whose ridges cross at right angles, 0.5 apart: edge-edge.
+TEST(Gjk, CrossingEdges) {
+  const ConvexPolytope a(std::vector<Vec3>{Vec3(-1, -1, 0), Vec3(1, -1, 0), Vec3(-1, 1, 0), Vec3(1, 1, 0),
+                                           Vec3(-1, 0, 1), Vec3(1, 0, 1)});
+  const ConvexPolytope b(std::vector<Vec3>{Vec3(0, -1, 0), Vec3(0, 1, 0), Vec3(-1, -1, 1), Vec3(1, -1, 1),
+                                           Vec3(-1, 1, 1), Vec3(1, 1, 1)});
+  const Pose b_in_a = Pose::from_translation(Vec3(0.1, 0.2, 1.5));
+  for (const bool enhanced : {false, true}) {
+    DistanceCache cache;
+    const DistanceResult r = enhanced ? enhanced_gjk_distance(a, b, b_in_a, gjk_options(), 1e-14, cache)
+                                      : gjk_distance(a, b, b_in_a, gjk_options(), 1e-14);
+    expect_finite(r);
+    EXPECT_EQ(r.status, Status::separated);
+    EXPECT_NEAR(r.distance, 0.5, 1e-15);
+    EXPECT_TRUE(r.point_a.isApprox(Vec3(0.1, 0, 1), 1e-15)) << r.point_a.transpose();
+    EXPECT_TRUE(r.point_b.isApprox(Vec3(0.1, 0, 1.5), 1e-15)) << r.point_b.transpose();
+    EXPECT_EQ(r.feature_a.type, FeatureType::edge);
+    EXPECT_EQ(r.feature_b.type, FeatureType::edge);
+    const auto edge = [](int u, int v) { return std::array<int, 3>{std::min(u, v), std::max(u, v), -1}; };
+    const std::array<int, 3> ridge_a = edge(vertex_at(a, Vec3(-1, 0, 1)), vertex_at(a, Vec3(1, 0, 1)));
+    const std::array<int, 3> ridge_b = edge(vertex_at(b, Vec3(0, -1, 0)), vertex_at(b, Vec3(0, 1, 0)));
+    EXPECT_EQ(r.feature_a.vertices, ridge_a);
+    EXPECT_EQ(r.feature_b.vertices, ridge_b);
+  }
+}
+
+// Contacts at machine precision: face on face, edge on edge, vertex on
+// vertex, a rotated cube resting on an edge. Touching, never separated or
+// intersecting, and the points coincide within the band.
+TEST(Gjk, TouchingContacts) {
+  const ConvexPolytope cube(unit_cube());
+  const Pose poses[] = {
+      Pose::from_translation(Vec3(1, 0, 0)),    Pose::from_translation(Vec3(1, 0.3, -0.2)),
+      Pose::from_translation(Vec3(1, 1, 0)),    Pose::from_translation(Vec3(1, 1, 1)),
+      Pose::from_translation(Vec3(0, 0, -1)),   Pose::from_translation(Vec3(-1, -1, 0.5)),
+      Pose(Mat3(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())), Vec3(1 + std::sqrt(0.5), 0.5 - std::sqrt(0.5), 0.25)),
+  };
+  for (const Pose& b_in_a : poses) {
+    const double tol = contact_band(cube, cube, b_in_a);
+    for (const bool enhanced : {false, true}) {
+      DistanceCache cache;
+      const DistanceResult r = enhanced ? enhanced_gjk_distance(cube, cube, b_in_a, gjk_options(), tol, cache)
+                                        : gjk_distance(cube, cube, b_in_a, gjk_options(), tol);
+      expect_finite(r);
+      EXPECT_EQ(r.status, Status::touching) << b_in_a.translation.transpose() << " " << to_string(r.status);
+      EXPECT_LE(r.distance, tol);
+      EXPECT_LE((r.point_a - r.point_b).norm(), tol);
+      EXPECT_LE(outside_by(cube, Pose::identity(), r.point_a), tol);
+      EXPECT_LE(outside_by(cube, b_in_a, r.point_b), tol);
+    }
+  }
+}
+
+// Overlaps, the symmetric ones included (identical cubes put the origin on
+// segments and triangles of the Minkowski difference, not inside a
+// tetrahedron): intersecting, distance 0, one contact point in both hulls.
+TEST(Gjk, IntersectingContacts) {
+  const ConvexPolytope cube(unit_cube());
+  const ConvexPolytope small(box(Vec3(0.25, 0.25, 0.25), Vec3(0.75, 0.75, 0.75)));
+  struct Case {
+    const ConvexPolytope* b;
+    Pose pose;
+  };
+  const Case cases[] = {
+      {&cube, Pose::identity()},
+      {&cube, Pose::from_translation(Vec3(0.5, 0, 0))},
+      {&cube, Pose::from_translation(Vec3(0.5, 0.5, 0.5))},
+      {&cube, Pose(Mat3(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ())), Vec3(0.5, 0.5, 0.5))},
+      {&small, Pose::identity()},  // B inside A
+      {&cube, Pose::from_translation(Vec3(0.999, 0.999, 0.999))},
+  };
+  for (const Case& c : cases) {
+    const double tol = contact_band(cube, *c.b, c.pose);
+    for (const bool enhanced : {false, true}) {
+      DistanceCache cache;
+      const DistanceResult r = enhanced ? enhanced_gjk_distance(cube, *c.b, c.pose, gjk_options(), tol, cache)
+                                        : gjk_distance(cube, *c.b, c.pose, gjk_options(), tol);
+      expect_finite(r);
+      EXPECT_EQ(r.status, Status::intersecting) << c.pose.translation.transpose();
+      EXPECT_EQ(r.distance, 0.0);
+      EXPECT_EQ(r.lower_bound, 0.0);
+      EXPECT_EQ(r.point_a, r.point_b);
+      EXPECT_LE(outside_by(cube, Pose::identity(), r.point_a), tol);
+      EXPECT_LE(outside_by(*c.b, c.pose, r.point_b), tol);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Random polytopes against the brute force.
+// ---------------------------------------------------------------------------
+
+struct Tally {
+  int vertex_face = 0;
+  int edge_edge = 0;
+  int other = 0;
+};
+
+// Checks one separated answer against the reference distance and the
+// optimality certificate, and tallies its feature pair.
+void check_separated(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a, const DistanceResult& r,
+                     double reference, Tally& tally) {
+  const double big_r = largest_coordinate(a, b, b_in_a);
+  const double band = 64.0 * kUnitRoundoff * big_r;
+  // Accuracy standard, plus the reference's own rounding (a few u R).
+  const double slack = 1e-12 * reference + band + 16.0 * kUnitRoundoff * big_r;
+  expect_finite(r);
+  EXPECT_EQ(r.status, Status::separated);
+  EXPECT_NEAR(r.distance, reference, slack);
+  EXPECT_LE(r.lower_bound, reference + slack);
+  EXPECT_NEAR((r.point_b - r.point_a).norm(), r.distance, band);
+  EXPECT_LE(outside_by(a, Pose::identity(), r.point_a), band);
+  EXPECT_LE(outside_by(b, b_in_a, r.point_b), band);
+  // Certificate: the normal separates, with A's support plane through
+  // point_a and B's through point_b.
+  double max_a = -std::numeric_limits<double>::infinity();
+  double min_b = std::numeric_limits<double>::infinity();
+  for (const Vec3& x : a.vertices()) max_a = std::max(max_a, r.normal.dot(x));
+  for (const Vec3& y : b.vertices()) min_b = std::min(min_b, r.normal.dot(b_in_a.apply(y)));
+  EXPECT_LE(max_a, r.normal.dot(r.point_a) + slack);
+  EXPECT_GE(min_b, r.normal.dot(r.point_b) - slack);
+  // The witness features hold the closest points, on the support planes.
+  expect_well_formed(a, r.feature_a);
+  expect_well_formed(b, r.feature_b);
+  for (int i = 0; i < r.feature_a.vertex_count(); ++i) {
+    EXPECT_NEAR(r.normal.dot(a.vertex(r.feature_a.vertices[static_cast<std::size_t>(i)])), max_a, slack + 1e-9 * big_r);
+  }
+  for (int i = 0; i < r.feature_b.vertex_count(); ++i) {
+    EXPECT_NEAR(r.normal.dot(b_in_a.apply(b.vertex(r.feature_b.vertices[static_cast<std::size_t>(i)]))), min_b,
+                slack + 1e-9 * big_r);
+  }
+  const FeatureType ta = r.feature_a.type;
+  const FeatureType tb = r.feature_b.type;
+  if ((ta == FeatureType::vertex && tb == FeatureType::face) || (ta == FeatureType::face && tb == FeatureType::vertex)) {
+    ++tally.vertex_face;
+  } else if (ta == FeatureType::edge && tb == FeatureType::edge) {
+    ++tally.edge_edge;
+  } else {
+    ++tally.other;
+  }
+}
+
+TEST(Gjk, RandomSeparatedPairsMatchBruteForce) {
+  Rng rng(20240611);
+  Tally tally;
+  int large = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    // A few large bodies (the brute force is quadratic in edges), many small.
+    const bool big = trial % 30 == 0;
+    const ConvexPolytope a(big ? sphere_points(rng, uniform_int(rng, 100, 500), 1.0) : random_body(rng, 40));
+    const ConvexPolytope b(big ? sphere_points(rng, uniform_int(rng, 100, 500), 0.7) : random_body(rng, 40));
+    large += std::min(a.vertex_count(), b.vertex_count()) >= 100;
+    // Apart by 0.001 .. 10 beyond the bounding spheres.
+    const double gap = std::exp(uniform(rng, std::log(1e-3), std::log(10.0)));
+    const Vec3 dir = random_unit(rng);
+    const Vec3 t = a.centroid() + dir * (a.bounding_radius() + b.bounding_radius() + gap);
+    const Mat3 rot = random_rotation(rng);
+    const Pose b_in_a(rot, Vec3(t - rot * b.centroid()));
+    const double reference = brute_force_distance(a, b, b_in_a);
+    SCOPED_TRACE(testing::Message() << "trial " << trial << " na " << a.vertex_count() << " nb " << b.vertex_count());
+    const DistanceResult classic = gjk_distance(a, b, b_in_a, gjk_options(), contact_band(a, b, b_in_a));
+    check_separated(a, b, b_in_a, classic, reference, tally);
+    DistanceCache cache;
+    const DistanceResult enhanced =
+        enhanced_gjk_distance(a, b, b_in_a, gjk_options(), contact_band(a, b, b_in_a), cache);
+    Tally ignored;
+    check_separated(a, b, b_in_a, enhanced, reference, ignored);
+  }
+  // The random set must contain the hard cases, not only vertex-vertex.
+  EXPECT_GE(tally.vertex_face, 30);
+  EXPECT_GE(tally.edge_edge, 30);
+  EXPECT_GE(large, 5);
+}
+
+// Near contact the separation is a few ulps to a few thousand ulps of R:
+// the status flips from touching to separated at the band, and the distance
+// is still right to the band.
+TEST(Gjk, RandomNearContact) {
+  Rng rng(77);
+  int touching = 0;
+  int separated = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const ConvexPolytope a(sphere_points(rng, uniform_int(rng, 4, 60), 1.0));
+    const ConvexPolytope b(sphere_points(rng, uniform_int(rng, 4, 60), 1.0));
+    const Mat3 rot = random_rotation(rng);
+    const Vec3 dir = random_unit(rng);
+    Pose b_in_a(rot, Vec3(dir * 3.0));
+    // Slide B along -normal by the distance found, less a few ulps: a
+    // contact within or just beyond the band.
+    const DistanceResult first = gjk_distance(a, b, b_in_a, gjk_options(), contact_band(a, b, b_in_a));
+    ASSERT_EQ(first.status, Status::separated);
+    const double extra = std::ldexp(uniform(rng, 0.0, 1.0), uniform_int(rng, -60, -40));
+    b_in_a.translation -= first.normal * (first.distance - extra);
+    const double tol = contact_band(a, b, b_in_a);
+    const double reference = brute_force_distance(a, b, b_in_a);
+    for (const bool enhanced : {false, true}) {
+      DistanceCache cache;
+      const DistanceResult r = enhanced ? enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, cache)
+                                        : gjk_distance(a, b, b_in_a, gjk_options(), tol);
+      expect_finite(r);
+      // The brute force itself rounds at a few u R, so only clear cases
+      // are held to a status.
+      if (reference > 2.0 * tol) {
+        EXPECT_EQ(r.status, Status::separated);
+      }
+      if (reference < 0.5 * tol) {
+        EXPECT_EQ(r.status, Status::touching) << reference / tol;
+      }
+      EXPECT_NE(r.status, Status::intersecting);
+      EXPECT_NEAR(r.distance, reference, tol);
+      touching += r.status == Status::touching;
+      separated += r.status == Status::separated;
+    }
+  }
+  EXPECT_GE(touching, 20);
+  EXPECT_GE(separated, 20);
+}
+
+// Bodies that share a ball around a common point: intersecting, with a
+// contact point in both hulls.
+TEST(Gjk, RandomIntersectingPairs) {
+  Rng rng(5150);
+  int checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const ConvexPolytope a(sphere_points(rng, uniform_int(rng, 12, 200), 1.0));
+    const ConvexPolytope b(sphere_points(rng, uniform_int(rng, 12, 200), uniform(rng, 0.2, 2.0)));
+    const Mat3 rot = random_rotation(rng);
+    const Pose b_in_a(rot, Vec3(uniform(rng, 0.0, 0.3) * random_unit(rng)));
+    const Vec3 common = 0.5 * b_in_a.translation;
+    if (depth(a, Pose::identity(), common) < 1e-3 || depth(b, b_in_a, common) < 1e-3) continue;
+    ++checked;
+    const double tol = contact_band(a, b, b_in_a);
+    for (const bool enhanced : {false, true}) {
+      DistanceCache cache;
+      const DistanceResult r = enhanced ? enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, cache)
+                                        : gjk_distance(a, b, b_in_a, gjk_options(), tol);
+      expect_finite(r);
+      EXPECT_EQ(r.status, Status::intersecting);
+      EXPECT_EQ(r.distance, 0.0);
+      EXPECT_EQ(r.point_a, r.point_b);
+      EXPECT_LE(outside_by(a, Pose::identity(), r.point_a), tol);
+      EXPECT_LE(outside_by(b, b_in_a, r.point_b), tol);
+    }
+  }
+  EXPECT_GE(checked, 100);
+}
+
+// ---------------------------------------------------------------------------
+// Enhanced GJK: tracking and caches.
+// ---------------------------------------------------------------------------
+
+// B circles A, spinning, and dips into it and out again: at every step the
+// tracked Enhanced GJK gives classic GJK's answer (same status, distance
+// within the band), and on average needs fewer support evaluations.
+TEST(EnhancedGjk, MatchesClassicAlongAMotion) {
+  Rng rng(4242);
+  const ConvexPolytope a(sphere_points(rng, 300, 1.0));
+  const ConvexPolytope b(sphere_points(rng, 120, 0.5));
+  DistanceCache cache;
+  int classic_iterations = 0;
+  int enhanced_iterations = 0;
+  int intersecting = 0;
+  const int steps = 400;
+  for (int k = 0; k < steps; ++k) {
+    const double s = 2.0 * M_PI * k / steps;
+    const double radius = 1.7 + 0.4 * std::cos(3.0 * s);  // dips below 1.5: overlap
+    const Pose b_in_a(Mat3(Eigen::AngleAxisd(4.0 * s, Vec3(1, 2, 3).normalized())),
+                      Vec3(radius * std::cos(s), radius * std::sin(s), 0.3 * std::sin(2.0 * s)));
+    const double tol = contact_band(a, b, b_in_a);
+    const DistanceResult c = gjk_distance(a, b, b_in_a, gjk_options(), tol);
+    const DistanceResult e = enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, cache);
+    SCOPED_TRACE(testing::Message() << "step " << k);
+    expect_finite(e);
+    EXPECT_EQ(e.status, c.status);
+    EXPECT_NEAR(e.distance, c.distance, 1e-12 * c.distance + tol);
+    if (c.status == Status::separated) {
+      EXPECT_NEAR((e.point_a - c.point_a).norm(), 0.0, 1e-6);  // unique closest points here
+      EXPECT_LE(e.lower_bound, c.distance + tol);
+    }
+    classic_iterations += c.iterations;
+    enhanced_iterations += e.iterations;
+    intersecting += c.status == Status::intersecting;
+  }
+  EXPECT_GE(intersecting, 20);
+  EXPECT_LT(enhanced_iterations, classic_iterations);
+}
+
+// With the pose unchanged, the cached simplex is already the answer: one
+// support evaluation confirms it.
+TEST(EnhancedGjk, RepeatedQueryConfirmsInOneIteration) {
+  Rng rng(99);
+  for (int trial = 0; trial < 20; ++trial) {
+    const ConvexPolytope a(sphere_points(rng, 200, 1.0));
+    const ConvexPolytope b(sphere_points(rng, 200, 1.0));
+    const Pose b_in_a(random_rotation(rng), Vec3(3.0 * random_unit(rng)));
+    const double tol = contact_band(a, b, b_in_a);
+    DistanceCache cache;
+    const DistanceResult first = enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, cache);
+    EXPECT_FALSE(cache.is_cold());
+    const DistanceResult second = enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, cache);
+    EXPECT_EQ(second.iterations, 1);
+    EXPECT_NEAR(second.distance, first.distance, tol);
+  }
+}
+
+// A cache from another pair, or full of garbage, costs iterations but never
+// changes the answer; the cache written back is valid for this pair.
+TEST(EnhancedGjk, ForeignAndGarbageCachesGiveTheSameAnswer) {
+  Rng rng(31337);
+  const ConvexPolytope other_a(sphere_points(rng, 500, 1.0));
+  const ConvexPolytope other_b(sphere_points(rng, 500, 1.0));
+  DistanceCache foreign;
+  enhanced_gjk_distance(other_a, other_b, Pose::from_translation(Vec3(2.5, 0, 0)), gjk_options(), 1e-13, foreign);
+  for (int trial = 0; trial < 100; ++trial) {
+    const ConvexPolytope a(random_body(rng, 60));
+    const ConvexPolytope b(random_body(rng, 60));
+    const Pose b_in_a(random_rotation(rng), Vec3(uniform(rng, 0.0, 3.5) * random_unit(rng)));
+    const double tol = contact_band(a, b, b_in_a);
+    const DistanceResult reference = gjk_distance(a, b, b_in_a, gjk_options(), tol);
+
+    DistanceCache garbage;
+    for (std::size_t k = 0; k < 4; ++k) {
+      garbage.vertices_a[k] = static_cast<std::int32_t>(uniform_int(rng, -1000, 1000));
+      garbage.vertices_b[k] = static_cast<std::int32_t>(uniform_int(rng, -1000, 1000));
+    }
+    garbage.hint_a = trial % 2 == 0 ? std::numeric_limits<std::int32_t>::max() : -17;
+    garbage.hint_b = static_cast<std::int32_t>(uniform_int(rng, -1000, 1000));
+    DistanceCache in_range;  // valid ids, meaningless for this pose
+    for (std::size_t k = 0; k < 4; ++k) {
+      in_range.vertices_a[k] = static_cast<std::int32_t>(uniform_int(rng, 0, a.vertex_count() - 1));
+      in_range.vertices_b[k] = static_cast<std::int32_t>(uniform_int(rng, 0, b.vertex_count() - 1));
+    }
+    DistanceCache foreign_copy = foreign;
+    for (DistanceCache* cache : {&garbage, &in_range, &foreign_copy}) {
+      const DistanceResult r = enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, *cache);
+      SCOPED_TRACE(testing::Message() << "trial " << trial);
+      expect_finite(r);
+      EXPECT_EQ(r.status, reference.status);
+      EXPECT_NEAR(r.distance, reference.distance, 1e-12 * reference.distance + tol);
+      for (std::size_t k = 0; k < 4; ++k) {
+        EXPECT_GE(cache->vertices_a[k], -1);
+        EXPECT_LT(cache->vertices_a[k], a.vertex_count());
+        EXPECT_GE(cache->vertices_b[k], -1);
+        EXPECT_LT(cache->vertices_b[k], b.vertex_count());
+      }
+      EXPECT_GE(cache->hint_a, 0);
+      EXPECT_LT(cache->hint_a, a.vertex_count());
+      EXPECT_GE(cache->hint_b, 0);
+      EXPECT_LT(cache->hint_b, b.vertex_count());
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Limits.
+// ---------------------------------------------------------------------------
+
+TEST(Gjk, IterationCapIsReportedWithValidBounds) {
+  Rng rng(8);
+  const ConvexPolytope a(sphere_points(rng, 500, 1.0));
+  const ConvexPolytope b(sphere_points(rng, 500, 1.0));
+  const Pose b_in_a(random_rotation(rng), Vec3(2.2, 0.3, -0.1));
+  const double reference = brute_force_distance(a, b, b_in_a);
+  DistanceOptions capped = gjk_options();
+  capped.max_iterations = 2;
+  DistanceCache cache;
+  for (const DistanceResult& r : {gjk_distance(a, b, b_in_a, capped, 1e-13),
+                                  enhanced_gjk_distance(a, b, b_in_a, capped, 1e-13, cache)}) {
+    expect_finite(r);
+    EXPECT_EQ(r.status, Status::iteration_cap);
+    EXPECT_EQ(r.iterations, 2);
+    // Still bounds: the upper bound is a pair of hull points, the lower
+    // bound certified.
+    EXPECT_GE(r.distance, reference - 1e-14);
+    EXPECT_LE(r.lower_bound, reference + 1e-14);
+    EXPECT_LE(outside_by(a, Pose::identity(), r.point_a), 1e-14);
+    EXPECT_LE(outside_by(b, b_in_a, r.point_b), 1e-14);
+  }
+}
+
+// The paper's stress scales (tiny and huge bodies) and one beyond where the
+// signed volumes' cubic terms would overflow without the unit rescaling: the
+// answer scales with the bodies.
+TEST(Gjk, ScaleInvariance) {
+  const std::vector<Vec3> tet = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
+  const Mat3 rot(Eigen::AngleAxisd(0.7, Vec3(1, -2, 0.5).normalized()));
+  const Vec3 offset(1.1, 0.9, 1.3);
+  const ConvexPolytope a1(tet);
+  const ConvexPolytope b1(tet);
+  const DistanceResult base = gjk_distance(a1, b1, Pose(rot, offset), gjk_options(), 1e-14);
+  ASSERT_EQ(base.status, Status::separated);
+  for (const double s : {0x1p-76, 1e-23, 1e39, 1e120}) {
+    std::vector<Vec3> scaled;
+    for (const Vec3& p : tet) scaled.push_back(p * s);
+    const ConvexPolytope a(scaled);
+    const ConvexPolytope b(scaled);
+    const Pose b_in_a(rot, Vec3(offset * s));
+    const double tol = contact_band(a, b, b_in_a);
+    DistanceCache cache;
+    for (const DistanceResult& r : {gjk_distance(a, b, b_in_a, gjk_options(), tol),
+                                    enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, cache)}) {
+      SCOPED_TRACE(testing::Message() << "scale " << s);
+      expect_finite(r);
+      EXPECT_EQ(r.status, Status::separated);
+      EXPECT_NEAR(r.distance / s, base.distance, 1e-12 * base.distance + 64 * kUnitRoundoff * 4);
+      EXPECT_NEAR(r.lower_bound / s, base.lower_bound, 1e-12);
+      EXPECT_EQ(r.feature_a.type, base.feature_a.type);
+      EXPECT_EQ(r.feature_b.type, base.feature_b.type);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace proxima
