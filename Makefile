@@ -36,3 +36,7 @@ bench: release
 
 clean:
 	rm -rf build out
+
+# Fuzzes the mesh readers for 30 s (clang, libFuzzer + ASan + UBSan).
+.PHONY: fuzz
+fuzz: ; bash scripts/fuzz 30
