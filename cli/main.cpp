@@ -1,0 +1,122 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 7: the `proxima` command-line tool.
+//   proxima demo                                   the main job of `make run`
+//   proxima query [FILE] [--algorithm NAME] ...    JSON Lines in, JSON Lines out
+//
+// Exit codes: 0 when the run completed (a query line with an error answer is
+// still a completed run), 1 when the input cannot be read or the demo fails,
+// 2 for usage errors.
+#include "demo.h"
+#include "query.h"
+
+#include "proxima/types.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitUsage = 2;
+// Upper end of --max-iterations: far above any real need (the default is
+// 64); it only keeps a typo from turning the cap off.
+constexpr int kMaxIterationsLimit = 1000000;
+
+proxima::Algorithm parse_algorithm(const std::string& name) {
+  if (name == "gjk") return proxima::Algorithm::gjk;
+  if (name == "enhanced_gjk") return proxima::Algorithm::enhanced_gjk;
+  return proxima::Algorithm::hybrid;
+}
+
+int run_query_command(const std::string& file, const proxima::DistanceOptions& options) {
+  // Answers go through std::cout only; untying it from C stdio lets it
+  // buffer a whole answer line before the explicit flush.
+  std::ios::sync_with_stdio(false);
+  proxima::cli::QueryRunSummary summary;
+  if (file == "-") {
+    summary = proxima::cli::run_queries(std::cin, std::cout, options);
+  } else {
+    // An ifstream opens a directory without complaint and then reads
+    // nothing; that would look like an empty, successful run.
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) {
+      std::cerr << "proxima query: cannot open '" << file << "': it is a directory\n";
+      return kExitFailure;
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) {
+      std::cerr << "proxima query: cannot open '" << file << "': " << std::strerror(errno) << "\n";
+      return kExitFailure;
+    }
+    summary = proxima::cli::run_queries(in, std::cout, options);
+  }
+  if (summary.read_failed) {
+    std::cerr << "proxima query: reading the input failed after " << summary.answered
+              << " answers\n";
+    return kExitFailure;
+  }
+  if (!std::cout) {
+    std::cerr << "proxima query: writing the answers failed\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"proxima: minimum distance, closest points and closest features between convex "
+               "polyhedra"};
+  app.require_subcommand(1);
+
+  CLI::App* demo = app.add_subcommand(
+      "demo", "Build two seeded polytopes, print their hulls and the distance by each algorithm");
+
+  CLI::App* query = app.add_subcommand(
+      "query", "Answer distance queries in JSON Lines, one answer line per query line, in order "
+               "(format: docs/query-format.md)");
+  std::string file = "-";
+  std::string algorithm = "hybrid";
+  proxima::DistanceOptions options;
+  query->add_option("FILE", file, "Input file of queries; '-' or none reads standard input");
+  query->add_option("--algorithm", algorithm, "Algorithm answering the queries")
+      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
+      ->capture_default_str();
+  query
+      ->add_option("--max-iterations", options.max_iterations,
+                   "Iteration cap per query; a capped answer says \"iteration_cap\": true")
+      ->check(CLI::Range(1, kMaxIterationsLimit))
+      ->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11's own codes for bad usage are 100 and up; ours is 2 for all of
+    // them. Help (--help) is a successful run.
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+
+  try {
+    if (*demo) return proxima::cli::run_demo();
+    if (*query) {
+      options.algorithm = parse_algorithm(algorithm);
+      return run_query_command(file, options);
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "proxima: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  return kExitUsage;
+}

@@ -1,0 +1,29 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 7: `proxima query`, the JSON Lines exchange. One query per input
+// line, one answer per output line, in order. The format is specified in
+// docs/query-format.md; this header is the seam between the CLI's argument
+// parsing (main.cpp) and the stream loop (query.cpp).
+#pragma once
+
+#include "proxima/types.h"
+
+#include <istream>
+#include <ostream>
+
+namespace proxima::cli {
+
+struct QueryRunSummary {
+  long answered = 0;  // answer lines written, error answers included
+  long errors = 0;    // of which status "error"
+  bool read_failed = false;  // the input stream broke (not its end): answers may be missing
+};
+
+// Reads every line of `in`, answers each non-blank one on `out` and flushes
+// after each answer, so that a caller feeding queries through a pipe one at a
+// time gets each answer before it sends the next. A bad line yields an error
+// answer and the loop goes on; only the stream ending stops it.
+QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options);
+
+}  // namespace proxima::cli
