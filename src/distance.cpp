@@ -53,24 +53,16 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
 
   DistanceCache cold;
   DistanceCache& c = cache != nullptr ? *cache : cold;
-  DistanceResult local;
-  switch (options.algorithm) {
-    case Algorithm::hybrid:
-      local = hybrid_distance(a, b, b_in_a, options, contact_tolerance, c);
-      break;
-    case Algorithm::gjk:
-      local = gjk_distance(a, b, b_in_a, options, contact_tolerance);
-      break;
-    case Algorithm::enhanced_gjk:
-      local = enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, c);
-      break;
-  }
-
-  DistanceResult world = local;
-  world.point_a = pose_a.apply(local.point_a);
-  world.point_b = pose_a.apply(local.point_b);
-  world.normal = pose_a.rotation * local.normal;
-  return world;
+  DistanceResult result = options.algorithm == Algorithm::gjk
+                         ? gjk_distance(a, b, b_in_a, options, contact_tolerance)
+                     : options.algorithm == Algorithm::enhanced_gjk
+                         ? enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, c)
+                         : hybrid_distance(a, b, b_in_a, options, contact_tolerance, c);
+  // Back to the world frame, in place.
+  result.point_a = pose_a.apply(result.point_a);
+  result.point_b = pose_a.apply(result.point_b);
+  result.normal = pose_a.rotation * result.normal;
+  return result;
 }
 
 }  // namespace proxima
