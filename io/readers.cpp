@@ -417,7 +417,10 @@ PointCloud read_obj(const Source& src, std::string_view text) {
   callback.group_cb = [](void* user, const char** names, int count) {
     auto* ev = static_cast<ObjEvents*>(user);
     std::string name;
-    for (int i = 0; i < count; ++i) name += (i > 0 ? " " : "") + std::string(names[i]);
+    for (int i = 0; i < count; ++i) {
+      if (i > 0) name += ' ';
+      name += names[i];
+    }
     ev->groups.emplace_back(std::move(name), ev->vertices);
   };
   callback.object_cb = [](void* user, const char* name) {
