@@ -19,6 +19,7 @@
 #include <libqhull_r/qhull_ra.h>
 
 #include <algorithm>
+#include <bit>
 #include <cfenv>
 #include <climits>
 #include <cmath>
@@ -50,7 +51,10 @@ using Index = std::int32_t;
 // value), the sign of the rounded determinant is the exact sign. Otherwise the
 // determinant is recomputed exactly in integers: every double is m * 2^e with
 // a 53-bit integer m, so shifting all inputs of one predicate to their
-// smallest exponent turns the determinant into an integer polynomial.
+// smallest exponent turns the determinant into an integer polynomial. When
+// those integers are small (integer or dyadic data: the usual source of exact
+// degeneracies) 128-bit arithmetic holds the determinant; otherwise
+// Boost.Multiprecision's cpp_int does.
 //
 // Shewchuk's bound assumes no overflow and no underflow. Inputs larger than
 // kFilterMaxMagnitude skip the filter (a cubic term could overflow), and an
@@ -71,37 +75,71 @@ constexpr double kFilterMaxMagnitude = 0x1p300;
 constexpr double kUnderflowSlack = 0x1p-700;
 
 using BigInt = boost::multiprecision::cpp_int;
+__extension__ using Int128 = __int128;
 
-// Turns doubles into integers sharing one power-of-two scale, exactly.
+// Doubles as integers q_i = x_i / 2^s sharing the smallest exponent s, exactly:
+// each x = m * 2^e with a 53-bit integer m (frexp, then scaling by 2^53).
 template <std::size_t N>
-std::array<BigInt, N> to_common_integers(const std::array<double, N>& x) {
+struct CommonIntegers {
   std::array<std::int64_t, N> mantissa{};
-  std::array<int, N> exponent{};
-  int smallest = INT_MAX;
-  for (std::size_t i = 0; i < N; ++i) {
-    if (x[i] == 0.0) continue;
-    int e = 0;
-    const double f = std::frexp(x[i], &e);  // x = f * 2^e, 0.5 <= |f| < 1
-    mantissa[i] = static_cast<std::int64_t>(std::ldexp(f, 53));  // exact: f has 53 bits
-    exponent[i] = e - 53;
-    smallest = std::min(smallest, exponent[i]);
+  std::array<int, N> shift{};
+  int bits = 0;  // bit length of the largest |q_i|
+
+  explicit CommonIntegers(const std::array<double, N>& x) {
+    std::array<int, N> exponent{};
+    int smallest = INT_MAX;
+    for (std::size_t i = 0; i < N; ++i) {
+      if (x[i] == 0.0) continue;
+      int e = 0;
+      const double f = std::frexp(x[i], &e);  // x = f * 2^e, 0.5 <= |f| < 1
+      mantissa[i] = static_cast<std::int64_t>(std::ldexp(f, 53));  // exact: f has 53 bits
+      exponent[i] = e - 53;
+      smallest = std::min(smallest, exponent[i]);
+    }
+    for (std::size_t i = 0; i < N; ++i) {
+      if (mantissa[i] == 0) continue;
+      shift[i] = exponent[i] - smallest;
+      const auto magnitude = static_cast<std::uint64_t>(mantissa[i] < 0 ? -mantissa[i] : mantissa[i]);
+      bits = std::max(bits, static_cast<int>(std::bit_width(magnitude)) + shift[i]);
+    }
   }
-  std::array<BigInt, N> out;
-  for (std::size_t i = 0; i < N; ++i) {
-    if (mantissa[i] == 0) continue;
-    BigInt magnitude = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
-    magnitude <<= static_cast<unsigned>(exponent[i] - smallest);
-    out[i] = mantissa[i] < 0 ? BigInt(-magnitude) : magnitude;
+  // Only when bits leaves room: the caller checks.
+  std::array<Int128, N> small() const {
+    std::array<Int128, N> out{};
+    for (std::size_t i = 0; i < N; ++i) out[i] = static_cast<Int128>(mantissa[i]) * (static_cast<Int128>(1) << shift[i]);
+    return out;
   }
-  return out;
+  std::array<BigInt, N> big() const {
+    std::array<BigInt, N> out;
+    for (std::size_t i = 0; i < N; ++i) {
+      if (mantissa[i] == 0) continue;
+      BigInt magnitude = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
+      magnitude <<= static_cast<unsigned>(shift[i]);
+      out[i] = mantissa[i] < 0 ? BigInt(-magnitude) : magnitude;
+    }
+    return out;
+  }
+};
+
+template <class T>
+int sign_of(const T& v) {
+  return v > 0 ? 1 : v < 0 ? -1 : 0;
 }
 
-int sign_of(const BigInt& v) { return v.sign(); }
+// 128-bit limits: orient2d has degree 2, so inputs below 2^60 keep every
+// term below 2^123; orient3d has degree 3, so inputs below 2^40 keep every
+// term below 2^126.
+constexpr int kOrient2dSmallBits = 60;
+constexpr int kOrient3dSmallBits = 40;
+
+template <class T>
+int orient2d_integer(const std::array<T, 6>& q) {
+  return sign_of(T((q[0] - q[4]) * (q[3] - q[5]) - (q[1] - q[5]) * (q[2] - q[4])));
+}
 
 int orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {
-  const auto q = to_common_integers<6>({ax, ay, bx, by, cx, cy});
-  const BigInt det = (q[0] - q[4]) * (q[3] - q[5]) - (q[1] - q[5]) * (q[2] - q[4]);
-  return sign_of(det);
+  const CommonIntegers<6> q({ax, ay, bx, by, cx, cy});
+  return q.bits <= kOrient2dSmallBits ? orient2d_integer(q.small()) : orient2d_integer(q.big());
 }
 
 // Sign of orient2d: +1 counter-clockwise, -1 clockwise, 0 collinear (exact).
@@ -118,13 +156,18 @@ int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
   return orient2d_exact(ax, ay, bx, by, cx, cy);
 }
 
+// Sign of Shewchuk's orient3d(a, b, c, d) on exact integers.
+template <class T>
+int orient3d_integer(const std::array<T, 12>& q) {
+  const T adx = q[0] - q[9], ady = q[1] - q[10], adz = q[2] - q[11];
+  const T bdx = q[3] - q[9], bdy = q[4] - q[10], bdz = q[5] - q[11];
+  const T cdx = q[6] - q[9], cdy = q[7] - q[10], cdz = q[8] - q[11];
+  return sign_of(T(adx * (bdy * cdz - bdz * cdy) + bdx * (cdy * adz - cdz * ady) + cdx * (ady * bdz - adz * bdy)));
+}
+
 int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const auto q = to_common_integers<12>({a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()});
-  const BigInt adx = q[0] - q[9], ady = q[1] - q[10], adz = q[2] - q[11];
-  const BigInt bdx = q[3] - q[9], bdy = q[4] - q[10], bdz = q[5] - q[11];
-  const BigInt cdx = q[6] - q[9], cdy = q[7] - q[10], cdz = q[8] - q[11];
-  const BigInt det = adx * (bdy * cdz - bdz * cdy) + bdx * (cdy * adz - cdz * ady) + cdx * (ady * bdz - adz * bdy);
-  return sign_of(det);
+  const CommonIntegers<12> q({a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()});
+  return q.bits <= kOrient3dSmallBits ? orient3d_integer(q.small()) : orient3d_integer(q.big());
 }
 
 // Sign of side3d (see above): +1 when d is on the normal side of triangle abc.
@@ -648,24 +691,38 @@ bool face_triangle(const Cycles& faces, Index f, std::span<const Vec3> pts, std:
 // no boundary cycle any more.
 Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts, std::span<const Vec3> scaled) {
   const Index face_count = raw.count();
+  const HalfEdges he(raw, point_count);
+  const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
   Groups groups(face_count);
   {
-    const HalfEdges he(raw, point_count);
+    // A face is planar when all its vertices lie on the plane of a spread
+    // triangle of them (exact; zero is the expected answer, so this is where
+    // the exact fallback runs, once per vertex of a non-triangular face).
     std::vector<std::array<Index, 3>> tri(static_cast<std::size_t>(face_count));
-    std::vector<bool> has_tri(static_cast<std::size_t>(face_count), false);
+    std::vector<bool> planar(static_cast<std::size_t>(face_count), false);
     for (Index f = 0; f < face_count; ++f) {
-      has_tri[static_cast<std::size_t>(f)] = face_triangle(raw, f, pts, scaled, tri[static_cast<std::size_t>(f)]);
+      auto& t = tri[static_cast<std::size_t>(f)];
+      if (!face_triangle(raw, f, pts, scaled, t)) continue;
+      bool flat = true;
+      for (Index i = 0; i < raw.size(f) && flat; ++i) {
+        const Index v = raw.at(f, i);
+        flat = v == t[0] || v == t[1] || v == t[2] || side3d(at(t[0]), at(t[1]), at(t[2]), at(v)) == 0;
+      }
+      planar[static_cast<std::size_t>(f)] = flat;
     }
+    // Planar neighbours f and g share the edge of h; they are coplanar when
+    // the vertices of g's triangle off that edge are on f's plane.
     for (Index h = 0; h < static_cast<Index>(raw.vertices.size()); ++h) {
-      const Index t = he.twin(h);
-      if (t < 0) continue;
-      const Index f = he.face(h), g = he.face(t);
-      if (f >= g || !has_tri[static_cast<std::size_t>(f)] || groups.find(f) == groups.find(g)) continue;
-      const auto& [a, b, c] = tri[static_cast<std::size_t>(f)];
+      const Index twin = he.twin(h);
+      if (twin < 0) continue;
+      const Index f = he.face(h), g = he.face(twin);
+      if (f >= g || !planar[static_cast<std::size_t>(f)] || !planar[static_cast<std::size_t>(g)]) continue;
+      if (groups.find(f) == groups.find(g)) continue;
+      const auto& tf = tri[static_cast<std::size_t>(f)];
       bool coplanar = true;
-      for (Index i = 0; i < raw.size(g) && coplanar; ++i) {
-        coplanar = side3d(pts[static_cast<std::size_t>(a)], pts[static_cast<std::size_t>(b)],
-                          pts[static_cast<std::size_t>(c)], pts[static_cast<std::size_t>(raw.at(g, i))]) == 0;
+      for (const Index v : tri[static_cast<std::size_t>(g)]) {
+        if (!coplanar || v == he.source(h) || v == he.target(h)) continue;
+        coplanar = side3d(at(tf[0]), at(tf[1]), at(tf[2]), at(v)) == 0;
       }
       if (coplanar) groups.unite(f, g);
     }
@@ -675,118 +732,121 @@ Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> p
   // group, chained head to tail. A group that does not chain into one simple
   // cycle keeps its facets unmerged.
   std::vector<std::vector<Index>> members(static_cast<std::size_t>(face_count));
-  for (Index f = 0; f < face_count; ++f) members[static_cast<std::size_t>(groups.find(f))].push_back(f);
-  std::vector<std::vector<Index>> cycles;
-  {
-    const HalfEdges he(raw, point_count);
-    for (Index root = 0; root < face_count; ++root) {
-      const auto& group = members[static_cast<std::size_t>(root)];
-      if (group.empty()) continue;
-      const auto own_cycle = [&](Index f) {
-        std::vector<Index> c(static_cast<std::size_t>(raw.size(f)));
-        for (Index i = 0; i < raw.size(f); ++i) c[static_cast<std::size_t>(i)] = raw.at(f, i);
-        return c;
+  for (Index f = 0; f < face_count; ++f) {
+    const Index root = groups.find(f);
+    if (root != f) members[static_cast<std::size_t>(root)].push_back(f);
+  }
+  Cycles merged;
+  const auto add_own = [&](Index f) {
+    const auto first = raw.vertices.begin() + raw.offsets[static_cast<std::size_t>(f)];
+    merged.add(std::span<const Index>(&*first, static_cast<std::size_t>(raw.size(f))));
+  };
+  std::vector<std::pair<Index, Index>> boundary;  // (source, target)
+  std::vector<Index> chain;
+  for (Index root = 0; root < face_count; ++root) {
+    if (groups.find(root) != root) continue;
+    auto& group = members[static_cast<std::size_t>(root)];
+    if (group.empty()) {
+      add_own(root);
+      continue;
+    }
+    group.push_back(root);
+    boundary.clear();
+    for (const Index f : group) {
+      for (Index i = 0; i < raw.size(f); ++i) {
+        const Index h = raw.offsets[static_cast<std::size_t>(f)] + i;
+        const Index twin = he.twin(h);
+        if (twin < 0 || groups.find(he.face(twin)) != root) boundary.emplace_back(he.source(h), he.target(h));
+      }
+    }
+    std::sort(boundary.begin(), boundary.end());
+    bool simple = boundary.size() >= 3;
+    for (std::size_t k = 1; k < boundary.size() && simple; ++k) simple = boundary[k].first != boundary[k - 1].first;
+    chain.clear();
+    if (simple) {
+      const auto next_of = [&](Index v) {
+        const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair<Index, Index>(v, INT32_MIN));
+        return it != boundary.end() && it->first == v ? it->second : -1;
       };
-      if (group.size() == 1) {
-        cycles.push_back(own_cycle(root));
-        continue;
-      }
-      std::vector<std::pair<Index, Index>> boundary;  // (source, target)
-      for (const Index f : group) {
-        for (Index i = 0; i < raw.size(f); ++i) {
-          const Index h = raw.offsets[static_cast<std::size_t>(f)] + i;
-          const Index t = he.twin(h);
-          if (t < 0 || groups.find(he.face(t)) != root) boundary.emplace_back(he.source(h), he.target(h));
-        }
-      }
-      std::sort(boundary.begin(), boundary.end());
-      bool simple = boundary.size() >= 3;
-      for (std::size_t k = 1; k < boundary.size() && simple; ++k) simple = boundary[k].first != boundary[k - 1].first;
-      std::vector<Index> merged;
-      if (simple) {
-        const auto next_of = [&](Index v) {
-          const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair<Index, Index>(v, INT32_MIN));
-          return it != boundary.end() && it->first == v ? it->second : -1;
-        };
-        Index v = boundary.front().first;
-        do {
-          merged.push_back(v);
-          v = next_of(v);
-        } while (v >= 0 && v != boundary.front().first && merged.size() <= boundary.size());
-        simple = v == boundary.front().first && merged.size() == boundary.size();
-      }
-      if (simple) {
-        cycles.push_back(std::move(merged));
-      } else {
-        for (const Index f : group) cycles.push_back(own_cycle(f));
-      }
+      Index v = boundary.front().first;
+      do {
+        chain.push_back(v);
+        v = next_of(v);
+      } while (v >= 0 && v != boundary.front().first && chain.size() <= boundary.size());
+      simple = v == boundary.front().first && chain.size() == boundary.size();
+    }
+    if (simple) {
+      merged.add(chain);
+    } else {
+      for (const Index f : group) add_own(f);
     }
   }
 
-  // Drop vertices inside edges. Cycles as doubly linked lists over nodes.
-  std::vector<Index> node_vertex, node_next, node_prev, node_cycle;
-  std::vector<Index> cycle_size;
-  std::vector<std::vector<Index>> occurrences(static_cast<std::size_t>(point_count));
-  for (const auto& c : cycles) {
-    const auto base = static_cast<Index>(node_vertex.size());
-    const auto n = static_cast<Index>(c.size());
+  // Drop vertices inside edges. The cycles become doubly linked lists over
+  // nodes (one node per slot of merged.vertices); a vertex on exactly two
+  // faces remembers its two nodes.
+  const auto node_count = merged.vertices.size();
+  std::vector<Index> next(node_count), prev(node_count), node_face(node_count);
+  std::vector<Index> face_size(static_cast<std::size_t>(merged.count()));
+  for (Index f = 0; f < merged.count(); ++f) {
+    const Index b = merged.offsets[static_cast<std::size_t>(f)], n = merged.size(f);
+    face_size[static_cast<std::size_t>(f)] = n;
     for (Index i = 0; i < n; ++i) {
-      node_vertex.push_back(c[static_cast<std::size_t>(i)]);
-      node_next.push_back(base + (i + 1) % n);
-      node_prev.push_back(base + (i + n - 1) % n);
-      node_cycle.push_back(static_cast<Index>(cycle_size.size()));
-      occurrences[static_cast<std::size_t>(c[static_cast<std::size_t>(i)])].push_back(base + i);
+      next[static_cast<std::size_t>(b + i)] = b + (i + 1) % n;
+      prev[static_cast<std::size_t>(b + i)] = b + (i + n - 1) % n;
+      node_face[static_cast<std::size_t>(b + i)] = f;
     }
-    cycle_size.push_back(n);
   }
-  std::vector<bool> alive(node_vertex.size(), true);
+  std::vector<Index> occurrence_count(static_cast<std::size_t>(point_count), 0);
+  std::vector<std::array<Index, 2>> occurrence(static_cast<std::size_t>(point_count), {-1, -1});
+  for (std::size_t node = 0; node < node_count; ++node) {
+    const auto v = static_cast<std::size_t>(merged.vertices[node]);
+    if (occurrence_count[v] < 2) occurrence[v][static_cast<std::size_t>(occurrence_count[v])] = static_cast<Index>(node);
+    ++occurrence_count[v];
+  }
+  std::vector<bool> alive(node_count, true);
   std::vector<Index> work;
   for (Index v = 0; v < point_count; ++v) {
-    if (occurrences[static_cast<std::size_t>(v)].size() == 2) work.push_back(v);
+    if (occurrence_count[static_cast<std::size_t>(v)] == 2) work.push_back(v);
   }
-  const auto vertex_at = [&](Index node) { return node_vertex[static_cast<std::size_t>(node)]; };
+  const auto vertex_of = [&](Index node) { return merged.vertices[static_cast<std::size_t>(node)]; };
   while (!work.empty()) {
     const Index v = work.back();
     work.pop_back();
-    const auto& occ = occurrences[static_cast<std::size_t>(v)];
-    if (occ.size() != 2 || !alive[static_cast<std::size_t>(occ[0])]) continue;
-    const Index n0 = occ[0], n1 = occ[1];
-    const Index u = vertex_at(node_prev[static_cast<std::size_t>(n0)]);
-    const Index w = vertex_at(node_next[static_cast<std::size_t>(n0)]);
+    if (occurrence_count[static_cast<std::size_t>(v)] != 2) continue;
+    const auto [n0, n1] = occurrence[static_cast<std::size_t>(v)];
+    const Index u = vertex_of(prev[static_cast<std::size_t>(n0)]);
+    const Index w = vertex_of(next[static_cast<std::size_t>(n0)]);
     // The other face must run w -> v -> u: v sits on one edge of both.
-    if (vertex_at(node_prev[static_cast<std::size_t>(n1)]) != w || vertex_at(node_next[static_cast<std::size_t>(n1)]) != u) {
+    if (vertex_of(prev[static_cast<std::size_t>(n1)]) != w || vertex_of(next[static_cast<std::size_t>(n1)]) != u) continue;
+    if (face_size[static_cast<std::size_t>(node_face[static_cast<std::size_t>(n0)])] <= 3 ||
+        face_size[static_cast<std::size_t>(node_face[static_cast<std::size_t>(n1)])] <= 3) {
       continue;
     }
-    if (cycle_size[static_cast<std::size_t>(node_cycle[static_cast<std::size_t>(n0)])] <= 3 ||
-        cycle_size[static_cast<std::size_t>(node_cycle[static_cast<std::size_t>(n1)])] <= 3) {
-      continue;
-    }
-    if (!collinear3d(pts[static_cast<std::size_t>(u)], pts[static_cast<std::size_t>(v)], pts[static_cast<std::size_t>(w)])) {
-      continue;
-    }
+    if (!collinear3d(at(u), at(v), at(w))) continue;
     for (const Index node : {n0, n1}) {
-      const Index p = node_prev[static_cast<std::size_t>(node)], q = node_next[static_cast<std::size_t>(node)];
-      node_next[static_cast<std::size_t>(p)] = q;
-      node_prev[static_cast<std::size_t>(q)] = p;
+      const Index before = prev[static_cast<std::size_t>(node)], after = next[static_cast<std::size_t>(node)];
+      next[static_cast<std::size_t>(before)] = after;
+      prev[static_cast<std::size_t>(after)] = before;
       alive[static_cast<std::size_t>(node)] = false;
-      --cycle_size[static_cast<std::size_t>(node_cycle[static_cast<std::size_t>(node)])];
+      --face_size[static_cast<std::size_t>(node_face[static_cast<std::size_t>(node)])];
     }
-    occurrences[static_cast<std::size_t>(v)].clear();
+    occurrence_count[static_cast<std::size_t>(v)] = 0;
     work.push_back(u);  // their neighbours changed: check them again
     work.push_back(w);
   }
 
   Cycles out;
-  for (std::size_t c = 0, base = 0; c < cycles.size(); base += cycles[c].size(), ++c) {
-    std::vector<Index> cycle;
-    Index start = static_cast<Index>(base);
-    while (!alive[static_cast<std::size_t>(start)]) ++start;  // some node of the cycle survives (size >= 3)
+  out.vertices.reserve(node_count);
+  for (Index f = 0; f < merged.count(); ++f) {
+    Index start = merged.offsets[static_cast<std::size_t>(f)];
+    while (!alive[static_cast<std::size_t>(start)]) ++start;  // some node survives: faces keep >= 3
     Index node = start;
     do {
-      cycle.push_back(node_vertex[static_cast<std::size_t>(node)]);
-      node = node_next[static_cast<std::size_t>(node)];
+      out.vertices.push_back(vertex_of(node));
+      node = next[static_cast<std::size_t>(node)];
     } while (node != start);
-    out.add(cycle);
+    out.offsets.push_back(static_cast<Index>(out.vertices.size()));
   }
   return out;
 }
