@@ -1,0 +1,156 @@
+// proxima benchmarks: FCL 0.7 as a peer.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Why these settings (the list itself is at the top of fcl_peer.h):
+// - fcl::Convexd, not a BVH mesh: it is FCL's convex-polytope type, the one
+//   a user picks for this problem, and both GJK solvers run on it directly.
+//   Built from proxima's hull (same vertices, same face polygons, FCL's face
+//   list [n, i0, ..., i(n-1), n, ...]), so both libraries see the same body.
+//   With more than 32 vertices FCL's support search walks the vertex
+//   adjacency it derives from the faces (Convex::findExtremeVertex).
+// - The geometry-level fcl::distance (no CollisionObject): no broad-phase
+//   bookkeeping and no AABB update inside the timed work.
+// - FCL's default request except enable_nearest_points: the closest points
+//   are part of the answer the experiments check. distance_tolerance stays at
+//   FCL's default 1e-6 (absolute): users get that unless they tune it, and at
+//   the unit scale of the timing experiments it lets FCL stop earlier than
+//   proxima's relative 1e-12, which favours FCL in the timings.
+// - Debian's libccd 2.1 has no separation-distance function of its own;
+//   FCL's GST_LIBCCD solver (GJK on libccd's simplex code) is the libccd GJK
+//   that users get, so it stands for libccd here.
+// - Tracking: FCL 0.7's DistanceRequest has no cached-guess fields (only
+//   CollisionRequest has enable_cached_gjk_guess); for distance the cache is
+//   the solver's own (GJKSolver_indep::enableCachedGuess, cached_guess
+//   updated from the last simplex by every shapeDistance call). So the
+//   tracking mode keeps one GJKSolver_indep for the sequence and passes it to
+//   the solver-taking fcl::distance overload, with gjk_tolerance set from the
+//   request exactly as the plain overload does.
+#include "peers/fcl_peer.h"
+
+#include <fcl/fcl.h>
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+namespace proxima::bench {
+namespace {
+
+std::shared_ptr<fcl::Convexd> make_convex(const ConvexPolytope& p) {
+  if (p.dimension() != 3) {
+    throw std::invalid_argument("FclPeer: fcl::Convex needs a solid polytope (dimension 3)");
+  }
+  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
+  vertices->reserve(static_cast<std::size_t>(p.vertex_count()));
+  for (const Vec3& v : p.vertices()) vertices->push_back(v);
+  auto faces = std::make_shared<std::vector<int>>();
+  for (int f = 0; f < p.face_count(); ++f) {
+    const auto polygon = p.face(f);
+    faces->push_back(static_cast<int>(polygon.size()));
+    for (const std::int32_t v : polygon) faces->push_back(v);
+  }
+  auto convex = std::make_shared<fcl::Convexd>(vertices, p.face_count(), faces);
+  convex->computeLocalAABB();
+  return convex;
+}
+
+fcl::Transform3d to_fcl(const Pose& pose) {
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.linear() = pose.rotation;
+  tf.translation() = pose.translation;
+  return tf;
+}
+
+}  // namespace
+
+struct FclPeer::Impl {
+  FclSolver solver;
+  std::shared_ptr<fcl::Convexd> a;
+  std::shared_ptr<fcl::Convexd> b;
+  fcl::DistanceRequestd request;
+  // The tracking state of GST_INDEP: FCL keeps the cached guess in the
+  // solver (mutable members), so the solver object is the cache.
+  fcl::detail::GJKSolver_indep<double> tracking_solver;
+  std::vector<fcl::Transform3d> tf_a;
+  std::vector<fcl::Transform3d> tf_b;
+
+  Impl(const ConvexPolytope& pa, const ConvexPolytope& pb, FclSolver s)
+      : solver(s), a(make_convex(pa)), b(make_convex(pb)) {
+    request.enable_nearest_points = true;
+    request.gjk_solver_type = s == FclSolver::libccd ? fcl::GST_LIBCCD : fcl::GST_INDEP;
+    tracking_solver.gjk_tolerance = request.distance_tolerance;
+    reset();
+  }
+
+  void reset() {
+    tracking_solver.enableCachedGuess(true);
+    tracking_solver.setCachedGuess(fcl::Vector3d(1, 0, 0));  // FCL's own cold guess
+  }
+
+  bool tracks(bool tracking) const { return tracking && solver == FclSolver::indep; }
+
+  // One query into a fresh result (DistanceResult::update keeps the minimum
+  // over calls, so a reused result would hide later answers).
+  void query(std::size_t i, bool tracking, fcl::DistanceResultd& result) {
+    if (tracks(tracking)) {
+      fcl::distance(a.get(), tf_a[i], b.get(), tf_b[i], &tracking_solver, request, result);
+    } else {
+      fcl::distance(a.get(), tf_a[i], b.get(), tf_b[i], request, result);
+    }
+  }
+};
+
+FclPeer::FclPeer(const ConvexPolytope& a, const ConvexPolytope& b, FclSolver solver)
+    : impl_(std::make_unique<Impl>(a, b, solver)) {}
+
+FclPeer::~FclPeer() = default;
+
+std::string FclPeer::name() const { return impl_->solver == FclSolver::libccd ? "FCL libccd" : "FCL GJK"; }
+
+bool FclPeer::has_tracking() const { return impl_->solver == FclSolver::indep; }
+
+std::string FclPeer::tracking_note() const {
+  return impl_->solver == FclSolver::libccd ? "none (FCL's libccd solver ignores a cached guess)"
+                                            : "cached GJK guess of GJKSolver_indep (last simplex)";
+}
+
+void FclPeer::load_poses(std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
+  if (poses_a.size() != poses_b.size()) throw std::invalid_argument("FclPeer: pose sequences differ in length");
+  impl_->tf_a.clear();
+  impl_->tf_b.clear();
+  for (const Pose& p : poses_a) impl_->tf_a.push_back(to_fcl(p));
+  for (const Pose& p : poses_b) impl_->tf_b.push_back(to_fcl(p));
+}
+
+std::size_t FclPeer::pose_count() const { return impl_->tf_a.size(); }
+
+void FclPeer::reset() { impl_->reset(); }
+
+SystemAnswer FclPeer::query(std::size_t i, bool tracking) {
+  fcl::DistanceResultd result;
+  impl_->query(i, tracking, result);
+  SystemAnswer answer;
+  answer.distance = result.min_distance;
+  answer.point_a = result.nearest_points[0];
+  answer.point_b = result.nearest_points[1];
+  // FCL reports a failed or colliding GJK as -1 and leaves min_distance at
+  // its initial max() when no pair was tested.
+  answer.answered = result.min_distance != std::numeric_limits<double>::max();
+  answer.separated = result.min_distance > 0.0;
+  return answer;
+}
+
+double FclPeer::run_all(bool tracking) {
+  impl_->reset();
+  double sum = 0.0;
+  const std::size_t n = impl_->tf_a.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    fcl::DistanceResultd result;
+    impl_->query(i, tracking, result);
+    sum += result.min_distance;
+  }
+  return sum;
+}
+
+}  // namespace proxima::bench
