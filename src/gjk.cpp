@@ -120,16 +120,19 @@ Reduction single(const Points& p, int i) {
 }
 
 // ---------------------------------------------------------------------------
-// The distance subalgorithm: signed volumes (Montanari, Petrinic & Barbieri
-// 2017), written from the idea. The closest point of a simplex to the origin
-// is found by asking, in each dimension, where the origin's projection onto
-// the simplex's affine hull falls; barycentric coordinates are ratios of
-// signed volumes (lengths, areas, volumes) and only their signs decide the
-// region. Where the projection falls outside, the closest point lies on a
-// facet whose opposite vertex has a non-positive coordinate, and only those
-// facets are searched (all of them if the simplex is degenerate). Nothing
-// assumes that the newest point belongs to the answer, so the same code
-// solves a warm-started simplex of arbitrary points.
+// The distance subalgorithm, after the signed-volumes method of Montanari,
+// Petrinic & Barbieri (2017), written from the idea. The closest point of a
+// simplex to the origin is found by asking, in each dimension, where the
+// origin's projection onto the simplex's affine hull falls; its barycentric
+// coordinates are ratios of signed measures (lengths, areas, heights) and
+// only their signs decide the region. Where the projection falls outside,
+// the closest point lies on a facet whose opposite vertex has a non-positive
+// coordinate, and only those facets are searched (all of them if the
+// simplex is degenerate). Nothing assumes that the newest point belongs to
+// the answer, so the same code solves a warm-started simplex of arbitrary
+// points. Where the paper's formulas lose the direction of v for bodies
+// much larger than their distance (needles, slivers), the triangle and
+// tetrahedron cases below use face normals instead; each says why.
 // ---------------------------------------------------------------------------
 
 // Segment [wi, wj]. The line wi + s t, t = wj - wi, is closest to the origin
@@ -197,8 +200,14 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
       r.count = 3;
       r.index = {i, j, k, 0};
       r.lambda = {c[0] / den, c[1] / den, c[2] / den, 0.0};
-      r.v = r.lambda[0] * wi + r.lambda[1] * wj + r.lambda[2] * wk;
-      r.vv = r.v.squaredNorm();
+      // v is p0, not sum(lambda w): when the origin is much closer to the
+      // plane than the vertices are to the origin, the sum's rounding
+      // (u |w|) is a large error in v's direction, and the next support
+      // point would be searched in a wrong direction (a sliver next to the
+      // plane is then missed). p0 has n's direction, accurate to a few u
+      // relative to the triangle's shape whatever the distance.
+      r.v = p0;
+      r.vv = p0.squaredNorm();
       return r;
     }
     for (int m = 0; m < 3; ++m) test_edge[idx(m)] = !same_sign(mu, c[idx(m)]);
@@ -213,30 +222,48 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
   return best;
 }
 
-// Tetrahedron (w0, w1, w2, w3). With vol(q0, q1, q2, q3) =
-// det[q1 - q0, q2 - q0, q3 - q0], the origin's barycentric coordinate m is
-// vol with w_m replaced by the origin over vol(w0..w3). Expanding (column
-// operations and the alternating sign of det):
-//   C0 =  det[w1, w2, w3],  C1 = -det[w0, w2, w3],
-//   C2 =  det[w0, w1, w3],  C3 = -det[w0, w1, w2],
-// and vol = C0 + C1 + C2 + C3. The origin is strictly inside exactly when all
-// C_m have the sign of vol; otherwise the closest point is on a face opposite
-// a vertex with a wrong-signed (or zero) C_m.
+// Tetrahedron (w0, w1, w2, w3). The origin's barycentric coordinate for
+// vertex m is the ratio of heights over the opposite face's plane: with
+// (a, b, c) that face and n_m = (wb - wa) x (wc - wa),
+//   lambda_m = n_m.(0 - wa) / n_m.(w_m - wa).
+// (The signed-volumes cofactors det[w_i, w_j, w_k] are the same ratio's
+// terms with the origin as apex, but their rounding is u |w|^3 however thin
+// the tetrahedron: for a needle- or sliver-shaped one, whose volume is near
+// that, their signs are noise. A face normal from edge differences is
+// accurate in direction to a few u relative to the face's shape, so these
+// heights have the sign the geometry gives them.) The origin is strictly
+// inside exactly when every lambda_m is positive; otherwise the closest
+// point is on a face opposite a vertex whose lambda is not positive (every
+// face of a flat tetrahedron).
 constexpr std::array<std::array<int, 3>, 4> kOppositeFace = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
 
 Reduction solve_tetrahedron(const Points& p) {
-  const Vec3& w0 = p[0].w;
-  const Vec3& w1 = p[1].w;
-  const Vec3& w2 = p[2].w;
-  const Vec3& w3 = p[3].w;
-  const auto det = [](const Vec3& a, const Vec3& b, const Vec3& c) { return a.dot(b.cross(c)); };
-  const std::array<double, 4> c = {det(w1, w2, w3), -det(w0, w2, w3), det(w0, w1, w3), -det(w0, w1, w2)};
-  const double vol = c[0] + c[1] + c[2] + c[3];
-  if (same_sign(vol, c[0]) && same_sign(vol, c[1]) && same_sign(vol, c[2]) && same_sign(vol, c[3])) {
+  std::array<double, 4> origin_height{};
+  std::array<double, 4> vertex_height{};
+  bool inside = true;
+  for (int m = 0; m < 4; ++m) {
+    const auto& f = kOppositeFace[idx(m)];
+    const Vec3& wa = p[idx(f[0])].w;
+    const Vec3 n = (p[idx(f[1])].w - wa).cross(p[idx(f[2])].w - wa);
+    origin_height[idx(m)] = -n.dot(wa);
+    vertex_height[idx(m)] = n.dot(p[idx(m)].w - wa);
+    inside = inside && same_sign(origin_height[idx(m)], vertex_height[idx(m)]);
+  }
+  if (inside) {
     Reduction r;
     r.count = 4;
     r.index = {0, 1, 2, 3};
-    for (int m = 0; m < 4; ++m) r.lambda[idx(m)] = c[idx(m)] / vol;
+    double sum = 0.0;
+    for (int m = 0; m < 4; ++m) {
+      // Same signs, and the origin inside is nearer each face than the
+      // opposite vertex: the ratio is in (0, 1]; capping it at 1 keeps a
+      // rounding-size vertex height from overflowing it.
+      const double h_o = std::abs(origin_height[idx(m)]);
+      const double h_v = std::abs(vertex_height[idx(m)]);
+      r.lambda[idx(m)] = h_o < h_v ? h_o / h_v : 1.0;
+      sum += r.lambda[idx(m)];
+    }
+    for (double& l : r.lambda) l /= sum;  // sum >= each positive term
     r.v = Vec3::Zero();
     r.vv = 0.0;
     r.encloses_origin = true;
@@ -244,7 +271,7 @@ Reduction solve_tetrahedron(const Points& p) {
   }
   Reduction best;
   for (int m = 0; m < 4; ++m) {
-    if (same_sign(vol, c[idx(m)])) continue;
+    if (same_sign(origin_height[idx(m)], vertex_height[idx(m)])) continue;
     const auto& f = kOppositeFace[idx(m)];
     const Reduction r = solve_triangle(p, f[0], f[1], f[2]);
     if (r.vv < best.vv) best = r;
@@ -356,7 +383,9 @@ struct HillClimbSupport {
 // the hull passes within tol of the origin, so a support beyond tol is off
 // it). Then, as in an expanding polytope (EPA), the face nearest the origin
 // is pushed out by C's support point in its normal until one certificate
-// holds.
+// holds. Its support evaluations count as iterations: a contact still
+// undecided at options.max_iterations is reported as iteration_cap (the
+// distance is within the band either way).
 // ---------------------------------------------------------------------------
 struct ContactFace {
   std::array<int, 3> v{};
@@ -365,7 +394,7 @@ struct ContactFace {
 };
 
 template <class Support>
-Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations) {
+Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations, int max_iterations) {
   tol = std::max(tol, 0.0);
   std::array<Vec3, kMaxContactVertices> p;
   int n = 0;
@@ -390,6 +419,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
       d = e.cross(Vec3::Unit(axis));  // |d| >= |e| sqrt(2/3) > 0
     }
     d.normalize();
+    if (iterations >= max_iterations) return Status::iteration_cap;
     const SupportPoint w = support(d);
     ++iterations;
     if (d.dot(w.w) <= tol) return Status::touching;
@@ -428,6 +458,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
     }
     if (faces[idx(best)].offset > tol) return Status::intersecting;
     if (n == kMaxContactVertices) return Status::touching;
+    if (iterations >= max_iterations) return Status::iteration_cap;
     const Vec3 normal = faces[idx(best)].normal;
     const SupportPoint w = support(normal);
     ++iterations;
@@ -618,7 +649,7 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
 
   Status status = Status::separated;
   if (contact) {
-    status = classify_contact(simplex, tol, support, iterations);
+    status = classify_contact(simplex, tol, support, iterations, options.max_iterations);
     // A touching contact whose tetrahedron encloses the origin (by rounding,
     // or within the band): the origin is within tol of a face of it (else
     // the classification would have certified depth), so that face's
@@ -659,7 +690,9 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
     result.lower_bound = std::clamp(lower * frame.unit, 0.0, result.distance);
     if (!contact) status = result.distance > contact_tolerance ? Status::separated : Status::touching;
     if (capped) status = Status::iteration_cap;
-    result.normal = (status != Status::touching && result.distance > 0.0)
+    // Within the band the points' difference is rounding noise: keep the
+    // last search direction there.
+    result.normal = (!contact && status != Status::touching && result.distance > 0.0)
                         ? Vec3((point_b - point_a) / result.distance)
                         : direction;
   }
