@@ -52,7 +52,8 @@ std::vector<Vec3> ball_points() {
     const Vec3 p(uniform_symmetric(gen), uniform_symmetric(gen), uniform_symmetric(gen));
     const double n = p.norm();
     if (n > 1.0 || n < 0.125) continue;
-    const double radius = kBallInnerRadius + (1.0 - kBallInnerRadius) * (0.5 + 0.5 * uniform_symmetric(gen));
+    const double radius =
+        kBallInnerRadius + (1.0 - kBallInnerRadius) * (0.5 + 0.5 * uniform_symmetric(gen));
     points.push_back(p * (radius / n));
   }
   return points;
@@ -94,7 +95,10 @@ std::string format_point(const Vec3& p) {
 
 std::string format_feature(const Feature& f) {
   std::string out = to_string(f.type);
-  if (f.type == FeatureType::face) out += " " + std::to_string(f.face);
+  if (f.type == FeatureType::face) {
+    out += ' ';
+    out += std::to_string(f.face);
+  }
   out += " [";
   for (int i = 0; i < f.vertex_count(); ++i) {
     if (i > 0) out += ' ';
@@ -169,7 +173,8 @@ void print_feature_pair(const ConvexPolytope& a, const Pose& pose_a, const Conve
     }
   }
 
-  const std::array<Vec3, 2> seg = {pose_a.apply(a.vertex(edge[0])), pose_a.apply(a.vertex(edge[1]))};
+  const std::array<Vec3, 2> seg = {pose_a.apply(a.vertex(edge[0])),
+                                   pose_a.apply(a.vertex(edge[1]))};
   const std::array<Vec3, 3> tri_points = {pose_b.apply(b.vertex(triangles[tri][0])),
                                           pose_b.apply(b.vertex(triangles[tri][1])),
                                           pose_b.apply(b.vertex(triangles[tri][2]))};
@@ -248,8 +253,9 @@ int run_demo() {
   // B is turned 30 degrees about (1, 1, 0), so that no face of the cube is
   // parallel to anything, and moved off to the side of the ball.
   const Pose pose_a = Pose::identity();
-  const Pose pose_b(Quat(Eigen::AngleAxisd(std::numbers::pi / 6.0, Vec3(1.0, 1.0, 0.0).normalized())),
-                    Vec3(2.6, 0.3, -0.2));
+  const Pose pose_b(
+      Quat(Eigen::AngleAxisd(std::numbers::pi / 6.0, Vec3(1.0, 1.0, 0.0).normalized())),
+      Vec3(2.6, 0.3, -0.2));
 
   std::printf("proxima demo: A, %d seeded points in a ball of radius 1 at the origin;\n",
               kBallPoints);

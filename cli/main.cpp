@@ -77,16 +77,18 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"proxima: minimum distance, closest points and closest features between convex "
-               "polyhedra"};
+  CLI::App app{
+      "proxima: minimum distance, closest points and closest features between convex "
+      "polyhedra"};
   app.require_subcommand(1);
 
   CLI::App* demo = app.add_subcommand(
       "demo", "Build two seeded polytopes, print their hulls and the distance by each algorithm");
 
   CLI::App* query = app.add_subcommand(
-      "query", "Answer distance queries in JSON Lines, one answer line per query line, in order "
-               "(format: docs/query-format.md)");
+      "query",
+      "Answer distance queries in JSON Lines, one answer line per query line, in order "
+      "(format: docs/query-format.md)");
   std::string file = "-";
   std::string algorithm = "hybrid";
   proxima::DistanceOptions options;

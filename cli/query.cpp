@@ -44,14 +44,22 @@ class QueryError : public std::runtime_error {
 // "(it is a string)" reads better than nlohmann's bare type name.
 std::string kind(const Json& v) {
   switch (v.type()) {
-    case Json::value_t::null: return "null";
-    case Json::value_t::object: return "an object";
-    case Json::value_t::array: return "an array";
-    case Json::value_t::string: return "a string";
-    case Json::value_t::boolean: return "a boolean";
-    case Json::value_t::binary: return "binary data";
-    case Json::value_t::discarded: return "discarded";
-    default: return "a number";
+    case Json::value_t::null:
+      return "null";
+    case Json::value_t::object:
+      return "an object";
+    case Json::value_t::array:
+      return "an array";
+    case Json::value_t::string:
+      return "a string";
+    case Json::value_t::boolean:
+      return "a boolean";
+    case Json::value_t::binary:
+      return "binary data";
+    case Json::value_t::discarded:
+      return "discarded";
+    default:
+      return "a number";
   }
 }
 
@@ -139,7 +147,11 @@ class ParsePathTracker final : public nlohmann::json_sax<Json> {
       const Frame& f = frames_[i];
       if (f.is_array) {
         const long index = f.index + (next_element && i + 1 == frames_.size() ? 1 : 0);
-        if (index >= 0) out += "[" + std::to_string(index) + "]";
+        if (index >= 0) {
+          out += '[';
+          out += std::to_string(index);
+          out += ']';
+        }
       } else if (!f.key.empty()) {
         if (!out.empty()) out += '.';
         out += f.key;
@@ -215,8 +227,7 @@ void read_body(const Json& query, const std::string& name, std::vector<Vec3>& ve
   for (std::size_t i = 0; i < list->size(); ++i) {
     double xyz[3];
     const Json& p = (*list)[i];
-    if (p.is_array() && p.size() == 3 && p[0].is_number() && p[1].is_number() &&
-        p[2].is_number()) {
+    if (p.is_array() && p.size() == 3 && p[0].is_number() && p[1].is_number() && p[2].is_number()) {
       xyz[0] = p[0].get<double>();
       xyz[1] = p[1].get<double>();
       xyz[2] = p[2].get<double>();
@@ -261,8 +272,8 @@ void append_number(std::string& out, double x) {
   // printf it never looks at the locale (a decimal comma would break JSON).
   // 32 bytes hold the longest case, "-1.2345678901234567e-308".
   char buffer[32];
-  const auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), x,
-                                       std::chars_format::general, 17);
+  const auto [end, ec] =
+      std::to_chars(buffer, buffer + sizeof(buffer), x, std::chars_format::general, 17);
   if (ec != std::errc{}) throw std::logic_error("number formatting overflowed its buffer");
   out.append(buffer, end);
 }
@@ -294,7 +305,11 @@ void append_error_answer(std::string& out, const Json* id, long line_number,
   out += "{\"id\":";
   append_id(out, id);
   out += ",\"status\":\"error\",\"error\":";
-  append_json_string(out, "line " + std::to_string(line_number) + ": " + message);
+  std::string located = "line ";
+  located += std::to_string(line_number);
+  located += ": ";
+  located += message;
+  append_json_string(out, located);
   out += '}';
 }
 

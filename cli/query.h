@@ -15,8 +15,8 @@
 namespace proxima::cli {
 
 struct QueryRunSummary {
-  long answered = 0;  // answer lines written, error answers included
-  long errors = 0;    // of which status "error"
+  long answered = 0;         // answer lines written, error answers included
+  long errors = 0;           // of which status "error"
   bool read_failed = false;  // the input stream broke (not its end): answers may be missing
 };
 

@@ -44,9 +44,9 @@ const char* const kCliPath = PROXIMA_CLI_PATH;
 const char* const kCliPath = nullptr;
 #endif
 
-#define REQUIRE_CLI()                                                    \
-  do {                                                                   \
-    if (kCliPath == nullptr) GTEST_SKIP() << "built without the CLI";    \
+#define REQUIRE_CLI()                                                 \
+  do {                                                                \
+    if (kCliPath == nullptr) GTEST_SKIP() << "built without the CLI"; \
   } while (false)
 
 std::string shell_quote(const std::string& s) {
@@ -60,10 +60,10 @@ class TempFile {
  public:
   explicit TempFile(const std::string& contents) {
     static int counter = 0;
-    path_ = (std::filesystem::temp_directory_path() /
-             ("proxima_cli_test_" + std::to_string(getpid()) + "_" + std::to_string(counter++) +
-              ".jsonl"))
-                .string();
+    path_ =
+        (std::filesystem::temp_directory_path() / ("proxima_cli_test_" + std::to_string(getpid()) +
+                                                   "_" + std::to_string(counter++) + ".jsonl"))
+            .string();
     std::ofstream(path_, std::ios::binary) << contents;
   }
   TempFile(const TempFile&) = delete;
@@ -91,7 +91,8 @@ CliRun run_cli(const std::string& args) {
   }
   std::array<char, 4096> buffer;
   std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.out.append(buffer.data(), n);
   const int status = pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
@@ -139,12 +140,12 @@ std::string format_17g(double x) {
   return buffer;
 }
 
-// Parses the answer lines. Every number must be finite, have at most 17
-// significant digits and read back to a double that prints the same; with
-// `canonical`, it must also be exactly "%.17g" of that double (true for all
-// that proxima computes; false only when an id is a non-integral number,
-// which is echoed in its shortest form).
-std::vector<Json> parse_answers(const std::string& out, bool canonical = true) {
+// Parses the answer lines. With `check_numbers`, every number literal must
+// be finite, have at most 17 significant digits and be exactly "%.17g" of
+// the double it reads back as. That holds for all that proxima computes;
+// only numeric ids are echoed as given instead (0.1 as 0.1, a 20-digit
+// integer as itself).
+std::vector<Json> parse_answers(const std::string& out, bool check_numbers = true) {
   std::vector<Json> answers;
   std::istringstream lines(out);
   std::string line;
@@ -152,12 +153,11 @@ std::vector<Json> parse_answers(const std::string& out, bool canonical = true) {
     Json answer = Json::parse(line, nullptr, /*allow_exceptions=*/false);
     EXPECT_FALSE(answer.is_discarded()) << "not JSON: " << line;
     EXPECT_TRUE(answer.is_object()) << line;
-    for (const std::string& token : number_tokens(line)) {
-      EXPECT_LE(significant_digits(token), 17) << token << " in " << line;
-      const double value = std::strtod(token.c_str(), nullptr);
-      EXPECT_TRUE(std::isfinite(value)) << token;
-      EXPECT_EQ(std::strtod(format_17g(value).c_str(), nullptr), value) << token;
-      if (canonical) {
+    if (check_numbers) {
+      for (const std::string& token : number_tokens(line)) {
+        EXPECT_LE(significant_digits(token), 17) << token << " in " << line;
+        const double value = std::strtod(token.c_str(), nullptr);
+        EXPECT_TRUE(std::isfinite(value)) << token;
         EXPECT_EQ(token, format_17g(value)) << "not %.17g: " << line;
       }
     }
@@ -198,7 +198,8 @@ double check_answer_fields(const Json& answer) {
   EXPECT_GE(d, 0.0);
   const Vec3 a = point_of(answer, "point_a");
   const Vec3 b = point_of(answer, "point_b");
-  EXPECT_NEAR((a - b).norm(), d, accuracy_bound(d, std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff())) * 4);
+  EXPECT_NEAR((a - b).norm(), d,
+              accuracy_bound(d, std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff())) * 4);
   return d;
 }
 
@@ -256,7 +257,8 @@ TEST(CliQuery, TwoUnitCubesOneApart) {
 
 TEST(CliQuery, RotatedInputIsPlacedInTheWorldFrame) {
   REQUIRE_CLI();
-  const double c = std::cos(std::numbers::pi / 8.0);  // 45 degrees about z: [cos 22.5, 0, 0, sin 22.5]
+  const double c =
+      std::cos(std::numbers::pi / 8.0);  // 45 degrees about z: [cos 22.5, 0, 0, sin 22.5]
   const double s = std::sin(std::numbers::pi / 8.0);
   const std::vector<Vec3> cube = box(Vec3(-0.5, -0.5, -0.5), Vec3(0.5, 0.5, 0.5));
   std::vector<Json> queries;
@@ -264,17 +266,26 @@ TEST(CliQuery, RotatedInputIsPlacedInTheWorldFrame) {
   // x: the edges are at x = sqrt(1/2) and x = 3 - sqrt(1/2).
   queries.push_back({{"id", 0},
                      {"a", {{"vertices", points_json(cube)}, {"rotation", {c, 0, 0, s}}}},
-                     {"b", {{"vertices", points_json(cube)}, {"rotation", {c, 0, 0, s}}, {"translation", {3, 0, 0}}}}});
+                     {"b",
+                      {{"vertices", points_json(cube)},
+                       {"rotation", {c, 0, 0, s}},
+                       {"translation", {3, 0, 0}}}}});
   // The same with quaternions of length 3 and -1 (q and -q are the same
   // rotation): normalized by the tool, same answer.
   queries.push_back({{"id", 1},
                      {"a", {{"vertices", points_json(cube)}, {"rotation", {3 * c, 0, 0, 3 * s}}}},
-                     {"b", {{"vertices", points_json(cube)}, {"rotation", {-c, 0, 0, -s}}, {"translation", {3, 0, 0}}}}});
+                     {"b",
+                      {{"vertices", points_json(cube)},
+                       {"rotation", {-c, 0, 0, -s}},
+                       {"translation", {3, 0, 0}}}}});
   // A segment along x turned 90 degrees about z lies along y; moved up by
   // 1 it spans (0,0,1)..(0,1,1). Its closest point to (0.5, 2, 1) is
   // (0, 1, 1); unturned it would be (0.5, 0, 1) at distance 2.
   queries.push_back({{"id", 2},
-                     {"a", {{"vertices", {{0, 0, 0}, {1, 0, 0}}}, {"rotation", {2, 0, 0, 2}}, {"translation", {0, 0, 1}}}},
+                     {"a",
+                      {{"vertices", {{0, 0, 0}, {1, 0, 0}}},
+                       {"rotation", {2, 0, 0, 2}},
+                       {"translation", {0, 0, 1}}}},
                      {"b", {{"vertices", {{0.5, 2, 1}}}}}});
   const TempFile file(lines_of(queries));
   const CliRun run = run_cli("query " + shell_quote(file.path()));
@@ -310,14 +321,14 @@ TEST(CliQuery, RotatedInputIsPlacedInTheWorldFrame) {
 
 TEST(CliQuery, MalformedLineBetweenGoodLinesKeepsOrder) {
   REQUIRE_CLI();
-  const Json good_first = {{"id", "first"},
-                           {"a", {{"vertices", {{0, 0, 0}}}}},
-                           {"b", {{"vertices", {{3, 4, 0}}}}}};
+  const Json good_first = {
+      {"id", "first"}, {"a", {{"vertices", {{0, 0, 0}}}}}, {"b", {{"vertices", {{3, 4, 0}}}}}};
   const Json good_last = {{"id", "last"},
                           {"a", {{"vertices", {{0, 0, 0}, {1, 0, 0}}}}},
                           {"b", {{"vertices", {{0, 2, 0}}}}}};
-  const std::string text = good_first.dump() + "\n" + "{\"id\": 2, \"a\": {\"vertices\": [[0,0,0]]\n" +
-                           "{\"id\": 3, \"b\": {\"vertices\": [[0,0,0]]}}\n" + good_last.dump() + "\n";
+  const std::string text =
+      good_first.dump() + "\n" + "{\"id\": 2, \"a\": {\"vertices\": [[0,0,0]]\n" +
+      "{\"id\": 3, \"b\": {\"vertices\": [[0,0,0]]}}\n" + good_last.dump() + "\n";
   const TempFile file(text);
   const CliRun run = run_cli("query " + shell_quote(file.path()));
   ASSERT_EQ(run.exit_code, 0);
@@ -349,7 +360,8 @@ TEST(CliQuery, MalformedLineBetweenGoodLinesKeepsOrder) {
 
 TEST(CliQuery, EmptyVertexListIsAnErrorLine) {
   REQUIRE_CLI();
-  const Json query = {{"id", "empty"}, {"a", {{"vertices", Json::array()}}}, {"b", {{"vertices", {{0, 0, 0}}}}}};
+  const Json query = {
+      {"id", "empty"}, {"a", {{"vertices", Json::array()}}}, {"b", {{"vertices", {{0, 0, 0}}}}}};
   const TempFile file(query.dump() + "\n");
   const CliRun run = run_cli("query " + shell_quote(file.path()));
   ASSERT_EQ(run.exit_code, 0);
@@ -422,7 +434,8 @@ TEST(CliQuery, BadFieldsAreNamedAndTheRunGoesOn) {
   };
   std::string text;
   for (const Case& c : cases) text += std::string(c.line) + "\n";
-  text += R"({"id": "still here", "a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[1,0,0]]}})" "\n";
+  text += R"({"id": "still here", "a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[1,0,0]]}})"
+          "\n";
   const TempFile file(text);
   const CliRun run = run_cli("query " + shell_quote(file.path()));
   ASSERT_EQ(run.exit_code, 0);
@@ -445,18 +458,24 @@ TEST(CliQuery, BadFieldsAreNamedAndTheRunGoesOn) {
 
 TEST(CliQuery, IdIsEchoedAsGivenAndNullWhenMissing) {
   REQUIRE_CLI();
-  const std::vector<Json> ids = {"text", 42, -7, 0.1, 18446744073709551615ULL,
-                                 Json::array({nullptr, true}), Json{{"k", {1, 2}}}};
+  const std::vector<Json> ids = {"text",
+                                 42,
+                                 -7,
+                                 0.1,
+                                 18446744073709551615ULL,
+                                 Json::array({nullptr, true}),
+                                 Json{{"k", {1, 2}}}};
   std::vector<Json> queries;
   for (const Json& id : ids) {
-    queries.push_back({{"id", id}, {"a", {{"vertices", {{0, 0, 0}}}}}, {"b", {{"vertices", {{0, 0, 2}}}}}});
+    queries.push_back(
+        {{"id", id}, {"a", {{"vertices", {{0, 0, 0}}}}}, {"b", {{"vertices", {{0, 0, 2}}}}}});
   }
   Json missing = {{"a", {{"vertices", {{0, 0, 0}}}}}, {"b", {{"vertices", {{0, 0, 2}}}}}};
   queries.push_back(missing);
   const TempFile file(lines_of(queries));
   const CliRun run = run_cli("query " + shell_quote(file.path()));
   ASSERT_EQ(run.exit_code, 0);
-  const std::vector<Json> answers = parse_answers(run.out, /*canonical=*/false);
+  const std::vector<Json> answers = parse_answers(run.out, /*check_numbers=*/false);
   ASSERT_EQ(answers.size(), ids.size() + 1) << run.out;
   for (std::size_t i = 0; i < ids.size(); ++i) {
     EXPECT_EQ(answers[i].at("id"), ids[i]);
@@ -490,15 +509,17 @@ TEST(CliQuery, NumbersHaveSeventeenDigitsAndRoundTrip) {
       for (int k = 0; k < n; ++k) body.emplace_back(unit(gen), unit(gen), unit(gen));
     }
     bodies.push_back(pair);
-    translations.push_back({Vec3(unit(gen), unit(gen), unit(gen)) / 3.0, Vec3(2.0 * unit(gen), unit(gen), unit(gen))});
+    translations.push_back(
+        {Vec3(unit(gen), unit(gen), unit(gen)) / 3.0, Vec3(2.0 * unit(gen), unit(gen), unit(gen))});
   }
   std::vector<Json> queries;
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     Json query = {{"id", i}};
     for (int k = 0; k < 2; ++k) {
       const Vec3& t = translations[i][static_cast<std::size_t>(k)];
-      query[k == 0 ? "a" : "b"] = {{"vertices", points_json(bodies[i][static_cast<std::size_t>(k)])},
-                                   {"translation", {t.x(), t.y(), t.z()}}};
+      query[k == 0 ? "a" : "b"] = {
+          {"vertices", points_json(bodies[i][static_cast<std::size_t>(k)])},
+          {"translation", {t.x(), t.y(), t.z()}}};
     }
     queries.push_back(query);
   }
@@ -565,15 +586,22 @@ TEST(CliQuery, AlgorithmsAgreeOnRandomPosedHulls) {
     const auto& [a, b] = pair;
     queries.push_back(
         {{"id", i},
-         {"a", {{"vertices", points_json(a.local)}, {"rotation", {a.rotation.w(), a.rotation.x(), a.rotation.y(), a.rotation.z()}}, {"translation", {a.translation.x(), a.translation.y(), a.translation.z()}}}},
-         {"b", {{"vertices", points_json(b.local)}, {"rotation", {b.rotation.w(), b.rotation.x(), b.rotation.y(), b.rotation.z()}}, {"translation", {b.translation.x(), b.translation.y(), b.translation.z()}}}}});
+         {"a",
+          {{"vertices", points_json(a.local)},
+           {"rotation", {a.rotation.w(), a.rotation.x(), a.rotation.y(), a.rotation.z()}},
+           {"translation", {a.translation.x(), a.translation.y(), a.translation.z()}}}},
+         {"b",
+          {{"vertices", points_json(b.local)},
+           {"rotation", {b.rotation.w(), b.rotation.x(), b.rotation.y(), b.rotation.z()}},
+           {"translation", {b.translation.x(), b.translation.y(), b.translation.z()}}}}});
     pairs.push_back(pair);
   }
   const TempFile file(lines_of(queries));
   std::array<std::vector<Json>, 3> by_algorithm;
   const std::array<std::string, 3> algorithms = {"hybrid", "gjk", "enhanced_gjk"};
   for (std::size_t k = 0; k < algorithms.size(); ++k) {
-    const CliRun run = run_cli("query " + shell_quote(file.path()) + " --algorithm " + algorithms[k]);
+    const CliRun run =
+        run_cli("query " + shell_quote(file.path()) + " --algorithm " + algorithms[k]);
     ASSERT_EQ(run.exit_code, 0) << algorithms[k];
     by_algorithm[k] = parse_answers(run.out);
     ASSERT_EQ(by_algorithm[k].size(), static_cast<std::size_t>(kPairs)) << algorithms[k];
@@ -626,8 +654,10 @@ TEST(CliQuery, StandardInputWithAndWithoutDash) {
   const std::string text =
       R"({"id": "x", "a": {"vertices": [[0,0,0],[1,0,0],[0,1,0]]}, "b": {"vertices": [[0,0,2]]}})"
       "\n\n   \n"
-      R"({"id": "y", "a": {"vertices": []}, "b": {"vertices": [[0,0,2]]}})" "\r\n"
-      R"({"id": "z", "a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[0,0,-3]]}})";  // no final newline
+      R"({"id": "y", "a": {"vertices": []}, "b": {"vertices": [[0,0,2]]}})"
+      "\r\n"
+      R"({"id": "z", "a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[0,0,-3]]}})";  // no final
+                                                                                      // newline
   const TempFile file(text);
   const CliRun from_file = run_cli("query " + shell_quote(file.path()));
   const CliRun from_stdin = run_cli("query < " + shell_quote(file.path()));
@@ -641,7 +671,8 @@ TEST(CliQuery, StandardInputWithAndWithoutDash) {
     EXPECT_NEAR(check_answer_fields(answers[0]), 2.0, accuracy_bound(2.0, 2.0));
     EXPECT_EQ(answers[1].at("id"), "y");
     // Blank lines still count: the CRLF line is line 4.
-    EXPECT_EQ(answers[1].at("error").get<std::string>().rfind("line 4: a.vertices is empty", 0), 0U);
+    EXPECT_EQ(answers[1].at("error").get<std::string>().rfind("line 4: a.vertices is empty", 0),
+              0U);
     EXPECT_EQ(answers[2].at("id"), "z");
     EXPECT_NEAR(check_answer_fields(answers[2]), 3.0, accuracy_bound(3.0, 3.0));
   }
@@ -671,12 +702,15 @@ TEST(CliQuery, IterationCapIsFlaggedAndClassified) {
     }
     queries.push_back({{"id", i},
                        {"a", {{"vertices", points_json(a)}}},
-                       {"b", {{"vertices", points_json(b)}, {"translation", {3.5 + 0.5 * unit(gen), unit(gen), unit(gen)}}}}});
+                       {"b",
+                        {{"vertices", points_json(b)},
+                         {"translation", {3.5 + 0.5 * unit(gen), unit(gen), unit(gen)}}}}});
   }
   const TempFile file(lines_of(queries));
   for (const char* algorithm : {"hybrid", "gjk", "enhanced_gjk"}) {
     SCOPED_TRACE(algorithm);
-    const CliRun run = run_cli("query " + shell_quote(file.path()) + " --max-iterations 1 --algorithm " + algorithm);
+    const CliRun run = run_cli("query " + shell_quote(file.path()) +
+                               " --max-iterations 1 --algorithm " + algorithm);
     ASSERT_EQ(run.exit_code, 0);
     const std::vector<Json> answers = parse_answers(run.out);
     ASSERT_EQ(answers.size(), queries.size());
@@ -700,11 +734,20 @@ TEST(CliQuery, IterationCapIsFlaggedAndClassified) {
 TEST(CliQuery, ExitCodes) {
   REQUIRE_CLI();
   const TempFile file("");
-  EXPECT_EQ(run_cli("query " + shell_quote(file.path() + ".does-not-exist") + " 2>/dev/null").exit_code, 1);
-  EXPECT_EQ(run_cli("query " + shell_quote(std::filesystem::temp_directory_path().string()) + " 2>/dev/null").exit_code, 1);
+  EXPECT_EQ(
+      run_cli("query " + shell_quote(file.path() + ".does-not-exist") + " 2>/dev/null").exit_code,
+      1);
+  EXPECT_EQ(run_cli("query " + shell_quote(std::filesystem::temp_directory_path().string()) +
+                    " 2>/dev/null")
+                .exit_code,
+            1);
   EXPECT_EQ(run_cli("query " + shell_quote(file.path())).exit_code, 0);
-  EXPECT_EQ(run_cli("query --algorithm simplex " + shell_quote(file.path()) + " 2>/dev/null").exit_code, 2);
-  EXPECT_EQ(run_cli("query --max-iterations 0 " + shell_quote(file.path()) + " 2>/dev/null").exit_code, 2);
+  EXPECT_EQ(
+      run_cli("query --algorithm simplex " + shell_quote(file.path()) + " 2>/dev/null").exit_code,
+      2);
+  EXPECT_EQ(
+      run_cli("query --max-iterations 0 " + shell_quote(file.path()) + " 2>/dev/null").exit_code,
+      2);
   EXPECT_EQ(run_cli("query --no-such-option 2>/dev/null").exit_code, 2);
   EXPECT_EQ(run_cli("query a.jsonl b.jsonl 2>/dev/null").exit_code, 2);
   EXPECT_EQ(run_cli("2>/dev/null").exit_code, 2);
