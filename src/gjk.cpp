@@ -120,6 +120,70 @@ Reduction single(const Points& p, int i) {
 }
 
 // ---------------------------------------------------------------------------
+// Accurate cross products for thin faces. Each component of e1 x e2 is a
+// difference of products, a*b - c*d; for nearly parallel edges the products
+// agree in their leading digits, which cancel, and the plain result's
+// relative error grows like u / sin(angle). For a needle- or sliver-shaped
+// face that tilts its normal far enough to put the origin on the wrong side
+// of a plane it is 1e-13 from. Splitting each product into its rounded value
+// and its exact error (Dekker's two-product) gives a*b - c*d to a few u of
+// itself. It costs several plain products, so it is used only for faces
+// thinner than kThinFaceSine2.
+// ---------------------------------------------------------------------------
+
+// sin^2 of the angle between a face's edges below which its normal is
+// recomputed accurately: at sin >= 1/8 the plain cross product's direction
+// error is at most ~16 u, which moves a height over the face by ~16 u R,
+// inside the 64 u R band; thinner faces would exceed it.
+constexpr double kThinFaceSine2 = 1.0 / 64.0;
+
+// a * b == p + e exactly (no overflow at the unit's scale). With a hardware
+// fused multiply-add the error is one instruction; otherwise Veltkamp's
+// split into 26-bit halves makes every partial product exact.
+void two_product(double a, double b, double& p, double& e) {
+  p = a * b;
+#ifdef FP_FAST_FMA
+  e = std::fma(a, b, -p);
+#else
+  constexpr double kSplitter = 134217729.0;  // 2^27 + 1
+  const double ca = kSplitter * a;
+  const double a_hi = ca - (ca - a);
+  const double a_lo = a - a_hi;
+  const double cb = kSplitter * b;
+  const double b_hi = cb - (cb - b);
+  const double b_lo = b - b_hi;
+  e = ((a_hi * b_hi - p) + a_hi * b_lo + a_lo * b_hi) + a_lo * b_lo;
+#endif
+}
+
+// a*b - c*d to a few u of the result: p - q is exact when the products are
+// close (Sterbenz) and otherwise rounds once; the products' errors are added
+// back.
+double difference_of_products(double a, double b, double c, double d) {
+  double p = 0.0;
+  double e = 0.0;
+  double q = 0.0;
+  double f = 0.0;
+  two_product(a, b, p, e);
+  two_product(c, d, q, f);
+  return (p - q) + (e - f);
+}
+
+struct FaceNormal {
+  Vec3 n;     // e1 x e2, accurate in direction to a few u
+  bool thin;  // computed by the accurate path
+};
+
+FaceNormal face_normal(const Vec3& e1, const Vec3& e2) {
+  const Vec3 n = e1.cross(e2);
+  if (!(n.squaredNorm() < kThinFaceSine2 * e1.squaredNorm() * e2.squaredNorm())) return {n, false};
+  return {Vec3(difference_of_products(e1.y(), e2.z(), e1.z(), e2.y()),
+               difference_of_products(e1.z(), e2.x(), e1.x(), e2.z()),
+               difference_of_products(e1.x(), e2.y(), e1.y(), e2.x())),
+          true};
+}
+
+// ---------------------------------------------------------------------------
 // The distance subalgorithm, after the signed-volumes method of Montanari,
 // Petrinic & Barbieri (2017), written from the idea. The closest point of a
 // simplex to the origin is found by asking, in each dimension, where the
@@ -175,7 +239,8 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
   const Vec3& wi = p[idx(i)].w;
   const Vec3& wj = p[idx(j)].w;
   const Vec3& wk = p[idx(k)].w;
-  const Vec3 n = (wj - wi).cross(wk - wi);
+  const FaceNormal face = face_normal(wj - wi, wk - wi);
+  const Vec3& n = face.n;
   const double nn = n.squaredNorm();
   std::array<bool, 3> test_edge = {true, true, true};  // edge opposite i, j, k
   if (nn > 0.0) {
@@ -186,7 +251,14 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
     const int y = (axis + 2) % 3;
     // Doubled signed area in the (x, y) plane; (x, y, axis) is a cyclic
     // order, so for the whole triangle it equals n[axis].
-    const auto area = [x, y](const Vec3& a, const Vec3& b) { return a[x] * b[y] - a[y] * b[x]; };
+    // A thin triangle's areas cancel like its normal: computed accurately,
+    // the weights are exact functions of the (rounded) points, and the
+    // point they rebuild is off by rounding only, not by u / sin(angle)
+    // times the triangle's length.
+    const bool thin = face.thin;
+    const auto area = [x, y, thin](const Vec3& a, const Vec3& b) {
+      return thin ? difference_of_products(a[x], b[y], a[y], b[x]) : a[x] * b[y] - a[y] * b[x];
+    };
     const Vec3 di = wi - p0;
     const Vec3 dj = wj - p0;
     const Vec3 dk = wk - p0;
@@ -205,7 +277,7 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
       // (u |w|) is a large error in v's direction, and the next support
       // point would be searched in a wrong direction (a sliver next to the
       // plane is then missed). p0 has n's direction, accurate to a few u
-      // relative to the triangle's shape whatever the distance.
+      // whatever the distance and the triangle's shape.
       r.v = p0;
       r.vv = p0.squaredNorm();
       return r;
@@ -229,9 +301,9 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
 // (The signed-volumes cofactors det[w_i, w_j, w_k] are the same ratio's
 // terms with the origin as apex, but their rounding is u |w|^3 however thin
 // the tetrahedron: for a needle- or sliver-shaped one, whose volume is near
-// that, their signs are noise. A face normal from edge differences is
-// accurate in direction to a few u relative to the face's shape, so these
-// heights have the sign the geometry gives them.) The origin is strictly
+// that, their signs are noise. A face normal from edge differences,
+// accurate in direction to a few u (face_normal), gives these heights the
+// sign the geometry gives them.) The origin is strictly
 // inside exactly when every lambda_m is positive; otherwise the closest
 // point is on a face opposite a vertex whose lambda is not positive (every
 // face of a flat tetrahedron).
@@ -244,7 +316,7 @@ Reduction solve_tetrahedron(const Points& p) {
   for (int m = 0; m < 4; ++m) {
     const auto& f = kOppositeFace[idx(m)];
     const Vec3& wa = p[idx(f[0])].w;
-    const Vec3 n = (p[idx(f[1])].w - wa).cross(p[idx(f[2])].w - wa);
+    const Vec3 n = face_normal(p[idx(f[1])].w - wa, p[idx(f[2])].w - wa).n;
     origin_height[idx(m)] = -n.dot(wa);
     vertex_height[idx(m)] = n.dot(p[idx(m)].w - wa);
     inside = inside && same_sign(origin_height[idx(m)], vertex_height[idx(m)]);
@@ -432,7 +504,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
   // Orientation by the inner point, which stays strictly inside P as P grows.
   const auto add_face = [&](int i, int j, int k) {
     if (nf == kMaxContactFaces) return false;
-    Vec3 nrm = (p[idx(j)] - p[idx(i)]).cross(p[idx(k)] - p[idx(i)]);
+    Vec3 nrm = face_normal(p[idx(j)] - p[idx(i)], p[idx(k)] - p[idx(i)]).n;
     double side = nrm.dot(p[idx(i)] - inner);
     if (side < 0.0) {
       std::swap(j, k);
