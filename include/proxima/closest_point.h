@@ -26,9 +26,10 @@
 //    query relative to the feature's edges to within u times its distance,
 //    where b*e - c*d is only good to u / sin^2 of the feature's angle.
 //
-// Valid range for S = double: finite coordinates whose feature extents lie
-// in [1e-50, 1e50] (the interior solve forms a*det ~ length^6). A feature
-// below that extent is handled as degenerate; none traps or returns NaN.
+// Valid range for S = double: coordinates and feature extents within
+// [1e-75, 1e75] in magnitude (the kernels form length^4 quantities). Below
+// about 1e-77 a triangle's det underflows and it is taken as its longest edge;
+// no finite input in range traps or returns NaN.
 #pragma once
 
 #include "proxima/types.h"
@@ -38,6 +39,8 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <limits>
+#include <type_traits>
 #include <utility>
 
 namespace proxima {
@@ -152,6 +155,38 @@ void put_edge(std::array<S, 3>& coef, int i, int j, const S& lambda) {
   coef[static_cast<std::size_t>(j)] = lambda;
 }
 
+// Whether 1 / x is a finite, correctly scaled number: x positive, and for
+// floating point a normal number below the overflow threshold.
+template <class S>
+bool usable_divisor(const S& x) {
+  if constexpr (std::is_floating_point_v<S>) {
+    return x >= std::numeric_limits<S>::min() && x <= std::numeric_limits<S>::max();
+  } else {
+    return x > S(0);
+  }
+}
+
+// The interior solution of a 2x2 normal system by substitution: t = tn / det
+// (Cramer) and s = (rhs - b t) / a (the first normal equation a s + b t = rhs
+// solved for s given t). One division, of a*det, gives both reciprocals. That
+// product is a length^6; for double extents outside about [1e-50, 1e50] it
+// leaves the normal range and two divisions are used instead (same values).
+// Requires det > 0; returns false only if a underflowed to 0 (double).
+template <class S>
+bool substitute(const S& a, const S& det, const S& tn, const S& rhs, const S& b, S& s, S& t) {
+  const S a_det = a * det;
+  if (usable_divisor(a_det)) {
+    const S inv = S(1) / a_det;
+    t = tn * (a * inv);
+    s = (rhs - b * t) * (det * inv);
+    return true;
+  }
+  if (!(a > S(0))) return false;
+  t = tn / det;
+  s = (rhs - b * t) / a;
+  return true;
+}
+
 // A triangle prepared once for one or many point queries: edges from t0,
 // their normal n = E0 x E1 and det = |n|^2 = a*c - b^2 (Lagrange's identity).
 template <class S>
@@ -181,6 +216,24 @@ TriangleFoot<S> triangle_edge_foot(const TriangleFrame<S>& f, const Vec3T<S>& p,
   TriangleFoot<S> out{{}, e.point};
   put_edge(out.w, i, j, e.lambda);
   return out;
+}
+
+// The foot on edge (i, j), and, if it clamps to one of the edge's ends, the
+// foot on the other edge through that vertex, whichever is closer. In exact
+// arithmetic the region analysis already chose the edge holding the minimum
+// and Q is strictly convex, so a clamped end is the minimum and the second
+// foot returns that same vertex: nothing changes. In floating point a region
+// decided by rounding (a sliver, a point close to an edge line) may have
+// picked the wrong edge through a vertex, and the second foot repairs it. A
+// clamped foot does not divide, so this keeps one division per answer.
+template <class S>
+TriangleFoot<S> triangle_edge_or_corner(const TriangleFrame<S>& f, const Vec3T<S>& p, int i, int j,
+                                        const S& min_length_squared) {
+  TriangleFoot<S> foot = triangle_edge_foot(f, p, i, j, min_length_squared);
+  const int corner = foot.w[static_cast<std::size_t>(i)] == S(1) ? i : (foot.w[static_cast<std::size_t>(j)] == S(1) ? j : -1);
+  if (corner < 0) return foot;
+  TriangleFoot<S> other = triangle_edge_foot(f, p, corner, 3 - i - j, min_length_squared);
+  return (other.point - p).squaredNorm() < (foot.point - p).squaredNorm() ? other : foot;
 }
 
 // A triangle with dependent edges lies within its height of its longest edge,
@@ -229,11 +282,13 @@ TriangleFoot<S> longest_edge_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, 
 //     otherwise on the other one (both cannot decrease: that would contradict
 //     the positive definiteness of [a b; b c] at a vertex region). The
 //     directional derivatives are E.(vertex - p) dot products.
-// Each edge is then the one-variable problem of edge_foot (one division).
+// Each edge is then the one-variable problem of edge_foot (one division);
+// a foot clamped to a vertex also tries the vertex's other edge
+// (triangle_edge_or_corner), which changes nothing in exact arithmetic.
 //
-// Region 0 divides once, by a*det: t = tn / det as above, and s from the first
-// normal equation a s + b t = E0.(p - t0), so s = (E0.(p - t0) det - b tn) /
-// (a det). In exact arithmetic this is sn / det; in floating point it makes
+// Region 0 divides once, by a*det (detail::substitute): t = tn / det as
+// above, and s from the first normal equation a s + b t = E0.(p - t0), i.e.
+// s = (E0.(p - t0) - b t) / a. In exact arithmetic this is sn / det; in floating point it makes
 // the point the exact foot of p on the line {t0 + s E0 + t E1 : s}, so the
 // error of t (large on a sliver: t's line is nearly parallel to s's) moves
 // the point along the triangle instead of off the answer. If rounding puts s
@@ -248,33 +303,32 @@ TriangleFoot<S> triangle_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, cons
   if (sn + tn <= f.det) {
     if (sn < S(0)) {
       if (tn < S(0)) {  // region 4: vertex t0, leave it along E0 if E0.(t0 - p) < 0
-        return f.e0.dot(dp) > S(0) ? triangle_edge_foot(f, p, 0, 1, min_length_squared)
-                                   : triangle_edge_foot(f, p, 0, 2, min_length_squared);
+        return f.e0.dot(dp) > S(0) ? triangle_edge_or_corner(f, p, 0, 1, min_length_squared)
+                                   : triangle_edge_or_corner(f, p, 0, 2, min_length_squared);
       }
-      return triangle_edge_foot(f, p, 0, 2, min_length_squared);  // region 3: s = 0
+      return triangle_edge_or_corner(f, p, 0, 2, min_length_squared);  // region 3: s = 0
     }
-    if (tn < S(0)) return triangle_edge_foot(f, p, 0, 1, min_length_squared);  // region 5: t = 0
+    if (tn < S(0)) return triangle_edge_or_corner(f, p, 0, 1, min_length_squared);  // region 5: t = 0
     // Region 0.
-    const S a_det = f.a * f.det;
-    if (!(a_det > S(0))) return longest_edge_foot(f, p, min_length_squared);  // a*det underflowed (double, extent < 1e-50)
-    const S inv = S(1) / a_det;
-    const S t = tn * f.a * inv;
-    const S s = (f.e0.dot(dp) * f.det - f.e0.dot(f.e1) * tn) * inv;
-    if (s < S(0)) return triangle_edge_foot(f, p, 0, 2, min_length_squared);
+    S s, t;
+    if (!substitute(f.a, f.det, tn, f.e0.dot(dp), f.e0.dot(f.e1), s, t)) {
+      return longest_edge_foot(f, p, min_length_squared);  // |E0|^2 underflowed (double)
+    }
+    if (s < S(0)) return triangle_edge_or_corner(f, p, 0, 2, min_length_squared);
     const S s_plus_t = s + t;
-    if (s_plus_t > S(1)) return triangle_edge_foot(f, p, 1, 2, min_length_squared);
+    if (s_plus_t > S(1)) return triangle_edge_or_corner(f, p, 1, 2, min_length_squared);
     return {{S(1) - s_plus_t, s, t}, Vec3T<S>(f.t0 + s * f.e0 + t * f.e1)};
   }
   const Vec3T<S> e2 = f.t2 - f.t1;
   if (sn < S(0)) {  // region 2: vertex t2, leave it towards t1 if E2.(t2 - p) > 0
-    return e2.dot(f.t2 - p) > S(0) ? triangle_edge_foot(f, p, 1, 2, min_length_squared)
-                                   : triangle_edge_foot(f, p, 0, 2, min_length_squared);
+    return e2.dot(f.t2 - p) > S(0) ? triangle_edge_or_corner(f, p, 1, 2, min_length_squared)
+                                   : triangle_edge_or_corner(f, p, 0, 2, min_length_squared);
   }
   if (tn < S(0)) {  // region 6: vertex t1, leave it towards t2 if E2.(t1 - p) < 0
-    return e2.dot(p - f.t1) > S(0) ? triangle_edge_foot(f, p, 1, 2, min_length_squared)
-                                   : triangle_edge_foot(f, p, 0, 1, min_length_squared);
+    return e2.dot(p - f.t1) > S(0) ? triangle_edge_or_corner(f, p, 1, 2, min_length_squared)
+                                   : triangle_edge_or_corner(f, p, 0, 1, min_length_squared);
   }
-  return triangle_edge_foot(f, p, 1, 2, min_length_squared);  // region 1: s + t = 1
+  return triangle_edge_or_corner(f, p, 1, 2, min_length_squared);  // region 1: s + t = 1
 }
 
 // A segment crossing a triangle's plane strictly (its ends on opposite sides)
@@ -286,12 +340,27 @@ TriangleFoot<S> triangle_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, cons
 // (point on A, point on B) candidate whatever the rounding. Returns false
 // when the ends do not straddle the plane or the triangle is degenerate
 // (a segment crossing a degenerate triangle crosses one of its edges).
+//
+// The heights use n made orthogonal to the triangle's longest edge L,
+// n - (n.L / L.L) L, which is n itself in exact arithmetic. In floating point
+// the rounding of E0 x E1 has a component along L of relative size u / sin
+// (sin: the triangle's smallest angle); it tilts the plane about an axis
+// across L and puts the heights of points far along L (a segment running
+// along a sliver) off by more than the heights themselves. Removing it
+// leaves the tilt about L, which only scales with the distance from L.
+// (Found by ClosestPointExact.DegenerateSegmentTriangleAndTriangleTriangle:
+// a sliver of sine 3e-8 pierced by a segment along it at 2e-8 radians, whose
+// crossing came out 6 units away along the segment.)
 template <class S>
 bool crossing_candidate(const Vec3T<S>& a0, const Vec3T<S>& a1, const TriangleFrame<S>& f,
                         const KernelTolerance<S>& tol, ClosestPoints<S>& out) {
   if (f.degenerate) return false;
-  const S sa = f.n.dot(a0 - f.t0);
-  const S sb = f.n.dot(a1 - f.t0);
+  const Vec3T<S> e2 = f.t2 - f.t1;
+  const S l12 = e2.squaredNorm();
+  const Vec3T<S>& longest = f.a >= f.c ? (f.a >= l12 ? f.e0 : e2) : (f.c >= l12 ? f.e1 : e2);
+  const Vec3T<S> n = f.n - (f.n.dot(longest) / longest.squaredNorm()) * longest;
+  const S sa = n.dot(a0 - f.t0);
+  const S sb = n.dot(a1 - f.t0);
   if (!((sa < S(0) && sb > S(0)) || (sa > S(0) && sb < S(0)))) return false;
   const S lambda = sa / (sa - sb);
   out.point_a = a0 + lambda * (a1 - a0);
@@ -389,9 +458,9 @@ ClosestPoints<S> closest_point_triangle(const Vec3T<S>& p, const Vec3T<S>& t0, c
 //     directional derivatives cannot both be negative (H positive definite),
 //     so: if Q decreases entering along the t-edge, take that edge, else the
 //     s-edge. The derivative along s is M0.(A(s) - B(t)) at the corner.
-// Region 0 divides once, by a*det: t = tn / det, and s from the first normal
-// equation a s - (M0.M1) t = -M0.D, i.e. A(s) is the exact foot of B(t) on
-// line A. In exact arithmetic this is sn / det; in floating point, for nearly
+// Region 0 divides once, by a*det (detail::substitute): t = tn / det, and s
+// from the first normal equation a s - (M0.M1) t = -M0.D, i.e. A(s) is the
+// exact foot of B(t) on line A. In exact arithmetic this is sn / det; in floating point, for nearly
 // parallel segments, it keeps the error of t along the valley of Q, where
 // the distance is flat, instead of pulling the two points apart. If rounding
 // puts s outside [0, 1] (never in exact arithmetic) the facing edge is taken.
@@ -422,6 +491,25 @@ ClosestPoints<S> closest_segment_segment(const Vec3T<S>& a0, const Vec3T<S>& a1,
     return detail::finish(r);
   };
 
+  // A foot clamped to an end of the other segment sits at a corner of the
+  // square; the minimum may then lie on the other edge through that corner.
+  // In exact arithmetic the region analysis picked the right edge and Q is
+  // strictly convex, so the second foot returns the same corner and nothing
+  // changes. In floating point, for nearly parallel segments whose (sn, tn)
+  // are mostly rounding, the picked edge can miss the valley of Q by a whole
+  // segment length (ClosestPointExact.NearlyParallelSegments found one at
+  // sine 9u: antiparallel segments overlapping at their ends, off by 2.6% of
+  // their length); the corner's other edge then holds the answer. A clamped
+  // foot does not divide, so an answer still costs at most one division.
+  const auto corner_safe = [&](ClosestPoints<S> r, bool from_a) {
+    const std::uint8_t other_side = from_a ? r.active_b : r.active_a;
+    if (other_side == 3) return r;  // the foot is inside the other segment
+    ClosestPoints<S> other = from_a ? end_of_b(other_side == 2) : end_of_a(other_side == 2);
+    return detail::improves(other, r) ? other : r;
+  };
+  const auto from_end_of_a = [&](bool at_a1) { return corner_safe(end_of_a(at_a1), true); };
+  const auto from_end_of_b = [&](bool at_b1) { return corner_safe(end_of_b(at_b1), false); };
+
   const Vec3T<S> n = m0.cross(m1);
   const S det = n.squaredNorm();
   if (det <= tol.min_sin_squared * a * c) {
@@ -440,14 +528,11 @@ ClosestPoints<S> closest_segment_segment(const Vec3T<S>& a0, const Vec3T<S>& a1,
   const int s_side = sn < S(0) ? 0 : (sn > det ? 2 : 1);  // 0: s < 0, 1: inside, 2: s > 1
   const int t_side = tn < S(0) ? 0 : (tn > det ? 2 : 1);
   if (s_side == 1 && t_side == 1) {  // region 0
-    const S a_det = a * det;
-    if (a_det > S(0)) {  // false only if a*det underflowed (double, extents < 1e-50)
-      const S inv = S(1) / a_det;
-      S t = tn * a * inv;
+    S s, t;
+    if (detail::substitute(a, det, tn, S(-m0.dot(dd)), S(-m0.dot(m1)), s, t)) {
       if (t > S(1)) t = S(1);  // tn <= det: an excess is rounding
-      const S s = (m0.dot(m1) * tn - m0.dot(dd) * det) * inv;
-      if (s < S(0)) return end_of_a(false);
-      if (s > S(1)) return end_of_a(true);
+      if (s < S(0)) return from_end_of_a(false);
+      if (s > S(1)) return from_end_of_a(true);
       ClosestPoints<S> r;
       r.point_a = a0 + s * m0;
       r.point_b = b0 + t * m1;
@@ -456,9 +541,9 @@ ClosestPoints<S> closest_segment_segment(const Vec3T<S>& a0, const Vec3T<S>& a1,
       return detail::finish(r);
     }
   }
-  // Regions 5 (s = 0) and 1 (s = 1); region 0 only if a*det underflowed.
-  if (t_side == 1) return end_of_a(s_side == 2);
-  if (s_side == 1) return end_of_b(t_side == 2);  // regions 7 (t = 0) and 3 (t = 1)
+  // Regions 5 (s = 0) and 1 (s = 1); region 0 only if |M0|^2 underflowed.
+  if (t_side == 1) return from_end_of_a(s_side == 2);
+  if (s_side == 1) return from_end_of_b(t_side == 2);  // regions 7 (t = 0) and 3 (t = 1)
   // Corner regions 2, 4, 6, 8: corner (s, t) = (s_side / 2, t_side / 2).
   const Vec3T<S>& corner_a = s_side == 2 ? a1 : a0;
   const Vec3T<S>& corner_b = t_side == 2 ? b1 : b0;
@@ -466,7 +551,7 @@ ClosestPoints<S> closest_segment_segment(const Vec3T<S>& a0, const Vec3T<S>& a1,
   // Entering the square along the t-edge means decreasing s at s = 1 and
   // increasing it at s = 0.
   const bool along_t_edge = s_side == 2 ? slope_s > S(0) : slope_s < S(0);
-  return along_t_edge ? end_of_b(t_side == 2) : end_of_a(s_side == 2);
+  return along_t_edge ? from_end_of_b(t_side == 2) : from_end_of_a(s_side == 2);
 }
 
 namespace detail {
@@ -474,9 +559,14 @@ namespace detail {
 template <class S>
 ClosestPoints<S> segment_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1, const TriangleFrame<S>& f,
                                   const KernelTolerance<S>& tol) {
+  // A piercing at exactly zero distance cannot be improved on, and its pair
+  // is minimal: the segment's ends are strictly off the plane, and the
+  // triangle side is point_triangle's minimal set. Otherwise the piercing is
+  // one candidate among the others: in floating point a sliver's normal is
+  // mostly rounding, and its "piercing" may be far from the answer.
   ClosestPoints<S> crossing;
   const bool crosses = crossing_candidate(a0, a1, f, tol, crossing);
-  if (crosses && crossing.active_b == 7) return crossing;  // pierces the interior: distance 0, nothing smaller
+  if (crosses && crossing.distance_squared == S(0)) return crossing;
 
   const Vec3T<S>* v[3] = {&f.t0, &f.t1, &f.t2};
   ClosestPoints<S> best;
@@ -539,8 +629,10 @@ ClosestPoints<S> closest_segment_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1
 // and, repeating the argument on that edge, is a vertex of one against the
 // other triangle (six point-triangle problems) or an edge against an edge
 // (nine segment-segment problems). If v = 0 the triangles intersect: either
-// an edge of one pierces the other's interior (the piercing test, distance 0)
-// or they meet on their boundaries, where the fifteen problems find 0.
+// an edge of one pierces the other's interior (the six piercing tests,
+// distance 0) or they meet on their boundaries, where the fifteen problems
+// find 0. All candidates are pairs of points on the two triangles, so in
+// floating point too the smallest one is an upper bound within rounding.
 template <class S>
 ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1, const Vec3T<S>& a2,
                                            const Vec3T<S>& b0, const Vec3T<S>& b1, const Vec3T<S>& b2,
@@ -558,21 +650,6 @@ ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a
     coef[static_cast<std::size_t>(edge[1])] = w1;
   };
 
-  ClosestPoints<S> pierce;
-  for (const auto& edge : kEdges) {
-    if (detail::crossing_candidate(*va[edge[0]], *va[edge[1]], fb, tol, pierce) && pierce.active_b == 7) {
-      spread(pierce.coef_a, edge);
-      return detail::finish(pierce);
-    }
-  }
-  for (const auto& edge : kEdges) {
-    if (detail::crossing_candidate(*vb[edge[0]], *vb[edge[1]], fa, tol, pierce) && pierce.active_b == 7) {
-      ClosestPoints<S> r = detail::swapped(std::move(pierce));
-      spread(r.coef_b, edge);
-      return detail::finish(r);
-    }
-  }
-
   ClosestPoints<S> best;
   bool have = false;
   const auto consider = [&](ClosestPoints<S>& cand) {
@@ -582,6 +659,19 @@ ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a
       have = true;
     }
   };
+  // Piercings are candidates like the others (no early answer: in floating
+  // point a sliver's normal is mostly rounding, see segment_triangle).
+  for (int side = 0; side < 2; ++side) {
+    for (const auto& edge : kEdges) {
+      ClosestPoints<S> cand;
+      const bool crosses = side == 0 ? detail::crossing_candidate(*va[edge[0]], *va[edge[1]], fb, tol, cand)
+                                     : detail::crossing_candidate(*vb[edge[0]], *vb[edge[1]], fa, tol, cand);
+      if (!crosses) continue;
+      if (side == 1) cand = detail::swapped(std::move(cand));
+      spread(side == 0 ? cand.coef_a : cand.coef_b, edge);
+      consider(cand);
+    }
+  }
   for (int side = 0; side < 2; ++side) {  // vertices of one triangle against the other
     const detail::TriangleFrame<S>& other = side == 0 ? fb : fa;
     for (std::size_t k = 0; k < 3; ++k) {
