@@ -731,18 +731,20 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
   }
 
   // Closest points from the original coordinates (the weights are
-  // unit-free): sums of hull points with weights summing to one.
+  // unit-free): sums of hull points with weights summing to one. B's is
+  // formed in B's frame and mapped once (the pose is affine).
   Vec3 point_a = Vec3::Zero();
-  Vec3 point_b = Vec3::Zero();
+  Vec3 local_b = Vec3::Zero();
   std::array<std::int32_t, 4> ids_a{};
   std::array<std::int32_t, 4> ids_b{};
   for (int k = 0; k < simplex.size; ++k) {
     const SupportPoint& sp = simplex.p[idx(k)];
     point_a += simplex.lambda[idx(k)] * frame.a.vertex(sp.ia);
-    point_b += simplex.lambda[idx(k)] * frame.b_point(sp.ib);
+    local_b += simplex.lambda[idx(k)] * frame.b.vertex(sp.ib);
     ids_a[idx(k)] = sp.ia;
     ids_b[idx(k)] = sp.ib;
   }
+  const Vec3 point_b = frame.b_in_a.apply(local_b);
 
   DistanceResult result;
   result.iterations = iterations;

@@ -10,7 +10,10 @@
 //     separating direction, and lower_bound <= distance;
 //   - Enhanced GJK equal to classic GJK along a motion with a tracking cache,
 //     and with caches from another pair or full of garbage ids;
-//   - the iteration cap, and scale (1e-23 .. 1e120) without NaN or inf.
+//   - the iteration cap, and scale (1e-23 .. 1e120) without NaN or inf;
+//   - regressions (thin simplices) against the exact oracle.
+#include "support/exact_oracle.h"
+
 #include "proxima/gjk.h"
 
 #include <gtest/gtest.h>
@@ -20,6 +23,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -559,7 +563,10 @@ TEST(Gjk, RandomSeparatedPairsMatchBruteForce) {
 
 // Near contact the separation is a few ulps to a few thousand ulps of R:
 // the status flips from touching to separated at the band, and the distance
-// is still right to the band.
+// is still right to the band. (Regression, trial 65: a touching contact whose
+// last simplex was a sliver tetrahedron "enclosing" the origin reported the
+// sliver's barycentric rounding, 2e-14 = 1.6 bands, as its distance; it now
+// reports the nearest face's witnesses.)
 TEST(Gjk, RandomNearContact) {
   Rng rng(77);
   int touching = 0;
@@ -737,6 +744,74 @@ TEST(EnhancedGjk, ForeignAndGarbageCachesGiveTheSameAnswer) {
 }
 
 // ---------------------------------------------------------------------------
+// Regressions, found by the accuracy suite (distance_accuracy_test) and held
+// to the accuracy standard against the exact oracle.
+// ---------------------------------------------------------------------------
+
+void expect_within_standard(const std::vector<Vec3>& points_a, const std::vector<Vec3>& points_b) {
+  test::ExactOracle oracle;
+  const std::optional<test::ExactDistance> exact = oracle.distance(points_a, points_b);
+  ASSERT_TRUE(exact) << oracle.last_error();
+  const ConvexPolytope a(points_a);
+  const ConvexPolytope b(points_b);
+  const double band = contact_band(a, b, Pose::identity());
+  ASSERT_FALSE(test::sqrt_at_most(exact->distance_squared, 2.0 * band));  // clearly separated
+  DistanceCache cache;
+  for (const DistanceResult& r : {gjk_distance(a, b, Pose::identity(), gjk_options(), band),
+                                  enhanced_gjk_distance(a, b, Pose::identity(), gjk_options(), band, cache)}) {
+    expect_finite(r);
+    EXPECT_EQ(r.status, Status::separated) << to_string(r.status);
+    EXPECT_TRUE(test::within_bound(r.distance, exact->distance_squared, 1e-12, band))
+        << "distance " << r.distance << ", exact " << exact->distance();
+    EXPECT_LE(r.lower_bound, exact->distance() + band);
+  }
+}
+
+// A needle (six nearly collinear points, 5e-8 thick) 4.06e-13 from a point.
+// The tetrahedron GJK built of needle vertices has sliver faces; the plain
+// cross product of two nearly parallel edges cancels to a normal tilted by
+// ~1e-9, which put the origin on the wrong side of a face 4e-13 away: the
+// query was reported intersecting. Fixed by face_normal's accurate path.
+TEST(GjkRegression, NeedleAgainstAPoint) {
+  expect_within_standard({Vec3(0.91205002599172835, -0.055305202885795962, 0.40633248039290326),
+                          Vec3(-0.91205002599172835, 0.055305202885795962, -0.40633248039290326),
+                          Vec3(0.32267324960043692, -0.01956641887695702, 0.14375593974487805),
+                          Vec3(-0.40442624436303626, 0.024523689551102342, -0.1801781859965603),
+                          Vec3(0.49351066950109757, -0.029925619868540743, 0.2198666955276031),
+                          Vec3(-0.81928182393689297, 0.049679884060418164, -0.36500284290197688)},
+                         {Vec3(0.11104981746311303, -0.0067338408186590759, 0.049474430621343261)});
+}
+
+// A sliver tetrahedron (fourth vertex 1.5e-10 off the opposite face) and a
+// point between the two planes. v = sum(lambda w) was 1e-10 long but
+// rebuilt from points of size 1, so its direction was off by ~1e-6: the
+// support missed the sliver's vertex and GJK stopped at 1.03e-10 for
+// d* = 5.19e-11. Fixed by taking v as the projection along the normal.
+TEST(GjkRegression, SliverAgainstAPoint) {
+  expect_within_standard({Vec3(-0.40438775831825102, 0.23076554094979265, -0.43956547411334446),
+                          Vec3(0.63168403894713576, 0.21847978064173706, -0.056937337399740606),
+                          Vec3(-0.035506566231792588, -0.43993134724703892, 0.55244881524339629),
+                          Vec3(0.027250437085004194, 0.0029873187824893993, 0.0058120199934300716)},
+                         {Vec3(0.064152657460483986, 0.14959607398764491, -0.16941706013489832)});
+}
+
+// Unit boxes face to face, one turned by 1e-7 rad, 1e-9 apart: a vertex
+// against a nearly parallel face. The signed-volume cofactors of the flat
+// tetrahedra (rounding u |w|^3 against volumes near that) had random signs
+// and GJK stopped at 2.6e-9 for d* = 1e-9. Fixed by face heights.
+TEST(GjkRegression, KissingBoxesWithTinyRotatedGap) {
+  expect_within_standard(box(Vec3::Constant(-0.5), Vec3::Constant(0.5)),
+                         {Vec3(0.50000000427028424, -0.49999997302253646, -0.49999998246323579),
+                          Vec3(1.5000000042702799, -0.50000006532127439, -0.49999997919294786),
+                          Vec3(0.50000009656902222, 0.50000002697745849, -0.5000000208070513),
+                          Vec3(1.5000000965690179, 0.49999993467872067, -0.50000001753676349),
+                          Vec3(0.50000000099999997, -0.49999993467872067, 0.50000001753676349),
+                          Vec3(1.5000000009999956, -0.50000002697745849, 0.5000000208070513),
+                          Vec3(0.50000009329873796, 0.50000006532127439, 0.49999997919294786),
+                          Vec3(1.5000000932987336, 0.49999997302253646, 0.49999998246323579)});
+}
+
+// ---------------------------------------------------------------------------
 // Limits.
 // ---------------------------------------------------------------------------
 
@@ -760,6 +835,35 @@ TEST(Gjk, IterationCapIsReportedWithValidBounds) {
     EXPECT_LE(r.lower_bound, reference + 1e-14);
     EXPECT_LE(outside_by(a, Pose::identity(), r.point_a), 1e-14);
     EXPECT_LE(outside_by(b, b_in_a, r.point_b), 1e-14);
+  }
+}
+
+// A contact still undecided at the cap says so: the classification's
+// support evaluations count against options.max_iterations too.
+TEST(Gjk, IterationCapHoldsInContacts) {
+  const ConvexPolytope cube(unit_cube());
+  const Pose poses[] = {Pose::identity(), Pose::from_translation(Vec3(1, 0, 0)),
+                        Pose::from_translation(Vec3(0.5, 0.5, 0.5))};
+  for (const Pose& b_in_a : poses) {
+    const double tol = contact_band(cube, cube, b_in_a);
+    for (int cap = 1; cap <= 12; ++cap) {
+      DistanceOptions o = gjk_options();
+      o.max_iterations = cap;
+      DistanceCache cache;
+      for (const DistanceResult& r : {gjk_distance(cube, cube, b_in_a, o, tol),
+                                      enhanced_gjk_distance(cube, cube, b_in_a, o, tol, cache)}) {
+        expect_finite(r);
+        EXPECT_LE(r.iterations, cap);
+        EXPECT_NE(r.status, Status::separated);
+        EXPECT_LE(r.lower_bound, tol);  // d* = 0
+        if (r.status != Status::iteration_cap) {
+          EXPECT_LE(r.distance, tol);
+        }
+        if (cap == 12) {  // enough for all three contacts
+          EXPECT_NE(r.status, Status::iteration_cap);
+        }
+      }
+    }
   }
 }
 
