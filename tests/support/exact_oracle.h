@@ -43,6 +43,7 @@
 #include <CGAL/Polytope_distance_d.h>
 #include <CGAL/Polytope_distance_d_traits_3.h>
 #include <CGAL/Simple_cartesian.h>
+#include <boost/multiprecision/eigen.hpp>
 #include <boost/multiprecision/gmp.hpp>
 #include <gmpxx.h>
 #include <mpfr.h>
