@@ -30,6 +30,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace proxima {
 namespace {
@@ -82,6 +83,24 @@ Local from_kernel(const ClosestPoints<double>& c) {
   return {c.distance_squared, c.point_a, c.point_b, c.active_a, c.active_b};
 }
 
+// Barycentric coordinates of x in the tetrahedron t when x lies inside it
+// (signed volumes of the sub-tetrahedra over the whole), nothing otherwise or
+// when the tetrahedron is flat.
+std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Vec3, 4>& t, const Vec3& x) {
+  const auto volume = [](const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
+    return (p1 - p0).cross(p2 - p0).dot(p3 - p0);
+  };
+  const double whole = volume(t[0], t[1], t[2], t[3]);
+  if (whole == 0.0) return std::nullopt;
+  std::array<double, 4> c = {volume(x, t[1], t[2], t[3]), volume(t[0], x, t[2], t[3]), volume(t[0], t[1], x, t[3]),
+                             volume(t[0], t[1], t[2], x)};
+  for (double& ci : c) {
+    if (ci * whole < 0.0) return std::nullopt;
+    ci /= whole;
+  }
+  return c;
+}
+
 // Closest points of conv(fa) and conv(fb). Sizes 1..3 go to the closed-form
 // kernels. A fourth vertex only appears on the side that just received its
 // support point (index 3): the feature is then a tetrahedron whose closest
@@ -95,6 +114,20 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb, const KernelTol
   const bool on_a = fa.n == 4;
   const FeatureSet& four = on_a ? fa : fb;
   const FeatureSet& other = on_a ? fb : fa;
+  // The other feature may lie inside the tetrahedron (the bodies overlap):
+  // then no triangle is closest and the distance is 0. It suffices to test
+  // one of its vertices: if the feature crosses the boundary instead, a
+  // triangle below finds the crossing at distance 0.
+  if (const auto inside = tetrahedron_coordinates(four.p, other.p[0])) {
+    Local hit{0.0, other.p[0], other.p[0], 0, 0};
+    std::uint8_t tet_bits = 0;
+    for (int i = 0; i < 4; ++i) {
+      if ((*inside)[static_cast<std::size_t>(i)] != 0.0) tet_bits = static_cast<std::uint8_t>(tet_bits | (1u << i));
+    }
+    hit.active_a = on_a ? tet_bits : std::uint8_t{1};
+    hit.active_b = on_a ? std::uint8_t{1} : tet_bits;
+    return hit;
+  }
   static constexpr std::array<std::array<int, 3>, 3> kTriangles = {{{0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
   Local best{};
   bool have = false;
@@ -122,6 +155,31 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb, const KernelTol
 }
 
 bool valid_id(std::int32_t id, int count) { return id >= 0 && id < count; }
+
+// Unit direction from A towards B, as accurate as the features allow. The
+// difference XB - XA of two computed points carries an absolute error of a
+// few u R, so for nearly touching bodies (d << R) its direction is off by
+// u R / d: enough to pick wrong support points on a needle or a sliver. A
+// face normal or the cross product of two edges is accurate to a few u
+// whatever d is, so those are used where the pair is vertex-face or
+// edge-edge; XB - XA where it is exact enough (vertex-vertex, vertex-edge).
+Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb, const Vec3& w, double d) {
+  Vec3 n;
+  if (fa.n == 1 && fb.n == 3) {
+    n = (fb.p[1] - fb.p[0]).cross(fb.p[2] - fb.p[0]);
+  } else if (fa.n == 3 && fb.n == 1) {
+    n = (fa.p[1] - fa.p[0]).cross(fa.p[2] - fa.p[0]);
+  } else if (fa.n == 2 && fb.n == 2) {
+    n = (fa.p[1] - fa.p[0]).cross(fb.p[1] - fb.p[0]);
+  } else {
+    return w / d;
+  }
+  const double along = n.dot(w);
+  const double length = n.norm();
+  // Parallel edges (or a face seen edge-on): no better direction than w.
+  if (!(length > 0.0) || along == 0.0) return w / d;
+  return (along > 0.0 ? 1.0 : -1.0) / length * n;
+}
 
 // Loads a cached feature (ids range-checked, duplicates dropped). Returns
 // false when nothing usable is cached.
@@ -300,15 +358,15 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
       contact = true;
       break;
     }
-    const Vec3 w = loc.xb - loc.xa;  // from A towards B, |w| = d > 0
-    last_direction = w / d;
+    const Vec3 w = search_direction(fa, fb, loc.xb - loc.xa, d);  // unit, from A towards B
+    last_direction = w;
     hint_a = support_hill_climb(a, w, hint_a);
     hint_b = support_hill_climb(b, -(rot.transpose() * w), hint_b);
     const Vec3 pa = a_point(hint_a);
     const Vec3 pb = b_point(hint_b);
     const double wa = w.dot(pa);
     const double wb = w.dot(pb);
-    lower = std::max(lower, (wb - wa) / d);
+    lower = std::max(lower, wb - wa);
     if (d - lower <= options.relative_tolerance * d + kGapUlps * ulp_r) break;
     if (iterations >= options.max_iterations) {
       result.status = Status::iteration_cap;
