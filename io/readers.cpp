@@ -34,7 +34,7 @@
 #include <stdexcept>
 #include <streambuf>
 #include <system_error>
-#include <unordered_map>
+#include <set>
 #include <utility>
 
 namespace proxima {
@@ -95,9 +95,11 @@ constexpr std::size_t kQuoteLength = 40;
 // count cannot size an allocation.
 constexpr std::size_t kMinTextVertexBytes = 6;
 
-// Separators within a line. Commas too for XYZ, which is often written as CSV.
-constexpr std::string_view kBlanks = " \t\v\f";
-constexpr std::string_view kBlanksAndCommas = " \t\v\f,";
+// Separators within a line: blanks, and commas too for XYZ (often written
+// as CSV). Tested char by char: string_view::find_first_of calls memchr once
+// per character, which made it the hot spot of reading text.
+constexpr bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
+enum class Separators : std::uint8_t { blanks, blanks_and_commas };
 
 constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
@@ -178,9 +180,9 @@ class LineReader {
   bool next(std::string_view* line) {
     if (pos_ >= text_.size()) return false;
     ++number_;
-    std::size_t end = text_.find_first_of(std::string_view("\r\n\0", 3), pos_);
-    if (end != std::string_view::npos && text_[end] == '\0') src_.fail_line(number_, "NUL byte: this is not a text file");
-    if (end == std::string_view::npos) end = text_.size();
+    std::size_t end = pos_;
+    while (end < text_.size() && text_[end] != '\n' && text_[end] != '\r' && text_[end] != '\0') ++end;
+    if (end < text_.size() && text_[end] == '\0') src_.fail_line(number_, "NUL byte: this is not a text file");
     *line = text_.substr(pos_, end - pos_);
     pos_ = end;
     if (pos_ < text_.size() && text_[pos_] == '\r') ++pos_;
@@ -198,26 +200,31 @@ class LineReader {
   std::int64_t number_ = 0;
 };
 
-// Tokens of one line, split at any of `separators`.
+// Tokens of one line.
 class Tokens {
  public:
-  explicit Tokens(std::string_view line, std::string_view separators = kBlanks) : rest_(line), seps_(separators) {}
+  explicit Tokens(std::string_view line, Separators separators = Separators::blanks)
+      : rest_(line), commas_(separators == Separators::blanks_and_commas) {}
 
   bool next(std::string_view* token) {
-    const std::size_t b = rest_.find_first_not_of(seps_);
-    if (b == std::string_view::npos) {
+    std::size_t b = 0;
+    while (b < rest_.size() && is_separator(rest_[b])) ++b;
+    if (b == rest_.size()) {
       rest_ = {};
       return false;
     }
-    const std::size_t e = std::min(rest_.find_first_of(seps_, b), rest_.size());
+    std::size_t e = b;
+    while (e < rest_.size() && !is_separator(rest_[e])) ++e;
     *token = rest_.substr(b, e - b);
     rest_.remove_prefix(e);
     return true;
   }
 
  private:
+  bool is_separator(char c) const { return is_blank(c) || (commas_ && c == ','); }
+
   std::string_view rest_;
-  std::string_view seps_;
+  bool commas_;
 };
 
 enum class NumberStatus : std::uint8_t { ok, not_a_number, out_of_range };
@@ -318,33 +325,41 @@ double binary_float(const Source& src, std::string_view bytes, std::size_t offse
 // ---------------------------------------------------------------------------
 // Exact duplicates, merged for STL (each facet repeats its corners).
 
-struct PointKey {
-  std::array<std::uint64_t, 3> bits;
-  bool operator==(const PointKey&) const = default;
-};
-
-struct PointKeyHash {
-  std::size_t operator()(const PointKey& k) const {
-    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (const std::uint64_t b : k.bits) h = (h ^ b) * 0xff51afd7ed558ccdULL;
-    return static_cast<std::size_t>(h ^ (h >> 32));
+// The distinct points of `corners`, each at its first appearance, in file
+// order: sort (point, index) records by point then index, so that equal
+// points sit together with the earliest first, keep the first of each run,
+// and put the kept ones back in file order. O(n log n) whatever the values
+// (a hash table could be made to degrade by crafted input). The points are
+// finite, so < orders them strictly, and -0.0 == +0.0 merges the two zeros.
+std::vector<Vec3> merge_duplicates(const Source& src, const std::vector<Vec3>& corners) {
+  struct Record {
+    std::array<double, 3> p;
+    std::size_t index;
+  };
+  std::vector<Record> records(corners.size());
+  for (std::size_t i = 0; i < corners.size(); ++i) records[i] = {{corners[i].x(), corners[i].y(), corners[i].z()}, i};
+  std::sort(records.begin(), records.end(), [](const Record& a, const Record& b) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (a.p[k] != b.p[k]) return a.p[k] < b.p[k];
+    }
+    return a.index < b.index;
+  });
+  std::vector<bool> keep(corners.size(), false);
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    if (k == 0 || records[k].p != records[k - 1].p) {
+      keep[records[k].index] = true;
+      ++kept;
+    }
   }
-};
-
-class UniquePoints {
- public:
-  void add(const Source& src, const Vec3& p) {
-    // + 0.0 turns -0.0 into +0.0: equal values, one key.
-    const PointKey key{{std::bit_cast<std::uint64_t>(p.x() + 0.0), std::bit_cast<std::uint64_t>(p.y() + 0.0),
-                        std::bit_cast<std::uint64_t>(p.z() + 0.0)}};
-    if (seen_.emplace(key, static_cast<std::int32_t>(points_.size())).second) push_point(src, points_, p);
+  if (kept > kMaxPoints) src.fail("more than " + std::to_string(kMaxPoints) + " distinct vertices");
+  std::vector<Vec3> points;
+  points.reserve(kept);
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    if (keep[i]) points.push_back(corners[i]);
   }
-  std::vector<Vec3> take() { return std::move(points_); }
-
- private:
-  std::unordered_map<PointKey, std::int32_t, PointKeyHash> seen_;
-  std::vector<Vec3> points_;
-};
+  return points;
+}
 
 // ---------------------------------------------------------------------------
 // OBJ.
@@ -473,7 +488,7 @@ PointCloud read_obj(const Source& src, std::string_view text) {
 bool next_content_line(LineReader& lines, std::string_view* line) {
   while (lines.next(line)) {
     *line = strip_comment(*line);
-    if (line->find_first_not_of(kBlanks) != std::string_view::npos) return true;
+    if (!std::all_of(line->begin(), line->end(), is_blank)) return true;
   }
   return false;
 }
@@ -539,7 +554,7 @@ PointCloud read_xyz(const Source& src, std::string_view text) {
   LineReader lines(src, text);
   std::string_view line;
   while (next_content_line(lines, &line)) {
-    push_point(src, cloud.points, text_point(src, lines.number(), Tokens(line, kBlanksAndCommas), cloud.points.size()));
+    push_point(src, cloud.points, text_point(src, lines.number(), Tokens(line, Separators::blanks_and_commas), cloud.points.size()));
   }
   cloud.format = MeshFormat::xyz;
   return cloud;
@@ -582,23 +597,24 @@ PointCloud read_stl_binary(const Source& src, std::string_view bytes) {
                       std::to_string(expected) + " bytes (84 + 50 * " + std::to_string(n) + "), got " +
                       std::to_string(bytes.size()));
   }
-  UniquePoints unique;
+  std::vector<Vec3> corners;
+  corners.reserve(3 * static_cast<std::size_t>(n));  // n is bounded by the file's size, checked above
   for (std::size_t t = 0; t < n; ++t) {
-    const std::size_t corners = kStlPreambleBytes + kStlTriangleBytes * t + 12;  // after the normal
+    const std::size_t first_corner = kStlPreambleBytes + kStlTriangleBytes * t + 12;  // after the normal
     for (std::size_t k = 0; k < 3; ++k) {
       Vec3 p;
       for (int axis = 0; axis < 3; ++axis) {
-        const std::size_t offset = corners + 12 * k + 4 * static_cast<std::size_t>(axis);
+        const std::size_t offset = first_corner + 12 * k + 4 * static_cast<std::size_t>(axis);
         p[axis] = binary_float(src, bytes, offset, false, [&] {
           return std::string(axis_name(axis)) + " of corner " + std::to_string(k) + " of triangle " +
                  std::to_string(t) + " (0-based)";
         });
       }
-      unique.add(src, p);
+      corners.push_back(p);
     }
   }
   PointCloud cloud;
-  cloud.points = unique.take();
+  cloud.points = merge_duplicates(src, corners);
   cloud.format = MeshFormat::stl_binary;
   return cloud;
 }
@@ -611,9 +627,8 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
   enum class State : std::uint8_t { outside, solid, facet, loop, loop_done };
   State state = State::outside;
   std::int64_t facet_line = 0;
-  int corners = 0;
-  std::size_t corner_count = 0;
-  UniquePoints unique;
+  int facet_corners = 0;
+  std::vector<Vec3> corners;
   LineReader lines(src, text);
   std::string_view line;
   while (lines.next(&line)) {
@@ -636,7 +651,7 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
         if (iequals(keyword, "facet")) {
           state = State::facet;
           facet_line = at;
-          corners = 0;
+          facet_corners = 0;
         } else if (iequals(keyword, "endsolid")) {
           state = State::outside;
         } else {
@@ -651,12 +666,11 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
       }
       case State::loop:
         if (iequals(keyword, "vertex")) {
-          unique.add(src, text_point(src, at, tokens, corner_count));
-          ++corner_count;
-          ++corners;
+          corners.push_back(text_point(src, at, tokens, corners.size()));
+          ++facet_corners;
         } else if (iequals(keyword, "endloop")) {
-          if (corners != 3) {
-            src.fail_line(at, "the facet at line " + std::to_string(facet_line) + " has " + std::to_string(corners) +
+          if (facet_corners != 3) {
+            src.fail_line(at, "the facet at line " + std::to_string(facet_line) + " has " + std::to_string(facet_corners) +
                                   " vertices; STL facets are triangles (3)");
           }
           state = State::loop_done;
@@ -677,7 +691,7 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
     src.fail_line(lines.number(), "the file ends inside the facet opened at line " + std::to_string(facet_line));
   }
   PointCloud cloud;
-  cloud.points = unique.take();
+  cloud.points = merge_duplicates(src, corners);
   cloud.format = MeshFormat::stl_ascii;
   return cloud;
 }
@@ -748,6 +762,8 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
   std::size_t pos = 0;
   bool have_format = false;
   bool ended = false;
+  std::set<std::string> element_names;
+  std::set<std::string> property_names;  // of the current element
   while (pos < bytes.size()) {
     // Header lines end with "\n" or "\r\n"; the binary data starts right after.
     const std::size_t nl = bytes.find('\n', pos);
@@ -792,12 +808,11 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
       if (!parse_count(count, &element.count)) {
         src.fail_line(at, "PLY element count " + quote(count) + " is not a non-negative integer");
       }
-      for (const PlyElement& e : header.elements) {
-        if (e.name == name) src.fail_line(at, "duplicate PLY element " + quote(name));
-      }
       element.name = std::string(name);
+      if (!element_names.insert(element.name).second) src.fail_line(at, "duplicate PLY element " + quote(name));
       element.line = at;
       header.elements.push_back(std::move(element));
+      property_names.clear();
     } else if (word == "property") {
       if (header.elements.empty()) src.fail_line(at, "PLY property before any element");
       PlyProperty property;
@@ -815,10 +830,10 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
       if (!ply_type(type, &property.type)) src.fail_line(at, "unknown PLY type " + quote(type));
       std::string_view name;
       if (!tokens.next(&name)) src.fail_line(at, "PLY property has no name");
-      for (const PlyProperty& p : header.elements.back().properties) {
-        if (p.name == name) src.fail_line(at, "duplicate PLY property " + quote(name));
-      }
       property.name = std::string(name);
+      // Names are unique per element (a set, not a scan: a header of a
+      // million properties must not take quadratic time).
+      if (!property_names.insert(property.name).second) src.fail_line(at, "duplicate PLY property " + quote(name));
       header.elements.back().properties.push_back(std::move(property));
     } else {
       src.fail_line(at, "unknown PLY header keyword " + quote(word) + " (is end_header missing?)");
@@ -1024,7 +1039,7 @@ class PlyTextReader {
         ++line_;
       } else if (c == '\0') {
         src_.fail_line(line_, "NUL byte in ASCII PLY data");
-      } else if (kBlanks.find(c) == std::string_view::npos && c != '\r') {
+      } else if (!is_blank(c) && c != '\r') {
         break;
       }
       ++pos_;
@@ -1035,8 +1050,9 @@ class PlyTextReader {
     }
     const std::size_t b = pos_;
     last_line_ = line_;
-    while (pos_ < bytes_.size() && std::string_view(" \t\v\f\r\n", 6).find(bytes_[pos_]) == std::string_view::npos &&
-           bytes_[pos_] != '\0') {
+    while (pos_ < bytes_.size()) {
+      const char c = bytes_[pos_];
+      if (is_blank(c) || c == '\r' || c == '\n' || c == '\0') break;
       ++pos_;
     }
     return bytes_.substr(b, pos_ - b);
@@ -1109,12 +1125,12 @@ MeshFormat sniff_format(std::string_view bytes) {
   LineReader lines(quiet, text);
   std::string_view line;
   if (!next_content_line(lines, &line)) return MeshFormat::unknown;
-  Tokens tokens(line, kBlanksAndCommas);
+  Tokens tokens(line, Separators::blanks_and_commas);
   std::string_view word;
   tokens.next(&word);
   if (off_keyword(word) != 0) return MeshFormat::off;
   if (is_obj_statement(word)) return MeshFormat::obj;
-  if (all_numbers(Tokens(line, kBlanksAndCommas), 3)) return MeshFormat::xyz;
+  if (all_numbers(Tokens(line, Separators::blanks_and_commas), 3)) return MeshFormat::xyz;
   return MeshFormat::unknown;
 }
 
@@ -1162,7 +1178,10 @@ PointCloud read_points(const std::string& path) {
   const Source src{path};
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (!std::filesystem::exists(status)) src.fail("cannot open: no such file");
+  if (!std::filesystem::exists(status)) {
+    const bool missing = !ec || ec == std::errc::no_such_file_or_directory;
+    src.fail("cannot open: " + (missing ? std::string("no such file") : ec.message()));
+  }
   if (std::filesystem::is_directory(status)) src.fail("cannot open: is a directory");
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
   if (!file) src.fail(std::string("cannot open: ") + std::strerror(errno));
