@@ -4,11 +4,13 @@
 // Layer 7: the `proxima` command-line tool.
 //   proxima demo                                   the main job of `make run`
 //   proxima query [FILE] [--algorithm NAME] ...    JSON Lines in, JSON Lines out
+//   proxima paper [--quick] [--out DIR]            the paper's experiments against the peers
 //
 // Exit codes: 0 when the run completed (a query line with an error answer is
-// still a completed run), 1 when the input cannot be read or the demo fails,
-// 2 for usage errors.
+// still a completed run), 1 when the input cannot be read, the demo fails or
+// `paper` cannot write its files, 2 for usage errors.
 #include "demo.h"
+#include "paper/paper.h"
 #include "query.h"
 
 #include "proxima/types.h"
@@ -102,6 +104,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, kMaxIterationsLimit))
       ->capture_default_str();
 
+  CLI::App* paper = app.add_subcommand(
+      "paper",
+      "Reproduce the paper's experiments (robustness, figures 1-3, cold queries) for proxima, FCL "
+      "and Bullet; tables on the terminal, CSV files and PNG plots in --out");
+  proxima::bench::PaperOptions paper_options;
+  paper->add_flag("--quick", paper_options.quick, "Reduced run, under a minute");
+  paper->add_option("--out", paper_options.out_dir, "Directory for the CSV files and plots")
+      ->capture_default_str();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -112,6 +123,7 @@ int main(int argc, char** argv) {
 
   try {
     if (*demo) return proxima::cli::run_demo();
+    if (*paper) return proxima::bench::run_paper(paper_options, std::cout) == 0 ? kExitOk : kExitFailure;
     if (*query) {
       options.algorithm = parse_algorithm(algorithm);
       return run_query_command(file, options);
