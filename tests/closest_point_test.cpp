@@ -18,13 +18,13 @@
 //     divisions by zero).
 #include "proxima/closest_point.h"
 
-#include <boost/multiprecision/eigen.hpp>
-#include <boost/multiprecision/gmp.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <boost/multiprecision/eigen.hpp>
+#include <boost/multiprecision/gmp.hpp>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -39,8 +39,8 @@
 namespace proxima {
 namespace {
 
-using Rational =
-    boost::multiprecision::number<boost::multiprecision::gmp_rational, boost::multiprecision::et_off>;
+using Rational = boost::multiprecision::number<boost::multiprecision::gmp_rational,
+                                               boost::multiprecision::et_off>;
 using Vec3d = Vec3T<double>;
 using Vec3q = Vec3T<Rational>;
 
@@ -77,7 +77,8 @@ struct Expected {
 template <class S>
 ::testing::AssertionResult same(const S& got, double want) {
   if constexpr (std::is_floating_point_v<S>) {
-    if (std::abs(got - want) <= 8 * kU * std::max(1.0, std::abs(want))) return ::testing::AssertionSuccess();
+    if (std::abs(got - want) <= 8 * kU * std::max(1.0, std::abs(want)))
+      return ::testing::AssertionSuccess();
   } else {
     if (got == S(want)) return ::testing::AssertionSuccess();
   }
@@ -97,8 +98,8 @@ template <class S>
 }
 
 template <class S>
-void expect_answer(const ClosestPoints<S>& r, const Expected<S>& e, const Vec3T<S>* a, int na, const Vec3T<S>* b,
-                   int nb, const char* what) {
+void expect_answer(const ClosestPoints<S>& r, const Expected<S>& e, const Vec3T<S>* a, int na,
+                   const Vec3T<S>* b, int nb, const char* what) {
   SCOPED_TRACE(what);
   EXPECT_TRUE(same(r.distance_squared, e.distance_squared)) << "distance_squared";
   for (std::size_t i = 0; i < 3; ++i) {
@@ -122,8 +123,10 @@ TYPED_TEST_SUITE(HandComputed, Scalars);
 TYPED_TEST(HandComputed, PointPoint) {
   using S = TypeParam;
   const Vec3T<S> p = v3<S>(1, 2, 3), q = v3<S>(1, 2, 5);
-  expect_answer(closest_point_point(p, q), {4, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1, &q, 1, "distinct");
-  expect_answer(closest_point_point(p, p), {0, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1, &p, 1, "coincident");
+  expect_answer(closest_point_point(p, q), {4, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1, &q, 1,
+                "distinct");
+  expect_answer(closest_point_point(p, p), {0, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1, &p, 1,
+                "coincident");
 }
 
 TYPED_TEST(HandComputed, PointSegmentRegions) {
@@ -138,7 +141,9 @@ TYPED_TEST(HandComputed, PointSegmentRegions) {
       {v3<S>(-1, 1, 0), {2, {1, 0, 0}, {1, 0, 0}, 1, 1}, "before s0: vertex s0"},
       {v3<S>(0.5, 1, 0), {1, {1, 0, 0}, {0.75, 0.25, 0}, 1, 3}, "interior"},
       {v3<S>(3, 0, 2), {5, {1, 0, 0}, {0, 1, 0}, 1, 2}, "beyond s1: vertex s1"},
-      {v3<S>(0, 3, 0), {9, {1, 0, 0}, {1, 0, 0}, 1, 1}, "on the boundary plane of s0: minimal set is s0 alone"},
+      {v3<S>(0, 3, 0),
+       {9, {1, 0, 0}, {1, 0, 0}, 1, 1},
+       "on the boundary plane of s0: minimal set is s0 alone"},
       {v3<S>(1, 0, 0), {0, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, "on the segment"},
   };
   for (const Case& c : cases) {
@@ -147,8 +152,8 @@ TYPED_TEST(HandComputed, PointSegmentRegions) {
   }
   const Vec3T<S> zero[2] = {v3<S>(0, 0, 0), v3<S>(0, 0, 0)};
   const Vec3T<S> p = v3<S>(1, 1, 1);
-  expect_answer(closest_point_segment(p, zero[0], zero[1]), {3, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1, zero, 2,
-                "zero-length segment is its first vertex");
+  expect_answer(closest_point_segment(p, zero[0], zero[1]), {3, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1,
+                zero, 2, "zero-length segment is its first vertex");
 }
 
 // The seven Voronoi regions of a right triangle in z = 0, and Eberly's vertex
@@ -171,7 +176,9 @@ TYPED_TEST(HandComputed, PointTriangleRegions) {
       {v3<S>(-1, 4, 0), {5, {1, 0, 0}, {0, 0, 1}, 1, 4}, "vertex t2 (region 2)"},
       {v3<S>(4, -1, 2), {9, {1, 0, 0}, {0, 1, 0}, 1, 2}, "vertex t1 (region 6)"},
       {v3<S>(0, 0, 0), {0, {1, 0, 0}, {1, 0, 0}, 1, 1}, "at vertex t0: only t0 active"},
-      {v3<S>(1, 0, 5), {25, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, "above edge t0 t1: the face boundary, edge only"},
+      {v3<S>(1, 0, 5),
+       {25, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3},
+       "above edge t0 t1: the face boundary, edge only"},
   };
   for (const Case& c : right) {
     expect_answer(closest_point_triangle(c.p, t[0], t[1], t[2]), c.e, &c.p, 1, t, 3, c.what);
@@ -182,7 +189,9 @@ TYPED_TEST(HandComputed, PointTriangleRegions) {
   const Vec3T<S> o[3] = {v3<S>(0, 0, 0), v3<S>(2, 0, 0), v3<S>(-2, 1, 0)};
   const Case obtuse[] = {
       {v3<S>(1, -1, 0), {1, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, "region 4 resolving to edge t0 t1"},
-      {v3<S>(-1.5, -0.5, 0), {1.25, {1, 0, 0}, {0.5, 0, 0.5}, 1, 5}, "region 4 resolving to edge t0 t2"},
+      {v3<S>(-1.5, -0.5, 0),
+       {1.25, {1, 0, 0}, {0.5, 0, 0.5}, 1, 5},
+       "region 4 resolving to edge t0 t2"},
       {v3<S>(-0.5, -1.5, 1), {3.5, {1, 0, 0}, {1, 0, 0}, 1, 1}, "region 4 at the vertex"},
   };
   for (const Case& c : obtuse) {
@@ -191,12 +200,13 @@ TYPED_TEST(HandComputed, PointTriangleRegions) {
   // The same obtuse vertex relabelled as t2 and t1 exercises regions 2 and 6.
   const Vec3T<S> p = v3<S>(1, -1, 0), q = v3<S>(-1.5, -0.5, 0);
   const Vec3T<S> o2[3] = {v3<S>(2, 0, 0), v3<S>(-2, 1, 0), v3<S>(0, 0, 0)};
-  expect_answer(closest_point_triangle(p, o2[0], o2[1], o2[2]), {1, {1, 0, 0}, {0.5, 0, 0.5}, 1, 5}, &p, 1, o2, 3,
-                "region 2 resolving to edge t2 t0");
+  expect_answer(closest_point_triangle(p, o2[0], o2[1], o2[2]), {1, {1, 0, 0}, {0.5, 0, 0.5}, 1, 5},
+                &p, 1, o2, 3, "region 2 resolving to edge t2 t0");
   const Vec3T<S> o6[3] = {v3<S>(-2, 1, 0), v3<S>(0, 0, 0), v3<S>(2, 0, 0)};
-  expect_answer(closest_point_triangle(p, o6[0], o6[1], o6[2]), {1, {1, 0, 0}, {0, 0.5, 0.5}, 1, 6}, &p, 1, o6, 3,
-                "region 6 resolving to edge t1 t2");
-  expect_answer(closest_point_triangle(q, o6[0], o6[1], o6[2]), {1.25, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, &q, 1, o6, 3,
+  expect_answer(closest_point_triangle(p, o6[0], o6[1], o6[2]), {1, {1, 0, 0}, {0, 0.5, 0.5}, 1, 6},
+                &p, 1, o6, 3, "region 6 resolving to edge t1 t2");
+  expect_answer(closest_point_triangle(q, o6[0], o6[1], o6[2]),
+                {1.25, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, &q, 1, o6, 3,
                 "region 6 resolving to edge t0 t1");
 }
 
@@ -205,16 +215,16 @@ TYPED_TEST(HandComputed, DegenerateTriangles) {
   const Vec3T<S> p = v3<S>(1, 1, 0);
   // Collinear: its hull is the longest edge t1 t2 (length 4) whatever the order.
   const Vec3T<S> c[3] = {v3<S>(0, 0, 0), v3<S>(-2, 0, 0), v3<S>(2, 0, 0)};
-  expect_answer(closest_point_triangle(p, c[0], c[1], c[2]), {1, {1, 0, 0}, {0, 0.25, 0.75}, 1, 6}, &p, 1, c, 3,
-                "collinear");
+  expect_answer(closest_point_triangle(p, c[0], c[1], c[2]), {1, {1, 0, 0}, {0, 0.25, 0.75}, 1, 6},
+                &p, 1, c, 3, "collinear");
   // Two coincident vertices: the segment.
   const Vec3T<S> d[3] = {v3<S>(0, 0, 0), v3<S>(0, 0, 0), v3<S>(2, 0, 0)};
-  expect_answer(closest_point_triangle(p, d[0], d[1], d[2]), {1, {1, 0, 0}, {0.5, 0, 0.5}, 1, 5}, &p, 1, d, 3,
-                "repeated vertex");
+  expect_answer(closest_point_triangle(p, d[0], d[1], d[2]), {1, {1, 0, 0}, {0.5, 0, 0.5}, 1, 5},
+                &p, 1, d, 3, "repeated vertex");
   // All three coincident: the point.
   const Vec3T<S> z[3] = {v3<S>(0, 0, 0), v3<S>(0, 0, 0), v3<S>(0, 0, 0)};
-  expect_answer(closest_point_triangle(p, z[0], z[1], z[2]), {2, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1, z, 3,
-                "all coincident");
+  expect_answer(closest_point_triangle(p, z[0], z[1], z[2]), {2, {1, 0, 0}, {1, 0, 0}, 1, 1}, &p, 1,
+                z, 3, "all coincident");
 }
 
 // Segment A along the x axis from 0 to 2, segment B in the plane z = 1:
@@ -228,20 +238,38 @@ TYPED_TEST(HandComputed, SegmentSegmentRegions) {
     const char* what;
   };
   const Case cases[] = {
-      {v3<S>(1, -1, 1), v3<S>(1, 1, 1), {1, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3}, "region 0: edge-edge"},
+      {v3<S>(1, -1, 1),
+       v3<S>(1, 1, 1),
+       {1, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3},
+       "region 0: edge-edge"},
       {v3<S>(3, -1, 1), v3<S>(3, 1, 1), {2, {0, 1, 0}, {0.5, 0.5, 0}, 2, 3}, "region 1: s = 1"},
       {v3<S>(1, -3, 1), v3<S>(1, -1, 1), {2, {0.5, 0.5, 0}, {0, 1, 0}, 3, 2}, "region 3: t = 1"},
       {v3<S>(-1, -1, 1), v3<S>(-1, 1, 1), {2, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, "region 5: s = 0"},
       {v3<S>(1, 1, 1), v3<S>(1, 3, 1), {2, {0.5, 0.5, 0}, {1, 0, 0}, 3, 1}, "region 7: t = 0"},
-      {v3<S>(3, -3, 1), v3<S>(3, -1, 1), {3, {0, 1, 0}, {0, 1, 0}, 2, 2}, "region 2: corner (1, 1)"},
-      {v3<S>(-1, -3, 1), v3<S>(-1, -1, 1), {3, {1, 0, 0}, {0, 1, 0}, 1, 2}, "region 4: corner (0, 1)"},
-      {v3<S>(-1, 1, 1), v3<S>(-1, 3, 1), {3, {1, 0, 0}, {1, 0, 0}, 1, 1}, "region 6: corner (0, 0)"},
+      {v3<S>(3, -3, 1),
+       v3<S>(3, -1, 1),
+       {3, {0, 1, 0}, {0, 1, 0}, 2, 2},
+       "region 2: corner (1, 1)"},
+      {v3<S>(-1, -3, 1),
+       v3<S>(-1, -1, 1),
+       {3, {1, 0, 0}, {0, 1, 0}, 1, 2},
+       "region 4: corner (0, 1)"},
+      {v3<S>(-1, 1, 1),
+       v3<S>(-1, 3, 1),
+       {3, {1, 0, 0}, {1, 0, 0}, 1, 1},
+       "region 6: corner (0, 0)"},
       {v3<S>(3, 1, 1), v3<S>(3, 3, 1), {3, {0, 1, 0}, {1, 0, 0}, 2, 1}, "region 8: corner (1, 0)"},
       // Unconstrained minimum at s = 1.25, t = 1.5, but the answer is inside
       // the edge t = 1: the corner's derivative test picks it.
-      {v3<S>(-0.5, -3, 1), v3<S>(1.5, -1, 1), {2, {0.25, 0.75, 0}, {0, 1, 0}, 3, 2}, "region 2 resolving to t = 1"},
+      {v3<S>(-0.5, -3, 1),
+       v3<S>(1.5, -1, 1),
+       {2, {0.25, 0.75, 0}, {0, 1, 0}, 3, 2},
+       "region 2 resolving to t = 1"},
       // Unconstrained minimum at s = 1.25, t = 0.75: region 1 with t inside.
-      {v3<S>(4, -1, 1), v3<S>(2, 1, 1), {1.5, {0, 1, 0}, {0.25, 0.75, 0}, 2, 3}, "region 1, t inside"},
+      {v3<S>(4, -1, 1),
+       v3<S>(2, 1, 1),
+       {1.5, {0, 1, 0}, {0.25, 0.75, 0}, 2, 3},
+       "region 1, t inside"},
       {v3<S>(1, -1, 0), v3<S>(1, 1, 0), {0, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3}, "crossing"},
       {v3<S>(3, 0, 0), v3<S>(5, 0, 0), {1, {0, 1, 0}, {1, 0, 0}, 2, 1}, "collinear, disjoint"},
       {v3<S>(2, 0, 0), v3<S>(2, 5, 0), {0, {0, 1, 0}, {1, 0, 0}, 2, 1}, "touching at a1 = b0"},
@@ -263,18 +291,20 @@ TYPED_TEST(HandComputed, SegmentSegmentRegions) {
     const Vec3T<S> b[2] = {overlapping[k].first, overlapping[k].second};
     const ClosestPoints<S> r = closest_segment_segment(a[0], a[1], b[0], b[1]);
     EXPECT_TRUE(same(r.distance_squared, d2[k])) << "parallel case " << k;
-    EXPECT_EQ(std::popcount(static_cast<unsigned>(r.active_a)) + std::popcount(static_cast<unsigned>(r.active_b)), 3)
+    EXPECT_EQ(std::popcount(static_cast<unsigned>(r.active_a)) +
+                  std::popcount(static_cast<unsigned>(r.active_b)),
+              3)
         << "parallel case " << k;
   }
   // Zero-length segments are points.
   const Vec3T<S> z[2] = {v3<S>(0, 0, 0), v3<S>(0, 0, 0)};
   const Vec3T<S> b[2] = {v3<S>(1, -1, 1), v3<S>(1, 1, 1)};
-  expect_answer(closest_segment_segment(z[0], z[1], b[0], b[1]), {2, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, z, 2, b, 2,
-                "zero-length A");
-  expect_answer(closest_segment_segment(b[0], b[1], z[0], z[1]), {2, {0.5, 0.5, 0}, {1, 0, 0}, 3, 1}, b, 2, z, 2,
-                "zero-length B");
-  expect_answer(closest_segment_segment(z[0], z[1], z[0], z[1]), {0, {1, 0, 0}, {1, 0, 0}, 1, 1}, z, 2, z, 2,
-                "both zero-length");
+  expect_answer(closest_segment_segment(z[0], z[1], b[0], b[1]),
+                {2, {1, 0, 0}, {0.5, 0.5, 0}, 1, 3}, z, 2, b, 2, "zero-length A");
+  expect_answer(closest_segment_segment(b[0], b[1], z[0], z[1]),
+                {2, {0.5, 0.5, 0}, {1, 0, 0}, 3, 1}, b, 2, z, 2, "zero-length B");
+  expect_answer(closest_segment_segment(z[0], z[1], z[0], z[1]), {0, {1, 0, 0}, {1, 0, 0}, 1, 1}, z,
+                2, z, 2, "both zero-length");
 }
 
 TYPED_TEST(HandComputed, SegmentTriangle) {
@@ -286,19 +316,41 @@ TYPED_TEST(HandComputed, SegmentTriangle) {
     const char* what;
   };
   const Case cases[] = {
-      {v3<S>(0.5, 0.5, -1), v3<S>(0.5, 0.5, 1), {0, {0.5, 0.5, 0}, {0.5, 0.25, 0.25}, 3, 7}, "piercing the face"},
-      {v3<S>(0.5, 0.5, 1), v3<S>(0.5, 0.5, 3), {1, {1, 0, 0}, {0.5, 0.25, 0.25}, 1, 7}, "end above the face"},
-      {v3<S>(0.5, 0.5, 3), v3<S>(0.5, 0.5, 1), {1, {0, 1, 0}, {0.5, 0.25, 0.25}, 2, 7}, "other end above the face"},
-      {v3<S>(1, -1, 1), v3<S>(1, -1, -1), {1, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3}, "edge against edge t0 t1"},
-      {v3<S>(-1, -1, 0), v3<S>(-2, -2, 0), {2, {1, 0, 0}, {1, 0, 0}, 1, 1}, "vertex against vertex"},
-      {v3<S>(3, 3, -1), v3<S>(3, 3, 1), {8, {0.5, 0.5, 0}, {0, 0.5, 0.5}, 3, 6}, "crossing the plane outside"},
-      {v3<S>(-1, 1, -1), v3<S>(-1, 1, 1), {1, {0.5, 0.5, 0}, {0.5, 0, 0.5}, 3, 5}, "crossing the plane beside t0 t2"},
+      {v3<S>(0.5, 0.5, -1),
+       v3<S>(0.5, 0.5, 1),
+       {0, {0.5, 0.5, 0}, {0.5, 0.25, 0.25}, 3, 7},
+       "piercing the face"},
+      {v3<S>(0.5, 0.5, 1),
+       v3<S>(0.5, 0.5, 3),
+       {1, {1, 0, 0}, {0.5, 0.25, 0.25}, 1, 7},
+       "end above the face"},
+      {v3<S>(0.5, 0.5, 3),
+       v3<S>(0.5, 0.5, 1),
+       {1, {0, 1, 0}, {0.5, 0.25, 0.25}, 2, 7},
+       "other end above the face"},
+      {v3<S>(1, -1, 1),
+       v3<S>(1, -1, -1),
+       {1, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3},
+       "edge against edge t0 t1"},
+      {v3<S>(-1, -1, 0),
+       v3<S>(-2, -2, 0),
+       {2, {1, 0, 0}, {1, 0, 0}, 1, 1},
+       "vertex against vertex"},
+      {v3<S>(3, 3, -1),
+       v3<S>(3, 3, 1),
+       {8, {0.5, 0.5, 0}, {0, 0.5, 0.5}, 3, 6},
+       "crossing the plane outside"},
+      {v3<S>(-1, 1, -1),
+       v3<S>(-1, 1, 1),
+       {1, {0.5, 0.5, 0}, {0.5, 0, 0.5}, 3, 5},
+       "crossing the plane beside t0 t2"},
   };
   for (const Case& c : cases) {
     const Vec3T<S> a[2] = {c.a0, c.a1};
     expect_answer(closest_segment_triangle(a[0], a[1], t[0], t[1], t[2]), c.e, a, 2, t, 3, c.what);
     expect_answer(closest_points(a, 2, t, 3), c.e, a, 2, t, 3, c.what);
-    const Expected<S> swapped_e{c.e.distance_squared, c.e.coef_b, c.e.coef_a, c.e.active_b, c.e.active_a};
+    const Expected<S> swapped_e{c.e.distance_squared, c.e.coef_b, c.e.coef_a, c.e.active_b,
+                                c.e.active_a};
     expect_answer(closest_points(t, 3, a, 2), swapped_e, t, 3, a, 2, c.what);
   }
   // Parallel above the face: both ends are at distance 1; one end is the
@@ -309,7 +361,8 @@ TYPED_TEST(HandComputed, SegmentTriangle) {
   EXPECT_EQ(std::popcount(static_cast<unsigned>(r.active_a)), 1);
   EXPECT_EQ(int{r.active_b}, 7);
   // In the plane, across the triangle: distance 0 at an edge crossing.
-  const ClosestPoints<S> q = closest_segment_triangle(v3<S>(-1, 0.5, 0), v3<S>(3, 0.5, 0), t[0], t[1], t[2]);
+  const ClosestPoints<S> q =
+      closest_segment_triangle(v3<S>(-1, 0.5, 0), v3<S>(3, 0.5, 0), t[0], t[1], t[2]);
   EXPECT_TRUE(same(q.distance_squared, 0));
   EXPECT_EQ(int{q.active_a}, 3);
   EXPECT_EQ(std::popcount(static_cast<unsigned>(q.active_b)), 2);
@@ -324,14 +377,22 @@ TYPED_TEST(HandComputed, TriangleTriangle) {
     const char* what;
   };
   const Case cases[] = {
-      {{v3<S>(0.5, 0.5, 1), v3<S>(0, 0, 5), v3<S>(1, 0, 5)}, {1, {0.5, 0.25, 0.25}, {1, 0, 0}, 7, 1}, "face-vertex"},
-      {{v3<S>(1, -1, 1), v3<S>(1, -1, -1), v3<S>(5, -5, 0)}, {1, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3}, "edge-edge"},
-      {{v3<S>(-1, -1, 0), v3<S>(-2, -1, 0), v3<S>(-1, -2, 0)}, {2, {1, 0, 0}, {1, 0, 0}, 1, 1}, "vertex-vertex"},
-      {{v3<S>(3, 3, -1), v3<S>(3, 3, 1), v3<S>(9, 9, 0)}, {8, {0, 0.5, 0.5}, {0.5, 0.5, 0}, 6, 3}, "edge-edge, skew"},
+      {{v3<S>(0.5, 0.5, 1), v3<S>(0, 0, 5), v3<S>(1, 0, 5)},
+       {1, {0.5, 0.25, 0.25}, {1, 0, 0}, 7, 1},
+       "face-vertex"},
+      {{v3<S>(1, -1, 1), v3<S>(1, -1, -1), v3<S>(5, -5, 0)},
+       {1, {0.5, 0.5, 0}, {0.5, 0.5, 0}, 3, 3},
+       "edge-edge"},
+      {{v3<S>(-1, -1, 0), v3<S>(-2, -1, 0), v3<S>(-1, -2, 0)},
+       {2, {1, 0, 0}, {1, 0, 0}, 1, 1},
+       "vertex-vertex"},
+      {{v3<S>(3, 3, -1), v3<S>(3, 3, 1), v3<S>(9, 9, 0)},
+       {8, {0, 0.5, 0.5}, {0.5, 0.5, 0}, 6, 3},
+       "edge-edge, skew"},
   };
   for (const Case& c : cases) {
-    expect_answer(closest_triangle_triangle(a[0], a[1], a[2], c.b[0], c.b[1], c.b[2]), c.e, a, 3, c.b.data(), 3,
-                  c.what);
+    expect_answer(closest_triangle_triangle(a[0], a[1], a[2], c.b[0], c.b[1], c.b[2]), c.e, a, 3,
+                  c.b.data(), 3, c.what);
     expect_answer(closest_points(a, 3, c.b.data(), 3), c.e, a, 3, c.b.data(), 3, c.what);
   }
   // B's edge b0 b1 pierces A at (0.5, 0.5, 0) and A's edge t1 t2 pierces B
@@ -339,13 +400,17 @@ TYPED_TEST(HandComputed, TriangleTriangle) {
   const Vec3T<S> b[3] = {v3<S>(0.5, 0.5, -1), v3<S>(0.5, 0.5, 1), v3<S>(5, 5, 0)};
   const ClosestPoints<S> r = closest_triangle_triangle(a[0], a[1], a[2], b[0], b[1], b[2]);
   EXPECT_TRUE(same(r.distance_squared, 0));
-  EXPECT_EQ(std::popcount(static_cast<unsigned>(r.active_a)) + std::popcount(static_cast<unsigned>(r.active_b)), 5);
+  EXPECT_EQ(std::popcount(static_cast<unsigned>(r.active_a)) +
+                std::popcount(static_cast<unsigned>(r.active_b)),
+            5);
   // Parallel planes, overlapping: distance 1.
   const Vec3T<S> up[3] = {v3<S>(0, 0, 1), v3<S>(2, 0, 1), v3<S>(0, 2, 1)};
-  EXPECT_TRUE(same(closest_triangle_triangle(a[0], a[1], a[2], up[0], up[1], up[2]).distance_squared, 1));
+  EXPECT_TRUE(
+      same(closest_triangle_triangle(a[0], a[1], a[2], up[0], up[1], up[2]).distance_squared, 1));
   // Coplanar, overlapping: distance 0.
   const Vec3T<S> co[3] = {v3<S>(0.5, 0.5, 0), v3<S>(3, 0.5, 0), v3<S>(0.5, 3, 0)};
-  EXPECT_TRUE(same(closest_triangle_triangle(a[0], a[1], a[2], co[0], co[1], co[2]).distance_squared, 0));
+  EXPECT_TRUE(
+      same(closest_triangle_triangle(a[0], a[1], a[2], co[0], co[1], co[2]).distance_squared, 0));
 }
 
 // ---------------------------------------------------------------------------
@@ -360,8 +425,10 @@ struct Query {
   const Vec3d* pb() const { return b.data(); }
   double scale() const {
     double r = 0;
-    for (int i = 0; i < na; ++i) r = std::max(r, a[static_cast<std::size_t>(i)].cwiseAbs().maxCoeff());
-    for (int j = 0; j < nb; ++j) r = std::max(r, b[static_cast<std::size_t>(j)].cwiseAbs().maxCoeff());
+    for (int i = 0; i < na; ++i)
+      r = std::max(r, a[static_cast<std::size_t>(i)].cwiseAbs().maxCoeff());
+    for (int j = 0; j < nb; ++j)
+      r = std::max(r, b[static_cast<std::size_t>(j)].cwiseAbs().maxCoeff());
     return r;
   }
   std::string describe() const {
@@ -400,15 +467,17 @@ Rational exact_distance_squared_to(const Vec3q& x, const std::array<Vec3q, 3>& f
 // features: v.(x - point_a) <= 0 for x in A, v.(y - point_b) >= 0 for y in B.
 // Together they prove that the answer is the minimum distance.
 ::testing::AssertionResult certified(const ExactQuery& q, const ClosestPoints<Rational>& r) {
-  const auto check_side = [](const std::array<Vec3q, 3>& f, int n, const std::array<Rational, 3>& coef,
-                             std::uint8_t active, const Vec3q& point, const char* side) -> std::string {
+  const auto check_side = [](const std::array<Vec3q, 3>& f, int n,
+                             const std::array<Rational, 3>& coef, std::uint8_t active,
+                             const Vec3q& point, const char* side) -> std::string {
     Rational sum = 0;
     Vec3q combo = Vec3q::Zero();
     unsigned bits = 0;
     for (int i = 0; i < 3; ++i) {
       const Rational& c = coef[static_cast<std::size_t>(i)];
       if (c < 0) return std::string(side) + ": negative coefficient";
-      if (i >= n && c != 0) return std::string(side) + ": coefficient on a vertex that does not exist";
+      if (i >= n && c != 0)
+        return std::string(side) + ": coefficient on a vertex that does not exist";
       if (c != 0) bits |= 1u << i;
       sum += c;
       if (i < n) combo += c * f[static_cast<std::size_t>(i)];
@@ -421,12 +490,15 @@ Rational exact_distance_squared_to(const Vec3q& x, const std::array<Vec3q, 3>& f
   std::string why = check_side(q.a, q.na, r.coef_a, r.active_a, r.point_a, "A");
   if (why.empty()) why = check_side(q.b, q.nb, r.coef_b, r.active_b, r.point_b, "B");
   const Vec3q v = r.point_b - r.point_a;
-  if (why.empty() && v.squaredNorm() != r.distance_squared) why = "distance_squared is not |point_b - point_a|^2";
+  if (why.empty() && v.squaredNorm() != r.distance_squared)
+    why = "distance_squared is not |point_b - point_a|^2";
   for (int i = 0; why.empty() && i < q.na; ++i) {
-    if (v.dot(q.a[static_cast<std::size_t>(i)] - r.point_a) > 0) why = "a vertex of A lies beyond the separating plane";
+    if (v.dot(q.a[static_cast<std::size_t>(i)] - r.point_a) > 0)
+      why = "a vertex of A lies beyond the separating plane";
   }
   for (int j = 0; why.empty() && j < q.nb; ++j) {
-    if (v.dot(q.b[static_cast<std::size_t>(j)] - r.point_b) < 0) why = "a vertex of B lies beyond the separating plane";
+    if (v.dot(q.b[static_cast<std::size_t>(j)] - r.point_b) < 0)
+      why = "a vertex of B lies beyond the separating plane";
   }
   if (why.empty()) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << why;
@@ -455,7 +527,8 @@ double conditioning(const Query& q) {
   double kappa = 1;
   for (const auto* e : {&edges_a, &edges_b}) {
     if (e->size() == 3) {
-      kappa = std::min({kappa, sine((*e)[0], (*e)[1]), sine((*e)[0], (*e)[2]), sine((*e)[1], (*e)[2])});
+      kappa =
+          std::min({kappa, sine((*e)[0], (*e)[1]), sine((*e)[0], (*e)[2]), sine((*e)[1], (*e)[2])});
     }
   }
   for (const Vec3d& x : edges_a) {
@@ -487,8 +560,8 @@ double conditioning(const Query& q) {
 bool on_boundary(const ExactQuery& q, const ClosestPoints<Rational>& r, double margin) {
   const Vec3q v = r.point_b - r.point_a;
   const bool touching = v.squaredNorm() == 0;
-  const auto side = [&](const std::array<Vec3q, 3>& f, int n, std::uint8_t active, const Vec3q& point,
-                        double sign) -> bool {
+  const auto side = [&](const std::array<Vec3q, 3>& f, int n, std::uint8_t active,
+                        const Vec3q& point, double sign) -> bool {
     std::array<Vec3q, 3> rest;
     int n_active = 0;
     for (int i = 0; i < n; ++i) n_active += (active >> i) & 1;
@@ -498,7 +571,8 @@ bool on_boundary(const ExactQuery& q, const ClosestPoints<Rational>& r, double m
         if (n_active < 2) continue;
         int k = 0;
         for (int j = 0; j < n; ++j) {
-          if (j != i && ((active >> j) & 1)) rest[static_cast<std::size_t>(k++)] = f[static_cast<std::size_t>(j)];
+          if (j != i && ((active >> j) & 1))
+            rest[static_cast<std::size_t>(k++)] = f[static_cast<std::size_t>(j)];
         }
         const double d = std::sqrt(static_cast<double>(exact_distance_squared_to(point, rest, k)));
         if (d <= margin) return true;
@@ -506,14 +580,16 @@ bool on_boundary(const ExactQuery& q, const ClosestPoints<Rational>& r, double m
         if (touching) return true;
         const Vec3d to_x = rounded(Vec3q(x - point));
         const double len = to_x.norm();
-        if (len <= margin) return true;  // a vertex next to the point: which one is active is a toss-up
+        if (len <= margin)
+          return true;  // a vertex next to the point: which one is active is a toss-up
         const double slack = sign * rounded(v).dot(to_x) / len;  // > 0 strictly inside the region
         if (slack <= margin) return true;
       }
     }
     return false;
   };
-  return side(q.a, q.na, r.active_a, r.point_a, -1.0) || side(q.b, q.nb, r.active_b, r.point_b, 1.0);
+  return side(q.a, q.na, r.active_a, r.point_a, -1.0) ||
+         side(q.b, q.nb, r.active_b, r.point_b, 1.0);
 }
 
 // Margin of on_boundary in units of u R / kappa: rounding moves the double
@@ -522,7 +598,8 @@ bool on_boundary(const ExactQuery& q, const ClosestPoints<Rational>& r, double m
 constexpr double kBoundaryUnits = 4096.0;
 
 struct Tally {
-  std::map<std::pair<int, int>, int> interior_by_pattern;  // exact (active_a, active_b) -> non-boundary count
+  std::map<std::pair<int, int>, int>
+      interior_by_pattern;  // exact (active_a, active_b) -> non-boundary count
   int queries = 0;
   int compared = 0;
   int failures = 0;
@@ -532,7 +609,8 @@ struct Tally {
 
 // Runs one query in double (with `tol`) and exactly (zero tolerances) and
 // checks the accuracy standard. Reports the first few failures in full.
-void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tally, bool compare_active = true) {
+void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tally,
+                 bool compare_active = true) {
   ++tally.queries;
   const ExactQuery eq(q);
   const ClosestPoints<Rational> ex = exact_answer(eq);
@@ -542,11 +620,13 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
   std::vector<std::string> problems;
 
   const auto certificate = certified(eq, ex);
-  if (!certificate) problems.push_back(std::string("exact answer not certified: ") + certificate.message());
+  if (!certificate)
+    problems.push_back(std::string("exact answer not certified: ") + certificate.message());
 
-  const bool finite = std::isfinite(r.distance_squared) && r.point_a.allFinite() && r.point_b.allFinite() &&
-                      std::all_of(r.coef_a.begin(), r.coef_a.end(), [](double c) { return std::isfinite(c); }) &&
-                      std::all_of(r.coef_b.begin(), r.coef_b.end(), [](double c) { return std::isfinite(c); });
+  const bool finite =
+      std::isfinite(r.distance_squared) && r.point_a.allFinite() && r.point_b.allFinite() &&
+      std::all_of(r.coef_a.begin(), r.coef_a.end(), [](double c) { return std::isfinite(c); }) &&
+      std::all_of(r.coef_b.begin(), r.coef_b.end(), [](double c) { return std::isfinite(c); });
   if (!finite) problems.push_back("non-finite double answer");
 
   if (finite) {
@@ -563,20 +643,23 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
       return bits == active && std::abs(sum - 1) <= 4 * kU;
     };
     if (!coefs_ok(r.coef_a, q.na, r.active_a) || !coefs_ok(r.coef_b, q.nb, r.active_b)) {
-      problems.push_back("double coefficients out of [0, 1], not summing to 1 or not matching the active sets");
+      problems.push_back(
+          "double coefficients out of [0, 1], not summing to 1 or not matching the active sets");
     }
     // Distance.
     const double d = std::sqrt(r.distance_squared);
     const double d_exact = std::sqrt(static_cast<double>(ex.distance_squared));
     const double err = std::abs(d - d_exact);
-    tally.worst_distance_units = std::max(tally.worst_distance_units, ulp_r > 0 ? err / ulp_r : 0.0);
+    tally.worst_distance_units =
+        std::max(tally.worst_distance_units, ulp_r > 0 ? err / ulp_r : 0.0);
     if (err > kRelative * d_exact + kAbsoluteUnits * ulp_r) {
       std::ostringstream os;
       os.precision(17);
       os << "distance " << d << " vs exact " << d_exact << " (error " << err / ulp_r << " u R)";
       problems.push_back(os.str());
     }
-    if (std::abs(d - (r.point_b - r.point_a).norm()) > 4 * ulp_r) problems.push_back("distance is not |pb - pa|");
+    if (std::abs(d - (r.point_b - r.point_a).norm()) > 4 * ulp_r)
+      problems.push_back("distance is not |pb - pa|");
     // Points: on their features (exactly measured) and equal to eq. 20.
     const Rational bound2 = Rational(kAbsoluteUnits * ulp_r) * Rational(kAbsoluteUnits * ulp_r);
     for (int s = 0; s < 2; ++s) {
@@ -586,13 +669,16 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
       const std::array<double, 3>& coef = s == 0 ? r.coef_a : r.coef_b;
       const Vec3q xp = exact(point);
       const Rational off2 = exact_distance_squared_to(xp, f, n);
-      tally.worst_point_units =
-          std::max(tally.worst_point_units, ulp_r > 0 ? std::sqrt(static_cast<double>(off2)) / ulp_r : 0.0);
-      if (off2 > bound2) problems.push_back(std::string(s == 0 ? "point_a" : "point_b") + " is off its feature");
+      tally.worst_point_units = std::max(
+          tally.worst_point_units, ulp_r > 0 ? std::sqrt(static_cast<double>(off2)) / ulp_r : 0.0);
+      if (off2 > bound2)
+        problems.push_back(std::string(s == 0 ? "point_a" : "point_b") + " is off its feature");
       Vec3q combo = Vec3q::Zero();
-      for (int i = 0; i < n; ++i) combo += Rational(coef[static_cast<std::size_t>(i)]) * f[static_cast<std::size_t>(i)];
+      for (int i = 0; i < n; ++i)
+        combo += Rational(coef[static_cast<std::size_t>(i)]) * f[static_cast<std::size_t>(i)];
       if (Vec3q(combo - xp).squaredNorm() > bound2) {
-        problems.push_back(std::string(s == 0 ? "point_a" : "point_b") + " is not sum coef * vertex (eq. 20)");
+        problems.push_back(std::string(s == 0 ? "point_a" : "point_b") +
+                           " is not sum coef * vertex (eq. 20)");
       }
     }
     // Active sets, away from region boundaries.
@@ -604,8 +690,8 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
         ++tally.interior_by_pattern[{ex.active_a, ex.active_b}];
         if (r.active_a != ex.active_a || r.active_b != ex.active_b) {
           std::ostringstream os;
-          os << "active sets " << int{r.active_a} << "/" << int{r.active_b} << " vs exact " << int{ex.active_a} << "/"
-             << int{ex.active_b} << " (kappa " << kappa << ")";
+          os << "active sets " << int{r.active_a} << "/" << int{r.active_b} << " vs exact "
+             << int{ex.active_a} << "/" << int{ex.active_b} << " (kappa " << kappa << ")";
           problems.push_back(os.str());
         }
       }
@@ -626,7 +712,9 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
 class Gen {
  public:
   explicit Gen(std::uint64_t seed) : rng_(seed) {}
-  double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+  double uniform(double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng_);
+  }
   int integer(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
   Vec3d cube(double h = 1) { return {uniform(-h, h), uniform(-h, h), uniform(-h, h)}; }
   Vec3d unit() {
@@ -644,7 +732,9 @@ class Gen {
       if (n > 0.1 * d.norm()) return v / n;
     }
   }
-  Vec3d integers(int h) { return {double(integer(-h, h)), double(integer(-h, h)), double(integer(-h, h))}; }
+  Vec3d integers(int h) {
+    return {double(integer(-h, h)), double(integer(-h, h)), double(integer(-h, h))};
+  }
   double pick(std::initializer_list<double> xs) {
     return *(xs.begin() + integer(0, static_cast<int>(xs.size()) - 1));
   }
@@ -684,19 +774,22 @@ Query rescaled(Gen& g, Query q) {
 
 // The tallies must show that the random set exercised each region type with
 // enough interior (non-boundary) cases to mean something.
-void expect_share(const Tally& t, const std::vector<std::pair<int, int>>& patterns, double min_share,
-                  const char* what) {
+void expect_share(const Tally& t, const std::vector<std::pair<int, int>>& patterns,
+                  double min_share, const char* what) {
   for (const auto& p : patterns) {
     const auto it = t.interior_by_pattern.find(p);
     const int n = it == t.interior_by_pattern.end() ? 0 : it->second;
-    EXPECT_GE(n, min_share * t.queries) << what << ": too few interior cases of active sets " << p.first << "/"
-                                        << p.second << " (" << n << " of " << t.queries << ")";
+    EXPECT_GE(n, min_share * t.queries)
+        << what << ": too few interior cases of active sets " << p.first << "/" << p.second << " ("
+        << n << " of " << t.queries << ")";
   }
 }
 
 void report(const Tally& t, const char* what) {
-  std::printf("[ %s ] %d queries, %d active-set comparisons, worst distance error %.2f u R, worst point offset %.2f u R\n",
-              what, t.queries, t.compared, t.worst_distance_units, t.worst_point_units);
+  std::printf(
+      "[ %s ] %d queries, %d active-set comparisons, worst distance error %.2f u R, worst point "
+      "offset %.2f u R\n",
+      what, t.queries, t.compared, t.worst_distance_units, t.worst_point_units);
   EXPECT_EQ(t.failures, 0) << what;
 }
 
@@ -737,7 +830,8 @@ TEST(ClosestPointExact, RandomSegmentSegment) {
     check_query(q, tolerance_for(q), t);
   }
   report(t, "segment-segment");
-  expect_share(t, {{1, 1}, {1, 2}, {2, 1}, {2, 2}, {1, 3}, {3, 1}, {2, 3}, {3, 2}, {3, 3}}, 0.03, "segment-segment");
+  expect_share(t, {{1, 1}, {1, 2}, {2, 1}, {2, 2}, {1, 3}, {3, 1}, {2, 3}, {3, 2}, {3, 3}}, 0.03,
+               "segment-segment");
 }
 
 TEST(ClosestPointExact, RandomSegmentTriangle) {
@@ -753,7 +847,8 @@ TEST(ClosestPointExact, RandomSegmentTriangle) {
   // vertex-face, edge-edge, edge-face (piercing).
   std::map<std::pair<int, int>, int> by_kind;
   for (const auto& [pattern, n] : t.interior_by_pattern) {
-    by_kind[{std::popcount(static_cast<unsigned>(pattern.first)), std::popcount(static_cast<unsigned>(pattern.second))}] += n;
+    by_kind[{std::popcount(static_cast<unsigned>(pattern.first)),
+             std::popcount(static_cast<unsigned>(pattern.second))}] += n;
   }
   Tally kinds = t;
   kinds.interior_by_pattern = by_kind;
@@ -771,7 +866,8 @@ TEST(ClosestPointExact, RandomTriangleTriangle) {
   report(t, "triangle-triangle");
   std::map<std::pair<int, int>, int> by_kind;
   for (const auto& [pattern, n] : t.interior_by_pattern) {
-    by_kind[{std::popcount(static_cast<unsigned>(pattern.first)), std::popcount(static_cast<unsigned>(pattern.second))}] += n;
+    by_kind[{std::popcount(static_cast<unsigned>(pattern.first)),
+             std::popcount(static_cast<unsigned>(pattern.second))}] += n;
   }
   Tally kinds = t;
   kinds.interior_by_pattern = by_kind;
@@ -785,9 +881,13 @@ TEST(ClosestPointExact, RandomTriangleTriangle) {
 
 Query scaled_degenerate(Gen& g, Query q) {
   switch (g.integer(0, 3)) {
-    case 0: return q;
-    case 1: return transformed(q, std::ldexp(1.0, g.integer(-100, 100)), Vec3d::Zero());  // exact structure kept
-    default: return rescaled(g, q);
+    case 0:
+      return q;
+    case 1:
+      return transformed(q, std::ldexp(1.0, g.integer(-100, 100)),
+                         Vec3d::Zero());  // exact structure kept
+    default:
+      return rescaled(g, q);
   }
 }
 
@@ -813,7 +913,8 @@ std::array<Vec3d, 3> thin_triangle(Gen& g, double eps) {
 }
 
 std::array<Vec3d, 3> shuffled(Gen& g, std::array<Vec3d, 3> t) {
-  for (int i = 2; i > 0; --i) std::swap(t[static_cast<std::size_t>(i)], t[static_cast<std::size_t>(g.integer(0, i))]);
+  for (int i = 2; i > 0; --i)
+    std::swap(t[static_cast<std::size_t>(i)], t[static_cast<std::size_t>(g.integer(0, i))]);
   return t;
 }
 
@@ -826,10 +927,14 @@ Vec3d point_near(Gen& g, const std::array<Vec3d, 3>& t) {
   const Vec3d n = e0.cross(e1);
   const double nn = n.norm();
   switch (g.integer(0, 3)) {
-    case 0: return in_plane;
-    case 1: return nn > 0 ? Vec3d(in_plane + n / nn * g.pick({1e-12, 1e-6, 1e-3})) : in_plane;
-    case 2: return in_plane + g.cube(2);
-    default: return t[static_cast<std::size_t>(g.integer(0, 2))];  // coincident with a vertex
+    case 0:
+      return in_plane;
+    case 1:
+      return nn > 0 ? Vec3d(in_plane + n / nn * g.pick({1e-12, 1e-6, 1e-3})) : in_plane;
+    case 2:
+      return in_plane + g.cube(2);
+    default:
+      return t[static_cast<std::size_t>(g.integer(0, 2))];  // coincident with a vertex
   }
 }
 
@@ -837,7 +942,8 @@ TEST(ClosestPointExact, SliverAndNeedleTriangles) {
   Gen g(606);
   Tally t;
   for (int k = 0; k < 2500; ++k) {
-    const double eps = g.pick({1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-15, 1e-16, 1e-17, 0});
+    const double eps =
+        g.pick({1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-15, 1e-16, 1e-17, 0});
     Query q;
     q.na = 1;
     q.nb = 3;
@@ -862,9 +968,15 @@ TEST(ClosestPointExact, CollinearAndRepeatedVertexTriangles) {
     const Vec3d base = g.integers(8), dir = g.integers(3);
     std::array<Vec3d, 3> tri;
     switch (g.integer(0, 2)) {
-      case 0: tri = {base, base + g.integer(-4, 4) * dir, base + g.integer(-4, 4) * dir}; break;
-      case 1: tri = {base, base, g.integers(8)}; break;
-      default: tri = {base, base, base}; break;
+      case 0:
+        tri = {base, base + g.integer(-4, 4) * dir, base + g.integer(-4, 4) * dir};
+        break;
+      case 1:
+        tri = {base, base, g.integers(8)};
+        break;
+      default:
+        tri = {base, base, base};
+        break;
     }
     tri = shuffled(g, tri);
     q.a[0] = g.integer(0, 1) ? g.integers(10) : tri[0] + 0.5 * (tri[1] - tri[0]);
@@ -886,7 +998,8 @@ TEST(ClosestPointExact, NearlyParallelSegments) {
     const Vec3d dir = g.unit() * g.uniform(0.5, 2);
     q.a[0] = g.cube();
     q.a[1] = q.a[0] + dir;
-    const Vec3d dir_b = (dir + g.orthogonal(dir) * eps * dir.norm()) * g.pick({1.0, -1.0, 0.5, 2.0});
+    const Vec3d dir_b =
+        (dir + g.orthogonal(dir) * eps * dir.norm()) * g.pick({1.0, -1.0, 0.5, 2.0});
     const double gap = g.pick({0.0, 1e-9, 1e-3, 1.0});
     q.b[0] = q.a[0] + g.uniform(-1.5, 1.5) * dir + g.orthogonal(dir) * gap;
     q.b[1] = q.b[0] + dir_b;
@@ -928,10 +1041,20 @@ TEST(ClosestPointExact, ZeroAndTinySegments) {
     for (auto& v : q.b) v = g.cube();
     q.a[0] = g.cube();
     switch (g.integer(0, 3)) {
-      case 0: q.a[1] = q.a[0]; break;                                        // zero length
-      case 1: q.a[1] = q.a[0] + g.unit() * g.pick({1e-17, 1e-16, 1e-15}); break;  // about the tolerance
-      case 2: q.a[0] = q.b[0]; q.a[1] = g.cube(); break;                     // shared vertex
-      default: q.a[0] = q.b[0]; q.a[1] = q.b[0]; break;                      // zero length on a vertex
+      case 0:
+        q.a[1] = q.a[0];
+        break;  // zero length
+      case 1:
+        q.a[1] = q.a[0] + g.unit() * g.pick({1e-17, 1e-16, 1e-15});
+        break;  // about the tolerance
+      case 2:
+        q.a[0] = q.b[0];
+        q.a[1] = g.cube();
+        break;  // shared vertex
+      default:
+        q.a[0] = q.b[0];
+        q.a[1] = q.b[0];
+        break;  // zero length on a vertex
     }
     if (g.integer(0, 1)) std::swap(q.a, q.b), std::swap(q.na, q.nb);
     q = scaled_degenerate(g, q);
@@ -951,7 +1074,8 @@ TEST(ClosestPointExact, DegenerateSegmentTriangleAndTriangleTriangle) {
     Query q;
     q.na = g.integer(2, 3);
     q.nb = 3;
-    const auto tri = g.integer(0, 2) == 0 ? thin_triangle(g, eps) : std::array<Vec3d, 3>{g.cube(), g.cube(), g.cube()};
+    const auto tri = g.integer(0, 2) == 0 ? thin_triangle(g, eps)
+                                          : std::array<Vec3d, 3>{g.cube(), g.cube(), g.cube()};
     std::copy(tri.begin(), tri.end(), q.b.begin());
     const Vec3d e0 = tri[1] - tri[0], e1 = tri[2] - tri[0];
     const Vec3d n = e0.cross(e1);
@@ -978,7 +1102,8 @@ TEST(ClosestPointExact, DegenerateSegmentTriangleAndTriangleTriangle) {
       }
       case 3: {  // sharing a vertex or an edge with the triangle
         q.a[0] = tri[static_cast<std::size_t>(g.integer(0, 2))];
-        q.a[1] = g.integer(0, 1) ? tri[static_cast<std::size_t>(g.integer(0, 2))] : plane_point(g.uniform(-1, 1));
+        q.a[1] = g.integer(0, 1) ? tri[static_cast<std::size_t>(g.integer(0, 2))]
+                                 : plane_point(g.uniform(-1, 1));
         q.a[2] = plane_point(g.uniform(-1, 1));
         break;
       }
@@ -993,6 +1118,73 @@ TEST(ClosestPointExact, DegenerateSegmentTriangleAndTriangleTriangle) {
     check_query(q, tolerance_for(q), t);
   }
   report(t, "degenerate segment/triangle pairs");
+}
+
+// Edges that meet near their ends at every angle from exactly parallel to
+// perpendicular: T-junctions, corners, overlapping ends. Where (s, t) is
+// decided by rounding, the kernel must still land on the right edge of the
+// parameter square (the corner rule of closest_segment_segment). The edges
+// are used as segments, and as edges of triangles against segments and
+// triangles.
+TEST(ClosestPointExact, EdgesMeetingNearTheirEnds) {
+  Gen g(1515);
+  Tally t;
+  for (int k = 0; k < 3000; ++k) {
+    const Vec3d m0 = g.unit() * g.uniform(0.3, 2);
+    const Vec3d a0 = g.cube();
+    const double s_star =
+        g.pick({0.0, 1e-15, 1e-9, 1e-3, 0.5, 1 - 1e-3, 1 - 1e-15, 1.0, -1e-12, 1 + 1e-12});
+    const double h = g.pick({0.0, 1e-15, 1e-9, 1e-3});
+    const Vec3d near = a0 + s_star * m0 + g.orthogonal(m0) * h;
+    const double angle = g.pick({0.0, 1e-16, 1e-15, 1e-12, 1e-8, 1e-4, 0.1, 1.0, 1.5});
+    const Vec3d across = g.orthogonal(m0);
+    const Vec3d dir = (std::cos(angle) * m0.normalized() + std::sin(angle) * across) *
+                      g.pick({1.0, -1.0}) * g.uniform(0.1, 2);
+    Query q;
+    q.na = g.integer(2, 3);
+    q.nb = g.integer(2, 3);
+    q.a[0] = a0;
+    q.a[1] = a0 + m0;
+    q.a[2] = a0 + 0.5 * m0 + g.orthogonal(m0) * g.pick({1e-9, 0.5});
+    q.b[0] = near;
+    q.b[1] = near + dir;
+    q.b[2] = near + 0.5 * dir + g.orthogonal(dir) * g.pick({1e-9, 0.5});
+    if (g.integer(0, 1)) std::swap(q.b[0], q.b[1]);
+    if (g.integer(0, 1)) std::swap(q.a, q.b), std::swap(q.na, q.nb);
+    q = scaled_degenerate(g, q);
+    check_query(q, tolerance_for(q), t);
+  }
+  report(t, "edges meeting near their ends");
+}
+
+// Points around the tip of a needle or a sliver, and far along its axis,
+// where two nearly parallel edges meet at a tiny angle.
+TEST(ClosestPointExact, PointsNearASliversTip) {
+  Gen g(1616);
+  Tally t;
+  for (int k = 0; k < 2000; ++k) {
+    const double eps = g.pick({1e-4, 1e-8, 1e-12, 1e-15, 1e-16});
+    const Vec3d tip = g.cube();
+    const Vec3d axis = g.unit();
+    const Vec3d across = g.orthogonal(axis);
+    const double len = g.uniform(0.5, 2);
+    std::array<Vec3d, 3> tri = {
+        tip, tip + len * axis + across * (eps * len),
+        tip + g.uniform(0.2, 1.5) * len * axis - across * (eps * len * g.uniform(0, 2))};
+    const double along = g.pick({-1.0, -1e-3, -1e-9, 0.0, 1e-9, 1e-3, 0.5, 2.0});
+    const double side = g.pick({0.0, 1e-15, 1e-9, 1e-3}) * g.pick({1.0, -1.0});
+    const double up = g.pick({0.0, 1e-12, 1e-3, 1.0});
+    const Vec3d n = axis.cross(across);
+    Query q;
+    q.na = 1;
+    q.nb = 3;
+    q.a[0] = tip + along * axis + side * across + up * n;
+    std::copy(tri.begin(), tri.end(), q.b.begin());
+    q.b = shuffled(g, q.b);
+    q = scaled_degenerate(g, q);
+    check_query(q, tolerance_for(q), t);
+  }
+  report(t, "points near a sliver's tip");
 }
 
 // Coplanar triangles and segments from small integers in z = const planes:
@@ -1026,7 +1218,9 @@ TEST(ClosestPointExact, FiniteWithoutTolerances) {
     q.nb = g.integer(1, 3);
     const double eps = g.pick({1e-8, 1e-15, 1e-17, 0});
     switch (g.integer(0, 3)) {
-      case 0: q = generic(g, q.na, q.nb, 1); break;
+      case 0:
+        q = generic(g, q.na, q.nb, 1);
+        break;
       case 1: {
         const auto tri = thin_triangle(g, eps);
         std::copy(tri.begin(), tri.end(), q.a.begin());
@@ -1049,13 +1243,16 @@ TEST(ClosestPointExact, FiniteWithoutTolerances) {
     q = transformed(q, std::pow(10.0, g.pick({-150, -60, -30, 0, 30, 60})), Vec3d::Zero());
     for (const KernelTolerance<double>& tol : {KernelTolerance<double>{}, tolerance_for(q)}) {
       const ClosestPoints<double> r = closest_points<double>(q.pa(), q.na, q.pb(), q.nb, tol);
-      const bool finite = std::isfinite(r.distance_squared) && r.point_a.allFinite() && r.point_b.allFinite();
+      const bool finite =
+          std::isfinite(r.distance_squared) && r.point_a.allFinite() && r.point_b.allFinite();
       EXPECT_TRUE(finite) << q.describe();
       if (!finite) return;
       for (int i = 0; i < 3; ++i) {
-        ASSERT_TRUE(r.coef_a[static_cast<std::size_t>(i)] >= 0 && r.coef_a[static_cast<std::size_t>(i)] <= 1)
+        ASSERT_TRUE(r.coef_a[static_cast<std::size_t>(i)] >= 0 &&
+                    r.coef_a[static_cast<std::size_t>(i)] <= 1)
             << q.describe();
-        ASSERT_TRUE(r.coef_b[static_cast<std::size_t>(i)] >= 0 && r.coef_b[static_cast<std::size_t>(i)] <= 1)
+        ASSERT_TRUE(r.coef_b[static_cast<std::size_t>(i)] >= 0 &&
+                    r.coef_b[static_cast<std::size_t>(i)] <= 1)
             << q.describe();
       }
       ++checked;
@@ -1072,11 +1269,13 @@ TEST(ClosestPointExact, SymmetryAndRelabelling) {
     Query q = generic(g, g.integer(1, 3), g.integer(1, 3), g.pick({0.0, 1.0}));
     const ExactQuery eq(q);
     const ClosestPoints<Rational> ab = exact_answer(eq);
-    const ClosestPoints<Rational> ba = closest_points<Rational>(eq.b.data(), eq.nb, eq.a.data(), eq.na);
+    const ClosestPoints<Rational> ba =
+        closest_points<Rational>(eq.b.data(), eq.nb, eq.a.data(), eq.na);
     ASSERT_EQ(ab.distance_squared, ba.distance_squared) << q.describe();
     std::array<Vec3q, 3> ra = eq.a;
     std::reverse(ra.begin(), ra.begin() + eq.na);
-    const ClosestPoints<Rational> rel = closest_points<Rational>(ra.data(), eq.na, eq.b.data(), eq.nb);
+    const ClosestPoints<Rational> rel =
+        closest_points<Rational>(ra.data(), eq.na, eq.b.data(), eq.nb);
     ASSERT_EQ(ab.distance_squared, rel.distance_squared) << q.describe();
     const double kappa = conditioning(q);
     if (!on_boundary(eq, ab, kBoundaryUnits * kU * q.scale() / std::max(kappa, 1e-300))) {
@@ -1166,16 +1365,19 @@ TEST(ClosestPointTolerance, ReducesDegenerateFeatures) {
   const double scale = 4.0;
   const KernelTolerance<double> tol = kernel_tolerance(scale);
   EXPECT_EQ(tol.min_sin_squared, (kParallelSinFactor * kU) * (kParallelSinFactor * kU));
-  EXPECT_EQ(tol.min_length_squared, (kShortFeatureFactor * kU * scale) * (kShortFeatureFactor * kU * scale));
+  EXPECT_EQ(tol.min_length_squared,
+            (kShortFeatureFactor * kU * scale) * (kShortFeatureFactor * kU * scale));
   // A cap of height 2^-60 over a unit edge: sin ~ 2^-59 < 8u = 2^-50. The
   // point is above its interior.
   const Vec3d t0(0, 0, 0), t1(1, 0, 0), t2(0.5, 0x1p-60, 0), p(0.5, 0x1p-62, 1);
   const ClosestPoints<double> flat = closest_point_triangle(p, t0, t1, t2, tol);
   EXPECT_EQ(int{flat.active_b}, 3);
   // Exactly, it is a face answer, within the tolerance's promise.
-  const ClosestPoints<Rational> face = closest_point_triangle(exact(p), exact(t0), exact(t1), exact(t2));
+  const ClosestPoints<Rational> face =
+      closest_point_triangle(exact(p), exact(t0), exact(t1), exact(t2));
   EXPECT_EQ(int{face.active_b}, 7);
-  EXPECT_LE(std::abs(std::sqrt(flat.distance_squared) - std::sqrt(static_cast<double>(face.distance_squared))),
+  EXPECT_LE(std::abs(std::sqrt(flat.distance_squared) -
+                     std::sqrt(static_cast<double>(face.distance_squared))),
             28 * kU * scale);
   // A segment of length 2^-52 at scale 4 (tolerance 16u = 2^-49): a point.
   const Vec3d s0(1, 1, 1), s1(1 + 0x1p-52, 1, 1);

@@ -21,7 +21,7 @@
 //    zero can happen, whatever the input (finite) and the tolerances.
 //  * Degenerate features are reduced, never divided by (KernelTolerance).
 //  * Numerators of the 2x2 normal equations are evaluated as triple products
-//    (Lagrange's identity, see closest_point_triangle). In exact arithmetic
+//    (Lagrange's identity, see detail::triangle_foot). In exact arithmetic
 //    they equal Eberly's b*e - c*d forms; in floating point they locate the
 //    query relative to the feature's edges to within u times its distance,
 //    where b*e - c*d is only good to u / sin^2 of the feature's angle.
@@ -32,16 +32,15 @@
 // no finite input in range traps or returns NaN.
 #pragma once
 
-#include "proxima/types.h"
-
 #include <Eigen/Geometry>
-
 #include <array>
 #include <bit>
 #include <cstdint>
 #include <limits>
 #include <type_traits>
 #include <utility>
+
+#include "proxima/types.h"
 
 namespace proxima {
 
@@ -52,16 +51,23 @@ using Vec3T = Eigen::Matrix<S, 3, 1>;
 // them relative to the bodies' scale (see kernel_tolerance below).
 template <class S>
 struct KernelTolerance {
-  S min_length_squared = S(0);  // a segment with |M|^2 <= this is a point
-  S min_sin_squared = S(0);     // (a*c - b*b) <= this * a * c means dependent edges (triangle -> edge) or parallel segments
+  // A segment with |M|^2 <= this is a point.
+  S min_length_squared = S(0);
+  // (a*c - b*b) <= this * a * c means dependent edges (triangle -> edge) or
+  // parallel segments.
+  S min_sin_squared = S(0);
 };
 
 template <class S>
 struct ClosestPoints {
   S distance_squared = S(0);
-  Vec3T<S> point_a, point_b;            // eq. 20: sum coef_a[i]*A[i], sum coef_b[j]*B[j]
-  std::array<S, 3> coef_a{}, coef_b{};  // barycentric over the input vertices, sum to 1, zero where inactive
-  std::uint8_t active_a = 0, active_b = 0;  // bit i set iff vertex i has a non-zero coefficient: the minimal feature realizing the distance
+  // eq. 20: sum coef_a[i]*A[i], sum coef_b[j]*B[j].
+  Vec3T<S> point_a, point_b;
+  // Barycentric over the input vertices, sum to 1, zero where inactive.
+  std::array<S, 3> coef_a{}, coef_b{};
+  // Bit i set iff vertex i has a non-zero coefficient: the minimal feature
+  // realizing the distance.
+  std::uint8_t active_a = 0, active_b = 0;
 };
 
 // A feature shorter than this many units of u*R (R: the largest coordinate
@@ -77,7 +83,8 @@ inline constexpr double kShortFeatureFactor = 4.0;
 // is about 6u / sin). A triangle reduced at that threshold is dropped by at
 // most its height, sin * (longest edge) <= 8u * 2*sqrt(3)*R < 28 u R, inside
 // the 64 u R standard. Pinned by ClosestPointExact.SliverAndNeedleTriangles
-// and ClosestPointExact.NearlyParallelSegments.
+// and ClosestPointExact.NearlyParallelSegments (accuracy next to the
+// threshold) and by ClosestPointTolerance.ReducesDegenerateFeatures.
 inline constexpr double kParallelSinFactor = 8.0;
 
 // The thresholds for S = double when every input coordinate is at most
@@ -118,7 +125,8 @@ ClosestPoints<S> swapped(ClosestPoints<S> r) {
 // tie, the smaller feature pair, so that the answer stays minimal.
 template <class S>
 bool improves(const ClosestPoints<S>& candidate, const ClosestPoints<S>& best) {
-  if (candidate.distance_squared != best.distance_squared) return candidate.distance_squared < best.distance_squared;
+  if (candidate.distance_squared != best.distance_squared)
+    return candidate.distance_squared < best.distance_squared;
   return std::popcount(static_cast<unsigned>(candidate.active_a | candidate.active_b << 3)) <
          std::popcount(static_cast<unsigned>(best.active_a | best.active_b << 3));
 }
@@ -136,7 +144,8 @@ struct EdgeFoot {
 };
 
 template <class S>
-EdgeFoot<S> edge_foot(const Vec3T<S>& p, const Vec3T<S>& s0, const Vec3T<S>& s1, const S& min_length_squared) {
+EdgeFoot<S> edge_foot(const Vec3T<S>& p, const Vec3T<S>& s0, const Vec3T<S>& s1,
+                      const S& min_length_squared) {
   const Vec3T<S> m = s1 - s0;
   const S a = m.squaredNorm();
   if (a <= min_length_squared) return {S(0), s0};
@@ -196,9 +205,18 @@ struct TriangleFrame {
   S a, c, det;         // a = E0.E0, c = E1.E1, det = n.n
   bool degenerate;     // det <= min_sin_squared * a * c: treated as its longest edge
 
-  TriangleFrame(const Vec3T<S>& v0, const Vec3T<S>& v1, const Vec3T<S>& v2, const KernelTolerance<S>& tol)
-      : t0(v0), t1(v1), t2(v2), e0(v1 - v0), e1(v2 - v0), n(e0.cross(e1)), a(e0.squaredNorm()),
-        c(e1.squaredNorm()), det(n.squaredNorm()), degenerate(det <= tol.min_sin_squared * a * c) {}
+  TriangleFrame(const Vec3T<S>& v0, const Vec3T<S>& v1, const Vec3T<S>& v2,
+                const KernelTolerance<S>& tol)
+      : t0(v0),
+        t1(v1),
+        t2(v2),
+        e0(v1 - v0),
+        e1(v2 - v0),
+        n(e0.cross(e1)),
+        a(e0.squaredNorm()),
+        c(e1.squaredNorm()),
+        det(n.squaredNorm()),
+        degenerate(det <= tol.min_sin_squared * a * c) {}
 };
 
 // Closest point of a triangle to p: barycentric weights (w0, w1, w2) and the point.
@@ -230,7 +248,9 @@ template <class S>
 TriangleFoot<S> triangle_edge_or_corner(const TriangleFrame<S>& f, const Vec3T<S>& p, int i, int j,
                                         const S& min_length_squared) {
   TriangleFoot<S> foot = triangle_edge_foot(f, p, i, j, min_length_squared);
-  const int corner = foot.w[static_cast<std::size_t>(i)] == S(1) ? i : (foot.w[static_cast<std::size_t>(j)] == S(1) ? j : -1);
+  const int corner = foot.w[static_cast<std::size_t>(i)] == S(1)   ? i
+                     : foot.w[static_cast<std::size_t>(j)] == S(1) ? j
+                                                                   : -1;
   if (corner < 0) return foot;
   TriangleFoot<S> other = triangle_edge_foot(f, p, corner, 3 - i - j, min_length_squared);
   return (other.point - p).squaredNorm() < (foot.point - p).squaredNorm() ? other : foot;
@@ -239,7 +259,8 @@ TriangleFoot<S> triangle_edge_or_corner(const TriangleFrame<S>& f, const Vec3T<S
 // A triangle with dependent edges lies within its height of its longest edge,
 // and is exactly that edge when det == 0; its closest point is taken there.
 template <class S>
-TriangleFoot<S> longest_edge_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, const S& min_length_squared) {
+TriangleFoot<S> longest_edge_foot(const TriangleFrame<S>& f, const Vec3T<S>& p,
+                                  const S& min_length_squared) {
   const S l12 = (f.t2 - f.t1).squaredNorm();
   if (f.a >= f.c && f.a >= l12) return triangle_edge_foot(f, p, 0, 1, min_length_squared);
   if (f.c >= l12) return triangle_edge_foot(f, p, 0, 2, min_length_squared);
@@ -288,13 +309,15 @@ TriangleFoot<S> longest_edge_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, 
 //
 // Region 0 divides once, by a*det (detail::substitute): t = tn / det as
 // above, and s from the first normal equation a s + b t = E0.(p - t0), i.e.
-// s = (E0.(p - t0) - b t) / a. In exact arithmetic this is sn / det; in floating point it makes
-// the point the exact foot of p on the line {t0 + s E0 + t E1 : s}, so the
-// error of t (large on a sliver: t's line is nearly parallel to s's) moves
-// the point along the triangle instead of off the answer. If rounding puts s
+// s = (E0.(p - t0) - b t) / a. In exact arithmetic this is sn / det. In
+// floating point it makes the point the exact foot of p on the line
+// {t0 + s E0 + t E1 : s}, so the error of t (large on a sliver, where the
+// lines of constant s and of constant t are nearly parallel) moves the point
+// along the triangle instead of off the answer. If rounding puts s
 // outside [0, 1 - t] (never in exact arithmetic) the nearer edge is taken.
 template <class S>
-TriangleFoot<S> triangle_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, const S& min_length_squared) {
+TriangleFoot<S> triangle_foot(const TriangleFrame<S>& f, const Vec3T<S>& p,
+                              const S& min_length_squared) {
   if (f.degenerate) return longest_edge_foot(f, p, min_length_squared);
   const Vec3T<S> dp = p - f.t0;
   const Vec3T<S> m = f.n.cross(dp);
@@ -308,7 +331,8 @@ TriangleFoot<S> triangle_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, cons
       }
       return triangle_edge_or_corner(f, p, 0, 2, min_length_squared);  // region 3: s = 0
     }
-    if (tn < S(0)) return triangle_edge_or_corner(f, p, 0, 1, min_length_squared);  // region 5: t = 0
+    if (tn < S(0))
+      return triangle_edge_or_corner(f, p, 0, 1, min_length_squared);  // region 5: t = 0
     // Region 0.
     S s, t;
     if (!substitute(f.a, f.det, tn, f.e0.dot(dp), f.e0.dot(f.e1), s, t)) {
@@ -348,9 +372,9 @@ TriangleFoot<S> triangle_foot(const TriangleFrame<S>& f, const Vec3T<S>& p, cons
 // across L and puts the heights of points far along L (a segment running
 // along a sliver) off by more than the heights themselves. Removing it
 // leaves the tilt about L, which only scales with the distance from L.
-// (Found by ClosestPointExact.DegenerateSegmentTriangleAndTriangleTriangle:
-// a sliver of sine 3e-8 pierced by a segment along it at 2e-8 radians, whose
-// crossing came out 6 units away along the segment.)
+// (ClosestPointRegression.SegmentAlongASliverPiercesIt: a sliver of sines
+// 1e-8 to 4e-8 pierced by a segment along it at 1.7e-8 radians to its plane,
+// whose crossing came out 6.6 units away along the segment.)
 template <class S>
 bool crossing_candidate(const Vec3T<S>& a0, const Vec3T<S>& a1, const TriangleFrame<S>& f,
                         const KernelTolerance<S>& tol, ClosestPoints<S>& out) {
@@ -615,9 +639,9 @@ ClosestPoints<S> segment_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1, const 
 // detected by crossing_candidate, distance 0. The best candidate wins, ties
 // going to the smaller feature pair.
 template <class S>
-ClosestPoints<S> closest_segment_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1, const Vec3T<S>& t0,
-                                          const Vec3T<S>& t1, const Vec3T<S>& t2,
-                                          const KernelTolerance<S>& tol = {}) {
+ClosestPoints<S> closest_segment_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1,
+                                          const Vec3T<S>& t0, const Vec3T<S>& t1,
+                                          const Vec3T<S>& t2, const KernelTolerance<S>& tol = {}) {
   return detail::segment_triangle(a0, a1, detail::TriangleFrame<S>(t0, t1, t2, tol), tol);
 }
 
@@ -634,8 +658,9 @@ ClosestPoints<S> closest_segment_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1
 // find 0. All candidates are pairs of points on the two triangles, so in
 // floating point too the smallest one is an upper bound within rounding.
 template <class S>
-ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1, const Vec3T<S>& a2,
-                                           const Vec3T<S>& b0, const Vec3T<S>& b1, const Vec3T<S>& b2,
+ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a1,
+                                           const Vec3T<S>& a2, const Vec3T<S>& b0,
+                                           const Vec3T<S>& b1, const Vec3T<S>& b2,
                                            const KernelTolerance<S>& tol = {}) {
   const detail::TriangleFrame<S> fa(a0, a1, a2, tol);
   const detail::TriangleFrame<S> fb(b0, b1, b2, tol);
@@ -643,7 +668,7 @@ ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a
   const Vec3T<S>* vb[3] = {&b0, &b1, &b2};
   constexpr int kEdges[3][2] = {{0, 1}, {1, 2}, {0, 2}};
   // Moves the edge weights held in coef[0], coef[1] to the edge's vertices.
-  const auto spread = [](std::array<S, 3>& coef, const int (&edge)[2]) {
+  const auto spread = [](std::array<S, 3>& coef, const int(&edge)[2]) {
     const S w0 = coef[0], w1 = coef[1];
     coef = {S(0), S(0), S(0)};
     coef[static_cast<std::size_t>(edge[0])] = w0;
@@ -664,8 +689,9 @@ ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a
   for (int side = 0; side < 2; ++side) {
     for (const auto& edge : kEdges) {
       ClosestPoints<S> cand;
-      const bool crosses = side == 0 ? detail::crossing_candidate(*va[edge[0]], *va[edge[1]], fb, tol, cand)
-                                     : detail::crossing_candidate(*vb[edge[0]], *vb[edge[1]], fa, tol, cand);
+      const bool crosses =
+          side == 0 ? detail::crossing_candidate(*va[edge[0]], *va[edge[1]], fb, tol, cand)
+                    : detail::crossing_candidate(*vb[edge[0]], *vb[edge[1]], fa, tol, cand);
       if (!crosses) continue;
       if (side == 1) cand = detail::swapped(std::move(cand));
       spread(side == 0 ? cand.coef_a : cand.coef_b, edge);
@@ -688,7 +714,8 @@ ClosestPoints<S> closest_triangle_triangle(const Vec3T<S>& a0, const Vec3T<S>& a
   }
   for (const auto& ea : kEdges) {  // edges against edges
     for (const auto& eb : kEdges) {
-      ClosestPoints<S> cand = closest_segment_segment(*va[ea[0]], *va[ea[1]], *vb[eb[0]], *vb[eb[1]], tol);
+      ClosestPoints<S> cand =
+          closest_segment_segment(*va[ea[0]], *va[ea[1]], *vb[eb[0]], *vb[eb[1]], tol);
       spread(cand.coef_a, ea);
       spread(cand.coef_b, eb);
       consider(cand);
@@ -705,15 +732,24 @@ template <class S>
 ClosestPoints<S> closest_points(const Vec3T<S>* a, int na, const Vec3T<S>* b, int nb,
                                 const KernelTolerance<S>& tol = {}) {
   switch (na * 4 + nb) {
-    case 1 * 4 + 1: return closest_point_point(a[0], b[0]);
-    case 1 * 4 + 2: return closest_point_segment(a[0], b[0], b[1], tol);
-    case 2 * 4 + 1: return detail::swapped(closest_point_segment(b[0], a[0], a[1], tol));
-    case 1 * 4 + 3: return closest_point_triangle(a[0], b[0], b[1], b[2], tol);
-    case 3 * 4 + 1: return detail::swapped(closest_point_triangle(b[0], a[0], a[1], a[2], tol));
-    case 2 * 4 + 2: return closest_segment_segment(a[0], a[1], b[0], b[1], tol);
-    case 2 * 4 + 3: return closest_segment_triangle(a[0], a[1], b[0], b[1], b[2], tol);
-    case 3 * 4 + 2: return detail::swapped(closest_segment_triangle(b[0], b[1], a[0], a[1], a[2], tol));
-    default: return closest_triangle_triangle(a[0], a[1], a[2], b[0], b[1], b[2], tol);
+    case 1 * 4 + 1:
+      return closest_point_point(a[0], b[0]);
+    case 1 * 4 + 2:
+      return closest_point_segment(a[0], b[0], b[1], tol);
+    case 2 * 4 + 1:
+      return detail::swapped(closest_point_segment(b[0], a[0], a[1], tol));
+    case 1 * 4 + 3:
+      return closest_point_triangle(a[0], b[0], b[1], b[2], tol);
+    case 3 * 4 + 1:
+      return detail::swapped(closest_point_triangle(b[0], a[0], a[1], a[2], tol));
+    case 2 * 4 + 2:
+      return closest_segment_segment(a[0], a[1], b[0], b[1], tol);
+    case 2 * 4 + 3:
+      return closest_segment_triangle(a[0], a[1], b[0], b[1], b[2], tol);
+    case 3 * 4 + 2:
+      return detail::swapped(closest_segment_triangle(b[0], b[1], a[0], a[1], a[2], tol));
+    default:
+      return closest_triangle_triangle(a[0], a[1], a[2], b[0], b[1], b[2], tol);
   }
 }
 
