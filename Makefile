@@ -1,9 +1,9 @@
 # proxima: the two commands of the README.
-#   make run   builds in release and runs the main job
+#   make run   builds in release and runs the main job (proxima paper)
 #   make test  installs what is missing, builds, runs every test (release + sanitizers)
 JOBS ?= $(shell nproc)
 
-.PHONY: all run test setup release asan dev bench clean
+.PHONY: all run test setup release asan dev bench fuzz clean
 
 all: release
 
@@ -23,13 +23,15 @@ dev: setup
 	cmake --build --preset dev -j $(JOBS)
 
 run: release
-	./build/release/cli/proxima demo
+	./build/release/cli/proxima paper
 
 test: release asan
 	@echo "== unit tests, release build =="
 	ctest --preset release -j $(JOBS)
 	@echo "== unit tests, ASan + UBSan build =="
 	ctest --preset asan -j $(JOBS)
+	@echo "== fuzz smoke run of the mesh readers (20 s) =="
+	bash scripts/fuzz 20
 
 bench: release
 	@for b in build/release/bench/*_bench; do echo "== $$b =="; $$b; done
@@ -38,5 +40,5 @@ clean:
 	rm -rf build out
 
 # Fuzzes the mesh readers for 30 s (clang, libFuzzer + ASan + UBSan).
-.PHONY: fuzz
-fuzz: ; bash scripts/fuzz 30
+fuzz:
+	bash scripts/fuzz 30
