@@ -649,6 +649,38 @@ TEST(CliQuery, AlgorithmsAgreeOnRandomPosedHulls) {
   EXPECT_GE(intersecting, 1);
 }
 
+// Regression: while the library was being written, `proxima query` answered
+// a point inside a tetrahedron with "separated" and the distance to the
+// tetrahedron's base face (0.2) under the hybrid, while GJK said
+// "intersecting". Bodies strictly inside others, in both orders, must be
+// intersecting with every algorithm.
+TEST(CliQuery, ContainedBodiesIntersectWithEveryAlgorithm) {
+  REQUIRE_CLI();
+  const Json tetrahedron = {{-1, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const Json inside_point = {{0, 0.2, 0.2}};
+  const Json cube = points_json(box(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  const Json small_tetrahedron = {
+      {0.4, 0.4, 0.4}, {0.6, 0.4, 0.4}, {0.4, 0.6, 0.4}, {0.4, 0.4, 0.6}};
+  const std::vector<Json> queries = {
+      {{"a", {{"vertices", tetrahedron}}}, {"b", {{"vertices", inside_point}}}},
+      {{"a", {{"vertices", inside_point}}}, {"b", {{"vertices", tetrahedron}}}},
+      {{"a", {{"vertices", cube}}}, {"b", {{"vertices", small_tetrahedron}}}},
+      {{"a", {{"vertices", small_tetrahedron}}}, {"b", {{"vertices", cube}}}},
+  };
+  const TempFile file(lines_of(queries));
+  for (const char* algorithm : {"hybrid", "gjk", "enhanced_gjk"}) {
+    SCOPED_TRACE(algorithm);
+    const CliRun run = run_cli("query " + shell_quote(file.path()) + " --algorithm " + algorithm);
+    ASSERT_EQ(run.exit_code, 0);
+    const std::vector<Json> answers = parse_answers(run.out);
+    ASSERT_EQ(answers.size(), queries.size());
+    for (const Json& answer : answers) {
+      EXPECT_EQ(answer.at("status"), "intersecting") << answer.dump();
+      EXPECT_EQ(check_answer_fields(answer), 0.0);
+    }
+  }
+}
+
 TEST(CliQuery, StandardInputWithAndWithoutDash) {
   REQUIRE_CLI();
   const std::string text =
