@@ -117,6 +117,47 @@ mpq_class exact_squared_distance(const Vec3& p, const Vec3& q) {
   return squared_norm(difference(to_rational(p), to_rational(q)));
 }
 
+// Largest side of the bounding box.
+double extent(const Points& p) {
+  Vec3 lo = p[0], hi = p[0];
+  for (const Vec3& x : p) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  return (hi - lo).maxCoeff();
+}
+
+// The optimality certificate of a separated answer: w = point_b - point_a
+// must separate the hulls, checked exactly against every input point.
+// The answer is only accurate to the standard, so the plane may tilt:
+// with tol the band for the points and eps = 1e-12 |w| + tol the bound on
+// |w| - d*, the answer's w lies within 2 tol of conv(B - A) and its norm
+// is at most d* + eps; the exact w* (the minimum-norm point of that set)
+// then satisfies |w - w*| <= 2 tol + sqrt(2 d* e + e^2) with
+// e = eps + 2 tol (for z in the set, w*.(z - w*) >= 0, so
+// |z - w*|^2 <= |z|^2 - d*^2). For x in A, w*.x <= w*.pa* and
+// w*.(pa* - point_a) <= d* (tol + eps), hence
+//   w.(x - point_a) <= d* (tol + eps) + |w - w*| (diam + tol),
+// and the mirror image for B. A wrong feature or a stale plane breaks it
+// by far more; near contact (d* ~ tol) the bound is loose by nature.
+std::string separation_certificate(const DistanceResult& r, const Points& wa, const Points& wb, double tol) {
+  const double wn = (r.point_b - r.point_a).norm();
+  const double eps = kRelativeTolerance * wn + tol;
+  const double e = eps + 2 * tol;
+  const double d_max = wn + eps;
+  const double diam = std::sqrt(3.0) * std::max(extent(wa), extent(wb));
+  const double allowed =
+      1.01 * (d_max * (tol + eps) + (2 * tol + std::sqrt(2 * d_max * e + e * e)) * (diam + tol));
+  const QPoint qa = to_rational(r.point_a), qb = to_rational(r.point_b);
+  const QPoint w = difference(qb, qa);
+  const mpq_class limit(allowed);
+  for (const Vec3& x : wa)
+    if (dot(w, difference(to_rational(x), qa)) > limit) return "point_b - point_a does not separate: A beyond";
+  for (const Vec3& y : wb)
+    if (-dot(w, difference(to_rational(y), qb)) > limit) return "point_b - point_a does not separate: B beyond";
+  return {};
+}
+
 // Counts per category: the kinds of cases really generated, and failures.
 struct Tally {
   int cases = 0;
@@ -217,15 +258,6 @@ class AccuracySuite {
   }
 
  private:
-  static double extent(const Points& p) {
-    Vec3 lo = p[0], hi = p[0];
-    for (const Vec3& x : p) {
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
-    }
-    return (hi - lo).maxCoeff();
-  }
-
   // Is p within tol of conv(hull)? First against the reported feature (a
   // tiny, cheap oracle query that is a certificate by itself when it
   // passes), then against the whole hull. A separated answer's point that
@@ -291,6 +323,10 @@ class AccuracySuite {
       v.push_back("|point_a - point_b| differs from distance");
     if (!point_near_hull(t, r.point_a, r.feature_a, separated_reported, pa, wa, tol)) v.push_back("point_a not within band of hull A");
     if (!point_near_hull(t, r.point_b, r.feature_b, separated_reported, pb, wb, tol)) v.push_back("point_b not within band of hull B");
+    if (separated_reported && !sqrt_at_most(e.distance_squared, 2 * band)) {
+      const std::string s = separation_certificate(r, wa, wb, tol);
+      if (!s.empty()) v.push_back(s);
+    }
     return v;
   }
 
@@ -688,7 +724,8 @@ TEST(DistanceProperties, InvariantUnderCommonRigidMotion) {
       const DistanceResult d2 = distance(a, t, b, t, o);
       RC_LOG() << to_string(alg) << " before " << describe(d0) << "\nmoved " << describe(d1) << "\nposed "
                << describe(d2) << "\nconst Points a = " << format_points(p.a) << ";\nconst Points b = "
-               << format_points(p.b) << ";\nT = " << format_pose(t) << "\n";
+               << format_points(p.b) << ";\nT = " << format_pose(t) << "\nmoved:\nconst Points a = "
+               << format_points(ta) << ";\nconst Points b = " << format_points(tb) << ";\n";
       const mpq_class d0_sq = squared(d0.distance);
       RC_ASSERT(within_bound(d1.distance, d0_sq, kRelativeTolerance, tol));
       RC_ASSERT(within_bound(d2.distance, d0_sq, kRelativeTolerance, tol));
@@ -717,6 +754,22 @@ TEST(DistanceProperties, IterationCapHolds) {
       RC_ASSERT(std::isfinite(capped.distance));
     }
   });
+}
+
+TEST(DistanceCertificate, SeparationCertificateRejectsAWrongPair) {
+  // The check itself must be able to fail: unit cubes 1 apart along x,
+  // with the right closest points it passes; with point_a moved to a far
+  // corner of A (still in A, but not closest) the plane tilts and A pokes
+  // through it.
+  const Points a = cube(1.0), b = translated(cube(1.0), Vec3(2, 0, 0));
+  const double tol = kBandUlps * kUnitRoundoff * 2.5;
+  DistanceResult r;
+  r.point_a = Vec3(0.5, 0, 0);
+  r.point_b = Vec3(1.5, 0, 0);
+  EXPECT_EQ(separation_certificate(r, a, b, tol), "");
+  r.point_a = Vec3(0.5, -0.5, -0.5);
+  r.point_b = Vec3(1.5, 0.5, 0.5);
+  EXPECT_NE(separation_certificate(r, a, b, tol), "");
 }
 
 // ---------------------------------------------------------------------------
@@ -798,6 +851,38 @@ TEST(DistanceRegression, ParallelClosestFaces) {
     const Points b = translated(box(Vec3(0.7, 0.4, 0.3)), Vec3(0.3, 1.0, 0.5 + 0.3 + gap));
     EXPECT_TRUE(run_named(gap > 1e-6 ? "parallel_faces_1e-3" : "parallel_faces_1e-12", a, b));
   }
+}
+
+TEST(DistanceRegression, CloudFarFromTheOriginKeepsItsHull) {
+  // Found by ScalesAndFarFromOrigin (2026-11-21): 23 points of a cloud of
+  // size ~5e11 some 4.7e13 from the origin. The polytope kept 5 hull
+  // vertices and left 15 input points up to 1e11 outside its hull, so all
+  // three algorithms answered 4.7855e13 (with a "certified" lower bound
+  // equal to it) for the distance from the origin, d* = 4.7792e13.
+  const Points cloud{Vec3(-45926003200944.18, -9629196180130.4258, -10337191103972.561),
+                    Vec3(-45620349428118.648, -9976505698232.5469, -10459320150535.633),
+                    Vec3(-45625055592862.773, -9985096146497.8086, -10463766466772.115),
+                    Vec3(-46004895940472.484, -9839064591322.1953, -10441623362836.598),
+                    Vec3(-45748212672173.648, -10087807469241.111, -10524702135543.17),
+                    Vec3(-45833286706647.672, -9626317318440.9375, -10325109157434.99),
+                    Vec3(-45909218793537.891, -10098518588191.51, -10548275676773.223),
+                    Vec3(-45784871682281.453, -9822527584956.0742, -10408546458524.146),
+                    Vec3(-46050375897517.164, -9691845031711.6719, -10380082859032.918),
+                    Vec3(-45795875007241.297, -9633790403451.4922, -10324153495356.668),
+                    Vec3(-46120673418602.117, -9870155058748.3301, -10469191206630.371),
+                    Vec3(-45887087045322.109, -9857098607693.2383, -10436118059368.434),
+                    Vec3(-46040289888879.859, -9682947679143.1699, -10374872006801.596),
+                    Vec3(-45792607136023.883, -9634689309109.4297, -10324181747293.166),
+                    Vec3(-45614304069720.984, -9786808798886.4824, -10372510215956.299),
+                    Vec3(-45772435576690.906, -9863977131926.1152, -10425915990714.887),
+                    Vec3(-46119164439212.188, -9822469135109.209, -10447370206754.934),
+                    Vec3(-46087504385156.273, -9736577724474.4609, -10404702894824.119),
+                    Vec3(-46038042820096.172, -10032535354223.086, -10533295972052.307),
+                    Vec3(-45768283773360.945, -9837292083870.1562, -10413320585418.457),
+                    Vec3(-45802186831091.477, -9632168925527.5273, -10324151009877.291),
+                    Vec3(-45720832587187.445, -10075543324848.436, -10515953172317.279),
+                    Vec3(-45700016347729.234, -10063414866488.398, -10508028625888.172)};
+  EXPECT_TRUE(run_named("cloud_far_from_origin", {Vec3(0, 0, 0)}, cloud));
 }
 
 }  // namespace
