@@ -1113,9 +1113,11 @@ bool all_numbers(Tokens tokens, int n) {
 
 MeshFormat sniff_format(std::string_view bytes) {
   if (bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n") return MeshFormat::ply_ascii;
-  if (bytes.size() >= kStlPreambleBytes && stl_is_binary(bytes)) {
-    const std::uint64_t n = load_le(bytes, kStlHeaderBytes, 4);
-    if (kStlPreambleBytes + kStlTriangleBytes * n == bytes.size()) return MeshFormat::stl_binary;
+  // Binary STL only by the exact size rule here: without a .stl extension,
+  // a size mismatch says nothing about the format.
+  if (bytes.size() >= kStlPreambleBytes &&
+      kStlPreambleBytes + kStlTriangleBytes * load_le(bytes, kStlHeaderBytes, 4) == bytes.size()) {
+    return MeshFormat::stl_binary;
   }
   if (bytes.find('\0') != std::string_view::npos) return MeshFormat::unknown;
   const std::string_view text = strip_bom(bytes);
