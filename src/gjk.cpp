@@ -34,8 +34,9 @@
 // stale or foreign cache can only cost iterations.
 //
 // Units. All simplex arithmetic runs on coordinates divided by a power of two
-// near the bodies' magnitude: exact, and it keeps the cubic terms of the
-// signed volumes away from overflow and underflow whatever the scale.
+// near the bodies' magnitude: exact, and it keeps the cubic terms (face
+// normals dotted with points) away from overflow and underflow whatever the
+// scale.
 #include "proxima/gjk.h"
 
 #include "proxima/support.h"
@@ -59,10 +60,11 @@ namespace {
 constexpr double kGapUlps = 16.0;
 
 // Budget of the contact classification (below): Minkowski-difference points
-// of its inner polytope. A contact that is not decided within it is within
-// the band by every test so far and is reported as touching; at 32 points the
-// classification has refined the faces around the origin ~28 times, far more
-// than any test case needs (they decide within a handful).
+// of its inner polytope. A contact not decided within it is reported as
+// touching: its distance is certified within the band, and no depth beyond
+// the band was found. At 32 points the faces around the origin have been
+// refined 28 times; every contact in the tests decides within a handful
+// (IterationCapHoldsInContacts shows six supports for concentric cubes).
 constexpr int kMaxContactVertices = 32;
 // A closed triangulated surface on V vertices has at most 2V - 4 faces.
 constexpr int kMaxContactFaces = 2 * kMaxContactVertices - 4;

@@ -643,7 +643,7 @@ TEST(Gjk, RandomIntersectingPairs) {
 
 // B circles A, spinning, and dips into it and out again: at every step the
 // tracked Enhanced GJK gives classic GJK's answer (same status, distance
-// within the band), and on average needs fewer support evaluations.
+// within the band), and needs far fewer support evaluations.
 TEST(EnhancedGjk, MatchesClassicAlongAMotion) {
   Rng rng(4242);
   const ConvexPolytope a(sphere_points(rng, 300, 1.0));
@@ -674,7 +674,9 @@ TEST(EnhancedGjk, MatchesClassicAlongAMotion) {
     intersecting += c.status == Status::intersecting;
   }
   EXPECT_GE(intersecting, 20);
-  EXPECT_LT(enhanced_iterations, classic_iterations);
+  // The warm start pays: about a quarter of classic GJK's support
+  // evaluations here (a cold Enhanced GJK would need as many as classic).
+  EXPECT_LT(2 * enhanced_iterations, classic_iterations);
 }
 
 // With the pose unchanged, the cached simplex is already the answer: one
