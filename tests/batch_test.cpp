@@ -1,0 +1,350 @@
+// Tests of distance_batch: the batch is the sequential loop, bit for bit
+// (results and caches), at 1 and 2 threads and in the caller's arena, for
+// every algorithm; caches carry tracking across calls; bad input is refused
+// with its index before anything is written; an exception thrown inside a
+// worker reaches the caller as InvalidInput with its message.
+//
+// The reference is distance() itself, called in a plain loop: the batch
+// promises nothing more than running that loop on several threads. Accuracy
+// of the answers is the business of distance_accuracy_test.cpp.
+#include "proxima/batch.h"
+
+#include "proxima/distance.h"
+#include "support/generators.h"
+
+#include <gtest/gtest.h>
+#include <oneapi/tbb/task_arena.h>
+#include <oneapi/tbb/task_scheduler_observer.h>
+
+#include <bit>
+#include <cfenv>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace proxima {
+namespace {
+
+using test::Rng;
+
+// A scene of `n` pairs drawn from a pool of shared polytopes (20 to 100
+// random points each, on a sphere or in a cube), with random poses spread so
+// that a fair share of the pairs overlap and the rest are separated.
+struct Scene {
+  std::vector<std::unique_ptr<ConvexPolytope>> pool;
+  std::vector<BatchPair> pairs;
+  std::vector<Pose> poses_a;
+  std::vector<Pose> poses_b;
+};
+
+Pose random_pose(Rng& rng, double spread) {
+  return {test::random_quaternion(rng),
+          Vec3(test::uniform(rng, -spread, spread), test::uniform(rng, -spread, spread),
+               test::uniform(rng, -spread, spread))};
+}
+
+Scene make_scene(Rng& rng, int n, int pool_size = 12) {
+  Scene s;
+  for (int i = 0; i < pool_size; ++i) {
+    const int count = test::uniform_int(rng, 20, 100);
+    s.pool.push_back(std::make_unique<ConvexPolytope>(i % 2 == 0 ? test::points_on_sphere(rng, count)
+                                                                 : test::points_in_cube(rng, count)));
+  }
+  for (int k = 0; k < n; ++k) {
+    const auto pick = [&] { return s.pool[static_cast<std::size_t>(test::uniform_int(rng, 0, pool_size - 1))].get(); };
+    s.pairs.push_back({pick(), pick()});
+    s.poses_a.push_back(random_pose(rng, 2.0));
+    s.poses_b.push_back(random_pose(rng, 2.0));
+  }
+  return s;
+}
+
+// Every pose moved by a small rotation and translation: the next frame of a
+// simulation, whose closest features mostly stay the same.
+void step(Rng& rng, std::vector<Pose>& poses) {
+  for (Pose& p : poses) {
+    p = Pose(Mat3(test::random_small_rotation(rng, 0.01) * p.rotation),
+             Vec3(p.translation + 0.01 * test::random_unit_vector(rng)));
+  }
+}
+
+bool same_bits(double x, double y) { return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y); }
+bool same_bits(const Vec3& x, const Vec3& y) {
+  return same_bits(x[0], y[0]) && same_bits(x[1], y[1]) && same_bits(x[2], y[2]);
+}
+bool same_feature(const Feature& x, const Feature& y) {
+  return x.type == y.type && x.vertices == y.vertices && x.face == y.face;
+}
+
+void expect_same_result(const DistanceResult& x, const DistanceResult& y, std::size_t k) {
+  EXPECT_EQ(x.status, y.status) << "pair " << k;
+  EXPECT_TRUE(same_bits(x.distance, y.distance)) << "pair " << k << ": " << x.distance << " vs " << y.distance;
+  EXPECT_TRUE(same_bits(x.lower_bound, y.lower_bound)) << "pair " << k;
+  EXPECT_TRUE(same_bits(x.point_a, y.point_a)) << "pair " << k;
+  EXPECT_TRUE(same_bits(x.point_b, y.point_b)) << "pair " << k;
+  EXPECT_TRUE(same_bits(x.normal, y.normal)) << "pair " << k;
+  EXPECT_TRUE(same_feature(x.feature_a, y.feature_a)) << "pair " << k;
+  EXPECT_TRUE(same_feature(x.feature_b, y.feature_b)) << "pair " << k;
+  EXPECT_EQ(x.iterations, y.iterations) << "pair " << k;
+}
+
+void expect_same_cache(const DistanceCache& x, const DistanceCache& y, std::size_t k) {
+  EXPECT_EQ(x.vertices_a, y.vertices_a) << "pair " << k;
+  EXPECT_EQ(x.vertices_b, y.vertices_b) << "pair " << k;
+  EXPECT_EQ(x.hint_a, y.hint_a) << "pair " << k;
+  EXPECT_EQ(x.hint_b, y.hint_b) << "pair " << k;
+}
+
+// The sequential reference: distance() in a loop, updating `caches` (empty:
+// cold queries).
+std::vector<DistanceResult> sequential(const Scene& s, std::vector<DistanceCache>& caches,
+                                       const DistanceOptions& options) {
+  std::vector<DistanceResult> out;
+  for (std::size_t k = 0; k < s.pairs.size(); ++k) {
+    out.push_back(distance(*s.pairs[k].a, s.poses_a[k], *s.pairs[k].b, s.poses_b[k], options,
+                           caches.empty() ? nullptr : &caches[k]));
+  }
+  return out;
+}
+
+// Large enough for many TBB tasks (the batch runs anything under two grains,
+// 64 pairs, in the calling thread).
+constexpr int kPairs = 2000;
+
+// The runs compared with the sequential loop: one thread, two threads in a
+// dedicated arena, and the caller's arena (threads = 0).
+constexpr int kThreadCounts[] = {1, 2, 0};
+
+TEST(Batch, EqualsSequentialBitForBitColdAndTracking) {
+  for (Algorithm algorithm : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
+    for (int threads : kThreadCounts) {
+      SCOPED_TRACE(std::string(to_string(algorithm)) + ", threads " + std::to_string(threads));
+      Rng rng(20240501);
+      Scene s = make_scene(rng, kPairs);
+      DistanceOptions options;
+      options.algorithm = algorithm;
+
+      // Cold, no caches.
+      std::vector<DistanceCache> none;
+      std::vector<DistanceResult> batch(s.pairs.size());
+      distance_batch(s.pairs, s.poses_a, s.poses_b, batch, {}, options, threads);
+      const std::vector<DistanceResult> cold = sequential(s, none, options);
+      for (std::size_t k = 0; k < batch.size(); ++k) expect_same_result(batch[k], cold[k], k);
+
+      // With caches, three frames of motion: each call starts from the
+      // caches the previous one left (tracking), in the batch as in the loop.
+      std::vector<DistanceCache> batch_caches(s.pairs.size());
+      std::vector<DistanceCache> loop_caches(s.pairs.size());
+      for (int frame = 0; frame < 3; ++frame) {
+        distance_batch(s.pairs, s.poses_a, s.poses_b, batch, batch_caches, options, threads);
+        const std::vector<DistanceResult> loop = sequential(s, loop_caches, options);
+        for (std::size_t k = 0; k < batch.size(); ++k) {
+          expect_same_result(batch[k], loop[k], k);
+          expect_same_cache(batch_caches[k], loop_caches[k], k);
+        }
+        step(rng, s.poses_a);
+        step(rng, s.poses_b);
+      }
+      if (HasFailure()) return;  // one algorithm's failures are enough to read
+    }
+  }
+}
+
+TEST(Batch, CachesAreUpdatedAndTrackingSavesIterations) {
+  Rng rng(7);
+  Scene s = make_scene(rng, kPairs);
+  // Separate every pair (B well away from A along x) so that every query has
+  // closest features to track; overlapping pairs stop at the first
+  // intersection test and say little about tracking.
+  // Unit-size bodies (radius at most sqrt(3)) 5 apart stay apart through a
+  // step of 0.01.
+  for (std::size_t k = 0; k < s.pairs.size(); ++k) s.poses_b[k].translation = s.poses_a[k].translation + Vec3(5, 0, 0);
+  std::vector<DistanceResult> first(s.pairs.size());
+  std::vector<DistanceCache> caches(s.pairs.size());
+  for (const DistanceCache& c : caches) ASSERT_TRUE(c.is_cold());
+  distance_batch(s.pairs, s.poses_a, s.poses_b, first, caches, {}, 2);
+  for (std::size_t k = 0; k < caches.size(); ++k) {
+    EXPECT_FALSE(caches[k].is_cold()) << "pair " << k << ": the batch did not write its cache";
+  }
+
+  // The next frame, tracked and cold: the same answers (the accuracy
+  // standard's "same with a warm cache"), and far fewer iterations tracked.
+  step(rng, s.poses_a);
+  step(rng, s.poses_b);
+  std::vector<DistanceResult> tracked(s.pairs.size());
+  std::vector<DistanceResult> cold(s.pairs.size());
+  distance_batch(s.pairs, s.poses_a, s.poses_b, tracked, caches, {}, 2);
+  distance_batch(s.pairs, s.poses_a, s.poses_b, cold, {}, {}, 2);
+  long tracked_iterations = 0;
+  long cold_iterations = 0;
+  for (std::size_t k = 0; k < s.pairs.size(); ++k) {
+    ASSERT_EQ(tracked[k].status, Status::separated) << "pair " << k;
+    ASSERT_EQ(cold[k].status, Status::separated) << "pair " << k;
+    // Both answers are within 1e-12 relative of d* (the standard's bound at
+    // these unit-size, well-separated bodies), hence within 2.5e-12 of each
+    // other.
+    EXPECT_NEAR(tracked[k].distance, cold[k].distance, 2.5e-12 * cold[k].distance) << "pair " << k;
+    tracked_iterations += tracked[k].iterations;
+    cold_iterations += cold[k].iterations;
+  }
+  EXPECT_LT(2 * tracked_iterations, cold_iterations)
+      << "tracking through the batch should at least halve the iterations after a small motion";
+}
+
+TEST(Batch, OnePairManyPosesEqualsPairsOverload) {
+  Rng rng(11);
+  const ConvexPolytope a(test::points_on_sphere(rng, 60));
+  const ConvexPolytope b(test::points_in_cube(rng, 40));
+  std::vector<Pose> poses_a;
+  std::vector<Pose> poses_b;
+  for (int k = 0; k < 500; ++k) {
+    poses_a.push_back(random_pose(rng, 2.0));
+    poses_b.push_back(random_pose(rng, 2.0));
+  }
+  const std::vector<BatchPair> pairs(poses_a.size(), BatchPair{&a, &b});
+  std::vector<DistanceResult> one(poses_a.size());
+  std::vector<DistanceResult> many(poses_a.size());
+  std::vector<DistanceCache> caches_one(poses_a.size());
+  std::vector<DistanceCache> caches_many(poses_a.size());
+  distance_batch(a, poses_a, b, poses_b, one, caches_one, {}, 2);
+  distance_batch(pairs, poses_a, poses_b, many, caches_many, {}, 2);
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    expect_same_result(one[k], many[k], k);
+    expect_same_cache(caches_one[k], caches_many[k], k);
+  }
+}
+
+TEST(Batch, EmptyBatchIsANoOp) {
+  EXPECT_NO_THROW(distance_batch(std::span<const BatchPair>{}, {}, {}, {}, {}, {}, 2));
+}
+
+// The message of the InvalidInput that `run` throws; fails if it throws
+// nothing or something else.
+template <class Run>
+std::string invalid_input_message(Run run) {
+  try {
+    run();
+  } catch (const InvalidInput& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected InvalidInput, got another exception: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected InvalidInput, nothing was thrown";
+  return {};
+}
+
+TEST(Batch, BadInputIsRefusedWithItsIndexBeforeAnythingIsWritten) {
+  Rng rng(3);
+  Scene s = make_scene(rng, 300);
+  const std::size_t n = s.pairs.size();
+  std::vector<DistanceResult> results(n);
+  std::vector<DistanceCache> caches(n);
+  // Sentinels: a refused call must leave them as they are.
+  for (DistanceResult& r : results) r.iterations = -7;
+  const auto untouched = [&] {
+    for (std::size_t k = 0; k < n; ++k) {
+      if (results[k].iterations != -7 || !caches[k].is_cold()) return false;
+    }
+    return true;
+  };
+  const auto run = [&](std::span<const BatchPair> pairs, std::span<const Pose> pa, std::span<const Pose> pb,
+                       std::span<DistanceResult> res, std::span<DistanceCache> cs, int threads = 2) {
+    return invalid_input_message([&] { distance_batch(pairs, pa, pb, res, cs, {}, threads); });
+  };
+  const std::span<DistanceResult> all_results(results);
+  const std::span<DistanceCache> all_caches(caches);
+  const std::span<const Pose> poses_a(s.poses_a);
+  const std::span<const Pose> poses_b(s.poses_b);
+
+  EXPECT_NE(run(s.pairs, poses_a.first(n - 1), poses_b, all_results, all_caches).find("poses_a has 299 elements"),
+            std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, poses_b.first(n - 2), all_results, all_caches).find("poses_b has 298 elements"),
+            std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results.first(10), all_caches).find("results has 10 elements"),
+            std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results, all_caches.first(5)).find("caches"), std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results, all_caches, -1).find("threads"), std::string::npos);
+
+  std::vector<BatchPair> with_null = s.pairs;
+  with_null[217].b = nullptr;
+  EXPECT_NE(run(with_null, poses_a, poses_b, all_results, all_caches).find("pairs[217].b is null"),
+            std::string::npos);
+  with_null[41].a = nullptr;  // the first bad index is the one named
+  EXPECT_NE(run(with_null, poses_a, poses_b, all_results, all_caches).find("pairs[41].a is null"),
+            std::string::npos);
+
+  std::vector<Pose> bad_b = s.poses_b;
+  bad_b[123].translation.y() = std::numeric_limits<double>::infinity();
+  bad_b[250].rotation(1, 2) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(run(s.pairs, poses_a, bad_b, all_results, all_caches).find("poses_b[123] is not finite"),
+            std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, bad_b, all_results, all_caches, 1).find("poses_b[123] is not finite"),
+            std::string::npos);
+
+  const ConvexPolytope& a = *s.pool[0];
+  EXPECT_NE(invalid_input_message([&] { distance_batch(a, poses_a, a, bad_b, all_results, all_caches, {}, 2); })
+                .find("poses_b[123] is not finite"),
+            std::string::npos);
+  EXPECT_NE(invalid_input_message([&] {
+              distance_batch(a, poses_a, a, poses_b.first(7), all_results, all_caches, {}, 2);
+            }).find("poses_b has 7 elements, expected 300"),
+            std::string::npos);
+  EXPECT_TRUE(untouched()) << "a refused batch wrote results or caches";
+}
+
+TEST(Batch, ExceptionInsideAWorkerReachesTheCallerWithItsMessage) {
+  // Bad options are checked by distance() itself, so with more than two
+  // grains of pairs the first throw happens on a TBB task (on a worker
+  // thread or the caller's), and TBB carries it to the caller.
+  Rng rng(5);
+  Scene s = make_scene(rng, kPairs);
+  std::vector<DistanceResult> results(s.pairs.size());
+  DistanceOptions bad;
+  bad.max_iterations = 0;
+  for (int threads : kThreadCounts) {
+    const std::string message =
+        invalid_input_message([&] { distance_batch(s.pairs, s.poses_a, s.poses_b, results, {}, bad, threads); });
+    EXPECT_EQ(message.rfind("distance_batch: pair ", 0), 0u) << message;
+    EXPECT_NE(message.find("max_iterations must be at least 1"), std::string::npos) << message;
+  }
+}
+
+// Turns the floating-point traps of the test main (which only cover the
+// main thread: the FP environment is per thread) on in every thread that
+// joins the observed arena, so that a NaN made on a worker stops the test
+// as it would in the main thread.
+class TrapObserver : public tbb::task_scheduler_observer {
+ public:
+  explicit TrapObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
+  ~TrapObserver() override { observe(false); }
+  void on_scheduler_entry(bool /*is_worker*/) override { feenableexcept(FE_INVALID | FE_DIVBYZERO); }
+};
+
+TEST(Batch, CallerArenaWithFloatingPointTrapsOnEveryThread) {
+  // threads = 0 runs in the caller's arena: here a two-thread arena whose
+  // threads all trap on invalid operations and divisions by zero, over
+  // overlapping and separated pairs.
+  tbb::task_arena arena(2);
+  const TrapObserver traps(arena);
+  Rng rng(13);
+  Scene s = make_scene(rng, kPairs);
+  std::vector<DistanceCache> caches(s.pairs.size());
+  std::vector<DistanceResult> results(s.pairs.size());
+  arena.execute([&] { distance_batch(s.pairs, s.poses_a, s.poses_b, results, caches, {}, 0); });
+  std::vector<DistanceCache> loop_caches(s.pairs.size());
+  const std::vector<DistanceResult> loop = sequential(s, loop_caches, {});
+  int overlapping = 0;
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    expect_same_result(results[k], loop[k], k);
+    overlapping += results[k].status == Status::intersecting ? 1 : 0;
+  }
+  // The scene must really mix overlapping and separated pairs.
+  EXPECT_GT(overlapping, kPairs / 10);
+  EXPECT_LT(overlapping, kPairs * 9 / 10);
+}
+
+}  // namespace
+}  // namespace proxima
