@@ -22,7 +22,7 @@ namespace {
 constexpr double kContactUlps = 64.0;
 
 void check_pose(const Pose& pose, const char* name) {
-  if (!pose.is_finite()) {
+  if (!pose.is_finite()) [[unlikely]] {
     throw InvalidInput(std::string("distance: ") + name + " is not finite (NaN or infinite rotation or translation)");
   }
 }

@@ -197,7 +197,10 @@ bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureS
 // The minimal hull feature containing the points spanned by `f`: a vertex, an
 // edge if the two vertices are adjacent, else a face holding all of them (for
 // a polygon, the side facing `toward`).
-Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& toward) {
+// `cached` and `cached_face` are the previous query's feature and face: when
+// the feature is unchanged on a solid, its face is too.
+Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& toward,
+                const std::array<std::int32_t, 4>& cached, std::int32_t cached_face) {
   Feature out;
   for (int i = 0; i < f.n && i < 3; ++i) out.vertices[static_cast<std::size_t>(i)] = f.id[static_cast<std::size_t>(i)];
   if (f.n <= 1) {
@@ -211,6 +214,11 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
     return out;
   }
   out.type = FeatureType::face;
+  if (cached_face >= 0 && poly.dimension() == 3 && cached[0] == out.vertices[0] && cached[1] == out.vertices[1] &&
+      cached[2] == out.vertices[2]) {
+    out.face = cached_face;
+    return out;
+  }
   const auto faces = poly.adjacency_faces();
   const auto begin = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v0)]);
   double best_alignment = -2.0;
@@ -418,8 +426,10 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
   } else if (result.status != Status::iteration_cap) {
     result.status = Status::separated;
   }
-  result.feature_a = witness(a, fa, result.normal);
-  result.feature_b = witness(b, fb, Vec3(-(rot.transpose() * result.normal)));
+  result.feature_a = witness(a, fa, result.normal, cache.vertices_a, cache.face_a);
+  result.feature_b = witness(b, fb, Vec3(-(rot.transpose() * result.normal)), cache.vertices_b, cache.face_b);
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
 
   cache.vertices_a = {-1, -1, -1, -1};
   cache.vertices_b = {-1, -1, -1, -1};

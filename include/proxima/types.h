@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -45,14 +46,19 @@ struct Pose {
   Pose operator*(const Pose& other) const {
     return {Mat3(rotation * other.rotation), Vec3(rotation * other.translation + translation)};
   }
+  // No NaN or infinity in any entry. Tests the exponent bits (all ones for
+  // both) with integer operations: branch-free, and no floating-point
+  // comparison that could raise FE_INVALID under a caller's traps.
   bool is_finite() const {
-    for (int i = 0; i < 3; ++i) {
-      if (!std::isfinite(translation[i])) return false;
-      for (int j = 0; j < 3; ++j) {
-        if (!std::isfinite(rotation(i, j))) return false;
-      }
+    constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL;
+    std::uint64_t non_finite = 0;
+    for (int i = 0; i < 9; ++i) {
+      non_finite |= static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(rotation.data()[i]) & kExponent) == kExponent);
     }
-    return true;
+    for (int i = 0; i < 3; ++i) {
+      non_finite |= static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(translation[i]) & kExponent) == kExponent);
+    }
+    return non_finite == 0;
   }
 };
 
@@ -137,6 +143,11 @@ struct DistanceCache {
   // Support hints: the last support vertex on each body.
   std::int32_t hint_a = -1;
   std::int32_t hint_b = -1;
+  // The hull faces of the last witness features (-1 for a vertex or an
+  // edge), so that a tracked query whose features did not change skips the
+  // face lookup.
+  std::int32_t face_a = -1;
+  std::int32_t face_b = -1;
 
   bool is_cold() const { return vertices_a[0] < 0 && hint_a < 0; }
   void reset() { *this = DistanceCache{}; }
