@@ -28,9 +28,28 @@ void check_pose(const Pose& pose, const char* name) {
 }
 
 // Upper bound on the largest coordinate magnitude of a body placed at `pose`:
-// |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale.
-double world_magnitude(const ConvexPolytope& p, const Pose& pose) {
+// |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale. O(1).
+double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
   return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * p.scale();
+}
+
+// The largest coordinate magnitude of the placed vertices themselves: the R
+// of the accuracy standard. O(N), so only computed when a distance falls
+// between the band of this R and the band of the bound above.
+double world_magnitude(const ConvexPolytope& p, const Pose& pose) {
+  double r = 0.0;
+  for (const Vec3& y : p.vertices()) r = std::max(r, pose.apply(y).cwiseAbs().maxCoeff());
+  return r;
+}
+
+DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                   const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
+  switch (options.algorithm) {
+    case Algorithm::gjk: return gjk_distance(a, b, b_in_a, options, contact_tolerance);
+    case Algorithm::enhanced_gjk: return enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, cache);
+    case Algorithm::hybrid: break;
+  }
+  return hybrid_distance(a, b, b_in_a, options, contact_tolerance, cache);
 }
 
 }  // namespace
@@ -48,16 +67,21 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   }
 
   const Pose b_in_a = pose_a.inverse() * pose_b;
-  const double r = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
-  const double contact_tolerance = kContactUlps * kUnitRoundoff * r + options.absolute_tolerance;
+  // The contact band 64 u R + Ae, first with a cheap bound on R. A distance
+  // found inside that band but above 0 may still be outside the band of the
+  // exact R; then the exact R is computed and the query resumed from its own
+  // cache with the exact band, so that "separated" means d > 64 u R exactly.
+  const double r_bound = std::max(world_magnitude_bound(a, pose_a), world_magnitude_bound(b, pose_b));
+  const double band_bound = kContactUlps * kUnitRoundoff * r_bound + options.absolute_tolerance;
 
   DistanceCache cold;
   DistanceCache& c = cache != nullptr ? *cache : cold;
-  DistanceResult result = options.algorithm == Algorithm::gjk
-                         ? gjk_distance(a, b, b_in_a, options, contact_tolerance)
-                     : options.algorithm == Algorithm::enhanced_gjk
-                         ? enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, c)
-                         : hybrid_distance(a, b, b_in_a, options, contact_tolerance, c);
+  DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
+  if (result.status == Status::touching && result.distance > 0.0) {
+    const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
+    const double band = kContactUlps * kUnitRoundoff * r_exact + options.absolute_tolerance;
+    if (band < band_bound && result.distance > band) result = run(a, b, b_in_a, options, band, c);
+  }
   // Back to the world frame, in place.
   result.point_a = pose_a.apply(result.point_a);
   result.point_b = pose_a.apply(result.point_b);
