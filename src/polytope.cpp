@@ -9,10 +9,16 @@
 //      points that are coplanar (or collinear, or equal) as doubles give a
 //      polygon (a segment, a point) at any scale, without Qhull's joggling;
 //   3. build the boundary: the two extreme points of a segment, a strict 2D
-//      hull for a polygon, Qhull's merged facets for a solid;
+//      hull for a polygon, Qhull's facets for a solid;
 //   4. clean a solid's facets with exact predicates (merge exactly coplanar
-//      neighbours, drop vertices that lie inside an edge) and derive the
-//      vertex adjacency, in rotational order, from the face cycles.
+//      neighbours, drop vertices that lie inside an edge), which also proves
+//      the result exactly convex, and derive the vertex adjacency, in
+//      rotational order, from the face cycles.
+// A solid is exact (planar faces, every edge strictly convex, only extreme
+// points as vertices) whenever Qhull's unmerged triangulation is convex in
+// exact arithmetic, which the cleaning checks; in every test input it was.
+// Otherwise (rotated, rounded data whose roundoff Qhull must merge) the faces
+// are Qhull's merged facets, planar and convex within its merge tolerance.
 #include "proxima/polytope.h"
 
 #include <boost/multiprecision/cpp_int.hpp>
@@ -53,8 +59,8 @@ using Index = std::int32_t;
 // a 53-bit integer m, so shifting all inputs of one predicate to their
 // smallest exponent turns the determinant into an integer polynomial. When
 // those integers are small (integer or dyadic data: the usual source of exact
-// degeneracies) 128-bit arithmetic holds the determinant; otherwise
-// Boost.Multiprecision's cpp_int does.
+// degeneracies) 128-bit arithmetic holds the determinant, else fixed 1024-bit
+// integers, else Boost.Multiprecision's cpp_int.
 //
 // Shewchuk's bound assumes no overflow and no underflow. Inputs larger than
 // kFilterMaxMagnitude skip the filter (a cubic term could overflow), and an
@@ -76,6 +82,9 @@ constexpr double kFilterMaxMagnitude = 0x1p300;
 constexpr double kUnderflowSlack = 0x1p-700;
 
 using BigInt = boost::multiprecision::cpp_int;
+// Fixed 1024-bit integers, no allocation: enough for inputs below 2^300.
+using MediumInt = boost::multiprecision::number<boost::multiprecision::cpp_int_backend<
+    1024, 1024, boost::multiprecision::signed_magnitude, boost::multiprecision::unchecked, void>>;
 __extension__ using Int128 = __int128;
 
 // Doubles as integers q_i = x_i / 2^s sharing the smallest exponent s, exactly:
@@ -110,13 +119,14 @@ struct CommonIntegers {
     for (std::size_t i = 0; i < N; ++i) out[i] = static_cast<Int128>(mantissa[i]) * (static_cast<Int128>(1) << shift[i]);
     return out;
   }
-  std::array<BigInt, N> big() const {
-    std::array<BigInt, N> out;
+  template <class T>
+  std::array<T, N> wide() const {
+    std::array<T, N> out;
     for (std::size_t i = 0; i < N; ++i) {
       if (mantissa[i] == 0) continue;
-      BigInt magnitude = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
+      T magnitude = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
       magnitude <<= static_cast<unsigned>(shift[i]);
-      out[i] = mantissa[i] < 0 ? BigInt(-magnitude) : magnitude;
+      out[i] = mantissa[i] < 0 ? T(-magnitude) : magnitude;
     }
     return out;
   }
@@ -132,6 +142,9 @@ int sign_of(const T& v) {
 // term below 2^126.
 constexpr int kOrient2dSmallBits = 60;
 constexpr int kOrient3dSmallBits = 40;
+// 1024-bit limit: inputs below 2^300 keep every orient3d term below 2^906.
+// Beyond (exponents spread over more than about 250 binades) cpp_int.
+constexpr int kMediumBits = 300;
 
 template <class T>
 int orient2d_integer(const std::array<T, 6>& q) {
@@ -140,7 +153,9 @@ int orient2d_integer(const std::array<T, 6>& q) {
 
 int orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {
   const CommonIntegers<6> q({ax, ay, bx, by, cx, cy});
-  return q.bits <= kOrient2dSmallBits ? orient2d_integer(q.small()) : orient2d_integer(q.big());
+  if (q.bits <= kOrient2dSmallBits) return orient2d_integer(q.small());
+  if (q.bits <= kMediumBits) return orient2d_integer(q.template wide<MediumInt>());
+  return orient2d_integer(q.template wide<BigInt>());
 }
 
 // Sign of orient2d: +1 counter-clockwise, -1 clockwise, 0 collinear (exact).
@@ -168,7 +183,9 @@ int orient3d_integer(const std::array<T, 12>& q) {
 
 int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   const CommonIntegers<12> q({a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()});
-  return q.bits <= kOrient3dSmallBits ? orient3d_integer(q.small()) : orient3d_integer(q.big());
+  if (q.bits <= kOrient3dSmallBits) return orient3d_integer(q.small());
+  if (q.bits <= kMediumBits) return orient3d_integer(q.template wide<MediumInt>());
+  return orient3d_integer(q.template wide<BigInt>());
 }
 
 // Sign of side3d (see above): +1 when d is on the normal side of triangle abc.
@@ -411,8 +428,10 @@ class HalfEdges {
         if (target(*it) == target(*(it + 1))) consistent_ = false;  // a directed edge twice
       }
     }
-    for (std::size_t h = 0; h < h_count && consistent_; ++h) {
-      if (find(target(static_cast<Index>(h)), source(static_cast<Index>(h))) < 0) consistent_ = false;  // no twin
+    twin_.resize(h_count);
+    for (std::size_t h = 0; h < h_count; ++h) {
+      twin_[h] = find(target(static_cast<Index>(h)), source(static_cast<Index>(h)));
+      if (twin_[h] < 0) consistent_ = false;  // no reverse edge
     }
   }
 
@@ -424,7 +443,7 @@ class HalfEdges {
   Index target(Index h) const { return cycles_.vertices[static_cast<std::size_t>(next_[static_cast<std::size_t>(h)])]; }
   Index face(Index h) const { return face_[static_cast<std::size_t>(h)]; }
   Index prev(Index h) const { return prev_[static_cast<std::size_t>(h)]; }
-  Index twin(Index h) const { return find(target(h), source(h)); }
+  Index twin(Index h) const { return twin_[static_cast<std::size_t>(h)]; }
 
   // The half-edge v -> w, or -1.
   Index find(Index v, Index w) const {
@@ -442,7 +461,7 @@ class HalfEdges {
 
  private:
   const Cycles& cycles_;
-  std::vector<Index> face_, next_, prev_;
+  std::vector<Index> face_, next_, prev_, twin_;
   std::vector<Index> source_offsets_, by_source_;
   bool consistent_ = true;
 };
@@ -527,6 +546,19 @@ class MessageBuffer {
   FILE* file_ = nullptr;
 };
 
+// One Qhull run's state, freed on every exit path.
+struct QhullContext {
+  qhT qh;
+  explicit QhullContext(FILE* messages) { qh_zero(&qh, messages); }
+  ~QhullContext() {
+    qh_freeqhull(&qh, !qh_ALL);
+    int current_long = 0, total_long = 0;
+    qh_memfreeshort(&qh, &current_long, &total_long);
+  }
+  QhullContext(const QhullContext&) = delete;
+  QhullContext& operator=(const QhullContext&) = delete;
+};
+
 struct QhullOutcome {
   int exit_code = 0;
   std::string message;
@@ -550,31 +582,39 @@ std::vector<Index> facet_cycle(qhT* qh, facetT* facet) {
   if (facet->simplicial) {
     for (vertexT* v : set_elements<vertexT>(facet->vertices)) cycle.push_back(v);
   } else {
-    std::vector<std::pair<vertexT*, vertexT*>> ridges;
+    // Both ends of every ridge, sorted by vertex: each vertex of the cycle
+    // must appear exactly twice, next to its two neighbours along it.
+    std::vector<std::pair<vertexT*, vertexT*>> ends;
     for (ridgeT* r : set_elements<ridgeT>(facet->ridges)) {
       const auto rv = set_elements<vertexT>(r->vertices);
       if (rv.size() != 2) return {};
-      ridges.emplace_back(rv[0], rv[1]);
+      ends.emplace_back(rv[0], rv[1]);
+      ends.emplace_back(rv[1], rv[0]);
     }
-    if (ridges.size() < 3) return {};
-    std::vector<bool> used(ridges.size(), false);
-    cycle.push_back(ridges[0].first);
-    vertexT* current = ridges[0].second;
-    used[0] = true;
-    while (current != cycle.front()) {
+    if (ends.size() < 6) return {};
+    const auto by_id = [](const auto& l, const auto& r) {
+      return l.first->id != r.first->id ? l.first->id < r.first->id : l.second->id < r.second->id;
+    };
+    std::sort(ends.begin(), ends.end(), by_id);
+    for (std::size_t k = 0; k < ends.size(); k += 2) {
+      if (ends[k].first != ends[k + 1].first || (k + 2 < ends.size() && ends[k + 2].first == ends[k].first)) return {};
+    }
+    const auto neighbours = [&](vertexT* v) {
+      const auto it = std::lower_bound(ends.begin(), ends.end(), v,
+                                       [](const auto& e, const vertexT* key) { return e.first->id < key->id; });
+      return std::pair<vertexT*, vertexT*>(it->second, (it + 1)->second);
+    };
+    vertexT* previous = ends[0].first;
+    vertexT* current = ends[0].second;
+    cycle.push_back(previous);
+    while (current != cycle.front() && cycle.size() <= ends.size() / 2) {
       cycle.push_back(current);
-      bool found = false;
-      for (std::size_t k = 0; k < ridges.size() && !found; ++k) {
-        if (used[k]) continue;
-        if (ridges[k].first == current || ridges[k].second == current) {
-          used[k] = true;
-          current = ridges[k].first == current ? ridges[k].second : ridges[k].first;
-          found = true;
-        }
-      }
-      if (!found) return {};
+      const auto [a, b] = neighbours(current);
+      vertexT* following = a == previous ? b : a;
+      previous = current;
+      current = following;
     }
-    if (cycle.size() != ridges.size()) return {};
+    if (current != cycle.front() || cycle.size() != ends.size() / 2) return {};
   }
   if (cycle.size() < 3) return {};
   // Newell's normal in Qhull's own coordinates, against the facet normal.
@@ -606,9 +646,8 @@ QhullOutcome run_qhull(std::vector<double> coordinates, const char* options) {
     return outcome;
   }
   const FloatingPointHold hold;
-  qhT qh_storage;
-  qhT* qh = &qh_storage;
-  qh_zero(qh, messages.file());
+  QhullContext context(messages.file());
+  qhT* qh = &context.qh;
   std::string command = std::string("qhull ") + options;
   outcome.exit_code = qh_new_qhull(qh, 3, static_cast<int>(coordinates.size() / 3), coordinates.data(), False,
                                    command.data(), nullptr, messages.file());
@@ -623,9 +662,6 @@ QhullOutcome run_qhull(std::vector<double> coordinates, const char* options) {
       outcome.faces.add(cycle);
     }
   }
-  qh_freeqhull(qh, !qh_ALL);
-  int current_long = 0, total_long = 0;
-  qh_memfreeshort(qh, &current_long, &total_long);
   if (outcome.message.empty()) outcome.message = messages.text();
   return outcome;
 }
@@ -682,17 +718,25 @@ bool face_triangle(const Cycles& faces, Index f, std::span<const Vec3> pts, std:
 }
 
 // Exact cleaning of Qhull's facets, in the coordinates of the given doubles:
-//  - neighbouring facets that are exactly coplanar become one face (Qhull
-//    merges coplanar facets within its roundoff estimate; this catches what
-//    it leaves);
+//  - neighbouring facets that are exactly coplanar (and lie on either side of
+//    their common edge, not folded) become one face: Qhull's triangles of
+//    a square, or facets Qhull left unmerged;
 //  - a vertex on exactly two faces and exactly collinear with its two
 //    neighbours along them lies inside an edge: it is not an extreme point and
 //    is dropped from both cycles (a cube's edge midpoints).
 // A vertex strictly inside a face disappears with the merge, because it is on
 // no boundary cycle any more.
-Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts, std::span<const Vec3> scaled) {
+//
+// `proven_convex` tells whether the result is exactly a convex polytope's
+// boundary: a closed, consistently oriented surface whose faces are planar
+// and whose every edge is exactly convex (x strictly below the plane of the
+// face across the edge). A closed surface that is locally convex at every
+// edge bounds a convex body, so no global test is needed.
+Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts, std::span<const Vec3> scaled,
+                   bool& proven_convex) {
   const Index face_count = raw.count();
   const HalfEdges he(raw, point_count);
+  proven_convex = he.consistent();
   const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
   Groups groups(face_count);
   {
@@ -710,22 +754,48 @@ Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> p
         flat = v == t[0] || v == t[1] || v == t[2] || side3d(at(t[0]), at(t[1]), at(t[2]), at(v)) == 0;
       }
       planar[static_cast<std::size_t>(f)] = flat;
+      proven_convex = proven_convex && flat;
     }
-    // Planar neighbours f and g share the edge of h; they are coplanar when
-    // the vertices of g's triangle off that edge are on f's plane.
+    // Planar neighbours f and g share the edge s -> t (in f; t -> s in g).
+    // With y a vertex of f and x one of g off the line s t, side3d(s, t, y, x)
+    // is the edge's convexity: negative convex, zero coplanar, positive
+    // reflex (Qhull's roundoff). Coplanar faces merge when, in a projection
+    // that keeps the plane's orientation, x and y lie on opposite sides of
+    // the edge.
     for (Index h = 0; h < static_cast<Index>(raw.vertices.size()); ++h) {
       const Index twin = he.twin(h);
       if (twin < 0) continue;
       const Index f = he.face(h), g = he.face(twin);
-      if (f >= g || !planar[static_cast<std::size_t>(f)] || !planar[static_cast<std::size_t>(g)]) continue;
-      if (groups.find(f) == groups.find(g)) continue;
-      const auto& tf = tri[static_cast<std::size_t>(f)];
-      bool coplanar = true;
-      for (const Index v : tri[static_cast<std::size_t>(g)]) {
-        if (!coplanar || v == he.source(h) || v == he.target(h)) continue;
-        coplanar = side3d(at(tf[0]), at(tf[1]), at(tf[2]), at(v)) == 0;
+      if (f >= g) continue;
+      if (!planar[static_cast<std::size_t>(f)] || !planar[static_cast<std::size_t>(g)]) continue;
+      const Index s = he.source(h), t = he.target(h);
+      const auto off_line = [&](Index face) {
+        for (const Index v : tri[static_cast<std::size_t>(face)]) {
+          if (v != s && v != t && !collinear3d(at(s), at(t), at(v))) return v;
+        }
+        return Index{-1};
+      };
+      const Index y = off_line(f), x = off_line(g);
+      if (x < 0 || y < 0) {
+        proven_convex = false;
+        continue;
       }
-      if (coplanar) groups.unite(f, g);
+      const int side = side3d(at(s), at(t), at(y), at(x));
+      if (side != 0) {
+        proven_convex = proven_convex && side < 0;
+        continue;
+      }
+      int y_side = 0, x_side = 0;
+      for (int k = 0; k < 3 && y_side == 0; ++k) {
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        y_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(y)[i], at(y)[j]);
+        x_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(x)[i], at(x)[j]);
+      }
+      if (x_side == -y_side) {
+        groups.unite(f, g);
+      } else {
+        proven_convex = false;  // folded onto itself
+      }
     }
   }
 
@@ -779,6 +849,7 @@ Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> p
     if (simple) {
       merged.add(chain);
     } else {
+      proven_convex = false;
       for (const Index f : group) add_own(f);
     }
   }
@@ -891,16 +962,25 @@ Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled,
     for (int k = 0; k < 3; ++k) coordinates.push_back((s[k] - centre[k]) * unscale);
   }
   const auto point_count = static_cast<Index>(pts.size());
-  // Default options merge coplanar facets (C-0). On a precision or flatness
-  // error ("the initial simplex is flat", QH6154, for a box 1e-30 thin),
-  // retry with every axis scaled to [-1, 1] (QbB), which makes an
-  // axis-aligned thin box well shaped; then give up on the third dimension.
+  // First "Q0": no merging, triangles only. It is fast even when thousands
+  // of points share a face (Qhull's default merging is quadratic there: a
+  // cylinder of 2 x 2000 points takes 1.5 s with it, 60 ms without), and the
+  // exact cleaning turns its triangles into the true faces. Accepted only if
+  // that cleaning proves the result convex. Otherwise the default options,
+  // which merge facets coplanar within Qhull's roundoff estimate (C-0), as
+  // they come. On a precision or flatness error ("the initial simplex is
+  // flat", QH6154, for a box 1e-30 thin), retry with every axis scaled to
+  // [-1, 1] (QbB), which makes an axis-aligned thin box well shaped; then
+  // give up on the third dimension.
   std::string last_message;
   bool flat = false;
-  for (const char* options : {"", "QbB"}) {
+  for (const char* options : {"Q0", "", "QbB"}) {
     QhullOutcome outcome = run_qhull(coordinates, options);
+    const bool unmerged = std::string(options) == "Q0";
     if (outcome.exit_code == 0) {
-      Cycles faces = clean_faces(outcome.faces, point_count, pts, scaled);
+      bool proven_convex = false;
+      Cycles faces = clean_faces(outcome.faces, point_count, pts, scaled, proven_convex);
+      if (unmerged && !proven_convex) continue;
       Boundary b;
       b.dimension = 3;
       std::vector<bool> used(pts.size(), false);
@@ -911,6 +991,7 @@ Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled,
       b.faces = std::move(faces);
       return b;
     }
+    if (unmerged) continue;
     last_message = outcome.message;
     flat = outcome.exit_code == qh_ERRsingular || outcome.exit_code == qh_ERRprec ||
            outcome.exit_code == qh_ERRwide || outcome.exit_code == qh_ERRtopology;
