@@ -45,7 +45,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <iomanip>
 #include <memory>
 #include <numbers>
@@ -1060,7 +1059,7 @@ std::string targets_csv(const std::vector<Target>& targets) {
   return s.str();
 }
 
-std::string notes_csv(bool quick) {
+std::string tracking_csv() {
   std::ostringstream s;
   s << "system,tracking\n";
   Rng rng(1);
@@ -1069,7 +1068,6 @@ std::string notes_csv(bool quick) {
     const auto sys = make_system(k, p, p);
     s << sys->name() << ",\"" << sys->tracking_note() << "\"\n";
   }
-  (void)quick;
   return s.str();
 }
 
@@ -1150,7 +1148,7 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
   ok = write_file(dir / "rotation.csv", timing_csv(rotation, "omega"), out) && ok;
   ok = write_file(dir / "cold.csv", timing_csv(cold, "n"), out) && ok;
   ok = write_file(dir / "targets.csv", targets_csv(targets), out) && ok;
-  ok = write_file(dir / "tracking_modes.csv", notes_csv(options.quick), out) && ok;
+  ok = write_file(dir / "tracking_modes.csv", tracking_csv(), out) && ok;
   ok = write_file(dir / "run.csv", run_csv(options.quick, seconds_since(start)), out) && ok;
   out << "\nCSV files written to " << fs::absolute(dir).string() << "/\n";
 

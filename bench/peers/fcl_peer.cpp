@@ -19,17 +19,26 @@
 //   FCL's GST_LIBCCD solver (GJK on libccd's simplex code) is the libccd GJK
 //   that users get, so it stands for libccd here.
 // - Tracking: FCL 0.7's DistanceRequest has no cached-guess fields (only
-//   CollisionRequest has enable_cached_gjk_guess); for distance the cache is
-//   the solver's own (GJKSolver_indep::enableCachedGuess, cached_guess
-//   updated from the last simplex by every shapeDistance call). So the
-//   tracking mode keeps one GJKSolver_indep for the sequence and passes it to
-//   the solver-taking fcl::distance overload, with gjk_tolerance set from the
-//   request exactly as the plain overload does.
+//   CollisionRequest has enable_cached_gjk_guess); for distance the cache
+//   lives in the solver (GJKSolver_indep::enableCachedGuess; every
+//   shapeDistance call starts GJK from cached_guess and stores the guess of
+//   its final simplex there). So the tracking mode keeps one
+//   GJKSolver_indep for the sequence (gjk_tolerance set from the request,
+//   as fcl::distance does) and calls its shapeDistance for the Convex pair:
+//   the very call fcl::distance makes after dispatching on the shape types.
+//   fcl::distance can take such a solver only through its templated
+//   overload, which instantiates FCL's whole distance-function table for
+//   that solver type in this file (50 s of compile time instead of 4 s, and
+//   far more under ASan). Skipping the dispatch favours FCL's tracking mode
+//   by its cost (type switch, traversal node, result update).
 #include "peers/fcl_peer.h"
 
-#include <fcl/fcl.h>
+#include <fcl/geometry/shape/convex.h>
+#include <fcl/narrowphase/detail/gjk_solver_indep.h>
+#include <fcl/narrowphase/distance.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -90,14 +99,20 @@ struct FclPeer::Impl {
 
   bool tracks(bool tracking) const { return tracking && solver == FclSolver::indep; }
 
-  // One query into a fresh result (DistanceResult::update keeps the minimum
-  // over calls, so a reused result would hide later answers).
-  void query(std::size_t i, bool tracking, fcl::DistanceResultd& result) {
+  // One query. Without tracking: fcl::distance into a fresh result
+  // (DistanceResult::update keeps the minimum over calls, so a reused result
+  // would hide later answers). FCL reports a failed or colliding GJK as -1.
+  double query(std::size_t i, bool tracking, fcl::Vector3d& p1, fcl::Vector3d& p2) {
     if (tracks(tracking)) {
-      fcl::distance(a.get(), tf_a[i], b.get(), tf_b[i], &tracking_solver, request, result);
-    } else {
-      fcl::distance(a.get(), tf_a[i], b.get(), tf_b[i], request, result);
+      double d = -1;
+      tracking_solver.shapeDistance(*a, tf_a[i], *b, tf_b[i], &d, &p1, &p2);
+      return d;
     }
+    fcl::DistanceResultd result;
+    fcl::distance(a.get(), tf_a[i], b.get(), tf_b[i], request, result);
+    p1 = result.nearest_points[0];
+    p2 = result.nearest_points[1];
+    return result.min_distance;
   }
 };
 
@@ -128,16 +143,17 @@ std::size_t FclPeer::pose_count() const { return impl_->tf_a.size(); }
 void FclPeer::reset() { impl_->reset(); }
 
 SystemAnswer FclPeer::query(std::size_t i, bool tracking) {
-  fcl::DistanceResultd result;
-  impl_->query(i, tracking, result);
+  fcl::Vector3d p1 = fcl::Vector3d::Zero();
+  fcl::Vector3d p2 = fcl::Vector3d::Zero();
+  const double d = impl_->query(i, tracking, p1, p2);
   SystemAnswer answer;
-  answer.distance = result.min_distance;
-  answer.point_a = result.nearest_points[0];
-  answer.point_b = result.nearest_points[1];
-  // FCL reports a failed or colliding GJK as -1 and leaves min_distance at
-  // its initial max() when no pair was tested.
-  answer.answered = result.min_distance != std::numeric_limits<double>::max();
-  answer.separated = result.min_distance > 0.0;
+  answer.distance = d;
+  answer.point_a = p1;
+  answer.point_b = p2;
+  // fcl::distance leaves min_distance at its initial max() when it tested
+  // no pair at all; -1 (a failed or colliding GJK) is an answer.
+  answer.answered = d != std::numeric_limits<double>::max();
+  answer.separated = d > 0.0;
   return answer;
 }
 
@@ -145,11 +161,8 @@ double FclPeer::run_all(bool tracking) {
   impl_->reset();
   double sum = 0.0;
   const std::size_t n = impl_->tf_a.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    fcl::DistanceResultd result;
-    impl_->query(i, tracking, result);
-    sum += result.min_distance;
-  }
+  fcl::Vector3d p1, p2;
+  for (std::size_t i = 0; i < n; ++i) sum += impl_->query(i, tracking, p1, p2);
   return sum;
 }
 

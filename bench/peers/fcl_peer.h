@@ -10,10 +10,11 @@
 //                 false, rel_err = abs_err = 0, distance_tolerance = 1e-6
 //                 (FCL's default), gjk_solver_type GST_LIBCCD or GST_INDEP.
 //   tracking      GST_INDEP only: one GJKSolver_indep kept for the whole
-//                 sequence with enableCachedGuess(true); FCL then starts
-//                 each query's GJK from the previous query's simplex.
-//                 GST_LIBCCD has no tracking (FCL's libccd solver ignores a
-//                 cached guess).
+//                 sequence with enableCachedGuess(true), its shapeDistance
+//                 called for the Convex pair (what fcl::distance calls after
+//                 its type dispatch); FCL then starts each query's GJK from
+//                 the previous query's simplex. GST_LIBCCD has no tracking
+//                 (FCL's libccd solver ignores a cached guess).
 // FCL's headers stay in fcl_peer.cpp: a user of this header does not compile
 // them.
 #pragma once
