@@ -612,6 +612,60 @@ TEST(Polytope, CombinatoricsInvariantUnderExactMotions) {
   check_polytope(m, moved);
 }
 
+// Regression: with Qhull's default merging, a prism over 2 x 2000 points on
+// a circle took 1.5 s (and 2 x 10000 far longer: the merging is quadratic in
+// the size of a coplanar face), which looked like a hang. The build now takes
+// Qhull's unmerged triangles and merges exactly coplanar ones itself.
+TEST(Polytope, CylinderWithLargeCoplanarFaces) {
+  constexpr int kPerCircle = 500;
+  Points pts;
+  for (int i = 0; i < kPerCircle; ++i) {
+    const double a = 2 * std::acos(-1.0) * i / kPerCircle;
+    pts.emplace_back(std::cos(a), std::sin(a), -0.5);
+    pts.emplace_back(std::cos(a), std::sin(a), 0.5);
+  }
+  pts.emplace_back(0.0, 0.0, 0.5);   // on the top face
+  pts.emplace_back(1.0, 0.0, 0.25);  // on a side edge
+  const ConvexPolytope p(pts);
+  ASSERT_EQ(p.dimension(), 3);
+  EXPECT_EQ(p.vertex_count(), 2 * kPerCircle);  // the rounded circle stays in convex position
+  EXPECT_EQ(p.face_count(), kPerCircle + 2);
+  EXPECT_EQ(largest_face(p), kPerCircle);
+  check_polytope(p, pts);
+}
+
+// A grid cube under a general rotation: rounded coordinates, so faces are
+// only nearly planar and Qhull must merge within its roundoff. The result is
+// still a consistent closed polytope, every input point within roundoff of
+// it, and its corners are the rotated corners.
+TEST(Polytope, RotatedGridCubeWithinRoundoff) {
+  Rng rng(47);
+  for (int rep = 0; rep < 5; ++rep) {
+    const Quat q = Quat(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1)).normalized();
+    Points pts;
+    for (int x = 0; x < 4; ++x) {
+      for (int y = 0; y < 4; ++y) {
+        for (int z = 0; z < 4; ++z) pts.push_back(q * Vec3(x, y, z));
+      }
+    }
+    const ConvexPolytope p(pts);
+    ASSERT_EQ(p.dimension(), 3);
+    check_adjacency(p);
+    check_summaries(p, pts);
+    EXPECT_EQ(p.vertex_count() - p.edge_count() + p.face_count(), 2);
+    for (int f = 0; f < p.face_count(); ++f) {
+      const Plane pl = p.face_plane(f);
+      for (const Vec3& v : pts) EXPECT_LE(pl.normal.dot(v) - pl.offset, 64 * kUnitRoundoff * p.scale());
+    }
+    for (int c = 0; c < 8; ++c) {
+      const Vec3 corner = q * Vec3(c & 1 ? 3 : 0, c & 2 ? 3 : 0, c & 4 ? 3 : 0);
+      bool found = false;
+      for (const Vec3& v : p.vertices()) found = found || v == corner;
+      EXPECT_TRUE(found) << "corner " << c;
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Degenerate inputs
 // ---------------------------------------------------------------------------
