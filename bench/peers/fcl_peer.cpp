@@ -30,7 +30,8 @@
 //   overload, which instantiates FCL's whole distance-function table for
 //   that solver type in this file (50 s of compile time instead of 4 s, and
 //   far more under ASan). Skipping the dispatch favours FCL's tracking mode
-//   by its cost (type switch, traversal node, result update).
+//   by its cost (type switch, traversal node, result update): measured at
+//   30 to 80 ns of about 1.1 us per cube-cube query, same answers.
 #include "peers/fcl_peer.h"
 
 #include <fcl/geometry/shape/convex.h>
