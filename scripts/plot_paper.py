@@ -24,6 +24,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib import ticker  # noqa: E402
 
 # One colour per system, the same in every figure.
 COLOURS = {
@@ -95,6 +96,12 @@ def systems_figure(rows, x_key, xlabel, title, path, logx=True):
     if logx:
         ax.set_xscale("log", base=2 if x_key == "n" else 10)
     ax.set_yscale("log")
+    # Labels at 1, 2, 5 per decade: the log axis spans few decades.
+    ax.yaxis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda y, _: f"{y:g}"))
+    ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+    if not logx or x_key == "n":
+        ax.xaxis.set_major_formatter(ticker.FuncFormatter(lambda x, _: f"{x:g}"))
     ax.set_xlabel(xlabel)
     ax.set_ylabel("time per query (µs, median)")
     ax.set_title(title, fontsize=10)
