@@ -33,6 +33,17 @@ test: release asan
 	@echo "== fuzz smoke run of the mesh readers (20 s) =="
 	bash scripts/fuzz 20
 
+# ThreadSanitizer: builds batch_test alone (the batch queries' threads) and runs it.
+tsan: setup
+	cmake --preset tsan >/dev/null
+	cmake --build --preset tsan -j $(JOBS)
+	ctest --preset tsan
+
+# The Python module alone; the build prints the PYTHONPATH that imports it.
+python: setup
+	cmake --preset release >/dev/null
+	cmake --build --preset release --target proxima_python -j $(JOBS)
+
 bench: release
 	@for b in build/release/bench/*_bench; do echo "== $$b =="; $$b; done
 
