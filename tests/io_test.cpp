@@ -502,7 +502,8 @@ TEST_F(IoTest, NonNumericTokenNamesTheLine) {
                   "end_header\n0 0 0 1\n0 0 1 abc 3\n", 9}};
   for (const auto& [name, bytes, line] : files) {
     SCOPED_TRACE(name);
-    const FileError e = expect_file_error([&] { read_points(write(name, bytes)); });
+    const std::string path = write(name, bytes);
+    const FileError e = expect_file_error([&] { read_points(path); });
     expect_message(e, {name, "line " + std::to_string(line), "non-numeric token 'abc'"});
     EXPECT_EQ(e.line(), line);
   }
@@ -543,7 +544,8 @@ TEST_F(IoTest, EmptyMesh) {
       {"empty.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n"}};
   for (const auto& [name, bytes] : files) {
     SCOPED_TRACE(name);
-    expect_message(expect_file_error([&] { read_points(write(name, bytes)); }), {name, "empty mesh (no vertices)"});
+    const std::string path = write(name, bytes);
+    expect_message(expect_file_error([&] { read_points(path); }), {name, "empty mesh (no vertices)"});
   }
   expect_message(expect_file_error([&] { read_points(write("zero.stl", stl_binary({}, "zero"))); }),
                  {"zero.stl", "empty mesh"});
@@ -569,7 +571,8 @@ TEST_F(IoTest, PlyHeaderErrors) {
   };
   for (const auto& [bytes, line, problem] : cases) {
     SCOPED_TRACE(problem);
-    const FileError e = expect_file_error([&] { read_points(write("header.ply", bytes)); });
+    const std::string path = write("header.ply", bytes);
+    const FileError e = expect_file_error([&] { read_points(path); });
     expect_message(e, {"header.ply", "line " + std::to_string(line), problem});
     EXPECT_EQ(e.line(), line);
   }
