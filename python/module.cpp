@@ -346,7 +346,7 @@ PYBIND11_MODULE(proxima, m) {
   // --- Pose -----------------------------------------------------------------
   py::class_<Pose>(m, "Pose", "A rigid motion: x -> rotation @ x + translation.")
       .def(py::init<>(), "The identity.")
-      .def(py::init([](py::handle rotation, py::handle translation) {
+      .def(py::init([](py::object rotation, py::object translation) {
              const Mat3 r = to_mat3(rotation, "rotation");
              check_rigid(r, Eigen::Vector4d(0, 0, 0, 1), "rotation");
              return Pose(r, to_vec3(translation, "translation"));
@@ -354,23 +354,23 @@ PYBIND11_MODULE(proxima, m) {
            py::arg("rotation"), py::arg("translation"), "From a 3x3 rotation matrix and a translation.")
       .def_static(
           "from_quaternion",
-          [](py::handle q, py::handle t) { return pose_from_quaternion(q, t, "pose"); }, py::arg("quaternion"),
+          [](py::object q, py::object t) { return pose_from_quaternion(q, t, "pose"); }, py::arg("quaternion"),
           py::arg("translation"), "From a quaternion (w, x, y, z), normalized here, and a translation.")
       .def_static(
           "from_matrix",
-          [](py::handle m4) { return to_pose(m4, "matrix"); }, py::arg("matrix"),
+          [](py::object m4) { return to_pose(m4, "matrix"); }, py::arg("matrix"),
           "From a 4x4 rigid transformation matrix.")
       .def_static("identity", &Pose::identity, "The identity.")
       .def_static(
           "from_translation",
-          [](py::handle t) { return Pose::from_translation(to_vec3(t, "translation")); }, py::arg("translation"),
+          [](py::object t) { return Pose::from_translation(to_vec3(t, "translation")); }, py::arg("translation"),
           "A pure translation.")
       .def_property_readonly(
           "rotation", [](const Pose& p) { return matrix_array(p.rotation); }, "3x3 rotation matrix (a copy).")
       .def_property_readonly(
           "translation", [](const Pose& p) { return vec3_array(p.translation); }, "Translation (a copy).")
       .def(
-          "apply", [](const Pose& p, py::handle x) { return vec3_array(p.apply(to_vec3(x, "point"))); },
+          "apply", [](const Pose& p, py::object x) { return vec3_array(p.apply(to_vec3(x, "point"))); },
           py::arg("point"), "rotation @ point + translation.")
       .def("inverse", &Pose::inverse, "The inverse motion.")
       .def("is_finite", &Pose::is_finite, "True when no entry is NaN or infinite.")
@@ -394,7 +394,7 @@ PYBIND11_MODULE(proxima, m) {
   py::class_<ConvexPolytope>(m, "ConvexPolytope",
                              "A convex polytope: the convex hull of a point set, built once and immutable (shareable "
                              "between threads). Lower-dimensional hulls (polygon, segment, point) are valid.")
-      .def(py::init([](py::handle points) {
+      .def(py::init([](py::object points) {
              const std::vector<Vec3> pts = to_points(points);
              py::gil_scoped_release release;
              return ConvexPolytope(pts);
@@ -564,7 +564,7 @@ PYBIND11_MODULE(proxima, m) {
   const DistanceOptions defaults;
   m.def(
       "distance",
-      [](const ConvexPolytope& a, py::handle pose_a, const ConvexPolytope& b, py::handle pose_b,
+      [](const ConvexPolytope& a, py::object pose_a, const ConvexPolytope& b, py::object pose_b,
          DistanceCache* cache, const std::string& algorithm, double relative_tolerance, double absolute_tolerance,
          int max_iterations) {
         const DistanceOptions options = make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
@@ -584,8 +584,8 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
 
   m.def(
       "distance_batch",
-      [](const ConvexPolytope& a, py::handle poses_a, const ConvexPolytope& b, py::handle poses_b,
-         py::handle caches, int threads, const std::string& algorithm, double relative_tolerance,
+      [](const ConvexPolytope& a, py::object poses_a, const ConvexPolytope& b, py::object poses_b,
+         py::object caches, int threads, const std::string& algorithm, double relative_tolerance,
          double absolute_tolerance, int max_iterations) {
         const DistanceOptions options = make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
         py::ssize_t k = batch_size(poses_a);

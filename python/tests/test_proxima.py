@@ -1,0 +1,516 @@
+"""Tests of the Python module proxima.
+
+Run with Debian's interpreter and the built module on the path:
+
+    PYTHONPATH=build/release/python /usr/bin/python3 -m pytest -q python/tests
+
+(CTest does this as `python_tests`). The checks are independent of the C++
+code where they can be: hand-computed distances, an optimality certificate
+computed in numpy (the normal separates the two vertex sets, the points lie
+on the hulls), hull structure recomputed from the arrays; and, for the
+bindings' own logic, equality with the single-query path (pose formats, batch
+rows, caches). Randomness is seeded.
+"""
+
+import math
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import proxima
+
+
+def random_rotation(rng):
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    w, x, y, z = q
+    return q, np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def matrix(rotation, translation):
+    m = np.eye(4)
+    m[:3, :3] = rotation
+    m[:3, 3] = translation
+    return m
+
+
+def cube(edge=1.0):
+    h = edge / 2
+    return np.array([[sx * h, sy * h, sz * h] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+
+
+def world(polytope, pose_matrix):
+    return polytope.vertices @ pose_matrix[:3, :3].T + pose_matrix[:3, 3]
+
+
+def random_scene(rng, k, spread=2.0):
+    """k pose matrices for A and for B, random orientations, centres within spread."""
+    pa, pb = np.empty((k, 4, 4)), np.empty((k, 4, 4))
+    for i in range(k):
+        pa[i] = matrix(random_rotation(rng)[1], rng.uniform(-spread, spread, 3))
+        pb[i] = matrix(random_rotation(rng)[1], rng.uniform(-spread, spread, 3))
+    return pa, pb
+
+
+@pytest.fixture(scope="module")
+def bodies():
+    rng = np.random.default_rng(1)
+    return proxima.ConvexPolytope(rng.normal(size=(60, 3))), proxima.ConvexPolytope(rng.uniform(-1, 1, (40, 3)))
+
+
+# --- hand-computed -----------------------------------------------------------
+
+
+def test_unit_cubes_face_to_face():
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    r = proxima.distance(a, None, b, ((1, 0, 0, 0), (3, 0, 0)))
+    assert r.status == "separated"
+    assert r.distance == pytest.approx(2.0, rel=1e-15)
+    assert r.lower_bound <= r.distance
+    assert r.lower_bound == pytest.approx(2.0, rel=1e-12)
+    np.testing.assert_allclose(r.normal, [1, 0, 0], atol=1e-15)
+    assert r.point_a[0] == pytest.approx(0.5)
+    assert r.point_b[0] == pytest.approx(2.5)
+    # The closest points lie on the facing faces (|y|, |z| <= 0.5).
+    assert np.all(np.abs(r.point_a[1:]) <= 0.5) and np.all(np.abs(r.point_b[1:]) <= 0.5)
+
+
+def test_vertex_to_vertex_along_the_diagonal():
+    # B moved along the diagonal: the closest features are A's corner
+    # (1,1,1)/2 and B's corner (1,1,1)/2 + t - (1,1,1), distance sqrt(3).
+    a = proxima.ConvexPolytope(cube())
+    r = proxima.distance(a, None, a, proxima.Pose.from_translation([2.0, 2.0, 2.0]))
+    assert r.status == "separated"
+    assert r.distance == pytest.approx(math.sqrt(3.0), rel=1e-15)
+    assert r.feature_a.type == "vertex" and r.feature_b.type == "vertex"
+    np.testing.assert_array_equal(r.point_a, [0.5, 0.5, 0.5])
+    np.testing.assert_array_equal(r.point_b, [1.5, 1.5, 1.5])
+    np.testing.assert_array_equal(a.vertices[r.feature_a.vertices[0]], [0.5, 0.5, 0.5])
+    np.testing.assert_array_equal(a.vertices[r.feature_b.vertices[0]], [-0.5, -0.5, -0.5])
+
+
+def test_overlap_and_contact():
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    assert proxima.distance(a, None, b, ((1, 0, 0, 0), (0.5, 0.1, 0))).status == "intersecting"
+    touching = proxima.distance(a, None, b, ((1, 0, 0, 0), (1.0, 0.2, 0.1)))
+    assert touching.status == "touching"
+    assert touching.distance <= 64 * 2.0**-53 * 2
+
+
+# --- certificate against numpy -----------------------------------------------
+
+
+@pytest.mark.parametrize("algorithm", ["hybrid", "gjk", "enhanced_gjk"])
+def test_random_pairs_certified_in_numpy(algorithm):
+    rng = np.random.default_rng(2)
+    separated = 0
+    for _ in range(200):
+        a = proxima.ConvexPolytope(rng.normal(size=(rng.integers(4, 60), 3)))
+        b = proxima.ConvexPolytope(rng.uniform(-1, 1, size=(rng.integers(4, 60), 3)))
+        pa, pb = random_scene(rng, 1, spread=2.5)
+        r = proxima.distance(a, pa[0], b, pb[0], algorithm=algorithm)
+        assert np.all(np.isfinite(r.point_a)) and np.all(np.isfinite(r.point_b))
+        assert r.lower_bound <= r.distance * (1 + 1e-12) + 1e-14
+        if r.status != "separated":
+            continue
+        separated += 1
+        va, vb = world(a, pa[0]), world(b, pb[0])
+        scale = max(np.abs(va).max(), np.abs(vb).max())
+        tol = 64 * 2.0**-53 * scale + 1e-12 * r.distance
+        n = r.normal
+        assert np.linalg.norm(n) == pytest.approx(1.0, abs=1e-12)
+        assert np.linalg.norm(r.point_a - r.point_b) == pytest.approx(r.distance, abs=tol)
+        # Optimality: the plane through point_a normal to n has all of A
+        # behind it and all of B at least `distance` in front. The points are
+        # right within 64 u R, so n's direction within 2 * 64 u R / distance,
+        # which moves vertices up to a diameter away by that much more.
+        diameter = np.ptp(np.vstack([va, vb]), axis=0).max()
+        plane_tol = tol + 2 * 64 * 2.0**-53 * scale * diameter / r.distance
+        assert np.max(va @ n) <= n @ r.point_a + plane_tol
+        assert np.min(vb @ n) >= n @ r.point_a + r.distance - 2 * plane_tol
+        # The witness features span the closest points.
+        fa, fb = r.feature_a.vertices, r.feature_b.vertices
+        assert 1 <= len(fa) <= 3 and 1 <= len(fb) <= 3
+        for ids, verts, point in ((fa, va, r.point_a), (fb, vb, r.point_b)):
+            # point is in the affine hull of the feature: least squares residual ~ 0
+            base = verts[ids[0]]
+            span = (verts[ids[1:]] - base).T if len(ids) > 1 else np.zeros((3, 0))
+            if span.shape[1]:
+                coef, *_ = np.linalg.lstsq(span, point - base, rcond=None)
+                residual = np.linalg.norm(span @ coef - (point - base))
+            else:
+                residual = np.linalg.norm(point - base)
+            assert residual <= 1e-9 * max(1.0, scale)
+    assert 50 <= separated <= 190  # the random set has both kinds
+
+
+def test_algorithms_agree(bodies):
+    a, b = bodies
+    rng = np.random.default_rng(3)
+    pa, pb = random_scene(rng, 100, spread=3.0)
+    for i in range(100):
+        d = [proxima.distance(a, pa[i], b, pb[i], algorithm=alg).distance for alg in ("hybrid", "gjk", "enhanced_gjk")]
+        assert d[1] == pytest.approx(d[0], rel=1e-9, abs=1e-12)
+        assert d[2] == pytest.approx(d[0], rel=1e-9, abs=1e-12)
+
+
+# --- pose formats ------------------------------------------------------------
+
+
+def test_pose_formats_agree():
+    rng = np.random.default_rng(4)
+    points_a, points_b = rng.normal(size=(30, 3)), rng.normal(size=(30, 3))
+    a, b = proxima.ConvexPolytope(points_a), proxima.ConvexPolytope(points_b)
+    q, rot = random_rotation(rng)
+    t = np.array([3.0, -1.0, 0.5])
+    as_matrix = proxima.distance(a, None, b, matrix(rot, t))
+    as_tuple = proxima.distance(a, None, b, (q, t))
+    as_list = proxima.distance(a, None, b, [list(q), list(t)])
+    as_pose = proxima.distance(a, None, b, proxima.Pose.from_quaternion(q, t))
+    as_pose_rt = proxima.distance(a, proxima.Pose(), b, proxima.Pose(rot, t))
+    # The quaternion path builds the matrix in C++ (Eigen): equal up to rounding.
+    for r in (as_tuple, as_list, as_pose):
+        assert r.distance == pytest.approx(as_matrix.distance, rel=1e-13)
+    assert as_pose_rt.distance == as_matrix.distance
+    # Moving the points in numpy instead of passing a pose: the same hull up
+    # to rounding of the coordinates.
+    moved = proxima.ConvexPolytope(points_b @ rot.T + t)
+    assert proxima.distance(a, None, moved, None).distance == pytest.approx(as_matrix.distance, rel=1e-12)
+    # A non-unit quaternion is normalized, not a scale.
+    assert proxima.distance(a, None, b, (3 * q, t)).distance == pytest.approx(as_tuple.distance, rel=1e-13)
+
+
+def test_pose_object():
+    rng = np.random.default_rng(5)
+    q, rot = random_rotation(rng)
+    p = proxima.Pose.from_quaternion(q, [1, 2, 3])
+    np.testing.assert_allclose(p.rotation, rot, atol=1e-15)
+    np.testing.assert_array_equal(p.translation, [1, 2, 3])
+    m = p.matrix()
+    assert m.shape == (4, 4)
+    np.testing.assert_array_equal(m[3], [0, 0, 0, 1])
+    x = np.array([0.3, -0.2, 0.9])
+    np.testing.assert_allclose(p.apply(x), rot @ x + [1, 2, 3], atol=1e-15)
+    np.testing.assert_allclose((p * p.inverse()).matrix(), np.eye(4), atol=1e-15)
+    np.testing.assert_array_equal(proxima.Pose.from_matrix(m).matrix(), m)
+    np.testing.assert_array_equal(proxima.Pose.from_translation([4, 5, 6]).translation, [4, 5, 6])
+    assert proxima.Pose.identity().is_finite()
+
+
+@pytest.mark.parametrize(
+    "pose, words",
+    [
+        (np.diag([2.0, 1.0, 1.0, 1.0]), "not a rotation"),
+        (np.diag([-1.0, 1.0, 1.0, 1.0]), "not a rotation"),  # a reflection
+        (np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0.5, 1.0]]), "bottom row"),
+        (np.eye(3), "4x4"),
+        (((0, 0, 0, 0), (1, 2, 3)), "quaternion is zero"),
+        (((1, 0, 0), (1, 2, 3)), "quaternion must be 4 numbers"),
+        (((1, 0, 0, 0), (1, 2)), "3 numbers"),
+    ],
+)
+def test_bad_poses_are_value_errors(pose, words):
+    a = proxima.ConvexPolytope(cube())
+    with pytest.raises(ValueError, match=words):
+        proxima.distance(a, None, a, pose)
+
+
+def test_non_finite_pose_is_invalid_input_from_cpp():
+    a = proxima.ConvexPolytope(cube())
+    m = np.eye(4)
+    m[1, 3] = np.nan
+    with pytest.raises(proxima.InvalidInput, match="pose_b is not finite"):
+        proxima.distance(a, None, a, m)
+
+
+def test_float32_pose_is_accepted():
+    rng = np.random.default_rng(6)
+    a = proxima.ConvexPolytope(cube())
+    m = matrix(random_rotation(rng)[1], [3, 0, 0]).astype(np.float32)
+    r = proxima.distance(a, None, a, m)
+    assert r.status == "separated"
+
+
+# --- caches and tracking -----------------------------------------------------
+
+
+def test_cache_tracking(bodies):
+    a, b = bodies
+    cache = proxima.DistanceCache()
+    assert cache.is_cold()
+    total_tracked = total_cold = 0
+    for step in range(50):
+        t = (3.0 + 0.01 * step, 0.5, 0.0)
+        q = (math.cos(0.005 * step), 0.0, math.sin(0.005 * step), 0.0)
+        tracked = proxima.distance(a, None, b, (q, t), cache=cache)
+        cold = proxima.distance(a, None, b, (q, t))
+        assert not cache.is_cold()
+        assert tracked.distance == pytest.approx(cold.distance, rel=2.5e-12)
+        if step > 0:
+            total_tracked += tracked.iterations
+            total_cold += cold.iterations
+    assert 2 * total_tracked < total_cold
+    cache.reset()
+    assert cache.is_cold() and cache.hint_a == -1 and list(cache.vertices_a) == [-1, -1, -1, -1]
+
+
+def test_cache_from_another_pair_is_harmless(bodies):
+    a, b = bodies
+    foreign = proxima.DistanceCache()
+    proxima.distance(b, None, b, ((1, 0, 0, 0), (5, 0, 0)), cache=foreign)
+    foreign.hint_a, foreign.vertices_b = 10**6, [10**6, -5, 3, 2]
+    r = proxima.distance(a, None, b, ((1, 0, 0, 0), (4, 1, 0)), cache=foreign)
+    assert r.distance == pytest.approx(proxima.distance(a, None, b, ((1, 0, 0, 0), (4, 1, 0))).distance, rel=2.5e-12)
+
+
+# --- batch --------------------------------------------------------------------
+
+
+def test_batch_rows_equal_single_queries(bodies):
+    a, b = bodies
+    rng = np.random.default_rng(7)
+    k = 300
+    pa, pb = random_scene(rng, k)
+    for threads in (1, 2, 0):
+        out = proxima.distance_batch(a, pa, b, pb, threads=threads)
+        assert set(out) >= {"status", "distance", "lower_bound", "point_a", "point_b", "normal", "iterations"}
+        assert out["point_a"].shape == (k, 3) and out["distance"].shape == (k,)
+        for i in range(k):
+            r = proxima.distance(a, pa[i], b, pb[i])
+            # The same C++ query: bit for bit.
+            assert out["distance"][i] == r.distance
+            assert out["lower_bound"][i] == r.lower_bound
+            assert np.array_equal(out["point_a"][i], r.point_a)
+            assert np.array_equal(out["point_b"][i], r.point_b)
+            assert np.array_equal(out["normal"][i], r.normal)
+            assert out["status"][i] == r.status
+            assert out["iterations"][i] == r.iterations
+            assert out["feature_a_type"][i] == r.feature_a.type
+            assert list(out["feature_b_vertices"][i][: len(r.feature_b.vertices)]) == list(r.feature_b.vertices)
+            assert out["feature_b_face"][i] == r.feature_b.face
+    statuses = set(out["status"])
+    assert {"separated", "intersecting"} <= statuses
+
+
+def test_batch_caches_track_across_calls(bodies):
+    a, b = bodies
+    rng = np.random.default_rng(8)
+    k = 200
+    pa, pb = random_scene(rng, k)
+    pb[:, :3, 3] = pa[:, :3, 3] + [5.0, 0.0, 0.0]  # all separated
+    caches = [proxima.DistanceCache() for _ in range(k)]
+    loop_caches = [proxima.DistanceCache() for _ in range(k)]
+    for frame in range(3):
+        out = proxima.distance_batch(a, pa, b, pb, caches=caches, threads=2)
+        for i in range(k):
+            r = proxima.distance(a, pa[i], b, pb[i], cache=loop_caches[i])
+            assert out["distance"][i] == r.distance
+            assert list(caches[i].vertices_a) == list(loop_caches[i].vertices_a)
+            assert list(caches[i].vertices_b) == list(loop_caches[i].vertices_b)
+            assert (caches[i].hint_a, caches[i].hint_b) == (loop_caches[i].hint_a, loop_caches[i].hint_b)
+        if frame == 0:
+            cold_iterations = out["iterations"].sum()
+        pb[:, :3, 3] += 0.001
+    assert not any(c.is_cold() for c in caches)
+    assert 2 * out["iterations"].sum() < cold_iterations
+
+
+def test_batch_broadcasts_one_pose(bodies):
+    a, b = bodies
+    k = 50
+    pb = np.tile(np.eye(4), (k, 1, 1))
+    pb[:, 0, 3] = np.linspace(3.0, 6.0, k)
+    ident = proxima.distance_batch(a, None, b, pb)
+    same = proxima.distance_batch(a, np.eye(4), b, pb)
+    tupled = proxima.distance_batch(a, ((1, 0, 0, 0), (0, 0, 0)), b, pb)
+    np.testing.assert_array_equal(ident["distance"], same["distance"])
+    np.testing.assert_array_equal(ident["distance"], tupled["distance"])
+    swapped = proxima.distance_batch(b, pb, a, None)  # K from either side
+    np.testing.assert_allclose(swapped["distance"], ident["distance"], rtol=1e-12)
+    # Distance to a convex body along a line is convex in the parameter.
+    d = ident["distance"]
+    assert np.all(d[:-2] + d[2:] >= 2 * d[1:-1] - 1e-12)
+
+
+def test_batch_errors(bodies):
+    a, b = bodies
+    pa = np.tile(np.eye(4), (10, 1, 1))
+    pb = pa.copy()
+    pb[:, 0, 3] = 5
+    with pytest.raises(ValueError, match="9 poses, but the other side has 10"):
+        proxima.distance_batch(a, pa, b, pb[:9])
+    with pytest.raises(ValueError, match=r"\(K, 4, 4\)"):
+        proxima.distance_batch(a, np.zeros((10, 3, 4)), b, pb)
+    with pytest.raises(ValueError, match="give K poses"):
+        proxima.distance_batch(a, None, b, None)
+    with pytest.raises(ValueError, match="caches: 3 caches for 10 poses"):
+        proxima.distance_batch(a, pa, b, pb, caches=[proxima.DistanceCache() for _ in range(3)])
+    with pytest.raises(ValueError, match=r"caches\[1\] is not a DistanceCache"):
+        proxima.distance_batch(a, pa, b, pb, caches=[proxima.DistanceCache(), 7] + [proxima.DistanceCache()] * 8)
+    bad = pb.copy()
+    bad[3, 2, 3] = np.inf
+    with pytest.raises(proxima.InvalidInput, match=r"poses_b\[3\] is not finite"):
+        proxima.distance_batch(a, pa, b, bad)
+    scaled = pb.copy()
+    scaled[6, :3, :3] *= 2
+    with pytest.raises(ValueError, match=r"poses_b\[6\].*not a rotation"):
+        proxima.distance_batch(a, pa, b, scaled)
+    with pytest.raises(proxima.InvalidInput, match="threads must be >= 0"):
+        proxima.distance_batch(a, pa, b, pb, threads=-1)
+    with pytest.raises(proxima.InvalidInput, match="max_iterations must be at least 1"):
+        proxima.distance_batch(a, np.tile(np.eye(4), (500, 1, 1)), b, None, max_iterations=0, threads=2)
+    with pytest.raises(ValueError, match="algorithm must be"):
+        proxima.distance_batch(a, pa, b, pb, algorithm="epa")
+
+
+def test_batch_releases_the_gil(bodies):
+    # While one Python thread waits in distance_batch, another keeps running
+    # Python code; if the GIL were held through the C++ call, the main thread
+    # could not take a single step until it returned.
+    a, b = bodies
+    rng = np.random.default_rng(9)
+    pa, pb = random_scene(rng, 30000)
+    window = {}
+
+    def run():
+        window["start"] = time.perf_counter()
+        proxima.distance_batch(a, pa, b, pb, threads=1, algorithm="gjk")
+        window["end"] = time.perf_counter()
+
+    worker = threading.Thread(target=run)
+    stamps = []
+    worker.start()
+    while worker.is_alive():
+        time.sleep(0.001)  # leaves the CPU to the worker; waking up needs the GIL
+        stamps.append(time.perf_counter())
+    worker.join()
+    start, end = window["start"], window["end"]
+    assert end - start > 0.05, "batch too short to tell"
+    # Leave out the argument conversion at the start (GIL held, a few ms).
+    inside = [s for s in stamps if start + 0.5 * (end - start) < s < end]
+    assert len(inside) > 10
+
+
+# --- polytope -----------------------------------------------------------------
+
+
+def test_polytope_arrays_are_consistent():
+    rng = np.random.default_rng(10)
+    points = rng.normal(size=(80, 3))
+    p = proxima.ConvexPolytope(points)
+    v = p.vertices
+    assert p.dimension == 3 and v.shape == (p.vertex_count, 3) and v.dtype == np.float64
+    np.testing.assert_array_equal(v, points[p.input_index])
+    assert p.interior_point_count == 80 - p.vertex_count
+    assert p.scale == np.abs(v).max()
+    np.testing.assert_allclose(p.centroid, v.mean(axis=0), atol=1e-15)
+    assert p.bounding_radius == pytest.approx(np.linalg.norm(v - p.centroid, axis=1).max())
+    # Adjacency: CSR, symmetric, the same edges as edges().
+    off, adj = p.adjacency_offsets, p.adjacency
+    assert off[0] == 0 and off[-1] == len(adj) and len(off) == p.vertex_count + 1
+    pairs = {(u, int(w)) for u in range(p.vertex_count) for w in adj[off[u] : off[u + 1]]}
+    assert all((w, u) in pairs for u, w in pairs)
+    assert {(min(u, w), max(u, w)) for u, w in pairs} == {tuple(e) for e in p.edges()}
+    assert p.edge_count == len(p.edges())
+    np.testing.assert_array_equal(p.neighbors(0), adj[off[0] : off[1]])
+    assert len(p.adjacency_faces) == len(adj)
+    # Faces: on their planes, every vertex behind every plane (convexity),
+    # Euler's formula V - E + F = 2.
+    assert len(p.faces) == p.face_count
+    assert p.vertex_count - p.edge_count + p.face_count == 2
+    np.testing.assert_array_equal(np.concatenate(p.faces), p.face_vertices)
+    for f, face in enumerate(p.faces):
+        normal, offset = p.face_plane(f)
+        np.testing.assert_array_equal(p.face(f), face)
+        assert np.abs(v[face] @ normal - offset).max() < 1e-12
+        assert (v @ normal).max() <= offset + 1e-12
+    tri = p.triangles()
+    assert tri.shape == (sum(len(f) - 2 for f in p.faces), 3)
+    assert len(p.triangle_face()) == len(tri)
+    assert p.memory_bytes() > v.nbytes
+    with pytest.raises(IndexError):
+        p.face(p.face_count)
+    with pytest.raises(IndexError):
+        p.neighbors(-1)
+
+
+def test_lower_dimensional_polytopes():
+    assert proxima.ConvexPolytope([[1.0, 2.0, 3.0]]).dimension == 0
+    assert proxima.ConvexPolytope([[0, 0, 0], [1, 1, 1], [0.5, 0.5, 0.5]]).dimension == 1
+    square = proxima.ConvexPolytope([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    assert square.dimension == 2 and square.face_count == 2
+    r = proxima.distance(square, None, proxima.ConvexPolytope([[0.5, 0.5, 2.0]]), None)
+    assert r.distance == pytest.approx(2.0, rel=1e-15)
+
+
+def test_bad_points():
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        proxima.ConvexPolytope(np.zeros((5, 2)))
+    with pytest.raises(proxima.InvalidInput):
+        proxima.ConvexPolytope(np.zeros((0, 3)))
+    pts = np.zeros((4, 3))
+    pts[2, 1] = np.nan
+    with pytest.raises(proxima.InvalidInput, match="2"):
+        proxima.ConvexPolytope(pts)
+    assert issubclass(proxima.InvalidInput, ValueError)
+    assert issubclass(proxima.FileError, proxima.InvalidInput)
+
+
+# --- files --------------------------------------------------------------------
+
+
+def test_from_file(tmp_path):
+    path = tmp_path / "cube.obj"
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in cube(2.0)] + ["v 0.1 0.2 0.3"]
+    path.write_text("\n".join(lines) + "\n")
+    p = proxima.ConvexPolytope.from_file(str(path))
+    assert p.vertex_count == 8 and p.interior_point_count == 1 and p.face_count == 6
+    loaded = proxima.load_convex(str(path))
+    assert loaded.input_points == 9 and loaded.interior_points == 1 and not loaded.input_was_convex
+    points = proxima.read_points(str(path))
+    assert points.shape == (9, 3)
+    np.testing.assert_array_equal(points[8], [0.1, 0.2, 0.3])
+
+
+def test_file_errors(tmp_path):
+    missing = tmp_path / "nope.obj"
+    with pytest.raises(FileNotFoundError, match="nope.obj") as info:
+        proxima.ConvexPolytope.from_file(str(missing))
+    assert info.value.filename == str(missing)
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 1 2 3\nv 1 two 3\n")
+    with pytest.raises(proxima.FileError, match="bad.obj, line 2") as info:
+        proxima.ConvexPolytope.from_file(str(bad))
+    assert isinstance(info.value, ValueError)
+    with pytest.raises(FileNotFoundError):
+        proxima.read_points(str(missing))
+
+
+# --- documentation --------------------------------------------------------------
+
+
+def test_every_binding_has_a_docstring():
+    missing = []
+    for name in dir(proxima):
+        if name.startswith("_"):
+            continue
+        obj = getattr(proxima, name)
+        if not (obj.__doc__ or "").strip():
+            missing.append(name)
+        if isinstance(obj, type) and not issubclass(obj, BaseException):
+            for member in vars(obj):
+                if member.startswith("_"):
+                    continue
+                if not (getattr(obj, member).__doc__ or "").strip():
+                    missing.append(f"{name}.{member}")
+    assert not missing, missing
