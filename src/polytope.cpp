@@ -16,7 +16,8 @@
 //      rotational order, from the face cycles.
 // A solid is exact (planar faces, every edge strictly convex, only extreme
 // points as vertices) whenever Qhull's unmerged triangulation is convex in
-// exact arithmetic, which the cleaning checks; in every test input it was.
+// exact arithmetic, which the cleaning checks (it is for every exactly
+// representable test input: grids, spheres, cubes, cylinders, scaled sets).
 // Otherwise (rotated, rounded data whose roundoff Qhull must merge) the faces
 // are Qhull's merged facets, planar and convex within its merge tolerance.
 #include "proxima/polytope.h"
@@ -1119,8 +1120,10 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   const Vec3 mean = sum / static_cast<double>(vertices_.size());
   double radius = 0.0;
   for (const Vec3& v : vertices_) radius = std::max(radius, (v * down - mean).norm());
-  centroid_ = mean * std::ldexp(1.0, exponent);
-  bounding_radius_ = radius * std::ldexp(1.0, exponent);
+  // Scale back per value: 2^exponent itself overflows for coordinates
+  // beyond 2^1023 (found by the reader fuzzer: a vertex at -1e308).
+  centroid_ = Vec3(std::ldexp(mean.x(), exponent), std::ldexp(mean.y(), exponent), std::ldexp(mean.z(), exponent));
+  bounding_radius_ = std::ldexp(radius, exponent);
   scale_ = max_abs_coordinate(vertices_);
   interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
 }
@@ -1150,7 +1153,7 @@ Plane ConvexPolytope::face_plane(int f) const {
   if (!(length > 0.0)) return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
   normal /= length;
   const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
-  return {normal, normal.dot(mean) * std::ldexp(1.0, exponent)};
+  return {normal, std::ldexp(normal.dot(mean), exponent)};
 }
 
 std::vector<std::array<std::int32_t, 3>> ConvexPolytope::triangles() const {

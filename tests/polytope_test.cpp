@@ -933,3 +933,28 @@ TEST(Polytope, BadInputThrowsNamingTheIndex) {
 
 }  // namespace
 }  // namespace proxima
+
+namespace proxima {
+namespace {
+
+// Regression (found by the reader fuzzer from the OBJ line `v 5.25 -1e308
+// -0.6`): the centroid and radius were scaled back by 2^exponent, which is
+// infinite for coordinates beyond 2^1023, so a polytope near the top of the
+// double range came out with an infinite centroid (SIGFPE under traps).
+TEST(Polytope, CoordinatesNearTheTopOfTheDoubleRange) {
+  const ConvexPolytope point(std::vector<Vec3>{Vec3(5.25, -1e308, -0.6)});
+  // Small coordinates beside a huge one pass through subnormals when scaled
+  // down: a few 2^-50 of absolute error, nothing infinite.
+  EXPECT_NEAR(point.centroid().x(), 5.25, 1e-14);
+  EXPECT_EQ(point.centroid().y(), -1e308);
+  EXPECT_NEAR(point.centroid().z(), -0.6, 1e-14);
+  EXPECT_EQ(point.bounding_radius(), 0.0);
+  const ConvexPolytope tet(std::vector<Vec3>{{1e308, 0, 0}, {0, 1e308, 0}, {0, 0, 1e308}, {-1e308, -1e308, -1e308}});
+  EXPECT_EQ(tet.dimension(), 3);
+  EXPECT_TRUE(tet.centroid().allFinite());
+  EXPECT_TRUE(std::isfinite(tet.bounding_radius()));
+  for (int f = 0; f < tet.face_count(); ++f) EXPECT_TRUE(std::isfinite(tet.face_plane(f).offset));
+}
+
+}  // namespace
+}  // namespace proxima
