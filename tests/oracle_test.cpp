@@ -16,9 +16,11 @@ namespace proxima::test {
 namespace {
 
 #if defined(__SANITIZE_ADDRESS__)
-constexpr int kRandomPairs = 60;  // ASan and UBSan make exact arithmetic ~5x slower
+constexpr int kRandomPairs = 40;  // ASan and UBSan make exact arithmetic ~5x slower
+constexpr int kPaperRepeats = 3;
 #else
 constexpr int kRandomPairs = 300;
+constexpr int kPaperRepeats = 10;
 #endif
 
 // Runs one candidate source directly (not through the fallback chain).
@@ -291,7 +293,7 @@ TEST(Generators, PaperStressExperimentsHaveTheirScale) {
   // the translation (a few u R).
   Rng rng(1998);
   ExactOracle oracle;
-  for (int i = 0; i < 10; ++i) {
+  for (int i = 0; i < kPaperRepeats; ++i) {
     for (const bool tetrahedra : {true, false}) {
       const BodyPair p = tetrahedra ? paper_tetrahedra(rng) : paper_cubes(rng);
       const double gap = tetrahedra ? kPaperTetrahedronGap : kPaperCubeGap;
