@@ -234,6 +234,11 @@ int magnitude_exponent(double max_abs) {
   return e;
 }
 
+// p * 2^e per component, through ldexp: exact unless a component underflows,
+// and never through the factor 2^e itself, which overflows when |e| > 1023
+// (inputs near the largest doubles, or subnormal ones).
+Vec3 times_pow2(const Vec3& p, int e) { return {std::ldexp(p.x(), e), std::ldexp(p.y(), e), std::ldexp(p.z(), e)}; }
+
 double max_abs_coordinate(std::span<const Vec3> pts) {
   double m = 0.0;
   for (const Vec3& p : pts) m = std::max(m, p.cwiseAbs().maxCoeff());
@@ -956,11 +961,11 @@ Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled,
   for (const Vec3& s : scaled) lo = lo.cwiseMin(s), hi = hi.cwiseMax(s);
   const Vec3 centre = 0.5 * lo + 0.5 * hi;
   const double extent = (hi - lo).maxCoeff();
-  const double unscale = std::ldexp(1.0, -magnitude_exponent(extent));
+  const int extent_exponent = magnitude_exponent(extent);
   std::vector<double> coordinates;
   coordinates.reserve(3 * scaled.size());
   for (const Vec3& s : scaled) {
-    for (int k = 0; k < 3; ++k) coordinates.push_back((s[k] - centre[k]) * unscale);
+    for (int k = 0; k < 3; ++k) coordinates.push_back(std::ldexp(s[k] - centre[k], -extent_exponent));
   }
   const auto point_count = static_cast<Index>(pts.size());
   // First "Q0": no merging, triangles only. It is fast even when thousands
@@ -1056,10 +1061,10 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   std::vector<Vec3> pts;
   pts.reserve(distinct.size());
   for (const Index i : distinct) pts.push_back(points[static_cast<std::size_t>(i)]);
-  const double unscale = std::ldexp(1.0, -magnitude_exponent(max_abs_coordinate(pts)));
+  const int input_exponent = magnitude_exponent(max_abs_coordinate(pts));
   std::vector<Vec3> scaled;
   scaled.reserve(pts.size());
-  for (const Vec3& p : pts) scaled.push_back(p * unscale);
+  for (const Vec3& p : pts) scaled.push_back(times_pow2(p, -input_exponent));
 
   const Frame frame = find_frame(pts, scaled);
   Boundary boundary;
@@ -1114,15 +1119,14 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   // Centroid and radius on power-of-two scaled copies: exact scaling, and no
   // sum or square can overflow near the largest doubles.
   const int exponent = magnitude_exponent(max_abs_coordinate(vertices_));
-  const double down = std::ldexp(1.0, -exponent);
   Vec3 sum = Vec3::Zero();
-  for (const Vec3& v : vertices_) sum += v * down;
+  for (const Vec3& v : vertices_) sum += times_pow2(v, -exponent);
   const Vec3 mean = sum / static_cast<double>(vertices_.size());
   double radius = 0.0;
-  for (const Vec3& v : vertices_) radius = std::max(radius, (v * down - mean).norm());
+  for (const Vec3& v : vertices_) radius = std::max(radius, (times_pow2(v, -exponent) - mean).norm());
   // Scale back per value: 2^exponent itself overflows for coordinates
   // beyond 2^1023 (found by the reader fuzzer: a vertex at -1e308).
-  centroid_ = Vec3(std::ldexp(mean.x(), exponent), std::ldexp(mean.y(), exponent), std::ldexp(mean.z(), exponent));
+  centroid_ = times_pow2(mean, exponent);
   bounding_radius_ = std::ldexp(radius, exponent);
   scale_ = max_abs_coordinate(vertices_);
   interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
@@ -1139,13 +1143,12 @@ Plane ConvexPolytope::face_plane(int f) const {
   double max_abs = 0.0;
   for (const Index v : cycle) max_abs = std::max(max_abs, vertex(v).cwiseAbs().maxCoeff());
   const int exponent = magnitude_exponent(max_abs);
-  const double down = std::ldexp(1.0, -exponent);
-  const Vec3 origin = vertex(cycle[0]) * down;
+  const Vec3 origin = times_pow2(vertex(cycle[0]), -exponent);
   Vec3 normal = Vec3::Zero();
   Vec3 sum = Vec3::Zero();
   for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const Vec3 p = vertex(cycle[i]) * down - origin;
-    const Vec3 q = vertex(cycle[(i + 1) % cycle.size()]) * down - origin;
+    const Vec3 p = times_pow2(vertex(cycle[i]), -exponent) - origin;
+    const Vec3 q = times_pow2(vertex(cycle[(i + 1) % cycle.size()]), -exponent) - origin;
     normal += p.cross(q);
     sum += p;
   }

@@ -830,6 +830,28 @@ TEST(Polytope, TinyAndHugeScales) {
   }
 }
 
+// Regression: the scaling factor 2^-e itself overflowed for subnormal
+// inputs (e near -1070), and 0 * inf raised an invalid operation. Subnormal
+// points are valid polytopes, exactly, like any others.
+TEST(Polytope, SubnormalCoordinates) {
+  const double d = std::numeric_limits<double>::denorm_min();
+  const Points single = {{3 * d, 0, -d}};
+  const ConvexPolytope point(single);
+  EXPECT_EQ(point.dimension(), 0);
+  EXPECT_EQ(point.centroid(), single[0]);
+  const Points tet = {{0, 0, 0}, {8 * d, 0, 0}, {0, 8 * d, 0}, {0, 0, 8 * d}, {d, d, d}};
+  const ConvexPolytope solid(tet);
+  EXPECT_EQ(solid.dimension(), 3);
+  EXPECT_EQ(solid.vertex_count(), 4);
+  check_polytope(solid, tet);
+  for (int f = 0; f < solid.face_count(); ++f) EXPECT_TRUE(solid.face_plane(f).normal.allFinite());
+  const Points square = {{0, 0, d}, {4 * d, 0, d}, {4 * d, 4 * d, d}, {0, 4 * d, d}, {2 * d, 0, d}};
+  const ConvexPolytope polygon(square);
+  EXPECT_EQ(polygon.dimension(), 2);
+  EXPECT_EQ(polygon.vertex_count(), 4);
+  check_polytope(polygon, square);
+}
+
 // Near-degenerate solids must not throw: a box 1e-30 thin is exactly a thin
 // box (8 vertices, 6 faces) once Qhull works on axis-scaled coordinates.
 TEST(Polytope, FlatBoxOfHeight1em30) {
