@@ -5,13 +5,17 @@
 //   proxima demo                                   the main job of `make run`
 //   proxima query [FILE] [--algorithm NAME] ...    JSON Lines in, JSON Lines out
 //   proxima paper [--quick] [--out DIR]            the paper's experiments against the peers
+//   proxima distance A B [--pose-a ...] [--json]   distance between two mesh files
+//   proxima hull FILE [--out FILE.obj|.off]        hull statistics and export
 //
 // Exit codes: 0 when the run completed (a query line with an error answer is
-// still a completed run), 1 when the input cannot be read, the demo fails or
-// `paper` cannot write its files, 2 for usage errors.
+// still a completed run), 1 when the input cannot be read (bad file, bad
+// numbers), the demo fails or `paper` cannot write its files, 2 for usage
+// errors.
 #include "demo.h"
 #include "paper/paper.h"
 #include "query.h"
+#include "tools.h"
 
 #include "proxima/types.h"
 
@@ -35,6 +39,9 @@ constexpr int kExitUsage = 2;
 // Upper end of --max-iterations: far above any real need (the default is
 // 64); it only keeps a typo from turning the cap off.
 constexpr int kMaxIterationsLimit = 1000000;
+// Upper end of --threads: far beyond any machine this runs on; it only keeps
+// a typo from starting a million threads per block.
+constexpr int kMaxThreads = 1024;
 
 proxima::Algorithm parse_algorithm(const std::string& name) {
   if (name == "gjk") return proxima::Algorithm::gjk;
@@ -42,13 +49,13 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
   return proxima::Algorithm::hybrid;
 }
 
-int run_query_command(const std::string& file, const proxima::DistanceOptions& options) {
+int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads) {
   // Answers go through std::cout only; untying it from C stdio lets it
   // buffer a whole answer line before the explicit flush.
   std::ios::sync_with_stdio(false);
   proxima::cli::QueryRunSummary summary;
   if (file == "-") {
-    summary = proxima::cli::run_queries(std::cin, std::cout, options);
+    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads);
   } else {
     // An ifstream opens a directory without complaint and then reads
     // nothing; that would look like an empty, successful run.
@@ -62,7 +69,7 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
       std::cerr << "proxima query: cannot open '" << file << "': " << std::strerror(errno) << "\n";
       return kExitFailure;
     }
-    summary = proxima::cli::run_queries(in, std::cout, options);
+    summary = proxima::cli::run_queries(in, std::cout, options, threads);
   }
   if (summary.read_failed) {
     std::cerr << "proxima query: reading the input failed after " << summary.answered
@@ -83,9 +90,16 @@ int main(int argc, char** argv) {
       "proxima: minimum distance, closest points and closest features between convex "
       "polyhedra"};
   app.require_subcommand(1);
+  app.footer(
+      "Examples:\n"
+      "  proxima distance a.obj b.stl --pose-b 0 0 2 1 0 0 0\n"
+      "  proxima hull body.ply --out hull.obj\n"
+      "  proxima query queries.jsonl --threads 2 > answers.jsonl\n"
+      "Exit codes: 0 ok, 1 bad input (unreadable file, bad numbers), 2 usage.");
 
   CLI::App* demo = app.add_subcommand(
       "demo", "Build two seeded polytopes, print their hulls and the distance by each algorithm");
+  demo->footer("Example:\n  proxima demo");
 
   CLI::App* query = app.add_subcommand(
       "query",
@@ -94,6 +108,11 @@ int main(int argc, char** argv) {
   std::string file = "-";
   std::string algorithm = "hybrid";
   proxima::DistanceOptions options;
+  int threads = 1;
+  query->footer(
+      "Example:\n"
+      "  echo '{\"id\":1,\"a\":{\"vertices\":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]]},"
+      "\"b\":{\"vertices\":[[3,0,0],[4,0,0],[3,1,0],[3,0,1]]}}' | proxima query");
   query->add_option("FILE", file, "Input file of queries; '-' or none reads standard input");
   query->add_option("--algorithm", algorithm, "Algorithm answering the queries")
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
@@ -102,6 +121,11 @@ int main(int argc, char** argv) {
       ->add_option("--max-iterations", options.max_iterations,
                    "Iteration cap per query; a capped answer says \"iteration_cap\": true")
       ->check(CLI::Range(1, kMaxIterationsLimit))
+      ->capture_default_str();
+  query
+      ->add_option("--threads", threads,
+                   "Threads answering blocks of queries; answers stay in input order")
+      ->check(CLI::Range(1, kMaxThreads))
       ->capture_default_str();
 
   CLI::App* paper = app.add_subcommand(
@@ -112,6 +136,49 @@ int main(int argc, char** argv) {
   paper->add_flag("--quick", paper_options.quick, "Reduced run, under a minute");
   paper->add_option("--out", paper_options.out_dir, "Directory for the CSV files and plots")
       ->capture_default_str();
+  paper->footer("Example:\n  proxima paper --quick --out paper-out");
+
+  CLI::App* distance = app.add_subcommand(
+      "distance",
+      "Distance, closest points, normal and witness features between the convex hulls of two "
+      "mesh files (OBJ, OFF, STL, PLY, XYZ)");
+  proxima::cli::DistanceCommand distance_command;
+  std::string distance_algorithm = "hybrid";
+  distance->add_option("A", distance_command.file_a, "First body's mesh file")->required();
+  distance->add_option("B", distance_command.file_b, "Second body's mesh file")->required();
+  distance
+      ->add_option("--pose-a", distance_command.pose_a,
+                   "Pose of A: translation x y z, then rotation quaternion qw qx qy qz")
+      ->expected(7)
+      ->type_name("x y z qw qx qy qz");
+  distance
+      ->add_option("--pose-b", distance_command.pose_b,
+                   "Pose of B: translation x y z, then rotation quaternion qw qx qy qz")
+      ->expected(7)
+      ->type_name("x y z qw qx qy qz");
+  distance->add_option("--algorithm", distance_algorithm, "Algorithm answering the query")
+      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
+      ->capture_default_str();
+  distance->add_flag("--json", distance_command.json, "One JSON object instead of the table");
+  distance->footer(
+      "Example:\n"
+      "  proxima distance a.obj b.stl --pose-b 0 0 2 0.7071067811865476 0 0 0.7071067811865476 "
+      "--json");
+
+  CLI::App* hull = app.add_subcommand(
+      "hull", "Hull statistics of a mesh file, and its export as OBJ or OFF");
+  proxima::cli::HullCommand hull_command;
+  hull->add_option("FILE", hull_command.file, "Mesh file (OBJ, OFF, STL, PLY, XYZ)")->required();
+  hull->add_option("--out", hull_command.out_file, "Write the hull here; the format from the extension")
+      ->check(CLI::Validator(
+          [](const std::string& path) {
+            return proxima::cli::export_format(path).empty()
+                       ? std::string("the hull is written as .obj or .off, not '" + path + "'")
+                       : std::string();
+          },
+          "FILE.obj|FILE.off"));
+  hull->add_flag("--json", hull_command.json, "One JSON object instead of the table");
+  hull->footer("Example:\n  proxima hull body.stl --out hull.off");
 
   try {
     app.parse(argc, argv);
@@ -126,8 +193,13 @@ int main(int argc, char** argv) {
     if (*paper) return proxima::bench::run_paper(paper_options, std::cout) == 0 ? kExitOk : kExitFailure;
     if (*query) {
       options.algorithm = parse_algorithm(algorithm);
-      return run_query_command(file, options);
+      return run_query_command(file, options, threads);
     }
+    if (*distance) {
+      distance_command.options.algorithm = parse_algorithm(distance_algorithm);
+      return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
+    }
+    if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cerr << "proxima: " << e.what() << "\n";
     return kExitFailure;

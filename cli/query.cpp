@@ -16,14 +16,18 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <exception>
+#include <functional>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -421,20 +425,95 @@ bool is_blank(std::string_view line) {
 
 }  // namespace
 
-QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options) {
+QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
+                            int threads) {
   QueryRunSummary summary;
-  Workspace work;
   std::string line;
-  std::string answer;
   long line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    if (is_blank(line)) continue;
-    answer.clear();
-    if (!answer_line(line, line_number, options, work, answer)) ++summary.errors;
-    ++summary.answered;
-    answer += '\n';
-    out.write(answer.data(), static_cast<std::streamsize>(answer.size()));
+  if (threads <= 1) {
+    Workspace work;
+    std::string answer;
+    while (std::getline(in, line)) {
+      ++line_number;
+      if (is_blank(line)) continue;
+      answer.clear();
+      if (!answer_line(line, line_number, options, work, answer)) ++summary.errors;
+      ++summary.answered;
+      answer += '\n';
+      out.write(answer.data(), static_cast<std::streamsize>(answer.size()));
+      out.flush();
+    }
+    summary.read_failed = in.bad();
+    return summary;
+  }
+
+  // Blocks of lines answered in parallel. Every answer depends on its line
+  // alone (answer_line keeps nothing between lines but buffers, one
+  // Workspace per thread), so the answers are those of the serial loop, and
+  // writing them in block order keeps the input order.
+  struct Pending {
+    std::string line;
+    long line_number = 0;
+    std::string answer;
+    bool ok = true;
+  };
+  const auto block_size = static_cast<std::size_t>(kQueryBlockLines);
+  std::vector<Pending> block(block_size);
+  std::vector<Workspace> work(static_cast<std::size_t>(threads));
+  bool more = true;
+  while (more) {
+    std::size_t count = 0;
+    while (count < block_size) {
+      if (!std::getline(in, line)) {
+        more = false;
+        break;
+      }
+      ++line_number;
+      if (!is_blank(line)) {
+        Pending& p = block[count++];
+        p.line.swap(line);
+        p.line_number = line_number;
+      }
+      // Stop the block at the end of what has arrived: reading on would wait
+      // for the next query before answering this one.
+      if (in.rdbuf()->in_avail() <= 0) break;
+    }
+    if (count == 0) continue;
+
+    std::atomic<std::size_t> next{0};
+    // answer_line turns every failure of a query into an error answer; what
+    // escapes it (out of memory) is carried to this thread, as the serial
+    // loop would let it escape.
+    std::mutex failure_mutex;
+    std::exception_ptr failure;
+    auto worker = [&](Workspace& ws) {
+      try {
+        for (std::size_t i = next++; i < count; i = next++) {
+          Pending& p = block[i];
+          p.answer.clear();
+          p.ok = answer_line(p.line, p.line_number, options, ws, p.answer);
+          p.answer += '\n';
+        }
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        next = count;  // the other threads stop at their next line
+      }
+    };
+    const std::size_t helpers = std::min(work.size(), count) - 1;
+    {
+      std::vector<std::jthread> pool;
+      pool.reserve(helpers);
+      for (std::size_t t = 0; t < helpers; ++t) pool.emplace_back(worker, std::ref(work[t + 1]));
+      worker(work[0]);
+    }  // joins the helpers
+    if (failure) std::rethrow_exception(failure);
+
+    for (std::size_t i = 0; i < count; ++i) {
+      if (!block[i].ok) ++summary.errors;
+      ++summary.answered;
+      out.write(block[i].answer.data(), static_cast<std::streamsize>(block[i].answer.size()));
+    }
     out.flush();
   }
   summary.read_failed = in.bad();

@@ -24,6 +24,14 @@ struct QueryRunSummary {
 // after each answer, so that a caller feeding queries through a pipe one at a
 // time gets each answer before it sends the next. A bad line yields an error
 // answer and the loop goes on; only the stream ending stops it.
-QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options);
+//
+// With threads > 1 the lines are answered in blocks: up to kQueryBlockLines
+// lines that are already available (a block never waits for input that has
+// not arrived, so a pipe fed one query at a time still gets each answer),
+// answered by `threads` threads, written in input order and flushed once per
+// block. The output is byte for byte the one of threads == 1.
+inline constexpr int kQueryBlockLines = 256;
+QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
+                            int threads = 1);
 
 }  // namespace proxima::cli

@@ -1,0 +1,391 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 7: `proxima distance` and `proxima hull` (cli/tools.h).
+//
+// Both read their files through proxima_io, build the hull of every point
+// (a non-convex input is reported, not refused) and print either a table for
+// people or one JSON object for programs. Every number is printed in its
+// shortest round-trip form, so the JSON output and an exported hull give back
+// the very doubles computed.
+#include "tools.h"
+
+#include "proxima/distance.h"
+#include "proxima/io.h"
+#include "proxima/polytope.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <span>
+#include <stdexcept>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+namespace proxima::cli {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+
+// A bad pose number or quaternion: bad input (exit 1), named by option.
+class BadArgument : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Shortest decimal that reads back as the same double (std::to_chars without
+// a precision is round-trip exact); "-0" prints as "0" so that tables do not
+// show signed zeros produced by rotations.
+std::string number(double x) {
+  if (x == 0.0) return "0";
+  std::array<char, 32> buffer{};
+  const auto [end, ec] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), x);
+  if (ec != std::errc()) return "nan";
+  return {buffer.data(), end};
+}
+
+std::string point_text(const Vec3& p) { return number(p.x()) + " " + number(p.y()) + " " + number(p.z()); }
+
+Json point_json(const Vec3& p) { return Json::array({p.x(), p.y(), p.z()}); }
+
+struct LoadedFile {
+  ConvexPolytope polytope;
+  MeshFormat format = MeshFormat::unknown;
+  int input_points = 0;
+};
+
+// read_points, then the hull of every point (what load_convex does), keeping
+// the format read for the report. A hull failure becomes a FileError naming
+// the file, like load_convex's.
+LoadedFile load_file(const std::string& path) {
+  PointCloud cloud = read_points(path);
+  try {
+    ConvexPolytope polytope(cloud.points);
+    return LoadedFile{std::move(polytope), cloud.format, static_cast<int>(cloud.points.size())};
+  } catch (const FileError&) {
+    throw;
+  } catch (const InvalidInput& e) {
+    throw FileError::in_file(path, e.what());
+  }
+}
+
+double parse_number(const std::string& token, const std::string& option, int position) {
+  static constexpr std::array<const char*, 7> kNames = {"x", "y", "z", "qw", "qx", "qy", "qz"};
+  double value = 0.0;
+  const char* first = token.data();
+  const char* last = token.data() + token.size();
+  if (!token.empty() && token.front() == '+') ++first;  // from_chars takes no plus sign
+  const auto [end, ec] = std::from_chars(first, last, value);
+  const std::string where = option + " " + kNames[static_cast<std::size_t>(position)];
+  if (ec == std::errc::result_out_of_range) throw BadArgument(where + ": '" + token + "' is out of the range of double");
+  if (ec != std::errc() || end != last || first == last) throw BadArgument(where + ": '" + token + "' is not a number");
+  if (!std::isfinite(value)) throw BadArgument(where + ": '" + token + "' is not finite");
+  return value;
+}
+
+// x y z qw qx qy qz; the quaternion is normalized by Pose, so it only has to
+// be non-zero (a zero quaternion has no rotation to normalize to).
+Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option) {
+  if (tokens.empty()) return Pose::identity();
+  std::array<double, 7> v{};
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = parse_number(tokens[i], option, static_cast<int>(i));
+  const Quat q(v[3], v[4], v[5], v[6]);
+  const double norm = q.norm();
+  // A quaternion whose norm underflows or overflows cannot be normalized
+  // into a rotation; every other non-zero one can.
+  if (!(norm > 0.0) || !std::isfinite(norm)) {
+    throw BadArgument(option + ": the quaternion (qw qx qy qz) must be non-zero and finite");
+  }
+  return Pose(q, Vec3(v[0], v[1], v[2]));
+}
+
+std::vector<std::int32_t> hull_ids(const Feature& f) {
+  std::vector<std::int32_t> ids;
+  for (int i = 0; i < f.vertex_count(); ++i) ids.push_back(f.vertices[static_cast<std::size_t>(i)]);
+  return ids;
+}
+
+std::vector<std::int32_t> input_ids(const Feature& f, const ConvexPolytope& p) {
+  std::vector<std::int32_t> ids;
+  for (const std::int32_t v : hull_ids(f)) ids.push_back(p.input_index()[static_cast<std::size_t>(v)]);
+  return ids;
+}
+
+std::string id_list(const std::vector<std::int32_t>& ids) {
+  std::string s;
+  for (const std::int32_t id : ids) {
+    if (!s.empty()) s += ' ';
+    s += std::to_string(id);
+  }
+  return s;
+}
+
+Json feature_json(const Feature& f, const ConvexPolytope& p) {
+  Json j;
+  j["type"] = to_string(f.type);
+  j["hull_vertices"] = hull_ids(f);
+  j["face"] = f.face >= 0 ? Json(f.face) : Json(nullptr);
+  j["input_indices"] = input_ids(f, p);
+  return j;
+}
+
+std::string feature_text(const Feature& f, const ConvexPolytope& p) {
+  std::string s = to_string(f.type);
+  if (f.face >= 0) s += " " + std::to_string(f.face);
+  s += ": hull vertices " + id_list(hull_ids(f)) + " (input points " + id_list(input_ids(f, p)) + ")";
+  return s;
+}
+
+Json body_json(const std::string& path, const LoadedFile& body) {
+  Json j;
+  j["file"] = path;
+  j["format"] = to_string(body.format);
+  j["input_points"] = body.input_points;
+  j["hull_vertices"] = body.polytope.vertex_count();
+  j["dimension"] = body.polytope.dimension();
+  j["points_inside"] = body.polytope.interior_point_count();
+  j["convex"] = body.polytope.interior_point_count() == 0;
+  return j;
+}
+
+std::string body_text(const std::string& path, const LoadedFile& body) {
+  std::ostringstream s;
+  s << path << " (" << to_string(body.format) << "): " << body.input_points << " points, "
+    << body.polytope.vertex_count() << " hull vertices, dimension " << body.polytope.dimension();
+  const int inside = body.polytope.interior_point_count();
+  if (inside > 0) {
+    s << "; not convex: " << inside << (inside == 1 ? " point is" : " points are")
+      << " inside the hull (or repeated), the hull of all points is used";
+  }
+  return s.str();
+}
+
+void row(std::ostream& out, const std::string& name, const std::string& value) {
+  out << std::left << std::setw(14) << name << value << "\n";
+}
+
+std::string hull_shape(int dimension) {
+  switch (dimension) {
+    case 0: return "a point";
+    case 1: return "a segment";
+    case 2: return "a polygon";
+    default: return "a solid";
+  }
+}
+
+struct ExportSummary {
+  int vertices = 0;
+  int faces = 0;
+  std::string note;  // what was written for a hull of lower dimension
+};
+
+// Writes the hull as OBJ or OFF: the hull vertices in hull order (vertex i
+// of the file is hull vertex i) and the faces as polygons, counter-clockwise
+// seen from outside. A polygon (dimension 2) has both sides as faces, so it
+// is written as two opposite polygons; a segment has no faces (OBJ gets one
+// `l` line element, OFF only the two vertices); a point is one vertex.
+ExportSummary write_hull(const ConvexPolytope& p, const std::string& path, const std::string& format,
+                         const std::string& source) {
+  std::ostringstream text;
+  const bool obj = format == "obj";
+  const int faces = p.face_count();
+  if (obj) {
+    text << "# convex hull of " << source << " written by proxima hull: " << p.vertex_count()
+         << " vertices, " << faces << " faces, dimension " << p.dimension() << "\n";
+    for (const Vec3& v : p.vertices()) text << "v " << point_text(v) << "\n";
+    for (int f = 0; f < faces; ++f) {
+      text << "f";
+      for (const std::int32_t v : p.face(f)) text << " " << v + 1;
+      text << "\n";
+    }
+    if (p.dimension() == 1) text << "l 1 2\n";
+  } else {
+    text << "OFF\n" << p.vertex_count() << " " << faces << " " << p.edge_count() << "\n";
+    for (const Vec3& v : p.vertices()) text << point_text(v) << "\n";
+    for (int f = 0; f < faces; ++f) {
+      text << p.face(f).size();
+      for (const std::int32_t v : p.face(f)) text << " " << v;
+      text << "\n";
+    }
+  }
+
+  std::ofstream file(path, std::ios::binary);
+  const std::string contents = text.str();
+  file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+  file.close();
+  if (!file) throw FileError::in_file(path, "cannot write the hull");
+
+  ExportSummary summary{p.vertex_count(), faces, {}};
+  if (p.dimension() == 2) {
+    summary.note = "the hull is a polygon: written as two faces, one per side";
+  } else if (p.dimension() == 1) {
+    summary.note = obj ? "the hull is a segment: its two end points and one line element, no faces"
+                       : "the hull is a segment: its two end points only (OFF has no line elements)";
+  } else if (p.dimension() == 0) {
+    summary.note = "the hull is a single point: one vertex, no faces";
+  }
+  return summary;
+}
+
+}  // namespace
+
+std::string export_format(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".obj") return "obj";
+  if (ext == ".off") return "off";
+  return {};
+}
+
+int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream& err) {
+  Pose pose_a;
+  Pose pose_b;
+  try {
+    pose_a = parse_pose(command.pose_a, "--pose-a");
+    pose_b = parse_pose(command.pose_b, "--pose-b");
+  } catch (const BadArgument& e) {
+    err << "proxima distance: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  std::optional<LoadedFile> a;
+  std::optional<LoadedFile> b;
+  try {
+    a.emplace(load_file(command.file_a));
+    b.emplace(load_file(command.file_b));
+  } catch (const InvalidInput& e) {
+    err << "proxima distance: " << e.what() << "\n";
+    return kExitFailure;
+  }
+
+  const DistanceResult r = distance(a->polytope, pose_a, b->polytope, pose_b, command.options, nullptr);
+  // Finite inputs whose products overflow (coordinates near 1e308) are the
+  // only way to a non-finite answer; JSON cannot carry it and a table of
+  // "inf" would look like an answer.
+  if (!std::isfinite(r.distance) || !r.point_a.allFinite() || !r.point_b.allFinite()) {
+    err << "proxima distance: the result is not finite: the coordinates are too large for double "
+           "arithmetic\n";
+    return kExitFailure;
+  }
+
+  if (command.json) {
+    Json j;
+    j["a"] = body_json(command.file_a, *a);
+    j["b"] = body_json(command.file_b, *b);
+    j["algorithm"] = to_string(command.options.algorithm);
+    j["status"] = to_string(r.status);
+    j["distance"] = r.distance;
+    j["lower_bound"] = r.lower_bound;
+    j["iterations"] = r.iterations;
+    j["point_a"] = point_json(r.point_a);
+    j["point_b"] = point_json(r.point_b);
+    j["normal"] = point_json(r.normal);
+    j["feature_a"] = feature_json(r.feature_a, a->polytope);
+    j["feature_b"] = feature_json(r.feature_b, b->polytope);
+    out << j.dump() << "\n";
+  } else {
+    row(out, "A", body_text(command.file_a, *a));
+    row(out, "B", body_text(command.file_b, *b));
+    row(out, "algorithm", to_string(command.options.algorithm));
+    row(out, "status", to_string(r.status));
+    row(out, "distance", number(r.distance));
+    row(out, "lower bound", number(r.lower_bound));
+    row(out, "iterations", std::to_string(r.iterations));
+    row(out, "point on A", point_text(r.point_a));
+    row(out, "point on B", point_text(r.point_b));
+    row(out, "normal", point_text(r.normal) + "  (from A towards B)");
+    row(out, "feature A", feature_text(r.feature_a, a->polytope));
+    row(out, "feature B", feature_text(r.feature_b, b->polytope));
+  }
+  out.flush();
+  if (!out) {
+    err << "proxima distance: writing the answer failed\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
+  std::optional<LoadedFile> body;
+  std::optional<ExportSummary> exported;
+  try {
+    body.emplace(load_file(command.file));
+    if (!command.out_file.empty()) {
+      exported = write_hull(body->polytope, command.out_file, export_format(command.out_file), command.file);
+    }
+  } catch (const InvalidInput& e) {
+    err << "proxima hull: " << e.what() << "\n";
+    return kExitFailure;
+  }
+  const ConvexPolytope& p = body->polytope;
+
+  if (command.json) {
+    Json j;
+    j["file"] = command.file;
+    j["format"] = to_string(body->format);
+    j["input_points"] = body->input_points;
+    j["vertices"] = p.vertex_count();
+    j["edges"] = p.edge_count();
+    j["faces"] = p.face_count();
+    j["dimension"] = p.dimension();
+    j["scale"] = p.scale();
+    j["bounding_radius"] = p.bounding_radius();
+    j["centroid"] = point_json(p.centroid());
+    j["points_inside"] = p.interior_point_count();
+    j["convex"] = p.interior_point_count() == 0;
+    j["memory_bytes"] = p.memory_bytes();
+    if (exported) {
+      Json e;
+      e["file"] = command.out_file;
+      e["format"] = export_format(command.out_file);
+      e["vertices"] = exported->vertices;
+      e["faces"] = exported->faces;
+      e["note"] = exported->note.empty() ? Json(nullptr) : Json(exported->note);
+      j["export"] = e;
+    }
+    out << j.dump() << "\n";
+  } else {
+    row(out, "file", command.file + " (" + to_string(body->format) + ")");
+    row(out, "input points", std::to_string(body->input_points));
+    row(out, "vertices", std::to_string(p.vertex_count()));
+    row(out, "edges", std::to_string(p.edge_count()));
+    row(out, "faces", std::to_string(p.face_count()));
+    row(out, "dimension", std::to_string(p.dimension()) + " (" + hull_shape(p.dimension()) + ")");
+    row(out, "scale", number(p.scale()) + "  (largest absolute vertex coordinate)");
+    row(out, "radius", number(p.bounding_radius()) + "  (bounding radius about the centroid)");
+    row(out, "centroid", point_text(p.centroid()));
+    const int inside = p.interior_point_count();
+    row(out, "points inside",
+        std::to_string(inside) + (inside == 0 ? "  (convex input)" : "  (not convex: inside the hull or repeated)"));
+    row(out, "memory", std::to_string(p.memory_bytes()) + " bytes");
+    if (exported) {
+      std::string line = command.out_file + ": " + std::to_string(exported->vertices) + " vertices, " +
+                         std::to_string(exported->faces) + " faces";
+      if (!exported->note.empty()) line += " (" + exported->note + ")";
+      row(out, "written", line);
+    }
+  }
+  out.flush();
+  if (!out) {
+    err << "proxima hull: writing the statistics failed\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace proxima::cli

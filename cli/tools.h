@@ -1,0 +1,47 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 7: `proxima distance` and `proxima hull`, the commands that work on
+// mesh files (read through proxima_io, include/proxima/io.h). main.cpp parses
+// the arguments; these run the commands and return the exit code.
+#pragma once
+
+#include "proxima/types.h"
+
+#include <optional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace proxima::cli {
+
+struct DistanceCommand {
+  std::string file_a;
+  std::string file_b;
+  // Seven tokens each, x y z qw qx qy qz, as typed (parsed by the command so
+  // that a bad number is bad input, exit 1, not a usage error).
+  std::vector<std::string> pose_a;
+  std::vector<std::string> pose_b;
+  DistanceOptions options;
+  bool json = false;
+};
+
+// Loads both files, runs one cold query, prints a table or one JSON object
+// to `out`. Problems with the input (unreadable file, bad pose numbers) go to
+// `err` with the file or option named; the return value is 0 or 1.
+int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream& err);
+
+struct HullCommand {
+  std::string file;
+  std::string out_file;  // empty: no export; otherwise .obj or .off (any case)
+  bool json = false;
+};
+
+// Hull statistics of one file (table or JSON) and optionally its export as
+// OBJ or OFF. Returns 0 or 1 like run_distance.
+int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err);
+
+// "obj" or "off" for a path with that extension (any case), empty otherwise.
+std::string export_format(const std::string& path);
+
+}  // namespace proxima::cli
