@@ -592,6 +592,30 @@ bool on_boundary(const ExactQuery& q, const ClosestPoints<Rational>& r, double m
          side(q.b, q.nb, r.active_b, r.point_b, 1.0);
 }
 
+// Whether the feature pair given by the bits (sub-features of the query)
+// realizes, exactly, a distance within `margin` of the exact minimum: a near
+// tie. The composite kernels and the corner rule choose between candidates
+// by comparing their computed distances, so two feature pairs whose exact
+// distances differ by less than rounding are a toss-up for double even when
+// the points are far from a region boundary (e.g. an edge point 1e-12 R from
+// its vertex, at distance 1e-6 R: the two candidates differ by 1e-18 R).
+bool near_tie(const ExactQuery& q, const ClosestPoints<Rational>& ex, std::uint8_t bits_a,
+              std::uint8_t bits_b, double margin) {
+  std::array<Vec3q, 3> fa, fb;
+  int na = 0, nb = 0;
+  for (int i = 0; i < q.na; ++i) {
+    if ((bits_a >> i) & 1) fa[static_cast<std::size_t>(na++)] = q.a[static_cast<std::size_t>(i)];
+  }
+  for (int j = 0; j < q.nb; ++j) {
+    if ((bits_b >> j) & 1) fb[static_cast<std::size_t>(nb++)] = q.b[static_cast<std::size_t>(j)];
+  }
+  if (na == 0 || nb == 0) return false;
+  const Rational pair = closest_points<Rational>(fa.data(), na, fb.data(), nb).distance_squared;
+  return std::sqrt(static_cast<double>(pair)) -
+             std::sqrt(static_cast<double>(ex.distance_squared)) <=
+         margin;
+}
+
 // Margin of on_boundary in units of u R / kappa: rounding moves the double
 // kernels' decisions by a few u R / kappa; 2^12 of them leaves ample room
 // and still classifies almost all generic random queries as interior ones.
@@ -681,14 +705,16 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
                            " is not sum coef * vertex (eq. 20)");
       }
     }
-    // Active sets, away from region boundaries.
+    // Active sets, away from region boundaries and near ties.
     if (compare_active) {
       const double kappa = conditioning(q);
       const double margin = kappa > 0 ? kBoundaryUnits * ulp_r / kappa : HUGE_VAL;
-      if (!on_boundary(eq, ex, margin)) {
+      const bool differ = r.active_a != ex.active_a || r.active_b != ex.active_b;
+      if (!on_boundary(eq, ex, margin) &&
+          !(differ && near_tie(eq, ex, r.active_a, r.active_b, kBoundaryUnits * ulp_r))) {
         ++tally.compared;
         ++tally.interior_by_pattern[{ex.active_a, ex.active_b}];
-        if (r.active_a != ex.active_a || r.active_b != ex.active_b) {
+        if (differ) {
           std::ostringstream os;
           os << "active sets " << int{r.active_a} << "/" << int{r.active_b} << " vs exact "
              << int{ex.active_a} << "/" << int{ex.active_b} << " (kappa " << kappa << ")";
@@ -705,6 +731,23 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
     }
   }
 }
+
+// Sanitizer builds run a quarter of the random queries: they are there to
+// find memory errors and undefined behaviour, which do not need the
+// statistics, and the exact rationals' allocations make them about 25 times
+// slower than a release build.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr int kQueryDivisor = 4;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr int kQueryDivisor = 4;
+#else
+constexpr int kQueryDivisor = 1;
+#endif
+#else
+constexpr int kQueryDivisor = 1;
+#endif
+constexpr int queries(int n) { return n / kQueryDivisor; }
 
 // ---------------------------------------------------------------------------
 // Seeded generators.
@@ -800,9 +843,9 @@ KernelTolerance<double> tolerance_for(const Query& q) { return kernel_tolerance(
 TEST(ClosestPointExact, RandomPointSegment) {
   Gen g(101);
   Tally t;
-  for (int k = 0; k < 1500; ++k) {
+  for (int k = 0; k < queries(1500); ++k) {
     Query q = generic(g, 1, 2, 1.5);
-    if (k >= 1000) q = rescaled(g, q);
+    if (k >= queries(1000)) q = rescaled(g, q);
     check_query(q, tolerance_for(q), t);
   }
   report(t, "point-segment");
@@ -812,9 +855,9 @@ TEST(ClosestPointExact, RandomPointSegment) {
 TEST(ClosestPointExact, RandomPointTriangle) {
   Gen g(202);
   Tally t;
-  for (int k = 0; k < 3000; ++k) {
+  for (int k = 0; k < queries(3000); ++k) {
     Query q = generic(g, 1, 3, g.pick({0.0, 1.0, 2.0}));
-    if (k >= 2000) q = rescaled(g, q);
+    if (k >= queries(2000)) q = rescaled(g, q);
     check_query(q, tolerance_for(q), t);
   }
   report(t, "point-triangle");
@@ -824,9 +867,9 @@ TEST(ClosestPointExact, RandomPointTriangle) {
 TEST(ClosestPointExact, RandomSegmentSegment) {
   Gen g(303);
   Tally t;
-  for (int k = 0; k < 3000; ++k) {
+  for (int k = 0; k < queries(3000); ++k) {
     Query q = generic(g, 2, 2, g.pick({0.0, 1.0, 2.0}));
-    if (k >= 2000) q = rescaled(g, q);
+    if (k >= queries(2000)) q = rescaled(g, q);
     check_query(q, tolerance_for(q), t);
   }
   report(t, "segment-segment");
@@ -837,9 +880,9 @@ TEST(ClosestPointExact, RandomSegmentSegment) {
 TEST(ClosestPointExact, RandomSegmentTriangle) {
   Gen g(404);
   Tally t;
-  for (int k = 0; k < 1500; ++k) {
+  for (int k = 0; k < queries(1500); ++k) {
     Query q = generic(g, 2, 3, g.pick({0.0, 0.5, 1.5}));
-    if (k >= 1000) q = rescaled(g, q);
+    if (k >= queries(1000)) q = rescaled(g, q);
     check_query(q, tolerance_for(q), t);
   }
   report(t, "segment-triangle");
@@ -858,9 +901,9 @@ TEST(ClosestPointExact, RandomSegmentTriangle) {
 TEST(ClosestPointExact, RandomTriangleTriangle) {
   Gen g(505);
   Tally t;
-  for (int k = 0; k < 900; ++k) {
+  for (int k = 0; k < queries(900); ++k) {
     Query q = generic(g, 3, 3, g.pick({0.5, 1.5, 2.5}));
-    if (k >= 600) q = rescaled(g, q);
+    if (k >= queries(600)) q = rescaled(g, q);
     check_query(q, tolerance_for(q), t);
   }
   report(t, "triangle-triangle");
@@ -941,7 +984,7 @@ Vec3d point_near(Gen& g, const std::array<Vec3d, 3>& t) {
 TEST(ClosestPointExact, SliverAndNeedleTriangles) {
   Gen g(606);
   Tally t;
-  for (int k = 0; k < 2500; ++k) {
+  for (int k = 0; k < queries(2500); ++k) {
     const double eps =
         g.pick({1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-15, 1e-16, 1e-17, 0});
     Query q;
@@ -961,7 +1004,7 @@ TEST(ClosestPointExact, SliverAndNeedleTriangles) {
 TEST(ClosestPointExact, CollinearAndRepeatedVertexTriangles) {
   Gen g(707);
   Tally t;
-  for (int k = 0; k < 1200; ++k) {
+  for (int k = 0; k < queries(1200); ++k) {
     Query q;
     q.na = 1;
     q.nb = 3;
@@ -990,7 +1033,7 @@ TEST(ClosestPointExact, CollinearAndRepeatedVertexTriangles) {
 TEST(ClosestPointExact, NearlyParallelSegments) {
   Gen g(808);
   Tally t;
-  for (int k = 0; k < 3000; ++k) {
+  for (int k = 0; k < queries(3000); ++k) {
     const double eps = g.pick({1e-3, 1e-6, 1e-9, 1e-12, 1e-14, 1e-15, 1e-16, 1e-17, 0});
     Query q;
     q.na = 2;
@@ -1014,7 +1057,7 @@ TEST(ClosestPointExact, NearlyParallelSegments) {
 TEST(ClosestPointExact, ParallelAndCollinearSegments) {
   Gen g(909);
   Tally t;
-  for (int k = 0; k < 1500; ++k) {
+  for (int k = 0; k < queries(1500); ++k) {
     Query q;
     q.na = 2;
     q.nb = 2;
@@ -1034,7 +1077,7 @@ TEST(ClosestPointExact, ParallelAndCollinearSegments) {
 TEST(ClosestPointExact, ZeroAndTinySegments) {
   Gen g(1010);
   Tally t;
-  for (int k = 0; k < 1500; ++k) {
+  for (int k = 0; k < queries(1500); ++k) {
     Query q;
     q.na = 2;
     q.nb = g.integer(1, 3);
@@ -1069,7 +1112,7 @@ TEST(ClosestPointExact, ZeroAndTinySegments) {
 TEST(ClosestPointExact, DegenerateSegmentTriangleAndTriangleTriangle) {
   Gen g(1111);
   Tally t;
-  for (int k = 0; k < 4000; ++k) {
+  for (int k = 0; k < queries(2800); ++k) {
     const double eps = g.pick({1e-3, 1e-8, 1e-12, 1e-15, 1e-17, 0});
     Query q;
     q.na = g.integer(2, 3);
@@ -1129,7 +1172,7 @@ TEST(ClosestPointExact, DegenerateSegmentTriangleAndTriangleTriangle) {
 TEST(ClosestPointExact, EdgesMeetingNearTheirEnds) {
   Gen g(1515);
   Tally t;
-  for (int k = 0; k < 3000; ++k) {
+  for (int k = 0; k < queries(2400); ++k) {
     const Vec3d m0 = g.unit() * g.uniform(0.3, 2);
     const Vec3d a0 = g.cube();
     const double s_star =
@@ -1162,7 +1205,7 @@ TEST(ClosestPointExact, EdgesMeetingNearTheirEnds) {
 TEST(ClosestPointExact, PointsNearASliversTip) {
   Gen g(1616);
   Tally t;
-  for (int k = 0; k < 2000; ++k) {
+  for (int k = 0; k < queries(2000); ++k) {
     const double eps = g.pick({1e-4, 1e-8, 1e-12, 1e-15, 1e-16});
     const Vec3d tip = g.cube();
     const Vec3d axis = g.unit();
@@ -1192,7 +1235,7 @@ TEST(ClosestPointExact, PointsNearASliversTip) {
 TEST(ClosestPointExact, CoplanarFeatures) {
   Gen g(1212);
   Tally t;
-  for (int k = 0; k < 800; ++k) {
+  for (int k = 0; k < queries(800); ++k) {
     Query q;
     q.na = g.integer(1, 3);
     q.nb = g.integer(1, 3);
@@ -1212,7 +1255,7 @@ TEST(ClosestPointExact, CoplanarFeatures) {
 TEST(ClosestPointExact, FiniteWithoutTolerances) {
   Gen g(1313);
   int checked = 0;
-  for (int k = 0; k < 20000; ++k) {
+  for (int k = 0; k < queries(20000); ++k) {
     Query q;
     q.na = g.integer(1, 3);
     q.nb = g.integer(1, 3);
@@ -1258,14 +1301,14 @@ TEST(ClosestPointExact, FiniteWithoutTolerances) {
       ++checked;
     }
   }
-  EXPECT_EQ(checked, 40000);
+  EXPECT_EQ(checked, 2 * queries(20000));
 }
 
 // Properties in exact arithmetic: exchanging A and B exchanges the answer;
 // relabelling the vertices of a feature does not change the distance.
 TEST(ClosestPointExact, SymmetryAndRelabelling) {
   Gen g(1414);
-  for (int k = 0; k < 400; ++k) {
+  for (int k = 0; k < queries(400); ++k) {
     Query q = generic(g, g.integer(1, 3), g.integer(1, 3), g.pick({0.0, 1.0}));
     const ExactQuery eq(q);
     const ClosestPoints<Rational> ab = exact_answer(eq);
@@ -1355,6 +1398,30 @@ TEST(ClosestPointRegression, NearlyAntiparallelSegmentsOverlappingAtTheEnds) {
   q.a[1] = Vec3d(-4.4478318791572114e-31, -4.501694833877655e-31, -7.3235065204659686e-31);
   q.b[0] = Vec3d(-4.2484043157943154e-31, -4.6203692360263077e-31, -6.8885784838985774e-31);
   q.b[1] = Vec3d(-9.5130733787158101e-31, -1.4874951086132926e-31, -1.8370201886912184e-30);
+  expect_accurate(q);
+}
+
+// Not a kernel bug but a lesson for the test itself, kept as a check of the
+// near-tie rule: b1 is 1e-6 R from segment A, and its exact foot on A is
+// 1.5e-12 R inside from a0. The vertex a0 and A's interior are candidates
+// whose exact distances differ by 1e-18 R, so double picks either; the
+// position margin of on_boundary (1.2e-12 R here) did not see it. Found by a
+// 10x run of EdgesMeetingNearTheirEnds.
+TEST(ClosestPointRegression, NearTieBetweenVertexAndEdgeIsNotAMismatch) {
+  Query q;
+  q.na = 2;
+  q.nb = 3;
+  q.a[0] = Vec3d(3.4874087581974426e-28, -9.2408163416971251e-28, 1.6059517484223495e-28);
+  q.a[1] = Vec3d(3.4768028807881493e-28, -9.2350374814031017e-28, 1.6126094079040913e-28);
+  q.b = {Vec3d(3.490339172766256e-28, -9.2494245763039457e-28, 1.6077263045525694e-28),
+         Vec3d(3.487413933763007e-28, -9.2408166924099883e-28, 1.6059602977218284e-28),
+         Vec3d(3.4919119547105944e-28, -9.2433585104464983e-28, 1.6104043764503599e-28)};
+  const ExactQuery eq(q);
+  const ClosestPoints<Rational> ex = exact_answer(eq);
+  EXPECT_EQ(int{ex.active_a}, 3);
+  const double ulp_r = kU * q.scale();
+  EXPECT_TRUE(near_tie(eq, ex, 1, ex.active_b, kBoundaryUnits * ulp_r));   // vertex a0 instead
+  EXPECT_FALSE(near_tie(eq, ex, 2, ex.active_b, kBoundaryUnits * ulp_r));  // vertex a1 is far
   expect_accurate(q);
 }
 
