@@ -964,5 +964,19 @@ TEST(DistanceRegression, MovedFlatPolygonsKeepTheirHulls) {
   EXPECT_TRUE(run_named("moved_flat_polygons", a, b));
 }
 
+TEST(DistanceRegression, PointNearANeedle) {
+  // Found by DegenerateShapes (2026-11-21): a point 2.4e-13 from a needle
+  // (5 points, 2 long, 4e-9 thick). The hybrid stopped on the edge
+  // [0 1] at 6.0e-10 with lower bound 0 after 2 iterations; both GJKs
+  // found d* to 0.01 u R.
+  const Points a{Vec3(-0.093249359488972894, -0.013550249080565874, 0)};
+  const Points b{Vec3(-0.69089681648325885, -0.013550248903682394, 5.7753080096034637e-10),
+                Vec3(1.3091031835167413, -0.013550248903682394, 5.7753080096034637e-10),
+                Vec3(1.0082165423143632, -0.013550249406037773, -1.0639477632246042e-09),
+                Vec3(-0.12503958944525853, -0.013550248625723738, 2.548473543306784e-09),
+                Vec3(1.0853006518400046, -0.013550251973242389, 4.1503033787471111e-09)};
+  EXPECT_TRUE(run_named("point_near_needle", a, b));
+}
+
 }  // namespace
 }  // namespace proxima::test
