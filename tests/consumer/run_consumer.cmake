@@ -1,0 +1,35 @@
+# Installs proxima from a build tree into a fresh prefix, configures and
+# builds tests/consumer against it with find_package(proxima CONFIG), and
+# runs the consumer. Run as a CTest test:
+#   cmake -DPROXIMA_BINARY_DIR=<build> -DCONSUMER_SOURCE_DIR=<tests/consumer>
+#         -DWORK_DIR=<scratch> -DGENERATOR=<gen> -DCXX_COMPILER=<c++>
+#         -DCXX_FLAGS=<flags> -DLINKER_FLAGS=<flags> -DBUILD_TYPE=<type>
+#         -P run_consumer.cmake
+# The compiler and its flags are the build tree's, so that a sanitizer build
+# (whose static libraries need the sanitizer runtime) links the consumer with
+# the same runtime.
+foreach(var PROXIMA_BINARY_DIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "run_consumer.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+
+function(run step)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "consumer test: ${step} failed (${result}): ${ARGN}")
+  endif()
+endfunction()
+
+# A fresh prefix every run: a stale install must not hide a broken one.
+file(REMOVE_RECURSE "${WORK_DIR}")
+set(prefix "${WORK_DIR}/prefix")
+run(install ${CMAKE_COMMAND} --install "${PROXIMA_BINARY_DIR}" --prefix "${prefix}"
+    --component proxima_development)
+run(configure ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${WORK_DIR}/build" -G "${GENERATOR}"
+    "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
+    "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}"
+    "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}")
+run(build ${CMAKE_COMMAND} --build "${WORK_DIR}/build")
+run(run "${WORK_DIR}/build/consumer")
+message(STATUS "consumer test: installed proxima found, built and run")
