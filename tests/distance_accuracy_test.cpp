@@ -33,6 +33,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <map>
 #include <sstream>
 #include <string>
@@ -479,7 +480,7 @@ TEST(DistanceAccuracy, ParallelFeatures) {
     const double gap = (rng() & 1) ? log_uniform(rng, 1e-12, 1e-6) : log_uniform(rng, 1e-3, 3);
     Points a = box(ha), b = box(hb);
     if (kind == 1) {  // edge-edge: both turned 45 degrees about z
-      const Mat3 turn = Eigen::AngleAxisd(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
+      const Mat3 turn = Eigen::AngleAxisd(std::numbers::pi / 4, Vec3::UnitZ()).toRotationMatrix();
       a = transformed(a, turn, Vec3::Zero());
       b = transformed(b, turn, Vec3::Zero());
     }
@@ -609,7 +610,7 @@ TEST(DistanceAccuracy, TrackingEqualsColdAlongMotion) {
     const Mat3 spin_step = random_small_rotation(rng, 0.02);
     Mat3 spin = random_rotation(rng);
     for (int s = 0; s < steps; ++s) {
-      const double phase = 2 * M_PI * s / steps;
+      const double phase = 2 * std::numbers::pi * s / steps;
       const Vec3 dir = (Eigen::AngleAxisd(phase, axis) * axis.unitOrthogonal()).normalized();
       spin = spin * spin_step;
       const double clearance = std::pow(10.0, -5.0 + 5.0 * std::cos(3 * phase));

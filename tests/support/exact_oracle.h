@@ -58,6 +58,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cfenv>
 #include <cmath>
 #include <cstdint>
@@ -221,7 +222,7 @@ inline std::optional<ConvexCombination> convex_coefficients(const std::vector<QP
   std::vector<unsigned> masks;
   for (unsigned m = 1; m < (1u << k); ++m) masks.push_back(m);
   std::stable_sort(masks.begin(), masks.end(),
-                   [](unsigned x, unsigned y) { return __builtin_popcount(x) < __builtin_popcount(y); });
+                   [](unsigned x, unsigned y) { return std::popcount(x) < std::popcount(y); });
   for (const unsigned mask : masks) {
     std::vector<int> sub;
     for (int i = 0; i < k; ++i)

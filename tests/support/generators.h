@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <numbers>
 #include <random>
 #include <string>
 #include <vector>
@@ -31,8 +32,8 @@ using Points = std::vector<Vec3>;
 // std::uniform_real_distribution whose algorithm the standard leaves open.
 inline double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
 inline double uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
-// Uniform integer in [lo, hi], portable (rejection-free modulo bias is
-// irrelevant at these ranges, but keep it exact anyway: 64-bit draws).
+// Integer in [lo, hi], portable (std::uniform_int_distribution is not).
+// The modulo bias of a 64-bit draw over ranges this small is ~1e-17.
 inline int uniform_int(Rng& rng, int lo, int hi) {
   const auto span = static_cast<std::uint64_t>(static_cast<std::int64_t>(hi) - lo + 1);
   return lo + static_cast<int>(rng() % span);
@@ -168,7 +169,7 @@ inline Points sliver(Rng& rng, double height) {
 inline Points flat_polygon(Rng& rng, int n) {
   Points pts;
   for (int i = 0; i < n; ++i) {
-    const double a = uniform(rng, 0, 2 * M_PI);
+    const double a = uniform(rng, 0, 2 * std::numbers::pi);
     const double r = (i % 4 == 3) ? uniform(rng, 0.1, 0.9) : 1.0;
     pts.push_back(Vec3(r * std::cos(a), r * std::sin(a), 0));
   }
