@@ -6,13 +6,12 @@
 // caches the first one left (tracking). Each is timed on its own, with 1 and
 // 2 threads; items_per_second is queries per second (wall clock).
 //
-//   ./build/release/bench/batch_bench --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+//   ./build/release/bench/batch_bench --benchmark_repetitions=3
+//   --benchmark_report_aggregates_only=true
 //
 // Scaling is the ratio of the 2-thread to the 1-thread items_per_second (wall
 // clock, so only meaningful on an otherwise idle machine); the CPU column is
 // the process CPU time of all threads per call.
-#include "proxima/batch.h"
-
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -20,6 +19,8 @@
 #include <memory>
 #include <random>
 #include <vector>
+
+#include "proxima/batch.h"
 
 namespace proxima {
 namespace {
@@ -30,7 +31,9 @@ constexpr int kPoolSize = 64;
 // Portable draws (the distributions of <random> are implementation-defined):
 // 53 random bits to [0, 1).
 double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
-double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * uniform01(rng);
+}
 
 Vec3 random_unit(std::mt19937_64& rng) {
   for (;;) {
@@ -41,8 +44,10 @@ Vec3 random_unit(std::mt19937_64& rng) {
 
 Quat random_quaternion(std::mt19937_64& rng) {
   for (;;) {
-    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0) return Quat(q[0], q[1], q[2], q[3]).normalized();
+    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
+                            uniform(rng, -1, 1));
+    if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0)
+      return Quat(q[0], q[1], q[2], q[3]).normalized();
   }
 }
 
@@ -62,7 +67,8 @@ const Scene& scene() {
       std::vector<Vec3> pts;
       for (int j = 0; j < n; ++j) {
         pts.push_back(i % 2 == 0 ? random_unit(rng)
-                                 : Vec3(uniform(rng, -0.55, 0.55), uniform(rng, -0.55, 0.55), uniform(rng, -0.55, 0.55)));
+                                 : Vec3(uniform(rng, -0.55, 0.55), uniform(rng, -0.55, 0.55),
+                                        uniform(rng, -0.55, 0.55)));
       }
       out.pool.push_back(std::make_unique<ConvexPolytope>(pts));
     }
@@ -70,7 +76,8 @@ const Scene& scene() {
       out.pairs.push_back({out.pool[rng() % kPoolSize].get(), out.pool[rng() % kPoolSize].get()});
       const Vec3 centre(uniform(rng, -100, 100), uniform(rng, -100, 100), uniform(rng, -100, 100));
       const Pose a(random_quaternion(rng), centre);
-      const Pose b(random_quaternion(rng), Vec3(centre + uniform(rng, 2.0, 3.5) * random_unit(rng)));
+      const Pose b(random_quaternion(rng),
+                   Vec3(centre + uniform(rng, 2.0, 3.5) * random_unit(rng)));
       // Frame 1: each body turned by 0.01 rad about a random axis and moved
       // by 0.01.
       const auto moved = [&](const Pose& p) {
@@ -139,7 +146,10 @@ void arguments(benchmark::internal::Benchmark* b) {
   // Process CPU time (all threads) beside wall time: on a busy machine the
   // wall-clock scaling is whatever share of the cores the run gets, while
   // the CPU time per query across threads shows the parallel overhead.
-  b->ArgNames({"threads", "algorithm"})->MeasureProcessCPUTime()->UseRealTime()->Unit(benchmark::kMillisecond);
+  b->ArgNames({"threads", "algorithm"})
+      ->MeasureProcessCPUTime()
+      ->UseRealTime()
+      ->Unit(benchmark::kMillisecond);
 }
 
 BENCHMARK(BM_BatchCold)->Apply(arguments);

@@ -9,12 +9,11 @@
 // bit for bit the sequential one.
 #include "proxima/batch.h"
 
-#include "proxima/distance.h"
-
-#include "parallel_ranges.h"
-
 #include <cstddef>
 #include <string>
+
+#include "parallel_ranges.h"
+#include "proxima/distance.h"
 
 #if defined(__SANITIZE_THREAD__)
 #define PROXIMA_TSAN 1
@@ -65,8 +64,8 @@ std::string at(std::size_t k) { return std::to_string(k); }
 
 void check_size(std::size_t size, std::size_t expected, const char* name) {
   if (size != expected) {
-    throw InvalidInput("distance_batch: " + std::string(name) + " has " + at(size) + " elements, expected " +
-                       at(expected) + " (one per pair)");
+    throw InvalidInput("distance_batch: " + std::string(name) + " has " + at(size) +
+                       " elements, expected " + at(expected) + " (one per pair)");
   }
 }
 
@@ -82,20 +81,22 @@ void check_poses(std::span<const Pose> poses, const char* name) {
 // The shared part of both overloads. `pair(k)` returns the BatchPair of
 // index k (a span lookup or the one fixed pair).
 template <class PairOf>
-void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a, std::span<const Pose> poses_b,
-               std::span<DistanceResult> results, std::span<DistanceCache> caches,
-               const DistanceOptions& options, int threads) {
+void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
+               std::span<const Pose> poses_b, std::span<DistanceResult> results,
+               std::span<DistanceCache> caches, const DistanceOptions& options, int threads) {
   check_size(poses_a.size(), n, "poses_a");
   check_size(poses_b.size(), n, "poses_b");
   check_size(results.size(), n, "results");
   if (!caches.empty()) check_size(caches.size(), n, "caches (when not empty)");
   if (threads < 0) {
-    throw InvalidInput("distance_batch: threads must be >= 0 (0: all cores), got " + std::to_string(threads));
+    throw InvalidInput("distance_batch: threads must be >= 0 (0: all cores), got " +
+                       std::to_string(threads));
   }
   for (std::size_t k = 0; k < n; ++k) {
     const BatchPair p = pair(k);
     if (p.a == nullptr || p.b == nullptr) {
-      throw InvalidInput("distance_batch: pairs[" + at(k) + "]." + (p.a == nullptr ? "a" : "b") + " is null");
+      throw InvalidInput("distance_batch: pairs[" + at(k) + "]." + (p.a == nullptr ? "a" : "b") +
+                         " is null");
     }
   }
   check_poses(poses_a, "poses_a");
@@ -109,7 +110,8 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a, std::s
     for (std::size_t k = begin; k < end; ++k) {
       const BatchPair p = pair(k);
       try {
-        results[k] = distance(*p.a, poses_a[k], *p.b, poses_b[k], options, caches.empty() ? nullptr : &caches[k]);
+        results[k] = distance(*p.a, poses_a[k], *p.b, poses_b[k], options,
+                              caches.empty() ? nullptr : &caches[k]);
       } catch (const InvalidInput& e) {
         throw InvalidInput("distance_batch: pair " + at(k) + ": " + e.what());
       }
@@ -138,12 +140,12 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a, std::s
 
 }  // namespace
 
-void distance_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a, std::span<const Pose> poses_b,
-                    std::span<DistanceResult> results, std::span<DistanceCache> caches,
-                    const DistanceOptions& options, int threads) {
+void distance_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a,
+                    std::span<const Pose> poses_b, std::span<DistanceResult> results,
+                    std::span<DistanceCache> caches, const DistanceOptions& options, int threads) {
   run_batch(
-      pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b, results, caches, options,
-      threads);
+      pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b, results, caches,
+      options, threads);
 }
 
 void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, const ConvexPolytope& b,
@@ -151,7 +153,8 @@ void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, cons
                     std::span<DistanceCache> caches, const DistanceOptions& options, int threads) {
   const BatchPair fixed{&a, &b};
   run_batch(
-      poses_a.size(), [fixed](std::size_t) { return fixed; }, poses_a, poses_b, results, caches, options, threads);
+      poses_a.size(), [fixed](std::size_t) { return fixed; }, poses_a, poses_b, results, caches,
+      options, threads);
 }
 
 }  // namespace proxima

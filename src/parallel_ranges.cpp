@@ -21,10 +21,13 @@
 namespace proxima::detail {
 
 void parallel_ranges(std::size_t n, std::size_t grain, int threads,
-                     void (*run)(void* context, std::size_t begin, std::size_t end), void* context) {
+                     void (*run)(void* context, std::size_t begin, std::size_t end),
+                     void* context) {
   const auto loop = [&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
-                      [run, context](const tbb::blocked_range<std::size_t>& r) { run(context, r.begin(), r.end()); });
+                      [run, context](const tbb::blocked_range<std::size_t>& r) {
+                        run(context, r.begin(), r.end());
+                      });
   };
   if (threads == 0) {
     loop();

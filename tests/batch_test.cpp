@@ -9,9 +9,6 @@
 // of the answers is the business of distance_accuracy_test.cpp.
 #include "proxima/batch.h"
 
-#include "proxima/distance.h"
-#include "support/generators.h"
-
 #include <gtest/gtest.h>
 #include <oneapi/tbb/task_arena.h>
 #include <oneapi/tbb/task_scheduler_observer.h>
@@ -23,6 +20,9 @@
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "proxima/distance.h"
+#include "support/generators.h"
 
 namespace proxima {
 namespace {
@@ -49,11 +49,13 @@ Scene make_scene(Rng& rng, int n, int pool_size = 12) {
   Scene s;
   for (int i = 0; i < pool_size; ++i) {
     const int count = test::uniform_int(rng, 20, 100);
-    s.pool.push_back(std::make_unique<ConvexPolytope>(i % 2 == 0 ? test::points_on_sphere(rng, count)
-                                                                 : test::points_in_cube(rng, count)));
+    s.pool.push_back(std::make_unique<ConvexPolytope>(
+        i % 2 == 0 ? test::points_on_sphere(rng, count) : test::points_in_cube(rng, count)));
   }
   for (int k = 0; k < n; ++k) {
-    const auto pick = [&] { return s.pool[static_cast<std::size_t>(test::uniform_int(rng, 0, pool_size - 1))].get(); };
+    const auto pick = [&] {
+      return s.pool[static_cast<std::size_t>(test::uniform_int(rng, 0, pool_size - 1))].get();
+    };
     s.pairs.push_back({pick(), pick()});
     s.poses_a.push_back(random_pose(rng, 2.0));
     s.poses_b.push_back(random_pose(rng, 2.0));
@@ -70,7 +72,9 @@ void step(Rng& rng, std::vector<Pose>& poses) {
   }
 }
 
-bool same_bits(double x, double y) { return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y); }
+bool same_bits(double x, double y) {
+  return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y);
+}
 bool same_bits(const Vec3& x, const Vec3& y) {
   return same_bits(x[0], y[0]) && same_bits(x[1], y[1]) && same_bits(x[2], y[2]);
 }
@@ -80,7 +84,8 @@ bool same_feature(const Feature& x, const Feature& y) {
 
 void expect_same_result(const DistanceResult& x, const DistanceResult& y, std::size_t k) {
   EXPECT_EQ(x.status, y.status) << "pair " << k;
-  EXPECT_TRUE(same_bits(x.distance, y.distance)) << "pair " << k << ": " << x.distance << " vs " << y.distance;
+  EXPECT_TRUE(same_bits(x.distance, y.distance))
+      << "pair " << k << ": " << x.distance << " vs " << y.distance;
   EXPECT_TRUE(same_bits(x.lower_bound, y.lower_bound)) << "pair " << k;
   EXPECT_TRUE(same_bits(x.point_a, y.point_a)) << "pair " << k;
   EXPECT_TRUE(same_bits(x.point_b, y.point_b)) << "pair " << k;
@@ -160,7 +165,8 @@ TEST(Batch, CachesAreUpdatedAndTrackingSavesIterations) {
   // intersection test and say little about tracking.
   // Unit-size bodies (radius at most sqrt(3)) 5 apart stay apart through a
   // step of 0.01.
-  for (std::size_t k = 0; k < s.pairs.size(); ++k) s.poses_b[k].translation = s.poses_a[k].translation + Vec3(5, 0, 0);
+  for (std::size_t k = 0; k < s.pairs.size(); ++k)
+    s.poses_b[k].translation = s.poses_a[k].translation + Vec3(5, 0, 0);
   std::vector<DistanceResult> first(s.pairs.size());
   std::vector<DistanceCache> caches(s.pairs.size());
   for (const DistanceCache& c : caches) ASSERT_TRUE(c.is_cold());
@@ -250,8 +256,9 @@ TEST(Batch, BadInputIsRefusedWithItsIndexBeforeAnythingIsWritten) {
     }
     return true;
   };
-  const auto run = [&](std::span<const BatchPair> pairs, std::span<const Pose> pa, std::span<const Pose> pb,
-                       std::span<DistanceResult> res, std::span<DistanceCache> cs, int threads = 2) {
+  const auto run = [&](std::span<const BatchPair> pairs, std::span<const Pose> pa,
+                       std::span<const Pose> pb, std::span<DistanceResult> res,
+                       std::span<DistanceCache> cs, int threads = 2) {
     return invalid_input_message([&] { distance_batch(pairs, pa, pb, res, cs, {}, threads); });
   };
   const std::span<DistanceResult> all_results(results);
@@ -259,14 +266,19 @@ TEST(Batch, BadInputIsRefusedWithItsIndexBeforeAnythingIsWritten) {
   const std::span<const Pose> poses_a(s.poses_a);
   const std::span<const Pose> poses_b(s.poses_b);
 
-  EXPECT_NE(run(s.pairs, poses_a.first(n - 1), poses_b, all_results, all_caches).find("poses_a has 299 elements"),
+  EXPECT_NE(run(s.pairs, poses_a.first(n - 1), poses_b, all_results, all_caches)
+                .find("poses_a has 299 elements"),
             std::string::npos);
-  EXPECT_NE(run(s.pairs, poses_a, poses_b.first(n - 2), all_results, all_caches).find("poses_b has 298 elements"),
+  EXPECT_NE(run(s.pairs, poses_a, poses_b.first(n - 2), all_results, all_caches)
+                .find("poses_b has 298 elements"),
             std::string::npos);
-  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results.first(10), all_caches).find("results has 10 elements"),
+  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results.first(10), all_caches)
+                .find("results has 10 elements"),
             std::string::npos);
-  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results, all_caches.first(5)).find("caches"), std::string::npos);
-  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results, all_caches, -1).find("threads"), std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results, all_caches.first(5)).find("caches"),
+            std::string::npos);
+  EXPECT_NE(run(s.pairs, poses_a, poses_b, all_results, all_caches, -1).find("threads"),
+            std::string::npos);
 
   std::vector<BatchPair> with_null = s.pairs;
   with_null[217].b = nullptr;
@@ -279,14 +291,17 @@ TEST(Batch, BadInputIsRefusedWithItsIndexBeforeAnythingIsWritten) {
   std::vector<Pose> bad_b = s.poses_b;
   bad_b[123].translation.y() = std::numeric_limits<double>::infinity();
   bad_b[250].rotation(1, 2) = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(run(s.pairs, poses_a, bad_b, all_results, all_caches).find("poses_b[123] is not finite"),
-            std::string::npos);
-  EXPECT_NE(run(s.pairs, poses_a, bad_b, all_results, all_caches, 1).find("poses_b[123] is not finite"),
-            std::string::npos);
+  EXPECT_NE(
+      run(s.pairs, poses_a, bad_b, all_results, all_caches).find("poses_b[123] is not finite"),
+      std::string::npos);
+  EXPECT_NE(
+      run(s.pairs, poses_a, bad_b, all_results, all_caches, 1).find("poses_b[123] is not finite"),
+      std::string::npos);
 
   const ConvexPolytope& a = *s.pool[0];
-  EXPECT_NE(invalid_input_message([&] { distance_batch(a, poses_a, a, bad_b, all_results, all_caches, {}, 2); })
-                .find("poses_b[123] is not finite"),
+  EXPECT_NE(invalid_input_message([&] {
+              distance_batch(a, poses_a, a, bad_b, all_results, all_caches, {}, 2);
+            }).find("poses_b[123] is not finite"),
             std::string::npos);
   EXPECT_NE(invalid_input_message([&] {
               distance_batch(a, poses_a, a, poses_b.first(7), all_results, all_caches, {}, 2);
@@ -305,8 +320,8 @@ TEST(Batch, ExceptionInsideAWorkerReachesTheCallerWithItsMessage) {
   DistanceOptions bad;
   bad.max_iterations = 0;
   for (int threads : kThreadCounts) {
-    const std::string message =
-        invalid_input_message([&] { distance_batch(s.pairs, s.poses_a, s.poses_b, results, {}, bad, threads); });
+    const std::string message = invalid_input_message(
+        [&] { distance_batch(s.pairs, s.poses_a, s.poses_b, results, {}, bad, threads); });
     EXPECT_EQ(message.rfind("distance_batch: pair ", 0), 0u) << message;
     EXPECT_NE(message.find("max_iterations must be at least 1"), std::string::npos) << message;
   }
@@ -318,9 +333,13 @@ TEST(Batch, ExceptionInsideAWorkerReachesTheCallerWithItsMessage) {
 // as it would in the main thread.
 class TrapObserver : public tbb::task_scheduler_observer {
  public:
-  explicit TrapObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
+  explicit TrapObserver(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) {
+    observe(true);
+  }
   ~TrapObserver() override { observe(false); }
-  void on_scheduler_entry(bool /*is_worker*/) override { feenableexcept(FE_INVALID | FE_DIVBYZERO); }
+  void on_scheduler_entry(bool /*is_worker*/) override {
+    feenableexcept(FE_INVALID | FE_DIVBYZERO);
+  }
 };
 
 TEST(Batch, CallerArenaWithFloatingPointTrapsOnEveryThread) {

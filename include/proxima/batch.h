@@ -31,10 +31,10 @@
 // thread among them).
 #pragma once
 
+#include <span>
+
 #include "proxima/polytope.h"
 #include "proxima/types.h"
-
-#include <span>
 
 namespace proxima {
 
