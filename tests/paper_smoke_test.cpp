@@ -10,8 +10,6 @@
 // answers another problem, e.g. a wrong frame or a forgotten margin, prints
 // a WARNING; Bullet's default 0.04 margin was caught that way). Timing
 // figures are not asserted: they are benchmarks, not tests.
-#include "paper/paper.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -22,6 +20,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "paper/paper.h"
 
 namespace {
 
@@ -53,13 +53,14 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
   return rows;
 }
 
-const std::set<std::string> kSystems = {"proxima hybrid", "proxima Enhanced GJK", "proxima GJK",
-                                        "FCL libccd",     "FCL GJK",              "Bullet GJK"};
+const std::set<std::string> kSystems = {
+    "proxima hybrid", "proxima Enhanced GJK", "proxima GJK", "FCL libccd", "FCL GJK", "Bullet GJK"};
 
 // One test, one run: ctest runs each discovered test in its own process, so
 // a fixture shared by several tests would run the quick mode once per test.
 TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
-  const fs::path dir = fs::temp_directory_path() / ("proxima_paper_smoke_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("proxima_paper_smoke_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   proxima::bench::PaperOptions options;
   options.quick = true;
@@ -70,10 +71,12 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
 
   {
     SCOPED_TRACE("every file");
-    for (const char* name : {"robustness.csv", "robustness_failures.csv", "translation.csv", "rotation.csv",
-                             "cold.csv", "targets.csv", "tracking_modes.csv", "run.csv"}) {
+    for (const char* name :
+         {"robustness.csv", "robustness_failures.csv", "translation.csv", "rotation.csv",
+          "cold.csv", "targets.csv", "tracking_modes.csv", "run.csv"}) {
       EXPECT_TRUE(fs::exists(dir / name)) << name;
-      EXPECT_FALSE(read_csv(dir / name).empty() && std::string(name) != "robustness_failures.csv") << name;
+      EXPECT_FALSE(read_csv(dir / name).empty() && std::string(name) != "robustness_failures.csv")
+          << name;
     }
   }
   {
@@ -84,12 +87,15 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
       const int cases = std::stoi(row.at("cases"));
       EXPECT_GT(cases, 0) << row.at("experiment") << " " << row.at("system");
       if (row.at("system").rfind("proxima", 0) == 0) {
-        EXPECT_EQ(std::stoi(row.at("within_standard")), cases) << row.at("experiment") << " " << row.at("system");
-        EXPECT_EQ(std::stoi(row.at("crash")) + std::stoi(row.at("hang")) + std::stoi(row.at("nan")), 0);
+        EXPECT_EQ(std::stoi(row.at("within_standard")), cases)
+            << row.at("experiment") << " " << row.at("system");
+        EXPECT_EQ(std::stoi(row.at("crash")) + std::stoi(row.at("hang")) + std::stoi(row.at("nan")),
+                  0);
       }
     }
     ASSERT_EQ(systems_per_experiment.size(), 2u);
-    for (const auto& [experiment, systems] : systems_per_experiment) EXPECT_EQ(systems, kSystems) << experiment;
+    for (const auto& [experiment, systems] : systems_per_experiment)
+      EXPECT_EQ(systems, kSystems) << experiment;
     // Every case had a certified exact reference (otherwise the run says so).
     EXPECT_EQ(log.str().find("no certified exact reference"), std::string::npos) << log.str();
   }

@@ -12,16 +12,15 @@
 //   make the answer wrong: only a certified answer is accepted.
 #include "paper/exact_reference.h"
 
-#include "proxima/closest_point.h"
-
-#include <boost/multiprecision/cpp_int.hpp>
-
 #include <algorithm>
 #include <array>
+#include <boost/multiprecision/cpp_int.hpp>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 #include <vector>
+
+#include "proxima/closest_point.h"
 
 namespace proxima::bench {
 namespace {
@@ -72,8 +71,10 @@ struct Body {
   std::vector<Vec3> approx;      // the same rounded (ranking only)
   std::vector<RVec> tri_normal;  // (v1 - v0) x (v2 - v0), outward
 
-  explicit Body(const ConvexPolytope& p) : polytope(&p), triangles(p.triangles()), edges(p.edges()) {
-    if (p.dimension() != 3) throw std::invalid_argument("ExactReference: the experiments use solid bodies");
+  explicit Body(const ConvexPolytope& p)
+      : polytope(&p), triangles(p.triangles()), edges(p.edges()) {
+    if (p.dimension() != 3)
+      throw std::invalid_argument("ExactReference: the experiments use solid bodies");
   }
 
   void place_all(const Pose& pose) {
@@ -86,7 +87,8 @@ struct Body {
     tri_normal.clear();
     for (const auto& t : triangles) {
       const RVec& v0 = exact[static_cast<std::size_t>(t[0])];
-      tri_normal.push_back(cross(sub(exact[static_cast<std::size_t>(t[1])], v0), sub(exact[static_cast<std::size_t>(t[2])], v0)));
+      tri_normal.push_back(cross(sub(exact[static_cast<std::size_t>(t[1])], v0),
+                                 sub(exact[static_cast<std::size_t>(t[2])], v0)));
     }
   }
 
@@ -104,7 +106,8 @@ struct Body {
   }
 
   int load(const Piece& p, RVec* out) const {
-    for (int k = 0; k < p.n; ++k) out[k] = exact[static_cast<std::size_t>(p.v[static_cast<std::size_t>(k)])];
+    for (int k = 0; k < p.n; ++k)
+      out[k] = exact[static_cast<std::size_t>(p.v[static_cast<std::size_t>(k)])];
     return p.n;
   }
 
@@ -113,7 +116,8 @@ struct Body {
   bool within(const RVec& x, const Rational& tol2) const {
     std::vector<std::size_t> visible;
     for (std::size_t t = 0; t < triangles.size(); ++t) {
-      const Rational s = dot(tri_normal[t], sub(x, exact[static_cast<std::size_t>(triangles[t][0])]));
+      const Rational s =
+          dot(tri_normal[t], sub(x, exact[static_cast<std::size_t>(triangles[t][0])]));
       if (s <= 0) continue;
       // Outside this plane by more than tol: farther than tol from the hull.
       if (s * s > tol2 * dot(tri_normal[t], tri_normal[t])) return false;
@@ -122,7 +126,8 @@ struct Body {
     if (visible.empty()) return true;
     for (const std::size_t t : visible) {
       RVec tri[3];
-      for (int k = 0; k < 3; ++k) tri[k] = exact[static_cast<std::size_t>(triangles[t][static_cast<std::size_t>(k)])];
+      for (int k = 0; k < 3; ++k)
+        tri[k] = exact[static_cast<std::size_t>(triangles[t][static_cast<std::size_t>(k)])];
       if (closest_points<Rational>(&x, 1, tri, 3).distance_squared <= tol2) return true;
     }
     return false;
@@ -131,7 +136,8 @@ struct Body {
 
 // A convex combination of a piece's vertices from kernel coefficients:
 // checks l >= 0, sum l = 1 and returns sum l_i v_i (nullopt-like: false).
-bool combine(const Body& body, const Piece& piece, const std::array<Rational, 3>& coef, RVec& point) {
+bool combine(const Body& body, const Piece& piece, const std::array<Rational, 3>& coef,
+             RVec& point) {
   Rational sum = 0;
   point = RVec(Rational(0), Rational(0), Rational(0));
   for (int k = 0; k < piece.n; ++k) {
@@ -150,8 +156,8 @@ struct ExactReference::Impl {
   Body a;
   Body b;
   ExactCase current;
-  Rational d2;    // exact d*^2 of the current case
-  Rational tol;   // 64 u R, exact
+  Rational d2;   // exact d*^2 of the current case
+  Rational tol;  // 64 u R, exact
   Rational tol2;
 
   Impl(const ConvexPolytope& pa, const ConvexPolytope& pb) : a(pa), b(pb) {}
@@ -200,10 +206,12 @@ struct ExactReference::Impl {
     auto add_pairs = [&](int dim_a, int dim_b) {
       for (const Piece& x : a.pieces(dim_a)) {
         Vec3 fa[3];
-        for (int k = 0; k < x.n; ++k) fa[k] = a.approx[static_cast<std::size_t>(x.v[static_cast<std::size_t>(k)])];
+        for (int k = 0; k < x.n; ++k)
+          fa[k] = a.approx[static_cast<std::size_t>(x.v[static_cast<std::size_t>(k)])];
         for (const Piece& y : b.pieces(dim_b)) {
           Vec3 fb[3];
-          for (int k = 0; k < y.n; ++k) fb[k] = b.approx[static_cast<std::size_t>(y.v[static_cast<std::size_t>(k)])];
+          for (int k = 0; k < y.n; ++k)
+            fb[k] = b.approx[static_cast<std::size_t>(y.v[static_cast<std::size_t>(k)])];
           candidates.push_back({closest_points<double>(fa, x.n, fb, y.n).distance_squared, x, y});
         }
       }
@@ -211,9 +219,10 @@ struct ExactReference::Impl {
     add_pairs(0, 2);  // vertex of A, triangle of B
     add_pairs(2, 0);  // triangle of A, vertex of B
     add_pairs(1, 1);  // edge-edge
-    std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-      return x.distance_squared < y.distance_squared;
-    });
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& x, const Candidate& y) {
+                       return x.distance_squared < y.distance_squared;
+                     });
 
     bool ok = false;
     for (const Candidate& c : candidates) {
@@ -235,7 +244,8 @@ struct ExactReference::Impl {
 
   Verdict judge(const SystemAnswer& answer) const {
     Verdict v;
-    v.finite = std::isfinite(answer.distance) && answer.point_a.allFinite() && answer.point_b.allFinite();
+    v.finite =
+        std::isfinite(answer.distance) && answer.point_a.allFinite() && answer.point_b.allFinite();
     v.status_ok = answer.answered && answer.separated == current.separated;
     if (!v.finite) {
       v.relative_error = std::numeric_limits<double>::infinity();
@@ -256,7 +266,8 @@ struct ExactReference::Impl {
     const Rational gap2 = dot(w, w);
     const Rational below = rd - tol;
     const Rational above = rd + tol;
-    const bool gap_ok = (below <= 0 || below * below <= gap2) && above >= 0 && gap2 <= above * above;
+    const bool gap_ok =
+        (below <= 0 || below * below <= gap2) && above >= 0 && gap2 <= above * above;
     v.points_ok = gap_ok && a.within(xa, tol2) && b.within(xb, tol2);
     return v;
   }
@@ -267,7 +278,9 @@ ExactReference::ExactReference(const ConvexPolytope& a, const ConvexPolytope& b)
 
 ExactReference::~ExactReference() = default;
 
-ExactCase ExactReference::solve(const Pose& pose_a, const Pose& pose_b) { return impl_->solve(pose_a, pose_b); }
+ExactCase ExactReference::solve(const Pose& pose_a, const Pose& pose_b) {
+  return impl_->solve(pose_a, pose_b);
+}
 
 Verdict ExactReference::judge(const SystemAnswer& answer) const { return impl_->judge(answer); }
 

@@ -34,11 +34,11 @@
 // triangles of the point-triangle kernel is exact.
 #pragma once
 
+#include <memory>
+
 #include "peers/system.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
-
-#include <memory>
 
 namespace proxima::bench {
 

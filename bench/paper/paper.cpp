@@ -20,13 +20,6 @@
 //   peer produces is counted in the robustness table, not trapped.
 #include "paper/paper.h"
 
-#include "paper/exact_reference.h"
-#include "paper/proxima_system.h"
-#include "peers/bullet_peer.h"
-#include "peers/fcl_peer.h"
-#include "proxima/polytope.h"
-#include "proxima/types.h"
-
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -54,6 +47,13 @@
 #include <thread>
 #include <vector>
 
+#include "paper/exact_reference.h"
+#include "paper/proxima_system.h"
+#include "peers/bullet_peer.h"
+#include "peers/fcl_peer.h"
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
 #ifndef PROXIMA_PLOT_SCRIPT
 #define PROXIMA_PLOT_SCRIPT "scripts/plot_paper.py"
 #endif
@@ -65,7 +65,9 @@ using Clock = std::chrono::steady_clock;
 using Rng = std::mt19937_64;
 using Points = std::vector<Vec3>;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 // CPU time of the calling thread, in ns. Timings use it rather than the wall
 // clock: on a shared 2-core machine another process that takes the core
@@ -85,7 +87,9 @@ double thread_cpu_ns() {
 
 double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
 double uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
-double log_uniform(Rng& rng, double lo, double hi) { return std::exp(uniform(rng, std::log(lo), std::log(hi))); }
+double log_uniform(Rng& rng, double lo, double hi) {
+  return std::exp(uniform(rng, std::log(lo), std::log(hi)));
+}
 
 // Uniform on the sphere: rejection in the cube keeps the distribution
 // uniform without a normal deviate.
@@ -100,7 +104,8 @@ Vec3 random_unit_vector(Rng& rng) {
 // Uniform rotation: a uniform unit quaternion (rejection in the 4-cube).
 Mat3 random_rotation(Rng& rng) {
   for (;;) {
-    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
+                            uniform(rng, -1, 1));
     const double n2 = q.squaredNorm();
     if (n2 > 1e-4 && n2 <= 1.0) {
       const Eigen::Vector4d u = q / std::sqrt(n2);
@@ -119,7 +124,8 @@ Points points_on_sphere(Rng& rng, int n) {
 Points cube(double edge) {
   const double h = edge / 2;
   Points pts;
-  for (int i = 0; i < 8; ++i) pts.emplace_back((i & 1) ? h : -h, (i & 2) ? h : -h, (i & 4) ? h : -h);
+  for (int i = 0; i < 8; ++i)
+    pts.emplace_back((i & 1) ? h : -h, (i & 2) ? h : -h, (i & 4) ? h : -h);
   return pts;
 }
 
@@ -134,20 +140,29 @@ Points tetrahedron(double edge) {
 // The systems, always in this order in tables and files.
 
 enum class SystemKind : std::uint8_t { hybrid, enhanced_gjk, gjk, fcl_libccd, fcl_indep, bullet };
-constexpr std::array<SystemKind, 6> kSystems = {SystemKind::hybrid,     SystemKind::enhanced_gjk,
-                                                SystemKind::gjk,        SystemKind::fcl_libccd,
-                                                SystemKind::fcl_indep,  SystemKind::bullet};
+constexpr std::array<SystemKind, 6> kSystems = {SystemKind::hybrid,    SystemKind::enhanced_gjk,
+                                                SystemKind::gjk,       SystemKind::fcl_libccd,
+                                                SystemKind::fcl_indep, SystemKind::bullet};
 
-bool is_peer(SystemKind k) { return k == SystemKind::fcl_libccd || k == SystemKind::fcl_indep || k == SystemKind::bullet; }
+bool is_peer(SystemKind k) {
+  return k == SystemKind::fcl_libccd || k == SystemKind::fcl_indep || k == SystemKind::bullet;
+}
 
-std::unique_ptr<DistanceSystem> make_system(SystemKind k, const ConvexPolytope& a, const ConvexPolytope& b) {
+std::unique_ptr<DistanceSystem> make_system(SystemKind k, const ConvexPolytope& a,
+                                            const ConvexPolytope& b) {
   switch (k) {
-    case SystemKind::hybrid: return std::make_unique<ProximaSystem>(a, b, Algorithm::hybrid);
-    case SystemKind::enhanced_gjk: return std::make_unique<ProximaSystem>(a, b, Algorithm::enhanced_gjk);
-    case SystemKind::gjk: return std::make_unique<ProximaSystem>(a, b, Algorithm::gjk);
-    case SystemKind::fcl_libccd: return std::make_unique<FclPeer>(a, b, FclSolver::libccd);
-    case SystemKind::fcl_indep: return std::make_unique<FclPeer>(a, b, FclSolver::indep);
-    case SystemKind::bullet: return std::make_unique<BulletPeer>(a, b);
+    case SystemKind::hybrid:
+      return std::make_unique<ProximaSystem>(a, b, Algorithm::hybrid);
+    case SystemKind::enhanced_gjk:
+      return std::make_unique<ProximaSystem>(a, b, Algorithm::enhanced_gjk);
+    case SystemKind::gjk:
+      return std::make_unique<ProximaSystem>(a, b, Algorithm::gjk);
+    case SystemKind::fcl_libccd:
+      return std::make_unique<FclPeer>(a, b, FclSolver::libccd);
+    case SystemKind::fcl_indep:
+      return std::make_unique<FclPeer>(a, b, FclSolver::indep);
+    case SystemKind::bullet:
+      return std::make_unique<BulletPeer>(a, b);
   }
   return nullptr;
 }
@@ -240,8 +255,8 @@ Vec3 rotated_support(const ConvexPolytope& p, const Mat3& rotation, const Vec3& 
 // two support points realize it (n lies in A's normal cone at its support
 // point, -n in B's), so the distance is d up to the rounding of this
 // placement; the exact reference is computed from the doubles anyway.
-Vec3 place_b(const ConvexPolytope& a, const Mat3& ra, const ConvexPolytope& b, const Mat3& rb, const Vec3& n,
-             double d) {
+Vec3 place_b(const ConvexPolytope& a, const Mat3& ra, const ConvexPolytope& b, const Mat3& rb,
+             const Vec3& n, double d) {
   return rotated_support(a, ra, n) + d * n - rotated_support(b, rb, -n);
 }
 
@@ -250,8 +265,8 @@ Vec3 place_b(const ConvexPolytope& a, const Mat3& ra, const ConvexPolytope& b, c
 // against a vertex or edge of B) and face against face, tilted by a random
 // angle between 1e-12 and 1e-3 rad: nearly parallel faces, the hardest case
 // for GJK's simplex solver.
-void start_configuration(const ConvexPolytope& a, const ConvexPolytope& b, double d, int kind, Rng& rng, Pose& pa,
-                         Pose& pb) {
+void start_configuration(const ConvexPolytope& a, const ConvexPolytope& b, double d, int kind,
+                         Rng& rng, Pose& pa, Pose& pb) {
   const Mat3 ra = random_rotation(rng);
   Mat3 rb = random_rotation(rng);
   Vec3 n = random_unit_vector(rng);
@@ -263,8 +278,10 @@ void start_configuration(const ConvexPolytope& a, const ConvexPolytope& b, doubl
     const int g = static_cast<int>(rng() % static_cast<std::uint64_t>(b.face_count()));
     const Vec3 m = b.face_plane(g).normal;
     const Mat3 align = Quat::FromTwoVectors(m, -n).toRotationMatrix();
-    const Mat3 spin = Eigen::AngleAxisd(uniform(rng, 0, 2 * std::numbers::pi), n).toRotationMatrix();
-    const Mat3 tilt = Eigen::AngleAxisd(log_uniform(rng, 1e-12, 1e-3), random_unit_vector(rng)).toRotationMatrix();
+    const Mat3 spin =
+        Eigen::AngleAxisd(uniform(rng, 0, 2 * std::numbers::pi), n).toRotationMatrix();
+    const Mat3 tilt = Eigen::AngleAxisd(log_uniform(rng, 1e-12, 1e-3), random_unit_vector(rng))
+                          .toRotationMatrix();
     rb = tilt * spin * align;
   }
   pa = Pose(ra, Vec3::Zero());
@@ -274,8 +291,8 @@ void start_configuration(const ConvexPolytope& a, const ConvexPolytope& b, doubl
 // `orientations` static cases, then `runs` rotation runs of `steps` steps,
 // the run j at omega_j, geometric from 0.001 to 0.5 rad per step, about a
 // random axis through B's centroid.
-CaseList make_cases(const ConvexPolytope& a, const ConvexPolytope& b, double d, int orientations, int runs,
-                    int steps, std::uint64_t seed) {
+CaseList make_cases(const ConvexPolytope& a, const ConvexPolytope& b, double d, int orientations,
+                    int runs, int steps, std::uint64_t seed) {
   Rng rng(seed);
   CaseList cases;
   for (int k = 0; k < orientations; ++k) {
@@ -290,7 +307,8 @@ CaseList make_cases(const ConvexPolytope& a, const ConvexPolytope& b, double d, 
   for (int j = 0; j < runs; ++j) {
     Pose pa, pb;
     start_configuration(a, b, d, j % 3, rng, pa, pb);
-    const double omega = runs > 1 ? 0.001 * std::pow(500.0, static_cast<double>(j) / (runs - 1)) : 0.01;
+    const double omega =
+        runs > 1 ? 0.001 * std::pow(500.0, static_cast<double>(j) / (runs - 1)) : 0.01;
     const Vec3 axis = random_unit_vector(rng);
     const Vec3 centre = pb.apply(b.centroid());
     for (int s = 0; s < steps; ++s) {
@@ -353,7 +371,8 @@ bool read_all(int fd, void* data, std::size_t size) {
   return true;
 }
 
-[[noreturn]] void child_main(DistanceSystem& system, bool peer, const CaseList& cases, std::size_t start, int fd) {
+[[noreturn]] void child_main(DistanceSystem& system, bool peer, const CaseList& cases,
+                             std::size_t start, int fd) {
   PeerFloatingPoint fp(peer);
   for (std::size_t i = start; i < cases.size(); ++i) {
     if (i == start || cases.cold_start[i]) system.reset();
@@ -478,9 +497,10 @@ RobustnessResult run_robustness(const PaperOptions& options, std::ostream& out) 
   // The paper's two bodies pairs (section 6). Experiment 2's scaling of 1e39
   // is applied to edge lengths and distance alike.
   std::vector<Experiment> experiments;
-  experiments.push_back({"experiment 1", "two tetrahedra of edge 1e-23, 2e-22 apart", tetrahedron(1e-23),
-                         tetrahedron(1e-23), 2e-22});
-  experiments.push_back({"experiment 2", "cubes of edge 2000 and 1e-15 scaled by 1e39, 1e-10 x 1e39 apart",
+  experiments.push_back({"experiment 1", "two tetrahedra of edge 1e-23, 2e-22 apart",
+                         tetrahedron(1e-23), tetrahedron(1e-23), 2e-22});
+  experiments.push_back({"experiment 2",
+                         "cubes of edge 2000 and 1e-15 scaled by 1e39, 1e-10 x 1e39 apart",
                          cube(2000 * 1e39), cube(1e-15 * 1e39), 1e-10 * 1e39});
 
   RobustnessResult result;
@@ -489,8 +509,8 @@ RobustnessResult run_robustness(const PaperOptions& options, std::ostream& out) 
     const ConvexPolytope a(e.points_a), b(e.points_b);
     const CaseList cases = make_cases(a, b, e.separation, orientations, runs, steps, seed++);
     result.cases_per_experiment = static_cast<int>(cases.size());
-    out << "  " << e.id << ": " << e.description << "; " << orientations << " orientations + " << runs
-        << " rotation runs x " << steps << " steps = " << cases.size() << " cases\n";
+    out << "  " << e.id << ": " << e.description << "; " << orientations << " orientations + "
+        << runs << " rotation runs x " << steps << " steps = " << cases.size() << " cases\n";
 
     const auto t0 = Clock::now();
     std::vector<std::vector<CaseAnswer>> answers;
@@ -499,7 +519,8 @@ RobustnessResult run_robustness(const PaperOptions& options, std::ostream& out) 
       system->load_poses(cases.pose_a, cases.pose_b);
       answers.push_back(run_isolated(*system, is_peer(k), cases));
     }
-    out << "    systems ran in " << fixed(seconds_since(t0), 1) << " s; judging against the exact reference\n";
+    out << "    systems ran in " << fixed(seconds_since(t0), 1)
+        << " s; judging against the exact reference\n";
 
     std::vector<RobustnessRow> rows(kSystems.size());
     std::vector<int> kept(kSystems.size(), 0);
@@ -530,7 +551,8 @@ RobustnessResult run_robustness(const PaperOptions& options, std::ostream& out) 
     };
     const auto t1 = Clock::now();
     {
-      const unsigned n_threads = std::clamp(std::thread::hardware_concurrency(), 1u, kMaxJudgeThreads);
+      const unsigned n_threads =
+          std::clamp(std::thread::hardware_concurrency(), 1u, kMaxJudgeThreads);
       std::vector<std::jthread> threads;
       for (unsigned t = 0; t < n_threads; ++t) threads.emplace_back(worker);
       auto last_progress = Clock::now();
@@ -538,8 +560,8 @@ RobustnessResult run_robustness(const PaperOptions& options, std::ostream& out) 
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
         if (seconds_since(last_progress) > 5.0) {
           last_progress = Clock::now();
-          out << "    judged " << judged.load() << " / " << cases.size() << " cases (" << fixed(seconds_since(t1), 0)
-              << " s)\n";
+          out << "    judged " << judged.load() << " / " << cases.size() << " cases ("
+              << fixed(seconds_since(t1), 0) << " s)\n";
           out.flush();
         }
       }
@@ -590,8 +612,8 @@ RobustnessResult run_robustness(const PaperOptions& options, std::ostream& out) 
         }
         if (!what.empty() && kept[s] < kFailuresKept) {
           ++kept[s];
-          result.failures.push_back({e.id, row.system, i, cases.omega[i], cases.step[i], exact.distance,
-                                     c.answer.distance, rel, what});
+          result.failures.push_back({e.id, row.system, i, cases.omega[i], cases.step[i],
+                                     exact.distance, c.answer.distance, rel, what});
         }
       }
     }
@@ -607,20 +629,22 @@ void print_robustness(const RobustnessResult& r, std::ostream& out) {
     if (row.experiment != experiment) {
       experiment = row.experiment;
       out << "\n  " << experiment << "\n";
-      out << "  " << pad("system", 22, true) << pad("cases", 7) << pad("within std", 12) << pad("%", 8)
-          << pad("wrong status", 14) << pad("dist. off", 11) << pad("points off", 12) << pad("worst rel.err", 15)
-          << pad("NaN", 6) << pad("no ans.", 9) << pad("crash", 7) << pad("hang", 6) << "\n";
+      out << "  " << pad("system", 22, true) << pad("cases", 7) << pad("within std", 12)
+          << pad("%", 8) << pad("wrong status", 14) << pad("dist. off", 11) << pad("points off", 12)
+          << pad("worst rel.err", 15) << pad("NaN", 6) << pad("no ans.", 9) << pad("crash", 7)
+          << pad("hang", 6) << "\n";
     }
     const double pct = row.cases > 0 ? 100.0 * row.within / row.cases : 0.0;
     out << "  " << pad(row.system, 22, true) << pad(std::to_string(row.cases), 7)
-        << pad(std::to_string(row.within), 12) << pad(fixed(pct, 1), 8) << pad(std::to_string(row.wrong_status), 14)
-        << pad(std::to_string(row.distance_off), 11) << pad(std::to_string(row.points_off), 12)
-        << pad(sci(row.worst_relative_error), 15) << pad(std::to_string(row.nan), 6)
-        << pad(std::to_string(row.no_answer), 9) << pad(std::to_string(row.crash), 7)
-        << pad(std::to_string(row.hang), 6) << "\n";
+        << pad(std::to_string(row.within), 12) << pad(fixed(pct, 1), 8)
+        << pad(std::to_string(row.wrong_status), 14) << pad(std::to_string(row.distance_off), 11)
+        << pad(std::to_string(row.points_off), 12) << pad(sci(row.worst_relative_error), 15)
+        << pad(std::to_string(row.nan), 6) << pad(std::to_string(row.no_answer), 9)
+        << pad(std::to_string(row.crash), 7) << pad(std::to_string(row.hang), 6) << "\n";
   }
   if (r.uncertified > 0) {
-    out << "  WARNING: " << r.uncertified << " cases had no certified exact reference and were left out\n";
+    out << "  WARNING: " << r.uncertified
+        << " cases had no certified exact reference and were left out\n";
   }
 }
 
@@ -647,16 +671,17 @@ struct TimingRow {
 
 // Times every configuration on the same polytopes and pose sequence (see
 // the fairness rules at the top of the file).
-std::vector<TimingRow> time_configs(const ConvexPolytope& a, const ConvexPolytope& b, const std::vector<Pose>& pa,
-                                    const std::vector<Pose>& pb, const std::vector<Config>& configs, int reps,
-                                    double x) {
+std::vector<TimingRow> time_configs(const ConvexPolytope& a, const ConvexPolytope& b,
+                                    const std::vector<Pose>& pa, const std::vector<Pose>& pb,
+                                    const std::vector<Config>& configs, int reps, double x) {
   std::vector<std::unique_ptr<DistanceSystem>> systems;
   for (const SystemKind k : kSystems) {
     systems.push_back(make_system(k, a, b));
     systems.back()->load_poses(pa, pb);
   }
   auto system_of = [&](SystemKind k) -> DistanceSystem& {
-    return *systems[static_cast<std::size_t>(std::find(kSystems.begin(), kSystems.end(), k) - kSystems.begin())];
+    return *systems[static_cast<std::size_t>(std::find(kSystems.begin(), kSystems.end(), k) -
+                                             kSystems.begin())];
   };
   const double n = static_cast<double>(pa.size());
   std::vector<std::vector<double>> times(configs.size());
@@ -696,7 +721,8 @@ std::vector<TimingRow> time_configs(const ConvexPolytope& a, const ConvexPolytop
 std::vector<Config> all_configs() {
   std::vector<Config> c;
   for (const SystemKind k : kSystems) {
-    const bool tracks = k == SystemKind::hybrid || k == SystemKind::enhanced_gjk || k == SystemKind::fcl_indep;
+    const bool tracks =
+        k == SystemKind::hybrid || k == SystemKind::enhanced_gjk || k == SystemKind::fcl_indep;
     if (tracks) c.push_back({k, true});
     c.push_back({k, false});
   }
@@ -706,7 +732,8 @@ std::vector<Config> all_configs() {
 std::vector<Config> tracking_configs() {  // tracking where the system has it
   std::vector<Config> c;
   for (const SystemKind k : kSystems) {
-    c.push_back({k, k == SystemKind::hybrid || k == SystemKind::enhanced_gjk || k == SystemKind::fcl_indep});
+    c.push_back({k, k == SystemKind::hybrid || k == SystemKind::enhanced_gjk ||
+                        k == SystemKind::fcl_indep});
   }
   return c;
 }
@@ -717,7 +744,9 @@ std::vector<Config> cold_configs() {
   return c;
 }
 
-std::string config_label(const TimingRow& r) { return r.system + (r.tracking ? " (tracking)" : ""); }
+std::string config_label(const TimingRow& r) {
+  return r.system + (r.tracking ? " (tracking)" : "");
+}
 
 // Mean distances that disagree between systems mean an adapter answers a
 // different problem. Peers stop at FCL's absolute 1e-6 or Bullet's relative
@@ -725,13 +754,15 @@ std::string config_label(const TimingRow& r) { return r.system + (r.tracking ? "
 // distance; 1e-4 leaves room and still catches a wrong frame or body.
 constexpr double kChecksumAgreement = 1e-4;
 
-void check_agreement(const std::vector<TimingRow>& rows, const std::string& where, std::ostream& out) {
+void check_agreement(const std::vector<TimingRow>& rows, const std::string& where,
+                     std::ostream& out) {
   if (rows.empty()) return;
   const double ref = rows.front().mean_distance;
   for (const TimingRow& r : rows) {
     if (!(std::abs(r.mean_distance - ref) <= kChecksumAgreement * std::abs(ref))) {
-      out << "    WARNING (" << where << "): " << config_label(r) << " mean distance " << exact_text(r.mean_distance)
-          << " differs from " << rows.front().system << "'s " << exact_text(ref) << "\n";
+      out << "    WARNING (" << where << "): " << config_label(r) << " mean distance "
+          << exact_text(r.mean_distance) << " differs from " << rows.front().system << "'s "
+          << exact_text(ref) << "\n";
     }
   }
 }
@@ -744,7 +775,8 @@ double fastest_peer(const std::vector<TimingRow>& rows, double x) {
   return best;
 }
 
-const TimingRow* find_row(const std::vector<TimingRow>& rows, double x, const std::string& system, bool tracking) {
+const TimingRow* find_row(const std::vector<TimingRow>& rows, double x, const std::string& system,
+                          bool tracking) {
   for (const TimingRow& r : rows) {
     if (r.x == x && r.system == system && r.tracking == tracking) return &r;
   }
@@ -753,8 +785,8 @@ const TimingRow* find_row(const std::vector<TimingRow>& rows, double x, const st
 
 // Table: one row per x, one column per configuration (median ns per query),
 // then the fastest peer and its ratio to proxima hybrid.
-void print_timing(const std::vector<TimingRow>& rows, const std::string& x_name, bool hybrid_tracking,
-                  std::ostream& out) {
+void print_timing(const std::vector<TimingRow>& rows, const std::string& x_name,
+                  bool hybrid_tracking, std::ostream& out) {
   std::vector<std::pair<std::string, bool>> columns;
   std::vector<double> xs;
   for (const TimingRow& r : rows) {
@@ -782,7 +814,8 @@ void print_timing(const std::vector<TimingRow>& rows, const std::string& x_name,
     const TimingRow* h = find_row(rows, x, "proxima hybrid", hybrid_tracking);
     out << pad(fixed(peer, 0), w) << pad(h ? fixed(peer / h->median_ns, 1) + "x" : "-", w) << "\n";
   }
-  out << "  (median ns of thread CPU time per query over the repetitions; 'trk' = with tracking; Bullet has no\n"
+  out << "  (median ns of thread CPU time per query over the repetitions; 'trk' = with tracking; "
+         "Bullet has no\n"
          "   tracking mode: Bullet 3.24 resets its cached separating axis on every call)\n";
 }
 
@@ -817,13 +850,14 @@ std::vector<TimingRow> run_translation(const PaperOptions& options, std::ostream
     for (int k = 0; k < steps; ++k) {
       const double theta = 2 * std::numbers::pi * k / steps;
       const double radius = 2.5 + 0.25 * std::sin(3 * theta);
-      pb[static_cast<std::size_t>(k)] = Pose(rb, Vec3(tilt * Vec3(radius * std::cos(theta), radius * std::sin(theta), 0)));
+      pb[static_cast<std::size_t>(k)] =
+          Pose(rb, Vec3(tilt * Vec3(radius * std::cos(theta), radius * std::sin(theta), 0)));
     }
     std::vector<TimingRow> r = time_configs(a, b, pa, pb, all_configs(), reps, n);
     check_agreement(r, "translation N=" + std::to_string(n), out);
     rows.insert(rows.end(), r.begin(), r.end());
-    out << "    N = " << pad(std::to_string(n), 4) << " (" << a.vertex_count() << " and " << b.vertex_count()
-        << " hull vertices): " << fixed(seconds_since(t0), 1) << " s\n";
+    out << "    N = " << pad(std::to_string(n), 4) << " (" << a.vertex_count() << " and "
+        << b.vertex_count() << " hull vertices): " << fixed(seconds_since(t0), 1) << " s\n";
     out.flush();
   }
   return rows;
@@ -835,9 +869,9 @@ std::vector<TimingRow> run_translation(const PaperOptions& options, std::ostream
 std::vector<TimingRow> run_rotation(const PaperOptions& options, std::ostream& out) {
   const int steps = options.quick ? 2000 : 10000;
   const int reps = kRepetitions;
-  const std::vector<double> speeds = options.quick ? std::vector<double>{0.001, 0.05, 0.5}
-                                                   : std::vector<double>{0.001, 0.002, 0.005, 0.01, 0.02,
-                                                                         0.05,  0.1,   0.2,   0.5};
+  const std::vector<double> speeds =
+      options.quick ? std::vector<double>{0.001, 0.05, 0.5}
+                    : std::vector<double>{0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5};
   Rng rng(3000);
   const ConvexPolytope a(points_on_sphere(rng, 50));
   const ConvexPolytope b(points_on_sphere(rng, 50));
@@ -855,7 +889,8 @@ std::vector<TimingRow> run_rotation(const PaperOptions& options, std::ostream& o
     std::vector<TimingRow> r = time_configs(a, b, pa, pb, tracking_configs(), reps, omega);
     check_agreement(r, "rotation omega=" + fixed(omega, 3), out);
     rows.insert(rows.end(), r.begin(), r.end());
-    out << "    omega = " << fixed(omega, 3) << " rad/step: " << fixed(seconds_since(t0), 1) << " s\n";
+    out << "    omega = " << fixed(omega, 3) << " rad/step: " << fixed(seconds_since(t0), 1)
+        << " s\n";
     out.flush();
   }
   return rows;
@@ -900,9 +935,10 @@ struct Target {
   std::string margin;  // by how much met or missed
 };
 
-std::vector<Target> evaluate_targets(const RobustnessResult& robust, const std::vector<TimingRow>& translation,
-                                     const std::vector<TimingRow>& rotation, const std::vector<TimingRow>& cold,
-                                     bool quick) {
+std::vector<Target> evaluate_targets(const RobustnessResult& robust,
+                                     const std::vector<TimingRow>& translation,
+                                     const std::vector<TimingRow>& rotation,
+                                     const std::vector<TimingRow>& cold, bool quick) {
   std::vector<Target> t;
   const std::vector<int> ns = sizes(quick);
   auto hybrid = [&](const std::vector<TimingRow>& rows, double x, bool tracking) {
@@ -920,22 +956,29 @@ std::vector<Target> evaluate_targets(const RobustnessResult& robust, const std::
         at = n;
       }
     }
-    t.push_back({"tracking: hybrid <= 60 ns per query at every N", fixed(worst, 1) + " ns (worst, N=" + std::to_string(at) + ")",
-                 "60 ns", worst <= 60.0, worst <= 60.0 ? fixed(60.0 - worst, 1) + " ns to spare"
-                                                      : "missed by " + fixed(worst - 60.0, 1) + " ns (" + fixed(worst / 60.0, 2) + "x)"});
+    t.push_back(
+        {"tracking: hybrid <= 60 ns per query at every N",
+         fixed(worst, 1) + " ns (worst, N=" + std::to_string(at) + ")", "60 ns", worst <= 60.0,
+         worst <= 60.0
+             ? fixed(60.0 - worst, 1) + " ns to spare"
+             : "missed by " + fixed(worst - 60.0, 1) + " ns (" + fixed(worst / 60.0, 2) + "x)"});
   }
   // Flat in N.
   {
     const double r = hybrid(translation, ns.back(), true) / hybrid(translation, ns.front(), true);
-    t.push_back({"tracking: hybrid flat, N=" + std::to_string(ns.back()) + " / N=" + std::to_string(ns.front()) + " <= 1.5",
-                 fixed(r, 2), "1.5", r <= 1.5, r <= 1.5 ? "met" : "missed by " + fixed(r / 1.5, 2) + "x"});
+    t.push_back({"tracking: hybrid flat, N=" + std::to_string(ns.back()) +
+                     " / N=" + std::to_string(ns.front()) + " <= 1.5",
+                 fixed(r, 2), "1.5", r <= 1.5,
+                 r <= 1.5 ? "met" : "missed by " + fixed(r / 1.5, 2) + "x"});
   }
   // Peer ratios.
-  auto ratio_at = [&](double n) { return fastest_peer(translation, n) / hybrid(translation, n, true); };
+  auto ratio_at = [&](double n) {
+    return fastest_peer(translation, n) / hybrid(translation, n, true);
+  };
   if (std::find(ns.begin(), ns.end(), 64) != ns.end()) {
     const double r = ratio_at(64);
-    t.push_back({"tracking: >= 10x faster than the fastest peer at N=64", fixed(r, 1) + "x", "10x", r >= 10.0,
-                 r >= 10.0 ? "met" : "missed: " + fixed(r, 1) + "x of 10x"});
+    t.push_back({"tracking: >= 10x faster than the fastest peer at N=64", fixed(r, 1) + "x", "10x",
+                 r >= 10.0, r >= 10.0 ? "met" : "missed: " + fixed(r, 1) + "x of 10x"});
   }
   {
     double worst = std::numeric_limits<double>::infinity();
@@ -1023,12 +1066,14 @@ bool write_file(const std::filesystem::path& path, const std::string& text, std:
 
 std::string robustness_csv(const RobustnessResult& r) {
   std::ostringstream s;
-  s << "experiment,system,cases,within_standard,wrong_status,distance_off,points_off,worst_relative_error,nan,"
+  s << "experiment,system,cases,within_standard,wrong_status,distance_off,points_off,worst_"
+       "relative_error,nan,"
        "no_answer,crash,hang\n";
   for (const RobustnessRow& row : r.rows) {
-    s << row.experiment << ',' << row.system << ',' << row.cases << ',' << row.within << ',' << row.wrong_status
-      << ',' << row.distance_off << ',' << row.points_off << ',' << exact_text(row.worst_relative_error) << ','
-      << row.nan << ',' << row.no_answer << ',' << row.crash << ',' << row.hang << '\n';
+    s << row.experiment << ',' << row.system << ',' << row.cases << ',' << row.within << ','
+      << row.wrong_status << ',' << row.distance_off << ',' << row.points_off << ','
+      << exact_text(row.worst_relative_error) << ',' << row.nan << ',' << row.no_answer << ','
+      << row.crash << ',' << row.hang << '\n';
   }
   return s.str();
 }
@@ -1038,19 +1083,21 @@ std::string failures_csv(const RobustnessResult& r) {
   s << "experiment,system,case,omega,step,exact_distance,distance,relative_error,failed\n";
   for (const Failure& f : r.failures) {
     s << f.experiment << ',' << f.system << ',' << f.index << ',' << f.omega << ',' << f.step << ','
-      << exact_text(f.exact) << ',' << exact_text(f.distance) << ',' << exact_text(f.relative_error) << ','
-      << f.what << '\n';
+      << exact_text(f.exact) << ',' << exact_text(f.distance) << ',' << exact_text(f.relative_error)
+      << ',' << f.what << '\n';
   }
   return s.str();
 }
 
 std::string timing_csv(const std::vector<TimingRow>& rows, const std::string& x_name) {
   std::ostringstream s;
-  s << x_name << ",system,peer,tracking,median_ns,min_ns,max_ns,repetitions,queries,mean_distance\n";
+  s << x_name
+    << ",system,peer,tracking,median_ns,min_ns,max_ns,repetitions,queries,mean_distance\n";
   for (const TimingRow& r : rows) {
-    s << exact_text(r.x) << ',' << r.system << ',' << (r.peer ? 1 : 0) << ',' << (r.tracking ? 1 : 0) << ','
-      << fixed(r.median_ns, 2) << ',' << fixed(r.min_ns, 2) << ',' << fixed(r.max_ns, 2) << ',' << r.repetitions
-      << ',' << r.queries << ',' << exact_text(r.mean_distance) << '\n';
+    s << exact_text(r.x) << ',' << r.system << ',' << (r.peer ? 1 : 0) << ','
+      << (r.tracking ? 1 : 0) << ',' << fixed(r.median_ns, 2) << ',' << fixed(r.min_ns, 2) << ','
+      << fixed(r.max_ns, 2) << ',' << r.repetitions << ',' << r.queries << ','
+      << exact_text(r.mean_distance) << '\n';
   }
   return s.str();
 }
@@ -1059,8 +1106,8 @@ std::string targets_csv(const std::vector<Target>& targets) {
   std::ostringstream s;
   s << "target,measured,threshold,met,margin\n";
   for (const Target& t : targets) {
-    s << '"' << t.name << "\",\"" << t.measured << "\",\"" << t.threshold << "\"," << (t.met ? 1 : 0) << ",\""
-      << t.margin << "\"\n";
+    s << '"' << t.name << "\",\"" << t.measured << "\",\"" << t.threshold << "\","
+      << (t.met ? 1 : 0) << ",\"" << t.margin << "\"\n";
   }
   return s.str();
 }
@@ -1121,13 +1168,16 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
     out << "ERROR: cannot create " << dir.string() << ": " << ec.message() << "\n";
     return 1;
   }
-  out << "proxima paper" << (options.quick ? " --quick" : "") << ": the experiments of the paper, proxima against FCL "
+  out << "proxima paper" << (options.quick ? " --quick" : "")
+      << ": the experiments of the paper, proxima against FCL "
       << "0.7 (libccd and its own GJK) and Bullet 3.24, " << std::thread::hardware_concurrency()
       << " hardware threads, load average " << fixed(load_at_start, 1) << "\n";
-  out << "accuracy standard (DESIGN.md): |d - d*| <= 1e-12 d* + 64 u R, closest points within 64 u R of their hulls,"
+  out << "accuracy standard (DESIGN.md): |d - d*| <= 1e-12 d* + 64 u R, closest points within 64 u "
+         "R of their hulls,"
          " status separated iff d* > 64 u R\n";
 
-  out << "\n[1/4] robustness (paper section 6, experiments 1 and 2), exact reference: kernels on cpp_rational, "
+  out << "\n[1/4] robustness (paper section 6, experiments 1 and 2), exact reference: kernels on "
+         "cpp_rational, "
          "certified\n";
   const RobustnessResult robust = run_robustness(options, out);
   print_robustness(robust, out);
@@ -1137,8 +1187,8 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
   const std::vector<TimingRow> translation = run_translation(options, out);
   print_timing(translation, "N", true, out);
 
-  out << "\n[3/4] timing, paper figure 3: rotation, 50 points per body, " << (options.quick ? 2000 : 10000)
-      << " steps, tracking where the system has it\n";
+  out << "\n[3/4] timing, paper figure 3: rotation, 50 points per body, "
+      << (options.quick ? 2000 : 10000) << " steps, tracking where the system has it\n";
   const std::vector<TimingRow> rotation = run_rotation(options, out);
   print_timing(rotation, "omega", true, out);
 
@@ -1146,12 +1196,13 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
   const std::vector<TimingRow> cold = run_cold(options, out);
   print_timing(cold, "N", false, out);
 
-  const std::vector<Target> targets = evaluate_targets(robust, translation, rotation, cold, options.quick);
-  out << "\ntargets of issue 4 (this run" << (options.quick ? ", quick mode: fewer sizes, shorter sequences" : "")
-      << ")\n";
+  const std::vector<Target> targets =
+      evaluate_targets(robust, translation, rotation, cold, options.quick);
+  out << "\ntargets of issue 4 (this run"
+      << (options.quick ? ", quick mode: fewer sizes, shorter sequences" : "") << ")\n";
   for (const Target& t : targets) {
-    out << "  " << (t.met ? "MET     " : "MISSED  ") << pad(t.name, 74, true) << " " << t.measured << "  ("
-        << t.margin << ")\n";
+    out << "  " << (t.met ? "MET     " : "MISSED  ") << pad(t.name, 74, true) << " " << t.measured
+        << "  (" << t.margin << ")\n";
   }
 
   bool ok = robust.uncertified == 0;
@@ -1162,7 +1213,9 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
   ok = write_file(dir / "cold.csv", timing_csv(cold, "n"), out) && ok;
   ok = write_file(dir / "targets.csv", targets_csv(targets), out) && ok;
   ok = write_file(dir / "tracking_modes.csv", tracking_csv(), out) && ok;
-  ok = write_file(dir / "run.csv", run_csv(options.quick, seconds_since(start), load_at_start), out) && ok;
+  ok = write_file(dir / "run.csv", run_csv(options.quick, seconds_since(start), load_at_start),
+                  out) &&
+       ok;
   out << "\nCSV files written to " << fs::absolute(dir).string() << "/\n";
 
   // Plots: Debian's interpreter explicitly (the python3 first on PATH may not
@@ -1170,10 +1223,12 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
   const std::string python = "/usr/bin/python3";
   const std::string script = PROXIMA_PLOT_SCRIPT;
   if (!fs::exists(python) || !fs::exists(script)) {
-    out << "warning: plots not drawn (" << (fs::exists(python) ? script : python) << " not found)\n";
+    out << "warning: plots not drawn (" << (fs::exists(python) ? script : python)
+        << " not found)\n";
   } else {
     out.flush();
-    const std::string command = shell_quote(python) + " " + shell_quote(script) + " " + shell_quote(dir.string());
+    const std::string command =
+        shell_quote(python) + " " + shell_quote(script) + " " + shell_quote(dir.string());
     const int rc = std::system(command.c_str());
     if (rc != 0) {
       out << "warning: plotting failed (" << command << " exited with " << rc << ")\n";

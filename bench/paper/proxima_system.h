@@ -11,11 +11,11 @@
 // Without tracking every query gets a null cache: cold.
 #pragma once
 
+#include <vector>
+
 #include "peers/system.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
-
-#include <vector>
 
 namespace proxima::bench {
 

@@ -20,11 +20,11 @@
 //   previous call left (or setCachedSeparatingAxis gave) is never used.
 #include "peers/bullet_peer.h"
 
-#include <btBulletCollisionCommon.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpaPenetrationDepthSolver.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkPairDetector.h>
 #include <BulletCollision/NarrowPhaseCollision/btPointCollector.h>
 #include <BulletCollision/NarrowPhaseCollision/btVoronoiSimplexSolver.h>
+#include <btBulletCollisionCommon.h>
 
 #include <limits>
 #include <memory>
@@ -41,8 +41,9 @@ Vec3 from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
 
 btTransform to_bt(const Pose& pose) {
   const Mat3& r = pose.rotation;
-  return btTransform(btMatrix3x3(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)),
-                     to_bt(pose.translation));
+  return btTransform(
+      btMatrix3x3(r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)),
+      to_bt(pose.translation));
 }
 
 void fill_hull(btConvexHullShape& shape, const ConvexPolytope& p) {
@@ -68,7 +69,8 @@ struct BulletPeer::Impl {
   Impl(const ConvexPolytope& a, const ConvexPolytope& b) {
     fill_hull(shape_a, a);
     fill_hull(shape_b, b);
-    detector = std::make_unique<btGjkPairDetector>(&shape_a, &shape_b, &simplex_solver, &penetration_solver);
+    detector = std::make_unique<btGjkPairDetector>(&shape_a, &shape_b, &simplex_solver,
+                                                   &penetration_solver);
   }
 
   void query(std::size_t i, btPointCollector& out) {
@@ -80,7 +82,8 @@ struct BulletPeer::Impl {
   }
 };
 
-BulletPeer::BulletPeer(const ConvexPolytope& a, const ConvexPolytope& b) : impl_(std::make_unique<Impl>(a, b)) {}
+BulletPeer::BulletPeer(const ConvexPolytope& a, const ConvexPolytope& b)
+    : impl_(std::make_unique<Impl>(a, b)) {}
 
 BulletPeer::~BulletPeer() = default;
 
@@ -93,7 +96,8 @@ std::string BulletPeer::tracking_note() const {
 }
 
 void BulletPeer::load_poses(std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
-  if (poses_a.size() != poses_b.size()) throw std::invalid_argument("BulletPeer: pose sequences differ in length");
+  if (poses_a.size() != poses_b.size())
+    throw std::invalid_argument("BulletPeer: pose sequences differ in length");
   impl_->tf_a.clear();
   impl_->tf_b.clear();
   for (const Pose& p : poses_a) impl_->tf_a.push_back(to_bt(p));

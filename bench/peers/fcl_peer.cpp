@@ -122,7 +122,9 @@ FclPeer::FclPeer(const ConvexPolytope& a, const ConvexPolytope& b, FclSolver sol
 
 FclPeer::~FclPeer() = default;
 
-std::string FclPeer::name() const { return impl_->solver == FclSolver::libccd ? "FCL libccd" : "FCL GJK"; }
+std::string FclPeer::name() const {
+  return impl_->solver == FclSolver::libccd ? "FCL libccd" : "FCL GJK";
+}
 
 bool FclPeer::has_tracking() const { return impl_->solver == FclSolver::indep; }
 
@@ -132,7 +134,8 @@ std::string FclPeer::tracking_note() const {
 }
 
 void FclPeer::load_poses(std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
-  if (poses_a.size() != poses_b.size()) throw std::invalid_argument("FclPeer: pose sequences differ in length");
+  if (poses_a.size() != poses_b.size())
+    throw std::invalid_argument("FclPeer: pose sequences differ in length");
   impl_->tf_a.clear();
   impl_->tf_b.clear();
   for (const Pose& p : poses_a) impl_->tf_a.push_back(to_fcl(p));

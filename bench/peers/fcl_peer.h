@@ -19,10 +19,10 @@
 // them.
 #pragma once
 
+#include <memory>
+
 #include "peers/system.h"
 #include "proxima/polytope.h"
-
-#include <memory>
 
 namespace proxima::bench {
 

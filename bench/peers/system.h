@@ -10,12 +10,12 @@
 // virtual call is inside the measured work of any system.
 #pragma once
 
-#include "proxima/types.h"
-
 #include <cstddef>
 #include <limits>
 #include <span>
 #include <string>
+
+#include "proxima/types.h"
 
 namespace proxima::bench {
 
