@@ -21,6 +21,11 @@ namespace {
 // 64 u R is indistinguishable from contact for doubles of magnitude R.
 constexpr double kContactUlps = 64.0;
 
+// Slack of an answer's certificate (distance - lower_bound) in units of
+// u R_bound: the lower bound's own rounding is a few u R, so a larger gap
+// means the answer was not certified at machine precision.
+constexpr double kCertificateUlps = 32.0;
+
 void check_pose(const Pose& pose, const char* name) {
   if (!pose.is_finite()) [[unlikely]] {
     throw InvalidInput(std::string("distance: ") + name + " is not finite (NaN or infinite rotation or translation)");
@@ -81,6 +86,43 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
     const double band = kContactUlps * kUnitRoundoff * r_exact + options.absolute_tolerance;
     if (band < band_bound && result.distance > band) result = run(a, b, b_in_a, options, band, c);
+  }
+  // The hybrid reports contact without telling touching from overlapping.
+  // Enhanced GJK's contact search decides it (a direction whose support gap
+  // is within the band: touching; a polytope inside A - B holding a ball of
+  // the band's radius around the origin: intersecting); undecided within the
+  // iteration cap counts as touching, the distance being in the band anyway.
+  if (options.algorithm == Algorithm::hybrid && result.status == Status::touching) {
+    DistanceCache contact_cache;
+    contact_cache.hint_a = c.hint_a;
+    contact_cache.hint_b = c.hint_b;
+    const DistanceResult contact = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, contact_cache);
+    if (contact.status == Status::intersecting) {
+      const Vec3 middle = 0.5 * (result.point_a + result.point_b);
+      result.status = Status::intersecting;
+      result.distance = 0.0;
+      result.point_a = result.point_b = middle;
+      result.iterations += contact.iterations;
+    }
+  }
+  // The hybrid stops when no support point improves its feature pair at
+  // machine precision. Near contact on needles and slivers the direction
+  // between two nearly touching features can be too rough for that to mean
+  // the pair is optimal: the answer is then an honest upper bound without a
+  // matching lower bound. Such an uncertified answer is checked by Enhanced
+  // GJK from its own cold start, and the closer of the two pairs of points
+  // (both lie in the hulls) is kept with the larger of the two lower bounds.
+  if (options.algorithm == Algorithm::hybrid && result.status == Status::separated &&
+      result.distance - result.lower_bound >
+          options.relative_tolerance * result.distance + kCertificateUlps * kUnitRoundoff * r_bound) {
+    DistanceCache second_cache;
+    DistanceResult second = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, second_cache);
+    const double lower = std::max(result.lower_bound, second.lower_bound);
+    if (second.status != Status::iteration_cap && second.distance < result.distance) {
+      second.iterations += result.iterations;
+      result = second;
+    }
+    result.lower_bound = std::min(lower, result.distance);
   }
   // Back to the world frame, in place.
   result.point_a = pose_a.apply(result.point_a);

@@ -246,77 +246,6 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
   return out;
 }
 
-// Touching or intersecting, once the local distance fell into the contact
-// band. By the separating axis theorem, two convex polytopes in contact are
-// only touching when some plane through the contact separates them, and such
-// a plane is parallel to a face of one body or to an edge of each. A plane
-// through the contact point supports both bodies there, so its face or edges
-// are incident to the contact features: the faces around FA's and FB's
-// vertices and the crosses of the edges leaving them are the candidates.
-// Touching when one of them separates the bodies to within the band.
-class ContactClassifier {
- public:
-  ContactClassifier(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                    std::int32_t hint_a, std::int32_t hint_b, double tolerance)
-      : a_(a), b_(b), rot_(b_in_a.rotation), tr_(b_in_a.translation),
-        hint_a_(hint_a), hint_b_(hint_b), tolerance_(tolerance) {}
-
-  bool touching(const FeatureSet& fa, const FeatureSet& fb, const Vec3& last_direction) {
-    if (separates(last_direction)) return true;
-    for (int i = 0; i < fa.n; ++i) {
-      if (any_face_separates(a_, fa.id[static_cast<std::size_t>(i)], Mat3::Identity(), 1.0)) return true;
-    }
-    for (int i = 0; i < fb.n; ++i) {
-      if (any_face_separates(b_, fb.id[static_cast<std::size_t>(i)], rot_, -1.0)) return true;
-    }
-    for (int i = 0; i < fa.n; ++i) {
-      for (std::int32_t na : a_.neighbors(fa.id[static_cast<std::size_t>(i)])) {
-        const Vec3 ea = a_.vertex(na) - fa.p[static_cast<std::size_t>(i)];
-        for (int j = 0; j < fb.n; ++j) {
-          const std::int32_t vb = fb.id[static_cast<std::size_t>(j)];
-          for (std::int32_t nb : b_.neighbors(vb)) {
-            const Vec3 eb = rot_ * (b_.vertex(nb) - b_.vertex(vb));
-            const Vec3 n = ea.cross(eb);
-            const double len = n.norm();
-            if (!(len > 0.0)) continue;
-            if (separates(n / len) || separates(-n / len)) return true;
-          }
-        }
-      }
-    }
-    return false;
-  }
-
- private:
-  // min over B of n.y - max over A of n.x >= -tolerance, for unit n.
-  bool separates(const Vec3& n) {
-    hint_a_ = support_hill_climb(a_, n, hint_a_);
-    hint_b_ = support_hill_climb(b_, -(rot_.transpose() * n), hint_b_);
-    const double gap = n.dot(rot_ * b_.vertex(hint_b_) + tr_) - n.dot(a_.vertex(hint_a_));
-    return gap >= -tolerance_;
-  }
-  // Faces around vertex v of `poly` (whose frame maps to A's by `to_a`); the
-  // outward normal times `sign` is the candidate direction from A to B.
-  bool any_face_separates(const ConvexPolytope& poly, std::int32_t v, const Mat3& to_a, double sign) {
-    const auto faces = poly.adjacency_faces();
-    const auto begin = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v)]);
-    const auto end = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v) + 1]);
-    for (std::size_t k = begin; k < end; ++k) {
-      if (faces[k] < 0) continue;
-      if (separates(Vec3(sign * (to_a * poly.face_plane(faces[k]).normal)))) return true;
-    }
-    return false;
-  }
-
-  const ConvexPolytope& a_;
-  const ConvexPolytope& b_;
-  const Mat3& rot_;
-  const Vec3& tr_;
-  std::int32_t hint_a_;
-  std::int32_t hint_b_;
-  double tolerance_;
-};
-
 }  // namespace
 
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
@@ -416,13 +345,10 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
   result.lower_bound = std::min(std::max(lower, 0.0), d);
   result.normal = d > 0.0 ? Vec3((loc.xb - loc.xa) / d) : last_direction;
   if (contact) {
-    ContactClassifier classifier(a, b, b_in_a, hint_a, hint_b, contact_tolerance);
-    result.status = classifier.touching(fa, fb, last_direction) ? Status::touching : Status::intersecting;
+    // In contact at machine precision. Whether the bodies only touch or
+    // overlap is decided by the query layer (distance.cpp).
+    result.status = Status::touching;
     result.lower_bound = 0.0;
-    if (result.status == Status::intersecting) {
-      result.distance = 0.0;
-      result.point_a = result.point_b = Vec3(0.5 * (loc.xa + loc.xb));
-    }
   } else if (result.status != Status::iteration_cap) {
     result.status = Status::separated;
   }
