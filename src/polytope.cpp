@@ -15,11 +15,13 @@
 //      the result exactly convex, and derive the vertex adjacency, in
 //      rotational order, from the face cycles.
 // A solid is exact (planar faces, every edge strictly convex, only extreme
-// points as vertices) whenever Qhull's unmerged triangulation is convex in
-// exact arithmetic, which the cleaning checks (it is for every exactly
-// representable test input: grids, spheres, cubes, cylinders, scaled sets).
-// Otherwise (rotated, rounded data whose roundoff Qhull must merge) the faces
-// are Qhull's merged facets, planar and convex within its merge tolerance.
+// points as vertices, every input point inside) whenever Qhull's unmerged
+// triangulation is convex in exact arithmetic and contains every input point,
+// which the cleaning and contains_all check. Otherwise (rotated, rounded,
+// nearly flat data) an exact incremental hull replaces it, within a work
+// budget (inputs of a few hundred points always fit); past that budget the
+// faces are Qhull's merged facets, planar and convex only within its merge
+// tolerance, and may miss extreme points (a known gap).
 #include "proxima/polytope.h"
 
 #include <boost/multiprecision/cpp_int.hpp>
@@ -1162,12 +1164,13 @@ Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled,
   // of points share a face (Qhull's default merging is quadratic there: a
   // cylinder of 2 x 2000 points takes 1.5 s with it, 60 ms without), and the
   // exact cleaning turns its triangles into the true faces. Accepted only if
-  // that cleaning proves the result convex. Otherwise the default options,
-  // which merge facets coplanar within Qhull's roundoff estimate (C-0), as
-  // they come. On a precision or flatness error ("the initial simplex is
-  // flat", QH6154, for a box 1e-30 thin), retry with every axis scaled to
-  // [-1, 1] (QbB), which makes an axis-aligned thin box well shaped; then
-  // give up on the third dimension.
+  // that cleaning proves the result convex and every other input point is
+  // exactly inside it (contains_all). Otherwise (rounded, nearly degenerate
+  // data, or Qhull calling the input flat) the exact incremental hull. Only
+  // past its work budget, the old fallbacks: Qhull's default options, which
+  // merge facets coplanar within its roundoff estimate (C-0); on a precision
+  // or flatness error, every axis scaled to [-1, 1] (QbB); then the projected
+  // polygon. Those are not exact (see below).
   const auto boundary_of = [&](Cycles faces) {
     Boundary b;
     b.dimension = 3;
