@@ -1,0 +1,121 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 6: a scene of many moving bodies. The caller moves the bodies (their
+// poses) each step and asks for the close pairs: every pair of bodies whose
+// distance is at most the scene's margin, with the distance, the closest
+// points, the witness features and (for compound bodies) the pieces.
+//
+// Each step runs a broad phase (bounding boxes within the margin of each
+// other) and then the tracked distance query on each candidate pair; each
+// pair's cache is kept across steps while the pair stays a candidate, so that
+// a scene of slowly moving bodies costs about one tracked query per close
+// pair.
+//
+//   proxima::SceneOptions options;
+//   options.margin = 0.05;
+//   proxima::Scene scene(options);
+//   auto id = scene.add(std::make_shared<proxima::ConvexPolytope>(points), pose);
+//   for each step:
+//     scene.set_pose(id, new_pose);  // for every body that moved
+//     for (const proxima::ClosePair& p : scene.step()) ... p.a, p.b, p.result.distance
+//
+// Thread safety: a Scene is one object of mutable state; use it from one
+// thread at a time. step() may spread the narrow phase over a TBB pool
+// (options.threads). The bodies' polytopes and compounds are shared,
+// immutable, and may also be used elsewhere at the same time.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "proxima/compound.h"
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
+namespace proxima {
+
+using BodyId = std::int32_t;
+
+enum class BroadPhase : std::uint8_t {
+  sweep_and_prune,    // sorted interval lists, kept sorted by insertion sort between steps
+  dynamic_aabb_tree,  // fattened boxes in a balanced tree, re-inserted when they leave their fat box
+};
+
+inline const char* to_string(BroadPhase b) {
+  switch (b) {
+    case BroadPhase::sweep_and_prune: return "sweep_and_prune";
+    case BroadPhase::dynamic_aabb_tree: return "dynamic_aabb_tree";
+  }
+  return "unknown";
+}
+
+struct SceneOptions {
+  // Pairs at distance <= margin are reported (touching and intersecting
+  // pairs included). Must be finite and >= 0.
+  double margin = 0.0;
+  DistanceOptions distance;
+  BroadPhase broad_phase = BroadPhase::dynamic_aabb_tree;
+  // Narrow-phase threads: 1 runs in the caller's thread, 0 in the caller's
+  // TBB arena, n > 1 in a dedicated arena (as distance_batch).
+  int threads = 1;
+};
+
+// One close pair: a < b, and the answer of the distance query between them
+// (for two convex bodies piece_a == piece_b == 0 and pairs_tested == 1).
+struct ClosePair {
+  BodyId a = -1;
+  BodyId b = -1;
+  CompoundResult result;
+};
+
+// What the last step did.
+struct SceneStats {
+  int bodies = 0;
+  int candidate_pairs = 0;  // pairs the broad phase passed to the narrow phase
+  int close_pairs = 0;      // of those, at distance <= margin
+  int convex_queries = 0;   // convex distance queries run (compounds run several per pair)
+};
+
+class Scene {
+ public:
+  // Throws InvalidInput for a negative or non-finite margin or threads < 0.
+  explicit Scene(const SceneOptions& options = {});
+  ~Scene();
+  Scene(Scene&&) noexcept;
+  Scene& operator=(Scene&&) noexcept;
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // Adds a body at `pose` and returns its id (ids of removed bodies may be
+  // reused). Throws InvalidInput for a null body or a non-finite pose.
+  BodyId add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose);
+  BodyId add(std::shared_ptr<const CompoundBody> body, const Pose& pose);
+  // Throws InvalidInput naming the id for an unknown id or a non-finite pose.
+  void set_pose(BodyId id, const Pose& pose);
+  void remove(BodyId id);
+
+  bool contains(BodyId id) const;
+  const Pose& pose(BodyId id) const;
+  // Every live body id, increasing.
+  std::vector<BodyId> body_ids() const;
+  int body_count() const;
+  const SceneOptions& options() const;
+
+  // Broad phase and tracked narrow phase on the current poses. The close
+  // pairs, sorted by (a, b); valid until the next call of a non-const method.
+  std::span<const ClosePair> step();
+  const SceneStats& stats() const;
+
+  // The slow, obvious twin of step(): the cold distance query on every pair
+  // of bodies, no broad phase, no caches; same output order. For tests.
+  std::vector<ClosePair> close_pairs_all_pairs() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace proxima
