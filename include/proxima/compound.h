@@ -52,7 +52,8 @@ class CompoundBody {
   };
 
   // Throws InvalidInput naming the piece index: no pieces, a null polytope,
-  // a non-finite pose or a pose whose rotation is not orthonormal.
+  // a non-finite pose, a pose whose rotation is not orthonormal (to 1e-12)
+  // or is a reflection, or placed vertices that overflow.
   explicit CompoundBody(std::vector<CompoundPiece> pieces);
 
   // One piece per point set, each hulled (identity piece poses). Throws
@@ -67,6 +68,15 @@ class CompoundBody {
   std::span<const Node> nodes() const { return nodes_; }
   std::span<const std::int32_t> piece_order() const { return piece_order_; }
 
+  // Bounding sphere of piece i in the body's frame: center at the placed
+  // centroid, radius holding every placed vertex (inflated by a few u so that
+  // containment holds in floating point).
+  struct PieceSphere {
+    Vec3 center = Vec3::Zero();
+    double radius = 0.0;
+  };
+  const PieceSphere& piece_sphere(int i) const { return piece_spheres_[static_cast<std::size_t>(i)]; }
+
   // Bounding sphere of the whole body, in its frame (the root's).
   const Vec3& center() const { return nodes_.front().center; }
   double bounding_radius() const { return nodes_.front().radius; }
@@ -79,7 +89,10 @@ class CompoundBody {
   std::size_t memory_bytes() const;
 
  private:
+  std::int32_t build_node(std::int32_t first, std::int32_t last);
+
   std::vector<CompoundPiece> pieces_;
+  std::vector<PieceSphere> piece_spheres_;
   std::vector<Node> nodes_;
   std::vector<std::int32_t> piece_order_;
   double scale_ = 0.0;
@@ -116,14 +129,18 @@ struct CompoundResult : DistanceResult {
 
 // Minimum distance between two compound bodies. Status is the convex
 // status of the closest pair (intersecting as soon as any two pieces
-// overlap). Throws InvalidInput for non-finite poses or bad options.
+// overlap: the search stops at the first such pair). The distance is the
+// twin's within the accuracy standard, R being the largest coordinate of
+// both bodies' placed vertices; which pair is reported may differ from the
+// twin's when two pairs are that close. Throws InvalidInput for non-finite
+// poses or bad options.
 CompoundResult distance(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                         const Pose& pose_b, const DistanceOptions& options = {},
                         CompoundCache* cache = nullptr);
 
 // The slow, obvious twin: the convex query on every piece pair, cold, and the
-// minimum (ties broken by the smaller (piece_a, piece_b)). For tests and
-// benchmarks.
+// minimum (ties broken by an intersecting pair first, then by the smaller
+// (piece_a, piece_b)). For tests and benchmarks.
 CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                                   const Pose& pose_b, const DistanceOptions& options = {});
 

@@ -1,0 +1,506 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Compound bodies: validation, the bounding-sphere hierarchy (built once,
+// top-down), and the branch-and-bound distance between two compounds with
+// its slow twin over all piece pairs.
+//
+// Spheres, not boxes: a sphere is rotation-invariant, so a node's bound in the
+// query frame is one transformed center and the same radius, whatever the
+// body's pose; a box in the body's frame would have to be re-fitted (or
+// tested as an oriented box) for every pose. bench/compound_bench.cpp holds
+// the measured comparison.
+//
+// Soundness of the pruning. A node pair is skipped only when its computed
+// lower bound, minus a slack for the rounding of that bound, exceeds the best
+// distance found so far. The exact lower bound is then above that best
+// distance, so every piece pair below is truly farther than an answer already
+// in hand: the pruned pairs can never hide a closer pair, and the answer is
+// the minimum over the tested pairs, each within the accuracy standard.
+#include "proxima/compound.h"
+
+#include "proxima/distance.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_set>
+#include <utility>
+
+namespace proxima {
+namespace {
+
+// Entries of R^T R - I above this refuse a piece pose: the convex query
+// inverts a pose by its transpose, so a skewed rotation would place the piece
+// differently in the query than in the hierarchy. Rotations from quaternions,
+// angle-axis or products of a few of them are orthonormal to a few u (1e-15);
+// one stored in floats (1e-7) is refused rather than silently skewed.
+constexpr double kOrthonormalTolerance = 1e-12;
+
+// Pieces per leaf. A leaf of k pieces tests the spheres of its pairs one by
+// one, so larger leaves only trade node visits for sphere tests.
+constexpr int kLeafSize = 1;
+
+// Inflation of every stored sphere so that containment holds in floating
+// point (the tests check it with plain doubles): the radius is a maximum of
+// rounded norms of rounded differences, each within a few u of the exact
+// value relative to the radius plus a few u of the coordinates' magnitude.
+constexpr double kSphereInflationUlps = 8.0;
+
+// Slack of a node pair's lower bound, in units of u times the two bodies'
+// world magnitude bounds: the centers in the query frame are a pose product
+// and a transformed point away from the stored doubles (a few u of the
+// translations and coordinates each), and the convex query itself places the
+// pieces through a differently rounded product. 256 u covers both with room.
+constexpr double kPruneSlackUlps = 256.0;
+// And relative to the bound's own terms (center distance plus radii): the
+// norm and the two subtractions round by at most 4 u of them.
+constexpr double kPruneRelativeUlps = 64.0;
+
+// The farthest entries the near list keeps: the tested piece pairs of the
+// last answer, closest first, up to this many. A tracked query re-tests
+// about the same pairs; 64 covers every near set the tests and benchmarks
+// produce (a few to a few dozen pairs) while bounding the cache's size.
+constexpr std::size_t kNearCapacity = 64;
+
+// The exponent e with max|x| < 2^e (0 for zero), and p * 2^e per component
+// through ldexp: exact scaling that never overflows through 2^e itself.
+int magnitude_exponent(double max_abs) {
+  if (max_abs == 0.0) return 0;
+  int e = 0;
+  std::frexp(max_abs, &e);
+  return e;
+}
+Vec3 times_pow2(const Vec3& p, int e) { return {std::ldexp(p.x(), e), std::ldexp(p.y(), e), std::ldexp(p.z(), e)}; }
+
+// |p - q| with no intermediate overflow or underflow of the squares: the
+// difference of the halves is formed (no overflow even for opposite
+// coordinates near the largest double) and normed on a power-of-two scaled
+// copy. Build time only.
+double safe_distance(const Vec3& p, const Vec3& q) {
+  const Vec3 h = 0.5 * p - 0.5 * q;
+  const int e = magnitude_exponent(h.cwiseAbs().maxCoeff());
+  return std::ldexp(times_pow2(h, -e).norm(), e + 1);
+}
+
+bool all_finite(const Vec3& v) { return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()); }
+
+std::string piece_prefix(std::size_t i) { return "CompoundBody: piece " + std::to_string(i) + ": "; }
+
+// The smallest sphere holding two spheres (the classic merge: on the line
+// through both centers, from the far side of one to the far side of the
+// other), or the larger one if it holds the other.
+Vec3 merged_center(const Vec3& c1, double r1, const Vec3& c2, double r2) {
+  const double d = safe_distance(c1, c2);
+  if (d + r2 <= r1) return c1;
+  if (d + r1 <= r2) return c2;
+  // Here d > 0 (else one radius would hold the other). The direction is
+  // formed from halves: no overflow for centers of opposite signs.
+  const double r = 0.5 * (d + r1 + r2);
+  const double t = (r - r1) / d;
+  return c1 + (2.0 * t) * (0.5 * c2 - 0.5 * c1);
+}
+
+}  // namespace
+
+CompoundBody::CompoundBody(std::vector<CompoundPiece> pieces) : pieces_(std::move(pieces)) {
+  if (pieces_.empty()) throw InvalidInput("CompoundBody: no pieces");
+  if (pieces_.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() / 2)) {
+    throw InvalidInput("CompoundBody: too many pieces (" + std::to_string(pieces_.size()) + ")");
+  }
+  const std::size_t n = pieces_.size();
+  piece_spheres_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const CompoundPiece& piece = pieces_[i];
+    if (!piece.polytope) throw InvalidInput(piece_prefix(i) + "null polytope");
+    if (!piece.pose.is_finite()) {
+      throw InvalidInput(piece_prefix(i) + "pose is not finite (NaN or infinite rotation or translation)");
+    }
+    const Mat3& r = piece.pose.rotation;
+    const double skew = (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff();
+    if (!(skew <= kOrthonormalTolerance)) {
+      throw InvalidInput(piece_prefix(i) + "pose rotation is not orthonormal (|R^T R - I| = " + std::to_string(skew) +
+                         ")");
+    }
+    if (r.determinant() < 0.0) throw InvalidInput(piece_prefix(i) + "pose rotation is a reflection (determinant -1)");
+
+    // The piece's sphere and its share of the scale from its placed
+    // vertices themselves: exact R, and a radius that holds every vertex
+    // as the body's frame sees it.
+    const Vec3 center = piece.pose.apply(piece.polytope->centroid());
+    double radius = 0.0;
+    double magnitude = center.cwiseAbs().maxCoeff();
+    for (const Vec3& v : piece.polytope->vertices()) {
+      const Vec3 placed = piece.pose.apply(v);
+      if (!all_finite(placed)) throw InvalidInput(piece_prefix(i) + "placed vertex overflows (coordinates not finite)");
+      scale_ = std::max(scale_, placed.cwiseAbs().maxCoeff());
+      magnitude = std::max(magnitude, placed.cwiseAbs().maxCoeff());
+      radius = std::max(radius, safe_distance(placed, center));
+    }
+    radius = radius * (1.0 + kSphereInflationUlps * kUnitRoundoff) +
+             kSphereInflationUlps * kUnitRoundoff * magnitude + 4.0 * std::numeric_limits<double>::denorm_min();
+    if (!all_finite(center) || !std::isfinite(radius)) {
+      throw InvalidInput(piece_prefix(i) + "bounding sphere overflows (coordinates near the largest double)");
+    }
+    piece_spheres_[i] = {center, radius};
+  }
+
+  piece_order_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) piece_order_[i] = static_cast<std::int32_t>(i);
+  nodes_.reserve(2 * n);
+  build_node(0, static_cast<std::int32_t>(n));
+}
+
+// Top-down: a node over piece_order_[first, last) splits its pieces at the
+// median of their sphere centers along the longest axis of the centers' box.
+// The median keeps the tree balanced (depth log2 n) whatever the layout.
+std::int32_t CompoundBody::build_node(std::int32_t first, std::int32_t last) {
+  const auto id = static_cast<std::int32_t>(nodes_.size());
+  nodes_.emplace_back();
+  const auto begin = piece_order_.begin() + first;
+  const auto end = piece_order_.begin() + last;
+  std::int32_t left = -1;
+  std::int32_t right = -1;
+  if (last - first > kLeafSize) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
+    for (auto it = begin; it != end; ++it) {
+      lo = lo.cwiseMin(piece_spheres_[static_cast<std::size_t>(*it)].center);
+      hi = hi.cwiseMax(piece_spheres_[static_cast<std::size_t>(*it)].center);
+    }
+    int axis = 0;
+    const Vec3 extent = 0.5 * hi - 0.5 * lo;  // halves: no overflow
+    extent.maxCoeff(&axis);
+    const std::int32_t middle = first + (last - first) / 2;
+    // Ties by piece index: the same tree on every platform.
+    std::nth_element(begin, piece_order_.begin() + middle, end, [&](std::int32_t p, std::int32_t q) {
+      const double cp = piece_spheres_[static_cast<std::size_t>(p)].center[axis];
+      const double cq = piece_spheres_[static_cast<std::size_t>(q)].center[axis];
+      return cp < cq || (cp == cq && p < q);
+    });
+    left = build_node(first, middle);
+    right = build_node(middle, last);
+  }
+
+  // The node's sphere: of two candidate centers (the merge of the children's
+  // spheres, and the center of the box around the pieces' spheres), the one
+  // whose enclosing radius over the pieces below is smaller. The radius is
+  // taken over the pieces' own spheres, not the children's, so it is never
+  // looser than the merge and often tighter.
+  std::array<Vec3, 2> candidates;
+  int candidate_count = 0;
+  if (left >= 0) {
+    const Node& l = nodes_[static_cast<std::size_t>(left)];
+    const Node& r = nodes_[static_cast<std::size_t>(right)];
+    candidates[static_cast<std::size_t>(candidate_count++)] = merged_center(l.center, l.radius, r.center, r.radius);
+  }
+  {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
+    for (auto it = begin; it != end; ++it) {
+      const PieceSphere& s = piece_spheres_[static_cast<std::size_t>(*it)];
+      lo = lo.cwiseMin(s.center - Vec3::Constant(s.radius));
+      hi = hi.cwiseMax(s.center + Vec3::Constant(s.radius));
+    }
+    candidates[static_cast<std::size_t>(candidate_count++)] = 0.5 * lo + 0.5 * hi;
+  }
+  double best_radius = std::numeric_limits<double>::infinity();
+  Vec3 best_center = Vec3::Zero();
+  for (int c = 0; c < candidate_count; ++c) {
+    const Vec3& center = candidates[static_cast<std::size_t>(c)];
+    double radius = 0.0;
+    double magnitude = center.cwiseAbs().maxCoeff();
+    for (auto it = begin; it != end; ++it) {
+      const PieceSphere& s = piece_spheres_[static_cast<std::size_t>(*it)];
+      radius = std::max(radius, safe_distance(s.center, center) + s.radius);
+      magnitude = std::max(magnitude, s.center.cwiseAbs().maxCoeff());
+    }
+    radius = radius * (1.0 + kSphereInflationUlps * kUnitRoundoff) +
+             kSphereInflationUlps * kUnitRoundoff * magnitude + 4.0 * std::numeric_limits<double>::denorm_min();
+    if (radius < best_radius) {
+      best_radius = radius;
+      best_center = center;
+    }
+  }
+  if (!all_finite(best_center) || !std::isfinite(best_radius)) {
+    throw InvalidInput("CompoundBody: the pieces' bounding sphere overflows (pieces near the largest double)");
+  }
+  Node& node = nodes_[static_cast<std::size_t>(id)];
+  node.center = best_center;
+  node.radius = best_radius;
+  node.left = left;
+  node.right = right;
+  node.first = left >= 0 ? 0 : first;
+  node.count = left >= 0 ? 0 : last - first;
+  return id;
+}
+
+CompoundBody CompoundBody::from_point_sets(std::span<const std::vector<Vec3>> point_sets) {
+  std::vector<CompoundPiece> pieces;
+  pieces.reserve(point_sets.size());
+  for (std::size_t i = 0; i < point_sets.size(); ++i) {
+    try {
+      pieces.push_back({std::make_shared<const ConvexPolytope>(point_sets[i]), Pose::identity()});
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(piece_prefix(i) + e.what());
+    }
+  }
+  return CompoundBody(std::move(pieces));
+}
+
+std::size_t CompoundBody::memory_bytes() const {
+  std::size_t bytes = sizeof(*this) + pieces_.capacity() * sizeof(CompoundPiece) + nodes_.capacity() * sizeof(Node) +
+                      piece_order_.capacity() * sizeof(std::int32_t) + piece_spheres_.capacity() * sizeof(PieceSphere);
+  // A polytope shared by several pieces (instances of one part) is counted once.
+  std::unordered_set<const ConvexPolytope*> seen;
+  for (const CompoundPiece& p : pieces_) {
+    if (seen.insert(p.polytope.get()).second) bytes += p.polytope->memory_bytes();
+  }
+  return bytes;
+}
+
+namespace {
+
+void check_pose(const Pose& pose, const char* name) {
+  if (!pose.is_finite()) [[unlikely]] {
+    throw InvalidInput(std::string("distance: ") + name + " is not finite (NaN or infinite rotation or translation)");
+  }
+}
+
+// Upper bound on the largest world coordinate of a body placed at `pose`:
+// |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale.
+double world_magnitude_bound(const CompoundBody& body, const Pose& pose) {
+  return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * body.scale();
+}
+
+// Whether (distance, intersecting, pair) orders `r` before the current best:
+// the smaller distance, then an intersecting pair before a touching one at
+// the same distance, then the smaller (piece_a, piece_b).
+bool better(const DistanceResult& r, std::int32_t pa, std::int32_t pb, const CompoundResult& best) {
+  if (r.distance != best.distance) return r.distance < best.distance;
+  const bool ri = r.status == Status::intersecting;
+  const bool bi = best.status == Status::intersecting;
+  if (ri != bi) return ri;
+  return std::pair(pa, pb) < std::pair(best.piece_a, best.piece_b);
+}
+
+void take(CompoundResult& best, const DistanceResult& r, std::int32_t pa, std::int32_t pb) {
+  static_cast<DistanceResult&>(best) = r;
+  best.piece_a = pa;
+  best.piece_b = pb;
+}
+
+struct NearEntry {
+  CompoundCache::Entry entry;
+  double distance;
+};
+
+bool pair_less(const CompoundCache::Entry& x, const CompoundCache::Entry& y) {
+  return std::pair(x.piece_a, x.piece_b) < std::pair(y.piece_a, y.piece_b);
+}
+
+// One branch-and-bound query. Lower bounds are computed in A's frame on
+// copies scaled by 2^-e, e the exponent of the two bodies' magnitude bound,
+// so that no square overflows or underflows at any scale the polytopes
+// accept.
+class Search {
+ public:
+  Search(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
+         const DistanceOptions& options, CompoundCache* cache)
+      : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options), cache_(cache) {
+    const double magnitude_a = world_magnitude_bound(a, pose_a);
+    const double magnitude_b = world_magnitude_bound(b, pose_b);
+    exponent_ = -magnitude_exponent(std::max(magnitude_a, magnitude_b));
+    rotation_ = pose_a.rotation.transpose() * pose_b.rotation;
+    translation_ = pose_a.rotation.transpose() *
+                   (times_pow2(pose_b.translation, exponent_) - times_pow2(pose_a.translation, exponent_));
+    slack_ = kPruneSlackUlps * kUnitRoundoff *
+             (std::ldexp(magnitude_a, exponent_) + std::ldexp(magnitude_b, exponent_));
+    // A near list the caller did not keep sorted is ignored (a binary search
+    // on it could miss entries): slower, never wrong.
+    if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
+      old_near_ = std::span<const CompoundCache::Entry>(cache_->near);
+    }
+  }
+
+  CompoundResult run() {
+    if (cache_ != nullptr && cache_->piece_a >= 0 && cache_->piece_a < a_.piece_count() && cache_->piece_b >= 0 &&
+        cache_->piece_b < b_.piece_count()) {
+      hint_a_ = cache_->piece_a;
+      hint_b_ = cache_->piece_b;
+      test_pair(hint_a_, hint_b_);
+    }
+    if (!done()) traverse();
+    best_.pairs_tested = static_cast<int>(tested_.size());
+    if (cache_ != nullptr) update_cache();
+    return best_;
+  }
+
+ private:
+  struct StackEntry {
+    std::int32_t node_a;
+    std::int32_t node_b;
+    double key;  // lower bound minus slack, in scaled units
+  };
+
+  bool done() const { return have_best_ && best_.status == Status::intersecting; }
+
+  // The pruning key of two spheres (body frames): their scaled lower bound
+  // minus its rounding slack. An overflowing distance cannot occur on scaled
+  // copies; the key is -inf (never pruned) should it anyway.
+  double key(const Vec3& center_a, double radius_a, const Vec3& center_b_in_a_scaled, double radius_b) const {
+    const double d = (times_pow2(center_a, exponent_) - center_b_in_a_scaled).norm();
+    if (!std::isfinite(d)) return -std::numeric_limits<double>::infinity();
+    const double ra = std::ldexp(radius_a, exponent_);
+    const double rb = std::ldexp(radius_b, exponent_);
+    return d - ra - rb - slack_ - kPruneRelativeUlps * kUnitRoundoff * (d + ra + rb);
+  }
+  Vec3 b_center_in_a(const Vec3& c) const { return rotation_ * times_pow2(c, exponent_) + translation_; }
+  bool pruned(double k) const { return have_best_ && k > std::ldexp(best_.distance, exponent_); }
+
+  void traverse() {
+    const auto& nodes_a = a_.nodes();
+    const auto& nodes_b = b_.nodes();
+    stack_.push_back({0, 0, -std::numeric_limits<double>::infinity()});
+    while (!stack_.empty() && !done()) {
+      const StackEntry e = stack_.back();
+      stack_.pop_back();
+      if (pruned(e.key)) continue;
+      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(e.node_a)];
+      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(e.node_b)];
+      const bool leaf_a = na.left < 0;
+      const bool leaf_b = nb.left < 0;
+      if (leaf_a && leaf_b) {
+        test_leaves(na, nb);
+        continue;
+      }
+      // Descend the larger sphere (a leaf cannot be split): it shrinks the
+      // bound the most per level.
+      const bool split_a = !leaf_a && (leaf_b || na.radius >= nb.radius);
+      StackEntry first{};
+      StackEntry second{};
+      if (split_a) {
+        const Vec3 cb = b_center_in_a(nb.center);
+        const CompoundBody::Node& l = nodes_a[static_cast<std::size_t>(na.left)];
+        const CompoundBody::Node& r = nodes_a[static_cast<std::size_t>(na.right)];
+        first = {na.left, e.node_b, key(l.center, l.radius, cb, nb.radius)};
+        second = {na.right, e.node_b, key(r.center, r.radius, cb, nb.radius)};
+      } else {
+        const CompoundBody::Node& l = nodes_b[static_cast<std::size_t>(nb.left)];
+        const CompoundBody::Node& r = nodes_b[static_cast<std::size_t>(nb.right)];
+        first = {e.node_a, nb.left, key(na.center, na.radius, b_center_in_a(l.center), l.radius)};
+        second = {e.node_a, nb.right, key(na.center, na.radius, b_center_in_a(r.center), r.radius)};
+      }
+      // The nearer child pair on top: visited first, it is the likelier to
+      // lower the best distance before its sibling is looked at.
+      if (first.key < second.key) std::swap(first, second);
+      if (!pruned(first.key)) stack_.push_back(first);
+      if (!pruned(second.key)) stack_.push_back(second);
+    }
+  }
+
+  void test_leaves(const CompoundBody::Node& na, const CompoundBody::Node& nb) {
+    const auto order_a = a_.piece_order();
+    const auto order_b = b_.piece_order();
+    for (std::int32_t i = 0; i < na.count && !done(); ++i) {
+      const std::int32_t pa = order_a[static_cast<std::size_t>(na.first + i)];
+      for (std::int32_t j = 0; j < nb.count && !done(); ++j) {
+        const std::int32_t pb = order_b[static_cast<std::size_t>(nb.first + j)];
+        if (pa == hint_a_ && pb == hint_b_) continue;  // tested first
+        if (na.count > 1 || nb.count > 1) {
+          const CompoundBody::PieceSphere& sa = a_.piece_sphere(pa);
+          const CompoundBody::PieceSphere& sb = b_.piece_sphere(pb);
+          if (pruned(key(sa.center, sa.radius, b_center_in_a(sb.center), sb.radius))) continue;
+        }
+        test_pair(pa, pb);
+      }
+    }
+  }
+
+  void test_pair(std::int32_t pa, std::int32_t pb) {
+    NearEntry& t = tested_.emplace_back();
+    t.entry.piece_a = pa;
+    t.entry.piece_b = pb;
+    const CompoundCache::Entry probe{pa, pb, {}};
+    const auto it = std::lower_bound(old_near_.begin(), old_near_.end(), probe, pair_less);
+    if (it != old_near_.end() && it->piece_a == pa && it->piece_b == pb) t.entry.cache = it->cache;
+    const CompoundPiece& piece_a = a_.piece(pa);
+    const CompoundPiece& piece_b = b_.piece(pb);
+    const DistanceResult r = distance(*piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope,
+                                      pose_b_ * piece_b.pose, options_, &t.entry.cache);
+    t.distance = r.distance;
+    if (!have_best_ || better(r, pa, pb, best_)) {
+      take(best_, r, pa, pb);
+      have_best_ = true;
+    }
+  }
+
+  // The next query's warm start: the best pair, and the feature caches of
+  // the closest tested pairs, sorted by pair for the binary search.
+  void update_cache() {
+    if (tested_.size() > kNearCapacity) {
+      std::nth_element(tested_.begin(), tested_.begin() + static_cast<std::ptrdiff_t>(kNearCapacity) - 1,
+                       tested_.end(), [](const NearEntry& x, const NearEntry& y) { return x.distance < y.distance; });
+      tested_.resize(kNearCapacity);
+    }
+    std::sort(tested_.begin(), tested_.end(),
+              [](const NearEntry& x, const NearEntry& y) { return pair_less(x.entry, y.entry); });
+    cache_->near.clear();
+    for (const NearEntry& t : tested_) cache_->near.push_back(t.entry);
+    cache_->piece_a = best_.piece_a;
+    cache_->piece_b = best_.piece_b;
+  }
+
+  const CompoundBody& a_;
+  const CompoundBody& b_;
+  const Pose& pose_a_;
+  const Pose& pose_b_;
+  const DistanceOptions& options_;
+  CompoundCache* cache_;
+  std::span<const CompoundCache::Entry> old_near_;
+  int exponent_ = 0;
+  Mat3 rotation_;       // B's frame -> A's frame
+  Vec3 translation_;    // scaled by 2^exponent_
+  double slack_ = 0.0;  // scaled
+  std::int32_t hint_a_ = -1;
+  std::int32_t hint_b_ = -1;
+  bool have_best_ = false;
+  CompoundResult best_;
+  std::vector<NearEntry> tested_;
+  std::vector<StackEntry> stack_;
+};
+
+}  // namespace
+
+CompoundResult distance(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
+                        const DistanceOptions& options, CompoundCache* cache) {
+  check_pose(pose_a, "pose_a");
+  check_pose(pose_b, "pose_b");
+  return Search(a, pose_a, b, pose_b, options, cache).run();
+}
+
+CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
+                                  const Pose& pose_b, const DistanceOptions& options) {
+  check_pose(pose_a, "pose_a");
+  check_pose(pose_b, "pose_b");
+  CompoundResult best;
+  bool have_best = false;
+  for (std::int32_t pa = 0; pa < a.piece_count(); ++pa) {
+    for (std::int32_t pb = 0; pb < b.piece_count(); ++pb) {
+      const DistanceResult r = distance(*a.piece(pa).polytope, pose_a * a.piece(pa).pose, *b.piece(pb).polytope,
+                                        pose_b * b.piece(pb).pose, options);
+      if (!have_best || better(r, pa, pb, best)) {
+        take(best, r, pa, pb);
+        have_best = true;
+      }
+    }
+  }
+  // Saturated: the product of two piece counts can exceed an int.
+  best.pairs_tested = static_cast<int>(std::min<std::int64_t>(
+      std::int64_t{a.piece_count()} * b.piece_count(), std::numeric_limits<int>::max()));
+  return best;
+}
+
+}  // namespace proxima
