@@ -15,17 +15,6 @@
 #include "parallel_ranges.h"
 #include "proxima/distance.h"
 
-#if defined(__SANITIZE_THREAD__)
-#define PROXIMA_TSAN 1
-#elif defined(__has_feature)
-#if __has_feature(thread_sanitizer)
-#define PROXIMA_TSAN 1
-#endif
-#endif
-#ifdef PROXIMA_TSAN
-#include <sanitizer/tsan_interface.h>
-#endif
-
 namespace proxima {
 namespace {
 
@@ -35,30 +24,6 @@ namespace {
 // cent; TBB's auto partitioner still splits larger ranges for balance. Below
 // two grains the batch runs in the calling thread. batch_bench measures it.
 constexpr std::size_t kGrainSize = 32;
-
-// ThreadSanitizer sees the happens-before edges of the code it instruments,
-// and TBB's scheduling is hidden from it (parallel_ranges.cpp says why). The
-// two edges TBB guarantees are stated to it here instead: the caller's writes
-// before the parallel loop happen before every range (released on the range
-// functor's address, acquired before the functor is read), and every range's
-// writes happen before the loop returns or throws (released on a marker the
-// caller acquires). Ranges only acquire the first and only release the
-// second, so no edge between two ranges is invented: a race between ranges is
-// still caught. Outside TSan these are empty.
-#ifdef PROXIMA_TSAN
-void tsan_release(void* address) { __tsan_release(address); }
-void tsan_acquire(void* address) { __tsan_acquire(address); }
-#else
-void tsan_release(void*) {}
-void tsan_acquire(void*) {}
-#endif
-
-// Calls a range functor through parallel_ranges' plain function pointer.
-template <class Range>
-void call_range(void* range, std::size_t begin, std::size_t end) {
-  tsan_acquire(range);
-  (*static_cast<Range*>(range))(begin, end);
-}
 
 std::string at(std::size_t k) { return std::to_string(k); }
 
@@ -122,20 +87,7 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
     run_range(0, n);
     return;
   }
-  char ranges_done = 0;  // only its address is used: the TSan marker above
-  auto range = [&](std::size_t begin, std::size_t end) {
-    struct RangeEnds {  // also when the range throws: the exception object is its write
-      char* marker;
-      ~RangeEnds() { tsan_release(marker); }
-    } ends{&ranges_done};
-    run_range(begin, end);
-  };
-  struct AfterRanges {
-    char* marker;
-    ~AfterRanges() { tsan_acquire(marker); }
-  } after{&ranges_done};
-  tsan_release(&range);
-  detail::parallel_ranges(n, kGrainSize, threads, &call_range<decltype(range)>, &range);
+  detail::parallel_ranges(n, kGrainSize, threads, run_range);
 }
 
 }  // namespace

@@ -1,13 +1,24 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Private to src/: the thread pool behind distance_batch, kept apart from the
-// work it runs. This file's .cpp is all of proxima's TBB scheduling code; the
-// top-level CMakeLists.txt compiles it without ThreadSanitizer, like libtbb
-// itself (see parallel_ranges.cpp for why).
+// Private to src/: the thread pool behind distance_batch and Scene::step,
+// kept apart from the work it runs. This file's .cpp is all of proxima's TBB
+// scheduling code; the top-level CMakeLists.txt compiles it without
+// ThreadSanitizer, like libtbb itself (see parallel_ranges.cpp for why).
 #pragma once
 
 #include <cstddef>
+
+#if defined(__SANITIZE_THREAD__)
+#define PROXIMA_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define PROXIMA_TSAN 1
+#endif
+#endif
+#ifdef PROXIMA_TSAN
+#include <sanitizer/tsan_interface.h>
+#endif
 
 namespace proxima::detail {
 
@@ -18,5 +29,49 @@ namespace proxima::detail {
 // reaches the caller (TBB cancels the ranges not yet started).
 void parallel_ranges(std::size_t n, std::size_t grain, int threads,
                      void (*run)(void* context, std::size_t begin, std::size_t end), void* context);
+
+// ThreadSanitizer sees the happens-before edges of the code it instruments,
+// and TBB's scheduling is hidden from it (parallel_ranges.cpp says why). The
+// two edges TBB guarantees are stated to it here instead: the caller's writes
+// before the parallel loop happen before every range (released on the range
+// functor's address, acquired before the functor is read), and every range's
+// writes happen before the loop returns or throws (released on a marker the
+// caller acquires). Ranges only acquire the first and only release the
+// second, so no edge between two ranges is invented: a race between ranges is
+// still caught. Outside TSan these are empty.
+#ifdef PROXIMA_TSAN
+inline void tsan_release(void* address) { __tsan_release(address); }
+inline void tsan_acquire(void* address) { __tsan_acquire(address); }
+#else
+inline void tsan_release(void*) {}
+inline void tsan_acquire(void*) {}
+#endif
+
+// Calls a range functor through parallel_ranges' plain function pointer.
+template <class Range>
+void call_range(void* range, std::size_t begin, std::size_t end) {
+  tsan_acquire(range);
+  (*static_cast<Range*>(range))(begin, end);
+}
+
+// parallel_ranges over a functor run_range(begin, end), with the hand-off
+// edges above stated to ThreadSanitizer.
+template <class RunRange>
+void parallel_ranges(std::size_t n, std::size_t grain, int threads, const RunRange& run_range) {
+  char ranges_done = 0;  // only its address is used: the TSan marker above
+  auto range = [&](std::size_t begin, std::size_t end) {
+    struct RangeEnds {  // also when the range throws: the exception object is its write
+      char* marker;
+      ~RangeEnds() { tsan_release(marker); }
+    } ends{&ranges_done};
+    run_range(begin, end);
+  };
+  struct AfterRanges {
+    char* marker;
+    ~AfterRanges() { tsan_acquire(marker); }
+  } after{&ranges_done};
+  tsan_release(&range);
+  parallel_ranges(n, grain, threads, &call_range<decltype(range)>, &range);
+}
 
 }  // namespace proxima::detail
