@@ -77,6 +77,7 @@ struct SceneStats {
   int candidate_pairs = 0;  // pairs the broad phase passed to the narrow phase
   int close_pairs = 0;      // of those, at distance <= margin
   int convex_queries = 0;   // convex distance queries run (compounds run several per pair)
+  int warm_pairs = 0;       // candidate pairs that started from the previous step's cache
 };
 
 class Scene {

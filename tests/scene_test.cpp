@@ -1,0 +1,502 @@
+// Tests of Scene: step() (broad phase, then tracked queries with the caches
+// kept between steps) against its slow twin close_pairs_all_pairs() (the
+// cold query on every pair), over seeded random scenes that move and change
+// between steps; the same answer, bit for bit, from both broad phases and
+// from 1 and 2 threads; hand-computed contact cases; bad input named by id;
+// and proof that the caches carry over (the tracked run does less work).
+#include "proxima/scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "support/generators.h"
+
+namespace proxima {
+namespace {
+
+using test::Rng;
+
+// A random body for a scene: mostly round or boxy clouds of 20 to 200
+// points, sometimes a degenerate shape (needle, polygon, segment, point,
+// grid with coplanar faces), scaled to a radius of about 0.5 to 1.2.
+std::shared_ptr<const ConvexPolytope> random_convex(Rng& rng) {
+  const int n = test::uniform_int(rng, 20, 200);
+  test::Points pts;
+  switch (test::uniform_int(rng, 0, 9)) {
+    case 0:
+      pts = test::random_shape(rng, test::ShapeKind::needle, n);
+      break;
+    case 1:
+      pts = test::random_shape(rng, test::ShapeKind::flat_polygon, n);
+      break;
+    case 2:
+      pts = test::random_shape(rng, test::ShapeKind::segment, n);
+      break;
+    case 3:
+      pts = test::random_shape(rng, test::ShapeKind::point, n);
+      break;
+    case 4:
+      pts = test::random_shape(rng, test::ShapeKind::grid, n);
+      break;
+    case 5:
+      pts = test::random_shape(rng, test::ShapeKind::box, n);
+      break;
+    case 6:
+    case 7:
+      pts = test::points_in_cube(rng, n, 0.6);
+      break;
+    default:
+      pts = test::points_on_sphere(rng, n);
+      break;
+  }
+  return std::make_shared<const ConvexPolytope>(test::scaled(pts, test::uniform(rng, 0.5, 1.2)));
+}
+
+// Two to four small clouds around offsets within the body: a non-convex
+// body (an L, a dumbbell, a cluster).
+std::shared_ptr<const CompoundBody> random_compound(Rng& rng) {
+  std::vector<std::vector<Vec3>> sets;
+  const int pieces = test::uniform_int(rng, 2, 4);
+  for (int i = 0; i < pieces; ++i) {
+    const Vec3 offset = test::uniform(rng, 0.2, 0.8) * test::random_unit_vector(rng);
+    sets.push_back(test::translated(
+        test::scaled(test::points_on_sphere(rng, test::uniform_int(rng, 12, 40)), 0.45), offset));
+  }
+  return std::make_shared<const CompoundBody>(CompoundBody::from_point_sets(sets));
+}
+
+Pose random_pose(Rng& rng, double side, const Vec3& offset) {
+  return {test::random_quaternion(rng),
+          Vec3(offset + Vec3(test::uniform(rng, 0, side), test::uniform(rng, 0, side),
+                             test::uniform(rng, 0, side)))};
+}
+
+// The next frame of a slow simulation.
+Pose moved(Rng& rng, const Pose& p) {
+  return {Mat3(test::random_small_rotation(rng, 0.03) * p.rotation),
+          Vec3(p.translation + test::uniform(rng, 0, 0.04) * test::random_unit_vector(rng))};
+}
+
+bool same_bits(double x, double y) {
+  return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y);
+}
+bool same_bits(const Vec3& x, const Vec3& y) {
+  return same_bits(x[0], y[0]) && same_bits(x[1], y[1]) && same_bits(x[2], y[2]);
+}
+bool same_feature(const Feature& x, const Feature& y) {
+  return x.type == y.type && x.vertices == y.vertices && x.face == y.face;
+}
+
+// Scenes fed the same calls: both broad phases, 1 and 2 threads. They must
+// give the same ids and, step by step, the same answers bit for bit.
+struct Lockstep {
+  std::vector<Scene> scenes;
+  // Magnitude bound |t|_inf + sqrt(3) scale of each body, by id: the R of
+  // the accuracy standard.
+  std::vector<double> magnitude;
+  std::vector<double> scale;
+
+  explicit Lockstep(double margin) {
+    for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
+      for (const int threads : {1, 2}) {
+        SceneOptions o;
+        o.margin = margin;
+        o.broad_phase = bp;
+        o.threads = threads;
+        scenes.emplace_back(o);
+      }
+    }
+  }
+
+  template <class Body>
+  BodyId add(const Body& body, const Pose& pose, double body_scale) {
+    const BodyId id = scenes[0].add(body, pose);
+    for (std::size_t k = 1; k < scenes.size(); ++k) EXPECT_EQ(scenes[k].add(body, pose), id);
+    if (static_cast<std::size_t>(id) >= scale.size()) {
+      scale.resize(static_cast<std::size_t>(id) + 1);
+      magnitude.resize(static_cast<std::size_t>(id) + 1);
+    }
+    scale[static_cast<std::size_t>(id)] = body_scale;
+    note_pose(id, pose);
+    return id;
+  }
+  void set_pose(BodyId id, const Pose& pose) {
+    for (Scene& s : scenes) s.set_pose(id, pose);
+    note_pose(id, pose);
+  }
+  void remove(BodyId id) {
+    for (Scene& s : scenes) s.remove(id);
+  }
+  void note_pose(BodyId id, const Pose& pose) {
+    magnitude[static_cast<std::size_t>(id)] = pose.translation.cwiseAbs().maxCoeff() +
+                                              std::sqrt(3.0) * scale[static_cast<std::size_t>(id)];
+  }
+
+  // Steps every scene; checks them against each other and the first one
+  // against the all-pairs twin. Returns the first scene's pairs.
+  std::vector<ClosePair> step_and_check(const std::string& where) {
+    const std::span<const ClosePair> first = scenes[0].step();
+    std::vector<ClosePair> out(first.begin(), first.end());
+    const SceneStats stats = scenes[0].stats();
+    for (std::size_t k = 1; k < scenes.size(); ++k) {
+      const std::span<const ClosePair> other = scenes[k].step();
+      const std::string which = where + ", scene " + std::to_string(k) + " (" +
+                                to_string(scenes[k].options().broad_phase) + ", " +
+                                std::to_string(scenes[k].options().threads) + " threads)";
+      EXPECT_EQ(scenes[k].stats().candidate_pairs, stats.candidate_pairs) << which;
+      EXPECT_EQ(scenes[k].stats().warm_pairs, stats.warm_pairs) << which;
+      EXPECT_EQ(scenes[k].stats().convex_queries, stats.convex_queries) << which;
+      EXPECT_EQ(scenes[k].stats().bodies, stats.bodies) << which;
+      EXPECT_EQ(scenes[k].stats().close_pairs, stats.close_pairs) << which;
+      EXPECT_EQ(other.size(), out.size()) << which;
+      if (other.size() != out.size()) continue;
+      for (std::size_t i = 0; i < out.size(); ++i) {
+        const ClosePair& x = out[i];
+        const ClosePair& y = other[i];
+        EXPECT_TRUE(x.a == y.a && x.b == y.b && x.result.status == y.result.status &&
+                    same_bits(x.result.distance, y.result.distance) &&
+                    same_bits(x.result.lower_bound, y.result.lower_bound) &&
+                    same_bits(x.result.point_a, y.result.point_a) &&
+                    same_bits(x.result.point_b, y.result.point_b) &&
+                    same_bits(x.result.normal, y.result.normal) &&
+                    same_feature(x.result.feature_a, y.result.feature_a) &&
+                    same_feature(x.result.feature_b, y.result.feature_b) &&
+                    x.result.iterations == y.result.iterations &&
+                    x.result.piece_a == y.result.piece_a && x.result.piece_b == y.result.piece_b &&
+                    x.result.pairs_tested == y.result.pairs_tested)
+            << which << ": pair " << i << " (" << x.a << ", " << x.b << ") differs";
+      }
+    }
+    EXPECT_EQ(stats.close_pairs, static_cast<int>(out.size()));
+    EXPECT_LE(stats.close_pairs, stats.candidate_pairs);
+    EXPECT_LE(stats.warm_pairs, stats.candidate_pairs);
+    EXPECT_GE(stats.convex_queries, stats.candidate_pairs);
+
+    const std::vector<ClosePair> twin = scenes[0].close_pairs_all_pairs();
+    EXPECT_EQ(twin.size(), out.size()) << where;
+    for (std::size_t i = 0, j = 0; i < out.size() || j < twin.size();) {
+      // Walk both sorted lists so that a missing pair is named.
+      const bool take_out =
+          j == twin.size() || (i < out.size() && (out[i].a < twin[j].a ||
+                                                  (out[i].a == twin[j].a && out[i].b < twin[j].b)));
+      const bool take_twin =
+          i == out.size() || (j < twin.size() && (twin[j].a < out[i].a ||
+                                                  (twin[j].a == out[i].a && twin[j].b < out[i].b)));
+      if (take_out) {
+        ADD_FAILURE() << where << ": step() reports (" << out[i].a << ", " << out[i].b
+                      << ") at distance " << out[i].result.distance << ", the twin does not";
+        ++i;
+        continue;
+      }
+      if (take_twin) {
+        ADD_FAILURE() << where << ": the twin reports (" << twin[j].a << ", " << twin[j].b
+                      << ") at distance " << twin[j].result.distance << " ("
+                      << to_string(twin[j].result.status) << "), step() does not";
+        ++j;
+        continue;
+      }
+      const ClosePair& x = out[i++];
+      const ClosePair& y = twin[j++];
+      const double r = std::max(magnitude[static_cast<std::size_t>(x.a)],
+                                magnitude[static_cast<std::size_t>(x.b)]);
+      // Both answers are within the standard's bound of the exact distance.
+      const double tol = 2 * (1e-12 * y.result.distance + 64 * kUnitRoundoff * r);
+      EXPECT_NEAR(x.result.distance, y.result.distance, tol)
+          << where << ": pair (" << x.a << ", " << x.b << ")";
+      EXPECT_EQ(x.result.status, y.result.status)
+          << where << ": pair (" << x.a << ", " << x.b << ")";
+      EXPECT_LE(x.result.distance, scenes[0].options().margin + tol);
+    }
+    return out;
+  }
+};
+
+struct RandomSceneCase {
+  double margin;
+  double offset;         // every body this far from the origin (each axis)
+  int compound_percent;  // share of compound bodies
+};
+
+class RandomScene : public testing::TestWithParam<RandomSceneCase> {};
+
+TEST_P(RandomScene, StepEqualsTheAllPairsTwinWhileBodiesMoveJoinAndLeave) {
+  const RandomSceneCase c = GetParam();
+  Rng rng(1000 + static_cast<std::uint64_t>(c.margin * 1000) +
+          static_cast<std::uint64_t>(c.compound_percent));
+  constexpr int kBodies = 120;
+  // A cube of side 10 holding 120 bodies of radius ~1: a few neighbours each.
+  constexpr double kSide = 10.0;
+  const Vec3 offset = Vec3::Constant(c.offset);
+  Lockstep scene(c.margin);
+  std::vector<BodyId> ids;
+  std::vector<Pose> poses;
+  const auto add_one = [&] {
+    const Pose p = random_pose(rng, kSide, offset);
+    BodyId id = -1;
+    if (test::uniform_int(rng, 0, 99) < c.compound_percent) {
+      const auto body = random_compound(rng);
+      id = scene.add(body, p, body->scale());
+    } else {
+      const auto body = random_convex(rng);
+      id = scene.add(body, p, body->scale());
+    }
+    if (static_cast<std::size_t>(id) >= poses.size())
+      poses.resize(static_cast<std::size_t>(id) + 1);
+    poses[static_cast<std::size_t>(id)] = p;
+    ids.push_back(id);
+  };
+  for (int i = 0; i < kBodies; ++i) add_one();
+
+  int contacts = 0;
+  int separated = 0;
+  for (int step = 0; step < 6; ++step) {
+    const std::vector<ClosePair> pairs = scene.step_and_check("step " + std::to_string(step));
+    for (const ClosePair& p : pairs) {
+      const bool contact =
+          p.result.status == Status::intersecting || p.result.status == Status::touching;
+      contacts += contact ? 1 : 0;
+      separated += contact ? 0 : 1;
+    }
+    // Everybody moves a little; two leave, two join (taking the freed ids
+    // first), one jumps across the scene.
+    for (const BodyId id : ids) {
+      poses[static_cast<std::size_t>(id)] = moved(rng, poses[static_cast<std::size_t>(id)]);
+      scene.set_pose(id, poses[static_cast<std::size_t>(id)]);
+    }
+    for (int k = 0; k < 2; ++k) {
+      const auto at =
+          static_cast<std::size_t>(test::uniform_int(rng, 0, static_cast<int>(ids.size()) - 1));
+      scene.remove(ids[at]);
+      ids.erase(ids.begin() + static_cast<std::ptrdiff_t>(at));
+    }
+    for (int k = 0; k < 2; ++k) add_one();
+    const BodyId jumper =
+        ids[static_cast<std::size_t>(test::uniform_int(rng, 0, static_cast<int>(ids.size()) - 1))];
+    poses[static_cast<std::size_t>(jumper)] = random_pose(rng, kSide, offset);
+    scene.set_pose(jumper, poses[static_cast<std::size_t>(jumper)]);
+  }
+  // The scene must really hold overlapping bodies, and (above margin 0)
+  // separated close pairs too.
+  EXPECT_GT(contacts, 20);
+  if (c.margin > 0) {
+    EXPECT_GT(separated, 10);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, RandomScene,
+    testing::Values(RandomSceneCase{0.0, 0.0, 0}, RandomSceneCase{0.05, 0.0, 0},
+                    RandomSceneCase{0.5, 0.0, 0}, RandomSceneCase{0.05, 1e5, 0},
+                    RandomSceneCase{0.1, 0.0, 20}, RandomSceneCase{0.0, -3e4, 20}),
+    [](const testing::TestParamInfo<RandomSceneCase>& p) {
+      return "margin" + std::to_string(static_cast<int>(p.param.margin * 100)) + "cm_offset" +
+             (p.param.offset < 0 ? "minus" : "") +
+             std::to_string(static_cast<long long>(std::abs(p.param.offset))) + "_compounds" +
+             std::to_string(p.param.compound_percent);
+    });
+
+std::shared_ptr<const ConvexPolytope> unit_cube() {
+  return std::make_shared<const ConvexPolytope>(test::cube(1.0));
+}
+
+TEST(Scene, TouchingIntersectingAndMarginPairsByHand) {
+  for (const double far : {0.0, 1e6}) {
+    // Unit cubes centred at x = 0, 1 (faces touching), 1.5 (overlapping the
+    // second) and 2.625 (0.125 from the third).
+    const Vec3 o(far, -far, far);
+    for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
+      for (const double margin : {0.0, 0.12, 0.125}) {
+        SceneOptions options;
+        options.margin = margin;
+        options.broad_phase = bp;
+        Scene scene(options);
+        for (const double x : {0.0, 1.0, 1.5, 2.625}) {
+          scene.add(unit_cube(), Pose::from_translation(o + Vec3(x, 0, 0)));
+        }
+        const std::span<const ClosePair> pairs = scene.step();
+        const std::string where = "far " + std::to_string(far) + ", margin " +
+                                  std::to_string(margin) + ", " + to_string(bp);
+        // Spans [-0.5, 0.5], [0.5, 1.5], [1, 2], [2.125, 3.125]: (0, 1)
+        // touch, (1, 2) overlap, (2, 3) are 0.125 apart, the others 0.5 or more.
+        const std::size_t expected = margin >= 0.125 ? 3 : 2;
+        ASSERT_EQ(pairs.size(), expected) << where;
+        EXPECT_EQ(pairs[0].a, 0);
+        EXPECT_EQ(pairs[0].b, 1);
+        EXPECT_EQ(pairs[0].result.status, Status::touching) << where;
+        EXPECT_LE(pairs[0].result.distance, 64 * kUnitRoundoff * (far + 4)) << where;
+        EXPECT_EQ(pairs[1].a, 1);
+        EXPECT_EQ(pairs[1].b, 2);
+        EXPECT_EQ(pairs[1].result.status, Status::intersecting) << where;
+        EXPECT_EQ(pairs[1].result.distance, 0.0);
+        if (expected == 3) {
+          EXPECT_EQ(pairs[2].a, 2);
+          EXPECT_EQ(pairs[2].b, 3);
+          EXPECT_EQ(pairs[2].result.status, Status::separated);
+          EXPECT_NEAR(pairs[2].result.distance, 0.125, 64 * kUnitRoundoff * (far + 4));
+        }
+        // The 0.125 gap is outside a 0.12 margin for the boxes as well.
+        EXPECT_EQ(scene.stats().candidate_pairs, static_cast<int>(expected)) << where;
+        EXPECT_EQ(scene.stats().close_pairs, static_cast<int>(expected)) << where;
+      }
+    }
+  }
+}
+
+TEST(Scene, RemovedIdsAreReusedWithFreshCaches) {
+  Rng rng(5);
+  SceneOptions options;
+  options.margin = 0.6;
+  Scene scene(options);
+  std::vector<std::shared_ptr<const ConvexPolytope>> bodies;
+  for (int i = 0; i < 4; ++i)
+    bodies.push_back(std::make_shared<const ConvexPolytope>(test::points_on_sphere(rng, 40)));
+  // A row of unit spheres (40 points on them) 2.2 apart: neighbours are 0.2
+  // to 0.5 apart (close pairs), the next ones over 2.4.
+  for (int i = 0; i < 4; ++i)
+    EXPECT_EQ(
+        scene.add(bodies[static_cast<std::size_t>(i)], Pose::from_translation(Vec3(2.2 * i, 0, 0))),
+        i);
+  ASSERT_EQ(scene.step().size(), 3u);
+  ASSERT_EQ(scene.step().size(), 3u);
+  EXPECT_EQ(scene.stats().warm_pairs, 3);
+  scene.remove(1);
+  EXPECT_FALSE(scene.contains(1));
+  EXPECT_EQ(scene.body_count(), 3);
+  EXPECT_EQ(scene.body_ids(), (std::vector<BodyId>{0, 2, 3}));
+  // Id 1 comes back as another body in the same place: its pairs are new.
+  const auto cube = std::make_shared<const ConvexPolytope>(test::cube(1.6));
+  EXPECT_EQ(scene.add(cube, Pose::from_translation(Vec3(2.2, 0, 0))), 1);
+  EXPECT_TRUE(scene.contains(1));
+  EXPECT_EQ(scene.pose(1).translation, Vec3(2.2, 0, 0));
+  const std::span<const ClosePair> pairs = scene.step();
+  ASSERT_EQ(pairs.size(), 3u);
+  EXPECT_EQ(scene.stats().warm_pairs, 1);  // only (2, 3) kept its cache
+  const std::vector<ClosePair> twin = scene.close_pairs_all_pairs();
+  ASSERT_EQ(twin.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(pairs[k].a, twin[k].a);
+    EXPECT_EQ(pairs[k].b, twin[k].b);
+    EXPECT_NEAR(pairs[k].result.distance, twin[k].result.distance, 1e-12);
+  }
+  // A fresh id after the free list is used up.
+  EXPECT_EQ(scene.add(cube, Pose::from_translation(Vec3(50, 0, 0))), 4);
+}
+
+TEST(Scene, CachesCarryOverBetweenSteps) {
+  // A slow scene with a wide margin: most candidate pairs are close pairs,
+  // and each keeps its cache from step to step. The tracked queries must
+  // then do clearly less work than the cold ones of the twin: this fails if
+  // the caches are dropped or reset each step.
+  Rng rng(77);
+  SceneOptions options;
+  options.margin = 0.5;
+  Scene scene(options);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 80; ++i) {
+    poses.push_back(random_pose(rng, 8.0, Vec3::Zero()));
+    const auto body = std::make_shared<const ConvexPolytope>(
+        test::points_on_sphere(rng, test::uniform_int(rng, 60, 200)));
+    scene.add(body, poses.back());
+  }
+  scene.step();
+  long long tracked = 0;
+  long long cold = 0;
+  int warm = 0;
+  int candidates = 0;
+  for (int step = 0; step < 8; ++step) {
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      poses[i] = Pose(Mat3(test::random_small_rotation(rng, 0.005) * poses[i].rotation),
+                      Vec3(poses[i].translation + 0.005 * test::random_unit_vector(rng)));
+      scene.set_pose(static_cast<BodyId>(i), poses[i]);
+    }
+    const std::span<const ClosePair> pairs = scene.step();
+    const std::vector<ClosePair> twin = scene.close_pairs_all_pairs();
+    ASSERT_EQ(pairs.size(), twin.size());
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      tracked += pairs[k].result.iterations;
+      cold += twin[k].result.iterations;
+    }
+    warm += scene.stats().warm_pairs;
+    candidates += scene.stats().candidate_pairs;
+  }
+  ASSERT_GT(cold, 500);
+  EXPECT_LT(tracked, cold / 2) << "tracked iterations " << tracked << ", cold " << cold;
+  EXPECT_GT(warm, candidates * 9 / 10);
+}
+
+TEST(Scene, BadInputIsRefusedAndNamesTheBody) {
+  const auto expect_error = [](const auto& f, const std::string& needle) {
+    try {
+      f();
+      ADD_FAILURE() << "no InvalidInput, expected one mentioning '" << needle << "'";
+    } catch (const InvalidInput& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  SceneOptions bad;
+  bad.margin = -0.1;
+  expect_error([&] { Scene s(bad); }, "margin");
+  bad.margin = std::numeric_limits<double>::quiet_NaN();
+  expect_error([&] { Scene s(bad); }, "margin");
+  bad.margin = std::numeric_limits<double>::infinity();
+  expect_error([&] { Scene s(bad); }, "margin");
+  bad.margin = 0.0;
+  bad.threads = -1;
+  expect_error([&] { Scene s(bad); }, "threads");
+  bad.threads = 1;
+  bad.distance.max_iterations = 0;
+  expect_error([&] { Scene s(bad); }, "max_iterations");
+
+  Scene scene;
+  const Pose nan_pose =
+      Pose::from_translation(Vec3(0, std::numeric_limits<double>::quiet_NaN(), 0));
+  expect_error([&] { scene.add(std::shared_ptr<const ConvexPolytope>(), Pose{}); }, "null");
+  expect_error([&] { scene.add(std::shared_ptr<const CompoundBody>(), Pose{}); }, "null");
+  expect_error([&] { scene.add(unit_cube(), nan_pose); }, "not finite");
+  EXPECT_EQ(scene.body_count(), 0);
+  const BodyId a = scene.add(unit_cube(), Pose{});
+  const BodyId b = scene.add(unit_cube(), Pose::from_translation(Vec3(3, 0, 0)));
+  expect_error([&] { scene.set_pose(b, nan_pose); }, "body " + std::to_string(b));
+  Pose inf_rotation;
+  inf_rotation.rotation(1, 2) = std::numeric_limits<double>::infinity();
+  expect_error([&] { scene.set_pose(a, inf_rotation); }, "body " + std::to_string(a));
+  expect_error([&] { scene.set_pose(7, Pose{}); }, "body 7");
+  expect_error([&] { scene.set_pose(-1, Pose{}); }, "body -1");
+  expect_error([&] { scene.remove(9); }, "body 9");
+  expect_error([&] { (void)scene.pose(9); }, "body 9");
+  scene.remove(a);
+  expect_error([&] { scene.set_pose(a, Pose{}); }, "body " + std::to_string(a));
+  expect_error([&] { scene.remove(a); }, "body " + std::to_string(a));
+  EXPECT_FALSE(scene.contains(a));
+  EXPECT_FALSE(scene.contains(-3));
+  // Nothing was changed by the refused calls.
+  EXPECT_EQ(scene.body_count(), 1);
+  EXPECT_EQ(scene.pose(b).translation, Vec3(3, 0, 0));
+  EXPECT_TRUE(scene.step().empty());
+}
+
+TEST(Scene, EmptyAndMovedScenes) {
+  Scene empty;
+  EXPECT_TRUE(empty.step().empty());
+  EXPECT_EQ(empty.stats().bodies, 0);
+  EXPECT_TRUE(empty.close_pairs_all_pairs().empty());
+  // A scene moved into another variable keeps its bodies.
+  Scene scene;
+  scene.add(unit_cube(), Pose{});
+  scene.add(unit_cube(), Pose::from_translation(Vec3(0.5, 0, 0)));
+  Scene other = std::move(scene);
+  EXPECT_EQ(other.body_count(), 2);
+  ASSERT_EQ(other.step().size(), 1u);
+  EXPECT_EQ(other.step()[0].result.status, Status::intersecting);
+}
+
+}  // namespace
+}  // namespace proxima
