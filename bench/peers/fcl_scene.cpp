@@ -279,7 +279,8 @@ void sort_by_bodies(std::vector<FclClosePair>& pairs) {
 
 PairSetDifference compare_close_pairs(std::span<const FclClosePair> fcl,
                                       std::span<const ReferencePair> reference, double margin,
-                                      double relative_tolerance, double absolute_tolerance) {
+                                      double relative_tolerance, double absolute_tolerance,
+                                      std::vector<std::array<int, 2>>* mismatched) {
   auto tolerance = [&](double d) { return relative_tolerance * d + absolute_tolerance; };
   auto near_margin = [&](double d) { return std::abs(std::max(d, 0.0) - margin) <= tolerance(margin); };
   PairSetDifference diff;
@@ -298,16 +299,27 @@ PairSetDifference compare_close_pairs(std::span<const FclClosePair> fcl,
       const double error = std::abs(std::max(fcl[i].distance, 0.0) - d_ref);
       diff.worst_absolute = std::max(diff.worst_absolute, error);
       if (d_ref > 0.0) diff.worst_relative = std::max(diff.worst_relative, error / d_ref);
-      if (error > tolerance(d_ref)) ++diff.distance_mismatches;
+      if (error > tolerance(d_ref)) {
+        ++diff.distance_mismatches;
+        if (mismatched) mismatched->push_back({fcl[i].a, fcl[i].b});
+      }
       ++i;
       ++j;
     } else if (take_fcl) {
       ++diff.only_fcl;
-      if (near_margin(fcl[i].distance)) ++diff.boundary;
+      if (near_margin(fcl[i].distance)) {
+        ++diff.boundary;
+      } else if (mismatched) {
+        mismatched->push_back({fcl[i].a, fcl[i].b});
+      }
       ++i;
     } else {
       ++diff.only_reference;
-      if (near_margin(reference[j].distance)) ++diff.boundary;
+      if (near_margin(reference[j].distance)) {
+        ++diff.boundary;
+      } else if (mismatched) {
+        mismatched->push_back({reference[j].a, reference[j].b});
+      }
       ++j;
     }
   }

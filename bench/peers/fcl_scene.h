@@ -26,6 +26,7 @@
 // FCL's headers stay in fcl_scene.cpp.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <span>
 #include <vector>
@@ -119,9 +120,11 @@ struct PairSetDifference {
   int mismatches() const { return only_fcl + only_reference - boundary + distance_mismatches; }
 };
 
-// Both spans sorted by (a, b).
+// Both spans sorted by (a, b). With `mismatched`, appends each mismatched
+// pair (not the boundary ones) as (a, b).
 PairSetDifference compare_close_pairs(std::span<const FclClosePair> fcl,
                                       std::span<const ReferencePair> reference, double margin,
-                                      double relative_tolerance, double absolute_tolerance);
+                                      double relative_tolerance, double absolute_tolerance,
+                                      std::vector<std::array<int, 2>>* mismatched = nullptr);
 
 }  // namespace proxima::bench
