@@ -1218,4 +1218,52 @@ LoadedPolytope load_convex(const std::string& path) {
   }
 }
 
+// Compound files: one hull per group. The groups' layout is checked here
+// rather than trusted, since a PointCloud may come from a caller, not only
+// from the OBJ reader.
+LoadedCompound compound_from_cloud(const PointCloud& cloud) {
+  const auto point_count = static_cast<std::int64_t>(cloud.points.size());
+  if (cloud.points.empty()) throw FileError::in_file(cloud.source, "no points");
+  if (cloud.group_names.size() != cloud.group_offsets.size()) {
+    throw FileError::in_file(cloud.source, "group names and group offsets differ in number (" +
+                                               std::to_string(cloud.group_names.size()) + " and " +
+                                               std::to_string(cloud.group_offsets.size()) + ")");
+  }
+  const std::size_t groups = std::max<std::size_t>(cloud.group_offsets.size(), 1);
+  std::vector<CompoundPiece> pieces;
+  std::vector<LoadedPiece> reports;
+  pieces.reserve(groups);
+  reports.reserve(groups);
+  for (std::size_t g = 0; g < groups; ++g) {
+    const bool grouped = !cloud.group_offsets.empty();
+    const std::string name = grouped ? cloud.group_names[g] : std::string();
+    const std::string label = "group " + std::to_string(g) + " '" + name + "'";
+    const std::int64_t begin = grouped ? cloud.group_offsets[g] : 0;
+    const std::int64_t end = grouped && g + 1 < groups ? cloud.group_offsets[g + 1] : point_count;
+    if ((g == 0 && begin != 0) || begin < 0 || end > point_count || begin >= end) {
+      throw FileError::in_file(cloud.source, label + ": bad point range [" + std::to_string(begin) + ", " +
+                                                 std::to_string(end) + ") of " + std::to_string(point_count) +
+                                                 " points (groups must be non-empty, in order, from 0)");
+    }
+    const std::span<const Vec3> points(cloud.points.data() + begin, static_cast<std::size_t>(end - begin));
+    try {
+      auto polytope = std::make_shared<const ConvexPolytope>(points);
+      const int interior = polytope->interior_point_count();
+      reports.push_back({name, static_cast<int>(points.size()), interior, interior == 0});
+      pieces.push_back({std::move(polytope), Pose::identity()});
+    } catch (const InvalidInput& e) {
+      throw FileError::in_file(cloud.source, label + ": " + e.what());
+    }
+  }
+  try {
+    return LoadedCompound{CompoundBody(std::move(pieces)), std::move(reports)};
+  } catch (const FileError&) {
+    throw;
+  } catch (const InvalidInput& e) {
+    throw FileError::in_file(cloud.source, e.what());
+  }
+}
+
+LoadedCompound load_compound(const std::string& path) { return compound_from_cloud(read_points(path)); }
+
 }  // namespace proxima

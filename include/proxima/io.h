@@ -24,6 +24,7 @@
 // the file's size can hold.
 #pragma once
 
+#include "proxima/compound.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
@@ -96,5 +97,30 @@ struct LoadedPolytope {
 // read_points, then the hull of all the points (groups are not split). A
 // non-convex input is reported, not refused.
 LoadedPolytope load_convex(const std::string& path);
+
+// What became of one group of a compound file: its name and how convex its
+// points were (the piece is their hull either way).
+struct LoadedPiece {
+  std::string name;         // the OBJ group's name; "" for points before the first group or a file without groups
+  int input_points = 0;     // points of the group
+  int interior_points = 0;  // of those, not hull vertices (inside, on a face, or repeated)
+  bool input_was_convex = true;  // interior_points == 0
+};
+
+struct LoadedCompound {
+  CompoundBody body;                // one piece per group, identity piece poses, in file order
+  std::vector<LoadedPiece> pieces;  // parallel to body.pieces()
+};
+
+// read_points, then one convex piece per group (OBJ `g`/`o` groups; a file
+// without groups is one piece). A non-convex group is reported in its
+// LoadedPiece, not refused. A group whose points cannot build a polytope is
+// a FileError naming the file and the group.
+LoadedCompound load_compound(const std::string& path);
+
+// The same from a point cloud already read (or built by hand): the groups of
+// `cloud` are checked (offsets increasing from 0, inside the points, one
+// name each) and hulled; errors name cloud.source and the group.
+LoadedCompound compound_from_cloud(const PointCloud& cloud);
 
 }  // namespace proxima
