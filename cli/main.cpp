@@ -7,6 +7,7 @@
 //   proxima paper [--quick] [--out DIR]            the paper's experiments against the peers
 //   proxima distance A B [--pose-a ...] [--json]   distance between two mesh files
 //   proxima hull FILE [--out FILE.obj|.off]        hull statistics and export
+//   proxima scene-demo [--bodies N] [--steps S]    many moving bodies through proxima::Scene
 //
 // Exit codes: 0 when the run completed (a query line with an error answer is
 // still a completed run), 1 when the input cannot be read (bad file, bad
@@ -15,11 +16,14 @@
 #include "demo.h"
 #include "paper/paper.h"
 #include "query.h"
+#include "scene_demo.h"
 #include "tools.h"
 
 #include "proxima/types.h"
 
 #include <CLI/CLI.hpp>
+
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -180,6 +184,34 @@ int main(int argc, char** argv) {
   hull->add_flag("--json", hull_command.json, "One JSON object instead of the table");
   hull->footer("Example:\n  proxima hull body.stl --out hull.off");
 
+  CLI::App* scene_demo = app.add_subcommand(
+      "scene-demo",
+      "Run a seeded scene of moving random convex bodies through proxima::Scene and print "
+      "per-step statistics (candidate, close and intersecting pairs, time per step)");
+  proxima::cli::SceneDemoOptions scene_demo_options;
+  scene_demo->add_option("--bodies", scene_demo_options.bodies, "Number of bodies")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  scene_demo->add_option("--steps", scene_demo_options.steps, "Number of steps")
+      ->check(CLI::Range(1, 10000000))
+      ->capture_default_str();
+  scene_demo
+      ->add_option("--margin", scene_demo_options.margin,
+                   "Pairs at distance <= margin are reported (bodies have radius 1)")
+      ->capture_default_str();
+  scene_demo->add_option("--seed", scene_demo_options.seed, "Seed of the scene")->capture_default_str();
+  scene_demo
+      ->add_option("--threads", scene_demo_options.threads,
+                   "Narrow-phase threads (0: all cores)")
+      ->check(CLI::Range(0, kMaxThreads))
+      ->capture_default_str();
+  scene_demo
+      ->add_option("--every", scene_demo_options.every,
+                   "A statistics row every this many steps (0: about ten rows)")
+      ->check(CLI::Range(0, 10000000))
+      ->capture_default_str();
+  scene_demo->footer("Example:\n  proxima scene-demo --bodies 2000 --steps 100 --margin 0.05 --every 10");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -200,6 +232,10 @@ int main(int argc, char** argv) {
       return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
     }
     if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);
+    if (*scene_demo) {
+      return proxima::cli::run_scene_demo(scene_demo_options, std::cout, std::cerr,
+                                          ::isatty(STDERR_FILENO) != 0);
+    }
   } catch (const std::exception& e) {
     std::cerr << "proxima: " << e.what() << "\n";
     return kExitFailure;
