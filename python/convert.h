@@ -1,0 +1,330 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 7: conversions between Python objects and proxima's C++ types,
+// shared by the binding files of the Python module (module.cpp,
+// compound_scene.cpp). Arrays in, arrays out (copies); a wrong shape or a
+// non-rigid pose raises ValueError naming the argument.
+#pragma once
+
+#include <Python.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "proxima/io.h"
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
+namespace proxima::python {
+
+namespace py = pybind11;
+
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using Int32Array = py::array_t<std::int32_t>;
+
+// How far a 4x4 pose may be from a rigid motion and still be taken as one:
+// max |R^T R - I| and max |bottom row - (0 0 0 1)|. Poses often arrive
+// through float32 (graphics and mesh tools), whose rounding leaves R^T R off
+// by a few 1e-7; a scale, shear or projective row any larger than this is a
+// mistake, not rounding, and would be silently wrong: the query inverts the
+// pose by transposing R.
+inline constexpr double kRigidTolerance = 1e-6;
+
+[[noreturn]] inline void value_error(const std::string& message) { throw py::value_error(message); }
+
+inline std::string shape_of(const py::array& a) {
+  std::string s = "(";
+  for (py::ssize_t i = 0; i < a.ndim(); ++i) s += (i ? ", " : "") + std::to_string(a.shape(i));
+  return s + (a.ndim() == 1 ? ",)" : ")");
+}
+
+inline DoubleArray as_double_array(py::handle obj, const std::string& name) {
+  auto a = DoubleArray::ensure(obj);
+  if (!a) value_error(name + ": expected an array of numbers");
+  return a;
+}
+
+inline Vec3 to_vec3(py::handle obj, const std::string& name) {
+  const DoubleArray a = as_double_array(obj, name);
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    value_error(name + ": expected 3 numbers, got shape " + shape_of(a));
+  return Vec3(a.at(0), a.at(1), a.at(2));
+}
+
+inline Mat3 to_mat3(py::handle obj, const std::string& name) {
+  const DoubleArray a = as_double_array(obj, name);
+  if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) {
+    value_error(name + ": expected a 3x3 matrix, got shape " + shape_of(a));
+  }
+  Mat3 m;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m(i, j) = a.at(i, j);
+  }
+  return m;
+}
+
+// Numpy copies of Eigen values (row-major, as numpy prints them).
+inline py::array_t<double> vec3_array(const Vec3& v) { return py::array_t<double>(3, v.data()); }
+
+template <int kRows, int kCols>
+py::array_t<double> matrix_array(const Eigen::Matrix<double, kRows, kCols>& m) {
+  py::array_t<double> out({py::ssize_t{kRows}, py::ssize_t{kCols}});
+  auto o = out.mutable_unchecked<2>();
+  for (int i = 0; i < kRows; ++i) {
+    for (int j = 0; j < kCols; ++j) o(i, j) = m(i, j);
+  }
+  return out;
+}
+
+// Rejects a finite matrix that is not a proper rotation (a non-finite one is
+// left to the C++ query, whose InvalidInput says so).
+inline void check_rigid(const Mat3& r, const Eigen::Vector4d& bottom, const std::string& name) {
+  if (!r.allFinite() || !bottom.allFinite()) return;
+  const double off_rigid = (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff();
+  const double off_bottom = (bottom - Eigen::Vector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff();
+  if (off_bottom > kRigidTolerance)
+    value_error(name + ": the bottom row of a pose matrix must be (0, 0, 0, 1)");
+  if (off_rigid > kRigidTolerance || r.determinant() < 0) {
+    value_error(name + ": the rotation part is not a rotation (max |R^T R - I| = " +
+                std::to_string(off_rigid) + ", det = " + std::to_string(r.determinant()) +
+                "); proxima takes rigid motions only");
+  }
+}
+
+inline Pose pose_from_matrix(const double* m, const std::string& name) {
+  Mat3 r;
+  Vec3 t;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = m[4 * i + j];
+    t[i] = m[4 * i + 3];
+  }
+  check_rigid(r, Eigen::Vector4d(m[12], m[13], m[14], m[15]), name);
+  return {r, t};
+}
+
+inline Pose pose_from_quaternion(py::handle q_obj, py::handle t_obj, const std::string& name) {
+  const DoubleArray q = as_double_array(q_obj, name + " quaternion");
+  if (q.ndim() != 1 || q.shape(0) != 4) {
+    value_error(name + ": the quaternion must be 4 numbers (w, x, y, z), got shape " + shape_of(q));
+  }
+  const Quat quat(q.at(0), q.at(1), q.at(2), q.at(3));
+  // Eigen leaves a zero quaternion unnormalized, which would be a zero
+  // "rotation": refuse it here (a NaN one is left to the query's check).
+  if (quat.coeffs().squaredNorm() == 0.0) value_error(name + ": the quaternion is zero");
+  return {quat, to_vec3(t_obj, name + " translation")};
+}
+
+// A pose argument: None (identity), a proxima.Pose, a 4x4 matrix or a
+// (quaternion wxyz, translation) pair.
+inline Pose to_pose(py::handle obj, const std::string& name) {
+  if (obj.is_none()) return Pose{};
+  if (py::isinstance<Pose>(obj)) return obj.cast<Pose>();
+  if ((py::isinstance<py::tuple>(obj) || py::isinstance<py::list>(obj)) && py::len(obj) == 2) {
+    return pose_from_quaternion(obj[py::int_(0)], obj[py::int_(1)], name);
+  }
+  const DoubleArray m = as_double_array(obj, name);
+  if (m.ndim() != 2 || m.shape(0) != 4 || m.shape(1) != 4) {
+    value_error(
+        name +
+        ": expected None, a 4x4 matrix, a (quaternion wxyz, translation) pair or a proxima.Pose; "
+        "got an array of shape " +
+        shape_of(m));
+  }
+  return pose_from_matrix(m.data(), name);
+}
+
+// K poses for a batch: None (K identities), one pose for all, or a (K, 4, 4)
+// array. `k` is the batch size, or -1 when this argument decides it.
+inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::string& name) {
+  if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj)) {
+    if (k < 0)
+      value_error(name +
+                  ": give K poses as a (K, 4, 4) array (the other poses may be one pose or None)");
+    return std::vector<Pose>(static_cast<std::size_t>(k), to_pose(obj, name));
+  }
+  const DoubleArray m = as_double_array(obj, name);
+  if (m.ndim() == 2 && m.shape(0) == 4 && m.shape(1) == 4) {
+    if (k < 0)
+      value_error(name +
+                  ": give K poses as a (K, 4, 4) array (the other poses may be one pose or None)");
+    return std::vector<Pose>(static_cast<std::size_t>(k), pose_from_matrix(m.data(), name));
+  }
+  if (m.ndim() != 3 || m.shape(1) != 4 || m.shape(2) != 4) {
+    value_error(name + ": expected a (K, 4, 4) array of poses, got shape " + shape_of(m));
+  }
+  if (k >= 0 && m.shape(0) != k) {
+    value_error(name + ": " + std::to_string(m.shape(0)) + " poses, but the other side has " +
+                std::to_string(k));
+  }
+  std::vector<Pose> poses;
+  poses.reserve(static_cast<std::size_t>(m.shape(0)));
+  for (py::ssize_t i = 0; i < m.shape(0); ++i) {
+    poses.push_back(pose_from_matrix(m.data(i, 0, 0), name + "[" + std::to_string(i) + "]"));
+  }
+  return poses;
+}
+
+// The K of a batch from whichever pose argument is a (K, 4, 4) array.
+inline py::ssize_t batch_size(py::handle obj) {
+  if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj)) return -1;
+  auto m = DoubleArray::ensure(obj);
+  return m && m.ndim() == 3 ? m.shape(0) : -1;
+}
+
+inline Algorithm to_algorithm(const std::string& name) {
+  for (Algorithm a : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
+    if (name == to_string(a)) return a;
+  }
+  value_error("algorithm must be 'hybrid', 'gjk' or 'enhanced_gjk', got '" + name + "'");
+}
+
+inline DistanceOptions make_options(const std::string& algorithm, double relative_tolerance,
+                             double absolute_tolerance, int max_iterations) {
+  DistanceOptions options;
+  options.algorithm = to_algorithm(algorithm);
+  options.relative_tolerance = relative_tolerance;
+  options.absolute_tolerance = absolute_tolerance;
+  options.max_iterations = max_iterations;
+  return options;
+}
+
+inline Int32Array int32_array(std::span<const std::int32_t> values) {
+  return Int32Array(static_cast<py::ssize_t>(values.size()), values.data());
+}
+
+inline py::array_t<double> points_array(std::span<const Vec3> points) {
+  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (int j = 0; j < 3; ++j) o(static_cast<py::ssize_t>(i), j) = points[i][j];
+  }
+  return out;
+}
+
+template <std::size_t kColumns>
+Int32Array index_rows(const std::vector<std::array<std::int32_t, kColumns>>& rows) {
+  Int32Array out({static_cast<py::ssize_t>(rows.size()), static_cast<py::ssize_t>(kColumns)});
+  auto o = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    for (std::size_t j = 0; j < kColumns; ++j)
+      o(static_cast<py::ssize_t>(i), static_cast<py::ssize_t>(j)) = rows[i][j];
+  }
+  return out;
+}
+
+inline std::vector<Vec3> to_points(py::handle obj) {
+  const DoubleArray a = as_double_array(obj, "points");
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    value_error("points: expected an (N, 3) array, got shape " + shape_of(a));
+  std::vector<Vec3> points(static_cast<std::size_t>(a.shape(0)));
+  auto r = a.unchecked<2>();
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    points[static_cast<std::size_t>(i)] = Vec3(r(i, 0), r(i, 1), r(i, 2));
+  return points;
+}
+
+// Runs a reader; a file that does not exist becomes FileNotFoundError (with
+// errno and filename set, as Python's open() does) carrying the C++ message.
+template <class Read>
+auto read_file(const std::string& path, Read read) {
+  try {
+    return read(path);
+  } catch (const FileError& e) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) {
+      const py::object error =
+          py::module_::import("builtins").attr("FileNotFoundError")(ENOENT, e.what(), path);
+      PyErr_SetObject(PyExc_FileNotFoundError, error.ptr());
+      throw py::error_already_set();
+    }
+    throw;
+  }
+}
+
+inline int check_index(int i, int count, const char* what) {
+  if (i < 0 || i >= count) {
+    throw py::index_error(std::string(what) + " " + std::to_string(i) + " out of range [0, " +
+                          std::to_string(count) + ")");
+  }
+  return i;
+}
+
+// The batch result as a dict of arrays (K rows each).
+inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
+  const auto k = static_cast<py::ssize_t>(results.size());
+  py::array_t<double> distance_(k), lower_bound(k), point_a({k, py::ssize_t{3}}),
+      point_b({k, py::ssize_t{3}}), normal({k, py::ssize_t{3}});
+  Int32Array iterations(k), face_a(k), face_b(k), vertices_a({k, py::ssize_t{3}}),
+      vertices_b({k, py::ssize_t{3}});
+  py::array_t<std::uint8_t> status_code(k), type_a(k), type_b(k);
+  auto d = distance_.mutable_unchecked<1>();
+  auto lb = lower_bound.mutable_unchecked<1>();
+  auto pa = point_a.mutable_unchecked<2>();
+  auto pb = point_b.mutable_unchecked<2>();
+  auto n = normal.mutable_unchecked<2>();
+  auto it = iterations.mutable_unchecked<1>();
+  auto fa = face_a.mutable_unchecked<1>();
+  auto fb = face_b.mutable_unchecked<1>();
+  auto va = vertices_a.mutable_unchecked<2>();
+  auto vb = vertices_b.mutable_unchecked<2>();
+  auto sc = status_code.mutable_unchecked<1>();
+  auto ta = type_a.mutable_unchecked<1>();
+  auto tb = type_b.mutable_unchecked<1>();
+  for (py::ssize_t i = 0; i < k; ++i) {
+    const DistanceResult& r = results[static_cast<std::size_t>(i)];
+    d(i) = r.distance;
+    lb(i) = r.lower_bound;
+    for (int j = 0; j < 3; ++j) {
+      pa(i, j) = r.point_a[j];
+      pb(i, j) = r.point_b[j];
+      n(i, j) = r.normal[j];
+      va(i, j) = r.feature_a.vertices[static_cast<std::size_t>(j)];
+      vb(i, j) = r.feature_b.vertices[static_cast<std::size_t>(j)];
+    }
+    it(i) = r.iterations;
+    fa(i) = r.feature_a.face;
+    fb(i) = r.feature_b.face;
+    sc(i) = static_cast<std::uint8_t>(r.status);
+    ta(i) = static_cast<std::uint8_t>(r.feature_a.type);
+    tb(i) = static_cast<std::uint8_t>(r.feature_b.type);
+  }
+  // Strings by table lookup in numpy (one fancy-indexing call instead of K
+  // Python strings).
+  const py::module_ np = py::module_::import("numpy");
+  py::list status_names, type_names;
+  for (Status s :
+       {Status::separated, Status::touching, Status::intersecting, Status::iteration_cap}) {
+    status_names.append(to_string(s));
+  }
+  for (FeatureType t : {FeatureType::vertex, FeatureType::edge, FeatureType::face})
+    type_names.append(to_string(t));
+  const py::object status_table = np.attr("array")(status_names);
+  const py::object type_table = np.attr("array")(type_names);
+
+  py::dict out;
+  out["status"] = status_table[status_code];
+  out["distance"] = distance_;
+  out["lower_bound"] = lower_bound;
+  out["point_a"] = point_a;
+  out["point_b"] = point_b;
+  out["normal"] = normal;
+  out["feature_a_type"] = type_table[type_a];
+  out["feature_a_vertices"] = vertices_a;
+  out["feature_a_face"] = face_a;
+  out["feature_b_type"] = type_table[type_b];
+  out["feature_b_vertices"] = vertices_b;
+  out["feature_b_face"] = face_b;
+  out["iterations"] = iterations;
+  return out;
+}
+
+}  // namespace proxima::python
