@@ -188,7 +188,7 @@ inline Algorithm to_algorithm(const std::string& name) {
 }
 
 inline DistanceOptions make_options(const std::string& algorithm, double relative_tolerance,
-                             double absolute_tolerance, int max_iterations) {
+                                    double absolute_tolerance, int max_iterations) {
   DistanceOptions options;
   options.algorithm = to_algorithm(algorithm);
   options.relative_tolerance = relative_tolerance;
@@ -326,5 +326,8 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   out["iterations"] = iterations;
   return out;
 }
+
+// Registers CompoundBody, Scene and their companions (compound_scene.cpp).
+void bind_compound_and_scene(py::module_& m);
 
 }  // namespace proxima::python

@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -121,7 +122,8 @@ PYBIND11_MODULE(proxima, m) {
       });
 
   // --- ConvexPolytope -------------------------------------------------------
-  py::class_<ConvexPolytope>(
+  // Held by shared_ptr: a Scene or a CompoundBody keeps the polytopes it is given.
+  py::class_<ConvexPolytope, std::shared_ptr<ConvexPolytope>>(
       m, "ConvexPolytope",
       "A convex polytope: the convex hull of a point set, built once and immutable (shareable "
       "between threads). Lower-dimensional hulls (polygon, segment, point) are valid.")
@@ -235,7 +237,10 @@ PYBIND11_MODULE(proxima, m) {
 
   py::class_<LoadedPolytope>(m, "LoadedPolytope",
                              "A polytope read from a file, with how convex the input was.")
-      .def_readonly("polytope", &LoadedPolytope::polytope, "The hull (ConvexPolytope).")
+      .def_property_readonly(
+          "polytope",
+          [](const LoadedPolytope& l) { return std::make_shared<ConvexPolytope>(l.polytope); },
+          "The hull (ConvexPolytope).")
       .def_readonly("input_points", &LoadedPolytope::input_points, "Points read from the file.")
       .def_readonly("interior_points", &LoadedPolytope::interior_points,
                     "Input points that are not hull vertices (inside, on a face, or repeated).")
@@ -397,4 +402,6 @@ threads: 0 for all cores, 1 for the calling thread only, n for n threads.
 Returns a dict of arrays with K rows: status (str), distance, lower_bound, point_a (K, 3),
 point_b (K, 3), normal (K, 3), feature_a_type (str), feature_a_vertices (K, 3; -1 unused),
 feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k], b, poses_b[k]).)doc");
+
+  bind_compound_and_scene(m);
 }

@@ -1,0 +1,316 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 7: the Python side of compound bodies and scenes (CompoundBody,
+// CompoundCache, CompoundResult, load_compound, distance over compounds,
+// Scene, ClosePair, SceneStats). Same conventions as module.cpp: names one
+// for one with C++, arrays are numpy copies, enums are strings, the long
+// calls release the GIL.
+//
+// Polytopes and compounds are held by std::shared_ptr on both sides, so that
+// a body added to a Scene or used as a piece stays alive as long as either
+// side needs it.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "convert.h"
+#include "proxima/compound.h"
+#include "proxima/io.h"
+#include "proxima/scene.h"
+
+namespace proxima::python {
+namespace {
+
+// One piece argument: a ConvexPolytope, an (N, 3) array of points (hulled
+// here), or a (polytope or points, pose) pair.
+CompoundPiece to_piece(py::handle obj, std::size_t index) {
+  const std::string name = "pieces[" + std::to_string(index) + "]";
+  const auto polytope_of = [&](py::handle p) -> std::shared_ptr<const ConvexPolytope> {
+    if (py::isinstance<ConvexPolytope>(p)) return p.cast<std::shared_ptr<ConvexPolytope>>();
+    try {
+      return std::make_shared<ConvexPolytope>(to_points(p));
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(name + ": " + e.what());
+    } catch (const py::value_error& e) {
+      value_error(name + ": " + e.what());
+    }
+  };
+  if (py::isinstance<py::tuple>(obj) && py::len(obj) == 2) {
+    return {polytope_of(obj[py::int_(0)]), to_pose(obj[py::int_(1)], name + " pose")};
+  }
+  return {polytope_of(obj), Pose{}};
+}
+
+BroadPhase to_broad_phase(const std::string& name) {
+  for (BroadPhase b : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
+    if (name == to_string(b)) return b;
+  }
+  value_error("broad_phase must be 'sweep_and_prune' or 'dynamic_aabb_tree', got '" + name + "'");
+}
+
+py::list close_pair_list(std::span<const ClosePair> pairs) {
+  py::list out;
+  for (const ClosePair& p : pairs) out.append(py::cast(p));
+  return out;
+}
+
+}  // namespace
+
+void bind_compound_and_scene(py::module_& m) {
+  // --- Compound bodies --------------------------------------------------------
+  py::class_<CompoundBody, std::shared_ptr<CompoundBody>>(
+      m, "CompoundBody",
+      "A non-convex body as a union of convex pieces, each a ConvexPolytope at its own pose in "
+      "the body's frame, under a bounding-sphere hierarchy built once. Immutable; shareable "
+      "between threads.")
+      .def(py::init([](const py::sequence& pieces) {
+             std::vector<CompoundPiece> list;
+             list.reserve(py::len(pieces));
+             for (std::size_t i = 0; i < py::len(pieces); ++i)
+               list.push_back(to_piece(pieces[i], i));
+             py::gil_scoped_release release;
+             return CompoundBody(std::move(list));
+           }),
+           py::arg("pieces"),
+           "From a list of pieces: each a ConvexPolytope, an (N, 3) array of points (hulled), or "
+           "a (polytope or points, pose) pair. Raises InvalidInput naming the piece.")
+      .def_static(
+          "from_file",
+          [](const std::string& path) {
+            return read_file(path, [](const std::string& p) { return load_compound(p).body; });
+          },
+          py::arg("path"),
+          "One piece per OBJ group/object (a file without groups is one piece), each hulled.")
+      .def_property_readonly("piece_count", &CompoundBody::piece_count, "Number of pieces.")
+      .def(
+          "piece",
+          [](const CompoundBody& body, int i) {
+            const CompoundPiece& p = body.piece(check_index(i, body.piece_count(), "piece"));
+            return py::make_tuple(std::const_pointer_cast<ConvexPolytope>(p.polytope), p.pose);
+          },
+          py::arg("i"), "(ConvexPolytope, Pose) of piece i.")
+      .def_property_readonly(
+          "center", [](const CompoundBody& body) { return vec3_array(body.center()); },
+          "Center of the body's bounding sphere, in its frame.")
+      .def_property_readonly("bounding_radius", &CompoundBody::bounding_radius,
+                             "Radius of the body's bounding sphere.")
+      .def_property_readonly("scale", &CompoundBody::scale,
+                             "Largest absolute coordinate of a placed piece vertex.")
+      .def("memory_bytes", &CompoundBody::memory_bytes, "Bytes held by the C++ object.")
+      .def("__len__", &CompoundBody::piece_count)
+      .def("__repr__", [](const CompoundBody& body) {
+        return "proxima.CompoundBody(pieces=" + std::to_string(body.piece_count()) + ")";
+      });
+
+  py::class_<LoadedPiece>(m, "LoadedPiece", "One group of a compound file and how convex it was.")
+      .def_readonly("name", &LoadedPiece::name, "The OBJ group's name ('' when unnamed).")
+      .def_readonly("input_points", &LoadedPiece::input_points, "Points of the group.")
+      .def_readonly("interior_points", &LoadedPiece::interior_points,
+                    "Points of the group that are not hull vertices.")
+      .def_readonly("input_was_convex", &LoadedPiece::input_was_convex, "interior_points == 0.");
+
+  py::class_<LoadedCompound>(m, "LoadedCompound",
+                             "A compound body read from a file, per-piece reports.")
+      .def_property_readonly(
+          "body", [](const LoadedCompound& l) { return std::make_shared<CompoundBody>(l.body); },
+          "The CompoundBody.")
+      .def_readonly("pieces", &LoadedCompound::pieces, "List of LoadedPiece, one per piece.");
+
+  m.def(
+      "load_compound", [](const std::string& path) { return read_file(path, load_compound); },
+      py::arg("path"),
+      "Reads a mesh file as a compound body: one convex piece per OBJ group; a non-convex group "
+      "is hulled and reported in its LoadedPiece.");
+
+  py::class_<CompoundCache>(
+      m, "CompoundCache",
+      "Coherence between compound queries of one pair (the best piece pair and each near piece "
+      "pair's feature cache). A new cache is cold; one cache per pair of bodies.")
+      .def(py::init<>(), "A cold cache.")
+      .def_readonly("piece_a", &CompoundCache::piece_a, "Best piece on A of the last answer.")
+      .def_readonly("piece_b", &CompoundCache::piece_b, "Best piece on B of the last answer.")
+      .def_property_readonly(
+          "near_pairs", [](const CompoundCache& c) { return c.near.size(); },
+          "Number of piece pairs whose feature caches are kept.")
+      .def("is_cold", &CompoundCache::is_cold, "True when the cache holds nothing.")
+      .def("reset", &CompoundCache::reset, "Makes the cache cold again.")
+      .def("__repr__", [](const CompoundCache& c) {
+        return std::string("proxima.CompoundCache(") + (c.is_cold() ? "cold" : "warm") + ")";
+      });
+
+  py::class_<CompoundResult, DistanceResult>(
+      m, "CompoundResult",
+      "A DistanceResult of the closest piece pair, plus which pieces (features are in the "
+      "pieces' hull ids) and how many convex queries ran.")
+      .def_readonly("piece_a", &CompoundResult::piece_a, "The closest piece of A.")
+      .def_readonly("piece_b", &CompoundResult::piece_b, "The closest piece of B.")
+      .def_readonly("pairs_tested", &CompoundResult::pairs_tested, "Convex queries run.")
+      .def("__repr__", [](const CompoundResult& r) {
+        return std::string("proxima.CompoundResult(status='") + to_string(r.status) +
+               "', distance=" + py::repr(py::float_(r.distance)).cast<std::string>() +
+               ", pieces=(" + std::to_string(r.piece_a) + ", " + std::to_string(r.piece_b) + "))";
+      });
+
+  const DistanceOptions defaults;
+  m.def(
+      "distance",
+      [](const CompoundBody& a, py::object pose_a, const CompoundBody& b, py::object pose_b,
+         CompoundCache* cache, const std::string& algorithm, double relative_tolerance,
+         double absolute_tolerance, int max_iterations) {
+        const DistanceOptions options =
+            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+        const Pose pa = to_pose(pose_a, "pose_a");
+        const Pose pb = to_pose(pose_b, "pose_b");
+        py::gil_scoped_release release;
+        return distance(a, pa, b, pb, options, cache);
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      py::arg("cache") = py::none(), py::arg("algorithm") = to_string(defaults.algorithm),
+      py::arg("relative_tolerance") = defaults.relative_tolerance,
+      py::arg("absolute_tolerance") = defaults.absolute_tolerance,
+      py::arg("max_iterations") = defaults.max_iterations,
+      "Minimum distance between two CompoundBody objects (branch and bound over piece pairs); "
+      "cache: a CompoundCache or None. Returns a CompoundResult.");
+  m.def(
+      "distance_all_pairs",
+      [](const CompoundBody& a, py::object pose_a, const CompoundBody& b, py::object pose_b,
+         const std::string& algorithm) {
+        DistanceOptions options;
+        options.algorithm = to_algorithm(algorithm);
+        const Pose pa = to_pose(pose_a, "pose_a");
+        const Pose pb = to_pose(pose_b, "pose_b");
+        py::gil_scoped_release release;
+        return distance_all_pairs(a, pa, b, pb, options);
+      },
+      py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
+      py::arg("algorithm") = to_string(defaults.algorithm),
+      "The slow twin of the compound distance: every piece pair, cold. For checks.");
+
+  // --- Scenes -----------------------------------------------------------------
+  py::class_<ClosePair>(m, "ClosePair", "A pair of bodies within the scene's margin (a < b).")
+      .def_readonly("a", &ClosePair::a, "Body id.")
+      .def_readonly("b", &ClosePair::b, "Body id.")
+      .def_readonly("result", &ClosePair::result, "The CompoundResult of the pair.")
+      .def("__repr__", [](const ClosePair& p) {
+        return "proxima.ClosePair(" + std::to_string(p.a) + ", " + std::to_string(p.b) +
+               ", distance=" + py::repr(py::float_(p.result.distance)).cast<std::string>() + ")";
+      });
+
+  py::class_<SceneStats>(m, "SceneStats", "What the last step did.")
+      .def_readonly("bodies", &SceneStats::bodies, "Bodies in the scene.")
+      .def_readonly("candidate_pairs", &SceneStats::candidate_pairs,
+                    "Pairs the broad phase passed to the narrow phase.")
+      .def_readonly("close_pairs", &SceneStats::close_pairs, "Pairs at distance <= margin.")
+      .def_readonly("convex_queries", &SceneStats::convex_queries, "Convex queries run.")
+      .def_readonly("warm_pairs", &SceneStats::warm_pairs,
+                    "Candidate pairs that started from the previous step's cache.");
+
+  py::class_<Scene>(
+      m, "Scene",
+      "Many bodies (ConvexPolytope or CompoundBody) moved by the caller; step() returns the "
+      "pairs within the margin, with tracked distance queries (each pair's cache kept across "
+      "steps). Use from one thread at a time.")
+      .def(py::init([](double margin, const std::string& broad_phase, int threads,
+                       const std::string& algorithm, double relative_tolerance,
+                       double absolute_tolerance, int max_iterations) {
+             SceneOptions options;
+             options.margin = margin;
+             options.broad_phase = to_broad_phase(broad_phase);
+             options.threads = threads;
+             options.distance =
+                 make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+             return Scene(options);
+           }),
+           py::arg("margin") = 0.0, py::arg("broad_phase") = to_string(SceneOptions{}.broad_phase),
+           py::arg("threads") = SceneOptions{}.threads,
+           py::arg("algorithm") = to_string(defaults.algorithm),
+           py::arg("relative_tolerance") = defaults.relative_tolerance,
+           py::arg("absolute_tolerance") = defaults.absolute_tolerance,
+           py::arg("max_iterations") = defaults.max_iterations,
+           "margin: pairs at distance <= margin are reported. broad_phase: 'dynamic_aabb_tree' or "
+           "'sweep_and_prune'. threads: narrow-phase threads (1: the calling thread, 0: all "
+           "cores).")
+      .def(
+          "add",
+          [](Scene& s, std::shared_ptr<ConvexPolytope> body, py::object pose) {
+            return s.add(std::shared_ptr<const ConvexPolytope>(std::move(body)),
+                         to_pose(pose, "pose"));
+          },
+          py::arg("body"), py::arg("pose") = py::none(), "Adds a ConvexPolytope; returns its id.")
+      .def(
+          "add",
+          [](Scene& s, std::shared_ptr<CompoundBody> body, py::object pose) {
+            return s.add(std::shared_ptr<const CompoundBody>(std::move(body)),
+                         to_pose(pose, "pose"));
+          },
+          py::arg("body"), py::arg("pose") = py::none(), "Adds a CompoundBody; returns its id.")
+      .def(
+          "set_pose",
+          [](Scene& s, BodyId id, py::object pose) { s.set_pose(id, to_pose(pose, "pose")); },
+          py::arg("id"), py::arg("pose"),
+          "Moves body id (pose: 4x4, (quaternion, translation) or Pose).")
+      .def(
+          "set_poses",
+          [](Scene& s, py::object ids, py::object poses) {
+            const auto id_array =
+                py::array_t<BodyId, py::array::c_style | py::array::forcecast>::ensure(ids);
+            if (!id_array || id_array.ndim() != 1)
+              value_error("ids: expected a 1-D array of body ids");
+            const std::vector<Pose> list = to_poses(poses, id_array.shape(0), "poses");
+            for (std::size_t k = 0; k < list.size(); ++k)
+              s.set_pose(id_array.at(static_cast<py::ssize_t>(k)), list[k]);
+          },
+          py::arg("ids"), py::arg("poses"),
+          "Moves many bodies at once: ids (K,) and poses (K, 4, 4).")
+      .def("remove", &Scene::remove, py::arg("id"), "Removes body id (its id may be reused).")
+      .def("contains", &Scene::contains, py::arg("id"))
+      .def("__contains__", &Scene::contains)
+      .def("__len__", &Scene::body_count)
+      .def("pose", &Scene::pose, py::arg("id"), "The current pose of body id.")
+      .def_property_readonly(
+          "body_ids",
+          [](const Scene& s) {
+            const std::vector<BodyId> ids = s.body_ids();
+            return int32_array(ids);
+          },
+          "Live body ids, increasing, int32.")
+      .def_property_readonly(
+          "margin", [](const Scene& s) { return s.options().margin; }, "The query margin.")
+      .def(
+          "step",
+          [](Scene& s) {
+            std::span<const ClosePair> pairs;
+            {
+              py::gil_scoped_release release;
+              pairs = s.step();
+            }
+            return close_pair_list(pairs);
+          },
+          "Broad phase and tracked narrow phase on the current poses: the list of ClosePair, "
+          "sorted by (a, b).")
+      .def_property_readonly(
+          "stats", [](const Scene& s) { return s.stats(); }, "SceneStats of the last step.")
+      .def(
+          "close_pairs_all_pairs",
+          [](const Scene& s) {
+            std::vector<ClosePair> pairs;
+            {
+              py::gil_scoped_release release;
+              pairs = s.close_pairs_all_pairs();
+            }
+            return close_pair_list(pairs);
+          },
+          "The slow twin of step(): cold queries on every pair. For checks.")
+      .def("__repr__", [](const Scene& s) {
+        return "proxima.Scene(bodies=" + std::to_string(s.body_count()) +
+               ", margin=" + py::repr(py::float_(s.options().margin)).cast<std::string>() + ")";
+      });
+}
+
+}  // namespace proxima::python

@@ -1,0 +1,211 @@
+"""Tests of the Python bindings of compound bodies and scenes.
+
+The C++ tests check the algorithms (tests/compound_test.cpp,
+tests/scene_test.cpp); these check what the binding adds: argument
+conversion, ownership across the language boundary, errors, and that each
+fast call agrees with its slow twin as seen from Python.
+"""
+
+import gc
+
+import numpy as np
+import pytest
+
+import proxima
+
+
+def random_compound(rng, pieces, spread=3.0):
+    """A compound of `pieces` random convex pieces around the origin."""
+    return proxima.CompoundBody(
+        [rng.normal(size=(int(rng.integers(8, 40)), 3)) * 0.5 + rng.uniform(-spread, spread, 3)
+         for _ in range(pieces)])
+
+
+def quaternion(rng):
+    q = rng.normal(size=4)
+    return q / np.linalg.norm(q)
+
+
+def tolerance(*bodies):
+    """The accuracy standard: 64 u R, R of the placed vertices (generous R here)."""
+    return 64 * 2.0**-53 * max(10.0, *(b.scale + 20.0 for b in bodies))
+
+
+# --- CompoundBody -------------------------------------------------------------
+
+
+def test_pieces_from_polytopes_points_and_posed_pairs():
+    rng = np.random.default_rng(1)
+    hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
+    body = proxima.CompoundBody([hull, rng.normal(size=(10, 3)), (hull, ((1, 0, 0, 0), (5, 0, 0)))])
+    assert body.piece_count == 3 and len(body) == 3
+    polytope, pose = body.piece(2)
+    assert polytope.vertex_count == hull.vertex_count
+    np.testing.assert_allclose(pose.translation, [5, 0, 0])
+    # The sphere holds every placed vertex of every piece.
+    for i in range(body.piece_count):
+        p, pose = body.piece(i)
+        for v in p.vertices:
+            assert np.linalg.norm(pose.apply(v) - body.center) <= body.bounding_radius * (1 + 1e-12)
+    with pytest.raises(IndexError):
+        body.piece(3)
+
+
+def test_bad_pieces_name_the_piece():
+    rng = np.random.default_rng(2)
+    good = rng.normal(size=(10, 3))
+    bad = good.copy()
+    bad[4, 1] = np.nan
+    with pytest.raises(proxima.InvalidInput, match=r"pieces\[1\]"):
+        proxima.CompoundBody([good, bad])
+    with pytest.raises(ValueError, match=r"pieces\[0\]"):
+        proxima.CompoundBody([np.zeros((4, 2))])
+    with pytest.raises(proxima.InvalidInput):
+        proxima.CompoundBody([])
+
+
+def test_pieces_outlive_the_python_objects():
+    rng = np.random.default_rng(3)
+    hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
+    body = proxima.CompoundBody([hull, (hull, ((1, 0, 0, 0), (4, 0, 0)))])
+    del hull
+    gc.collect()
+    r = proxima.distance(body, None, body, ((1, 0, 0, 0), (20, 0, 0)))
+    assert r.status == "separated" and r.distance > 0
+
+
+def test_compound_distance_equals_its_twin_and_tracking_equals_cold():
+    rng = np.random.default_rng(4)
+    a = random_compound(rng, 12)
+    b = random_compound(rng, 7)
+    cache = proxima.CompoundCache()
+    assert cache.is_cold()
+    position = np.array([9.0, 0.0, 0.0])
+    q_b = quaternion(rng)
+    tested_tracked, tested_cold = 0, 0
+    for _ in range(40):
+        position += rng.normal(size=3) * 0.05
+        pose_b = (q_b, position)
+        tracked = proxima.distance(a, None, b, pose_b, cache=cache)
+        cold = proxima.distance(a, None, b, pose_b)
+        twin = proxima.distance_all_pairs(a, None, b, pose_b)
+        assert isinstance(tracked, proxima.CompoundResult)
+        assert tracked.status == twin.status
+        assert abs(tracked.distance - twin.distance) <= tolerance(a, b) + 1e-12 * twin.distance
+        assert abs(cold.distance - twin.distance) <= tolerance(a, b) + 1e-12 * twin.distance
+        # The reported points lie on the reported pieces: the convex query of
+        # those two pieces gives the same distance.
+        pa, pose_pa = a.piece(tracked.piece_a)
+        pb, pose_pb = b.piece(tracked.piece_b)
+        world_b = proxima.Pose.from_quaternion(q_b, position) * pose_pb
+        pair = proxima.distance(pa, pose_pa, pb, world_b)
+        assert abs(pair.distance - tracked.distance) <= tolerance(a, b) + 1e-12 * pair.distance
+        tested_tracked += tracked.pairs_tested
+        tested_cold += cold.pairs_tested
+    assert not cache.is_cold() and cache.near_pairs >= 1
+    assert tested_tracked <= tested_cold
+    assert tested_cold < 40 * a.piece_count * b.piece_count
+
+
+def test_overlapping_compounds_are_intersecting():
+    rng = np.random.default_rng(5)
+    a = random_compound(rng, 5, spread=1.0)
+    r = proxima.distance(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
+    assert r.status == "intersecting" and r.distance == 0.0
+
+
+def test_load_compound_reports_each_group(tmp_path):
+    path = tmp_path / "two.obj"
+    cube = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
+    lines = ["o left"] + [f"v {x} {y} {z}" for x, y, z in cube] + ["v 0.5 0.5 0.5"]
+    lines += ["o right"] + [f"v {x + 3} {y} {z}" for x, y, z in cube]
+    path.write_text("\n".join(lines) + "\n")
+    loaded = proxima.load_compound(str(path))
+    assert [p.name for p in loaded.pieces] == ["left", "right"]
+    assert [p.input_points for p in loaded.pieces] == [9, 8]
+    assert [p.input_was_convex for p in loaded.pieces] == [False, True]
+    assert loaded.body.piece_count == 2
+    body = proxima.CompoundBody.from_file(str(path))
+    r = proxima.distance(body, None, body, ((1, 0, 0, 0), (0, 0, 5)))
+    assert abs(r.distance - 4.0) < 1e-12
+    with pytest.raises(FileNotFoundError):
+        proxima.load_compound(str(tmp_path / "missing.obj"))
+
+
+# --- Scene --------------------------------------------------------------------
+
+
+def random_scene(rng, bodies, margin, threads=1, broad_phase="dynamic_aabb_tree"):
+    shapes = [proxima.ConvexPolytope(rng.normal(size=(int(rng.integers(20, 60)), 3)) * 0.4)
+              for _ in range(6)]
+    compound = random_compound(rng, 4, spread=0.8)
+    scene = proxima.Scene(margin=margin, threads=threads, broad_phase=broad_phase)
+    side = 2.0 * bodies ** (1 / 3)
+    positions = rng.uniform(0, side, size=(bodies, 3))
+    ids = []
+    for i in range(bodies):
+        body = compound if i % 10 == 0 else shapes[i % len(shapes)]
+        ids.append(scene.add(body, (quaternion(rng), positions[i])))
+    return scene, np.array(ids), positions
+
+
+def same_pairs(fast, slow, tol):
+    assert [(p.a, p.b) for p in fast] == [(p.a, p.b) for p in slow]
+    for f, s in zip(fast, slow):
+        assert f.result.status == s.result.status
+        assert abs(f.result.distance - s.result.distance) <= tol
+
+
+@pytest.mark.parametrize("broad_phase", ["dynamic_aabb_tree", "sweep_and_prune"])
+def test_scene_step_equals_all_pairs_while_bodies_move(broad_phase):
+    rng = np.random.default_rng(6)
+    scene, ids, positions = random_scene(rng, 60, margin=0.3, broad_phase=broad_phase)
+    assert len(scene) == 60 and list(scene.body_ids) == list(ids)
+    seen_close = 0
+    for _ in range(8):
+        positions += rng.normal(size=positions.shape) * 0.05
+        poses = np.tile(np.eye(4), (len(ids), 1, 1))
+        poses[:, :3, 3] = positions
+        scene.set_poses(ids, poses)
+        fast = scene.step()
+        same_pairs(fast, scene.close_pairs_all_pairs(), 1e-9)
+        assert scene.stats.close_pairs == len(fast)
+        assert scene.stats.candidate_pairs >= len(fast)
+        seen_close += len(fast)
+    assert seen_close > 0  # the scene really has close pairs
+    assert scene.stats.warm_pairs > 0  # and tracking really carries caches across steps
+
+
+def test_scene_threads_give_the_same_answers():
+    answers = []
+    for threads in (1, 2):
+        rng = np.random.default_rng(7)
+        scene, _, _ = random_scene(rng, 80, margin=0.2, threads=threads)
+        answers.append([(p.a, p.b, p.result.distance, p.result.status) for p in scene.step()])
+    assert answers[0] == answers[1] and answers[0]
+
+
+def test_scene_add_remove_and_errors():
+    rng = np.random.default_rng(8)
+    hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
+    scene = proxima.Scene(margin=0.1)
+    a = scene.add(hull)
+    b = scene.add(hull, ((1, 0, 0, 0), (100, 0, 0)))
+    del hull
+    gc.collect()
+    assert scene.step() == []
+    scene.set_pose(b, ((1, 0, 0, 0), (0.5, 0, 0)))
+    pairs = scene.step()
+    assert [(p.a, p.b) for p in pairs] == [(a, b)] and pairs[0].result.status == "intersecting"
+    scene.remove(b)
+    assert b not in scene and a in scene and len(scene) == 1
+    with pytest.raises(proxima.InvalidInput, match=str(b)):
+        scene.set_pose(b, None)
+    with pytest.raises(proxima.InvalidInput):
+        scene.set_pose(a, ((1, 0, 0, 0), (np.nan, 0, 0)))
+    with pytest.raises(proxima.InvalidInput):
+        proxima.Scene(margin=-1.0)
+    with pytest.raises(ValueError, match="broad_phase"):
+        proxima.Scene(broad_phase="octree")
+    with pytest.raises(ValueError, match="ids"):
+        scene.set_poses(np.zeros((2, 2)), np.tile(np.eye(4), (2, 1, 1)))
