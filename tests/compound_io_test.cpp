@@ -4,8 +4,6 @@
 // refused; the body answers distance queries like the hulls of its groups;
 // a group that cannot be hulled, and a hand-made cloud with a bad group
 // layout, are FileErrors naming the file and the group.
-#include "proxima/io.h"
-
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -18,6 +16,7 @@
 #include <vector>
 
 #include "proxima/distance.h"
+#include "proxima/io.h"
 #include "support/generators.h"
 
 namespace proxima {
@@ -31,7 +30,8 @@ class CompoundIoTest : public testing::Test {
  protected:
   void SetUp() override {
     const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("proxima_compound_io_test_" + std::to_string(::getpid()) + "_" + info->name());
+    dir_ = fs::temp_directory_path() /
+           ("proxima_compound_io_test_" + std::to_string(::getpid()) + "_" + info->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -67,8 +67,8 @@ TEST_F(CompoundIoTest, GroupsBecomePiecesInFileOrder) {
   // Group 1 is not convex as given: a cube cloud with interior points.
   const Points p1 = test::points_in_cube(rng, 40);
   const Points p2 = test::translated(test::cube(1.0), Vec3(3, 0, 0));
-  const std::string obj = "# three parts\n" + obj_vertices(p0) + "o middle part\n" + obj_vertices(p1) +
-                          "g right\n" + obj_vertices(p2) + "f 1 2 3\n";
+  const std::string obj = "# three parts\n" + obj_vertices(p0) + "o middle part\n" +
+                          obj_vertices(p1) + "g right\n" + obj_vertices(p2) + "f 1 2 3\n";
   const LoadedCompound loaded = load_compound(write("parts.obj", obj));
   ASSERT_EQ(loaded.body.piece_count(), 3);
   ASSERT_EQ(loaded.pieces.size(), 3u);
@@ -87,7 +87,8 @@ TEST_F(CompoundIoTest, GroupsBecomePiecesInFileOrder) {
   // The body answers as the hulls of its groups do: a point probe at the
   // far right is closest to group 2, at the distance of that hull alone.
   const ConvexPolytope probe(Points{Vec3(10, 0.1, 0.2)});
-  const CompoundBody probe_body({{std::make_shared<const ConvexPolytope>(Points{Vec3(10, 0.1, 0.2)}), Pose()}});
+  const CompoundBody probe_body(
+      {{std::make_shared<const ConvexPolytope>(Points{Vec3(10, 0.1, 0.2)}), Pose()}});
   const CompoundResult r = distance(loaded.body, Pose(), probe_body, Pose());
   EXPECT_EQ(r.piece_a, 2);
   EXPECT_EQ(r.distance, distance(ConvexPolytope(p2), Pose(), probe, Pose()).distance);
@@ -116,8 +117,8 @@ TEST_F(CompoundIoTest, ErrorsNameTheFileAndTheGroup) {
   // A hand-made cloud: a NaN point in group 1 cannot be hulled.
   PointCloud cloud;
   cloud.source = "hand.obj";
-  cloud.points = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0),
-                  Vec3(5, 0, 0), Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0)};
+  cloud.points = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(5, 0, 0),
+                  Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0)};
   cloud.group_names = {"left", "broken"};
   cloud.group_offsets = {0, 3};
   try {
@@ -131,7 +132,8 @@ TEST_F(CompoundIoTest, ErrorsNameTheFileAndTheGroup) {
   // offsets of different lengths; no points at all.
   cloud.points[4] = Vec3(6, 0, 0);
   for (const std::vector<std::int32_t>& offsets :
-       {std::vector<std::int32_t>{1, 3}, std::vector<std::int32_t>{0, 0}, std::vector<std::int32_t>{0, 9}}) {
+       {std::vector<std::int32_t>{1, 3}, std::vector<std::int32_t>{0, 0},
+        std::vector<std::int32_t>{0, 9}}) {
     cloud.group_offsets = offsets;
     EXPECT_THROW(compound_from_cloud(cloud), FileError);
   }

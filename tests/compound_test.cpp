@@ -44,15 +44,19 @@ constexpr double kRelativeTolerance = 1e-12;
 Points random_piece_points(Rng& rng) {
   const int n = test::uniform_int(rng, 4, 24);
   switch (test::uniform_int(rng, 0, 5)) {
-    case 0: return test::points_in_cube(rng, n);
-    case 1: return test::random_shape(rng, test::random_shape_kind(rng), n);
-    default: return test::points_on_sphere(rng, n);
+    case 0:
+      return test::points_in_cube(rng, n);
+    case 1:
+      return test::random_shape(rng, test::random_shape_kind(rng), n);
+    default:
+      return test::points_on_sphere(rng, n);
   }
 }
 
 Pose random_pose(Rng& rng, double spread) {
-  return {test::random_quaternion(rng), Vec3(test::uniform(rng, -spread, spread), test::uniform(rng, -spread, spread),
-                                             test::uniform(rng, -spread, spread))};
+  return {test::random_quaternion(rng),
+          Vec3(test::uniform(rng, -spread, spread), test::uniform(rng, -spread, spread),
+               test::uniform(rng, -spread, spread))};
 }
 
 // `n` pieces of size `size` spread over a cube of half-width `spread` (small
@@ -61,12 +65,14 @@ Pose random_pose(Rng& rng, double spread) {
 CompoundBody random_compound(Rng& rng, int n, double spread, double size = 1.0) {
   std::vector<CompoundPiece> pieces;
   for (int i = 0; i < n; ++i) {
-    const Points local = test::scaled(random_piece_points(rng), size * test::uniform(rng, 0.3, 1.0));
+    const Points local =
+        test::scaled(random_piece_points(rng), size * test::uniform(rng, 0.3, 1.0));
     const Pose place = random_pose(rng, spread);
     if (rng() & 1) {
       pieces.push_back({std::make_shared<const ConvexPolytope>(local), place});
     } else {
-      pieces.push_back({std::make_shared<const ConvexPolytope>(test::transformed(local, place)), Pose::identity()});
+      pieces.push_back({std::make_shared<const ConvexPolytope>(test::transformed(local, place)),
+                        Pose::identity()});
     }
   }
   return CompoundBody(std::move(pieces));
@@ -77,13 +83,16 @@ double world_magnitude(const CompoundBody& body, const Pose& pose) {
   double r = 0.0;
   for (const CompoundPiece& p : body.pieces()) {
     const Pose placed = pose * p.pose;
-    for (const Vec3& v : p.polytope->vertices()) r = std::max(r, placed.apply(v).cwiseAbs().maxCoeff());
+    for (const Vec3& v : p.polytope->vertices())
+      r = std::max(r, placed.apply(v).cwiseAbs().maxCoeff());
   }
   return r;
 }
 
-double tolerance(const CompoundBody& a, const Pose& pa, const CompoundBody& b, const Pose& pb, double d) {
-  return kRelativeTolerance * d + kBandUlps * kUnitRoundoff * std::max(world_magnitude(a, pa), world_magnitude(b, pb));
+double tolerance(const CompoundBody& a, const Pose& pa, const CompoundBody& b, const Pose& pb,
+                 double d) {
+  return kRelativeTolerance * d +
+         kBandUlps * kUnitRoundoff * std::max(world_magnitude(a, pa), world_magnitude(b, pb));
 }
 
 // The checks every answer must pass against its twin: same distance within
@@ -92,12 +101,12 @@ double tolerance(const CompoundBody& a, const Pose& pa, const CompoundBody& b, c
 // the cold convex query of those two pieces agrees with the distance, and
 // each point is within the band of its piece (a convex query from a
 // one-point polytope).
-void check_against_twin(const CompoundBody& a, const Pose& pa, const CompoundBody& b, const Pose& pb,
-                        const CompoundResult& r, const CompoundResult& twin) {
+void check_against_twin(const CompoundBody& a, const Pose& pa, const CompoundBody& b,
+                        const Pose& pb, const CompoundResult& r, const CompoundResult& twin) {
   const double tol = tolerance(a, pa, b, pb, twin.distance);
   ASSERT_TRUE(std::isfinite(r.distance));
-  EXPECT_NEAR(r.distance, twin.distance, tol) << "pieces " << r.piece_a << "," << r.piece_b << " vs twin "
-                                              << twin.piece_a << "," << twin.piece_b;
+  EXPECT_NEAR(r.distance, twin.distance, tol) << "pieces " << r.piece_a << "," << r.piece_b
+                                              << " vs twin " << twin.piece_a << "," << twin.piece_b;
   if (twin.distance > 2 * tol) {
     EXPECT_EQ(r.status == Status::intersecting, twin.status == Status::intersecting);
   }
@@ -110,7 +119,8 @@ void check_against_twin(const CompoundBody& a, const Pose& pa, const CompoundBod
   ASSERT_LT(r.piece_b, b.piece_count());
   const CompoundPiece& piece_a = a.piece(r.piece_a);
   const CompoundPiece& piece_b = b.piece(r.piece_b);
-  const DistanceResult pair = distance(*piece_a.polytope, pa * piece_a.pose, *piece_b.polytope, pb * piece_b.pose);
+  const DistanceResult pair =
+      distance(*piece_a.polytope, pa * piece_a.pose, *piece_b.polytope, pb * piece_b.pose);
   EXPECT_NEAR(pair.distance, r.distance, tol);
   EXPECT_NEAR((r.point_a - r.point_b).norm(), r.distance, tol);
   const ConvexPolytope at_a(Points{r.point_a});
@@ -146,7 +156,8 @@ TEST(Compound, SinglePieceIsTheConvexQueryBitForBit) {
     DistanceCache convex_cache;
     for (int step = 0; step < 5; ++step) {
       const CompoundResult r = distance(a, pose_a, b, pose_b, {}, &compound_cache);
-      const DistanceResult c = distance(*pa, pose_a * local_a, *pb, pose_b * local_b, {}, &convex_cache);
+      const DistanceResult c =
+          distance(*pa, pose_a * local_a, *pb, pose_b * local_b, {}, &convex_cache);
       EXPECT_EQ(r.distance, c.distance);
       EXPECT_EQ(r.lower_bound, c.lower_bound);
       EXPECT_EQ(r.status, c.status);
@@ -181,7 +192,8 @@ TEST(Compound, RandomCompoundsAgreeWithTheTwin) {
     // Piece counts log-uniform in [1, 200]; the product kept moderate so the
     // twin stays fast.
     const int na = static_cast<int>(test::log_uniform(rng, 1.0, 200.5));
-    const int nb = std::max(1, std::min(static_cast<int>(test::log_uniform(rng, 1.0, 200.5)), 4000 / na));
+    const int nb =
+        std::max(1, std::min(static_cast<int>(test::log_uniform(rng, 1.0, 200.5)), 4000 / na));
     many_pieces += std::max(na, nb) >= 100;
     const double spread_a = test::log_uniform(rng, 0.2, 3.0 * std::cbrt(na));
     const double spread_b = test::log_uniform(rng, 0.2, 3.0 * std::cbrt(nb));
@@ -189,7 +201,8 @@ TEST(Compound, RandomCompoundsAgreeWithTheTwin) {
     const CompoundBody b = random_compound(rng, nb, spread_b);
     const Pose pose_a = random_pose(rng, 1.0);
     Pose pose_b = random_pose(rng, 1.0);
-    pose_b.translation += test::uniform(rng, 0.0, 2.0) * (a.bounding_radius() + b.bounding_radius()) *
+    pose_b.translation += test::uniform(rng, 0.0, 2.0) *
+                          (a.bounding_radius() + b.bounding_radius()) *
                           test::random_unit_vector(rng);
     CompoundResult twin = distance_all_pairs(a, pose_a, b, pose_b);
     // One case in three moved to near touching: the closest pair at a
@@ -198,7 +211,8 @@ TEST(Compound, RandomCompoundsAgreeWithTheTwin) {
       pose_b = closer_to(twin, pose_b, test::log_uniform(rng, 1e-9, 1e-3));
       twin = distance_all_pairs(a, pose_a, b, pose_b);
     }
-    SCOPED_TRACE("case " + std::to_string(k) + ": " + std::to_string(na) + " x " + std::to_string(nb) + " pieces");
+    SCOPED_TRACE("case " + std::to_string(k) + ": " + std::to_string(na) + " x " +
+                 std::to_string(nb) + " pieces");
     const CompoundResult r = distance(a, pose_a, b, pose_b);
     check_against_twin(a, pose_a, b, pose_b, r, twin);
     if (twin.status == Status::intersecting) {
@@ -209,8 +223,8 @@ TEST(Compound, RandomCompoundsAgreeWithTheTwin) {
       ++separated;
     }
   }
-  std::printf("[ compound ] intersecting %d, near touching %d, separated %d, >= 100 pieces %d\n", intersecting,
-              near_touching, separated, many_pieces);
+  std::printf("[ compound ] intersecting %d, near touching %d, separated %d, >= 100 pieces %d\n",
+              intersecting, near_touching, separated, many_pieces);
   EXPECT_GE(intersecting, count(120) / 10);
   EXPECT_GE(near_touching, count(120) / 10);
   EXPECT_GE(separated, count(120) / 10);
@@ -228,21 +242,26 @@ TEST(Compound, OverlappingPiecesWithinOneBody) {
     const Pose pose_a = random_pose(rng, 0.5);
     const Pose pose_b = random_pose(rng, test::uniform(rng, 0.5, 4.0));
     SCOPED_TRACE("case " + std::to_string(k));
-    check_against_twin(a, pose_a, b, pose_b, distance(a, pose_a, b, pose_b), distance_all_pairs(a, pose_a, b, pose_b));
+    check_against_twin(a, pose_a, b, pose_b, distance(a, pose_a, b, pose_b),
+                       distance_all_pairs(a, pose_a, b, pose_b));
   }
 }
 
 // Far from the origin, tiny and huge: the standard scales with R, and the
 // pruning's slack must scale with it too (a pruned pair must never hide a
-// closer one by more than 64 u R).
+// closer one by more than 64 u R). Scales stop at 1e150 and 1e-150: beyond
+// them the convex query itself fails (measured: FE_INVALID from about 1e155
+// on, its squares overflowing, and "touching at 0" for bodies a unit of
+// their size apart from about 1e-200 down, its squares underflowing).
 TEST(Compound, ScalesAndFarFromTheOrigin) {
   Rng rng(404);
   struct Setting {
     double size;
     double offset;
   };
-  for (const Setting s : {Setting{1.0, 1e6}, Setting{1e-20, 0.0}, Setting{1e20, 0.0}, Setting{1e-3, 1e6},
-                          Setting{1e-30, 1e-25}, Setting{1e30, 1e35}}) {
+  for (const Setting s :
+       {Setting{1.0, 1e6}, Setting{1e-20, 0.0}, Setting{1e20, 0.0}, Setting{1e-3, 1e6},
+        Setting{1e-30, 1e-25}, Setting{1e30, 1e35}, Setting{1e150, 0.0}, Setting{1e-150, 0.0}}) {
     SCOPED_TRACE("size " + std::to_string(s.size) + " offset " + std::to_string(s.offset));
     int near = 0;
     for (int k = 0; k < count(16); ++k) {
@@ -257,7 +276,8 @@ TEST(Compound, ScalesAndFarFromTheOrigin) {
       // Apart by about the bounding spheres: mostly separated, some
       // intersecting; half of the separated ones are then moved to near
       // touching.
-      pose_b.translation += far + test::uniform(rng, 0.5, 1.2) * (a.bounding_radius() + b.bounding_radius()) *
+      pose_b.translation += far + test::uniform(rng, 0.5, 1.2) *
+                                      (a.bounding_radius() + b.bounding_radius()) *
                                       test::random_unit_vector(rng);
       CompoundResult twin = distance_all_pairs(a, pose_a, b, pose_b);
       if (k % 2 == 0 && twin.status == Status::separated) {
@@ -284,7 +304,8 @@ TEST(Compound, TrackingAgreesWithColdAndTestsFewerPairs) {
     const CompoundBody b = random_compound(rng, test::uniform_int(rng, 20, 120), 6.0);
     Pose pose_a = random_pose(rng, 1.0);
     Pose pose_b = random_pose(rng, 1.0);
-    pose_b.translation += (a.bounding_radius() + b.bounding_radius()) * 0.9 * test::random_unit_vector(rng);
+    pose_b.translation +=
+        (a.bounding_radius() + b.bounding_radius()) * 0.9 * test::random_unit_vector(rng);
     CompoundCache cache;
     const Vec3 drift = 0.02 * test::random_unit_vector(rng);
     for (int step = 0; step < 30; ++step) {
@@ -297,14 +318,16 @@ TEST(Compound, TrackingAgreesWithColdAndTestsFewerPairs) {
       EXPECT_NEAR(warm.distance, cold.distance, tolerance(a, pose_a, b, pose_b, cold.distance));
       EXPECT_EQ(warm.status == Status::intersecting, cold.status == Status::intersecting);
       EXPECT_LE(cache.near.size(), 64u);
-      EXPECT_TRUE(std::is_sorted(cache.near.begin(), cache.near.end(), [](const auto& x, const auto& y) {
-        return std::pair(x.piece_a, x.piece_b) < std::pair(y.piece_a, y.piece_b);
-      }));
+      EXPECT_TRUE(
+          std::is_sorted(cache.near.begin(), cache.near.end(), [](const auto& x, const auto& y) {
+            return std::pair(x.piece_a, x.piece_b) < std::pair(y.piece_a, y.piece_b);
+          }));
       if (step > 0) {
         warm_pairs += warm.pairs_tested;
         cold_pairs += cold.pairs_tested;
       }
-      if (step % 10 == 0) check_against_twin(a, pose_a, b, pose_b, warm, distance_all_pairs(a, pose_a, b, pose_b));
+      if (step % 10 == 0)
+        check_against_twin(a, pose_a, b, pose_b, warm, distance_all_pairs(a, pose_a, b, pose_b));
     }
   }
   std::printf("[ compound ] tracked pairs tested %lld, cold %lld\n", warm_pairs, cold_pairs);
@@ -383,7 +406,8 @@ TEST(Compound, IntersectingBodiesStopEarly) {
     // The reported pair itself intersects.
     const CompoundPiece& pa = a.piece(r.piece_a);
     const CompoundPiece& pb = b.piece(r.piece_b);
-    EXPECT_EQ(distance(*pa.polytope, pose_a * pa.pose, *pb.polytope, pose_b * pb.pose).status, Status::intersecting);
+    EXPECT_EQ(distance(*pa.polytope, pose_a * pa.pose, *pb.polytope, pose_b * pb.pose).status,
+              Status::intersecting);
     EXPECT_LT(r.pairs_tested, a.piece_count() * b.piece_count());
   }
 }
@@ -397,8 +421,9 @@ TEST(Compound, PruningPrunes) {
     std::vector<CompoundPiece> pieces;
     for (int i = 0; i < 10; ++i) {
       for (int j = 0; j < 10; ++j) {
-        pieces.push_back({std::make_shared<const ConvexPolytope>(test::points_on_sphere(rng, 12, 0.4)),
-                          Pose::from_translation(Vec3(spacing * i, spacing * j, 0.0))});
+        pieces.push_back(
+            {std::make_shared<const ConvexPolytope>(test::points_on_sphere(rng, 12, 0.4)),
+             Pose::from_translation(Vec3(spacing * i, spacing * j, 0.0))});
       }
     }
     return CompoundBody(std::move(pieces));
@@ -413,7 +438,9 @@ TEST(Compound, PruningPrunes) {
     const CompoundResult r = distance(a, Pose::identity(), b, pose_b);
     worst = std::max(worst, r.pairs_tested);
     total += r.pairs_tested;
-    if (k < count(3)) check_against_twin(a, Pose::identity(), b, pose_b, r, distance_all_pairs(a, Pose::identity(), b, pose_b));
+    if (k < count(3))
+      check_against_twin(a, Pose::identity(), b, pose_b, r,
+                         distance_all_pairs(a, Pose::identity(), b, pose_b));
   }
   std::printf("[ compound ] pruning: pairs tested worst %d, mean %.1f of 10000\n", worst,
               static_cast<double>(total) / count(20));
@@ -422,60 +449,67 @@ TEST(Compound, PruningPrunes) {
 
 // Every vertex of every piece lies in its piece sphere and in the sphere of
 // each ancestor; leaves partition the pieces; piece_order is a permutation;
-// a binary tree over n single-piece leaves has 2n - 1 nodes.
+// a binary tree over n single-piece leaves has 2n - 1 nodes. Also at the
+// ends of the double range (the build scales its norms; the test divides by
+// the power-of-two scale, exactly, before squaring).
 TEST(Compound, HierarchyInvariants) {
   Rng rng(909);
-  for (const int n : {1, 2, 3, 7, 64, 200}) {
-    SCOPED_TRACE("pieces " + std::to_string(n));
-    const CompoundBody body = random_compound(rng, n, 5.0);
-    std::vector<int> seen(static_cast<std::size_t>(n), 0);
-    const auto order = body.piece_order();
-    ASSERT_EQ(order.size(), static_cast<std::size_t>(n));
-    for (const std::int32_t p : order) {
-      ASSERT_GE(p, 0);
-      ASSERT_LT(p, n);
-      ++seen[static_cast<std::size_t>(p)];
-    }
-    EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
-    EXPECT_EQ(body.nodes().size(), static_cast<std::size_t>(2 * n - 1));
-    std::vector<int> in_leaf(static_cast<std::size_t>(n), 0);
-    std::vector<std::int32_t> ancestors;
-    const auto visit = [&](auto&& self, std::int32_t id) -> void {
-      const CompoundBody::Node& node = body.nodes()[static_cast<std::size_t>(id)];
-      ancestors.push_back(id);
-      if (node.left < 0) {
-        EXPECT_GE(node.count, 1);
-        for (std::int32_t i = node.first; i < node.first + node.count; ++i) {
-          const std::int32_t p = order[static_cast<std::size_t>(i)];
-          ++in_leaf[static_cast<std::size_t>(p)];
-          const CompoundPiece& piece = body.piece(p);
-          const auto& sphere = body.piece_sphere(p);
-          for (const Vec3& v : piece.polytope->vertices()) {
-            const Vec3 placed = piece.pose.apply(v);
-            EXPECT_LE((placed - sphere.center).norm(), sphere.radius);
+  for (const double scale : {1.0, 0x1p-1000, 0x1p1000}) {
+    for (const int n : {1, 2, 3, 7, 64, 200}) {
+      SCOPED_TRACE("pieces " + std::to_string(n) + " scale 2^" + std::to_string(std::log2(scale)));
+      const CompoundBody body = random_compound(rng, n, 5.0 * scale, scale);
+      const auto dist = [scale](const Vec3& p, const Vec3& q) {
+        return (p / scale - q / scale).norm() * scale;
+      };
+      std::vector<int> seen(static_cast<std::size_t>(n), 0);
+      const auto order = body.piece_order();
+      ASSERT_EQ(order.size(), static_cast<std::size_t>(n));
+      for (const std::int32_t p : order) {
+        ASSERT_GE(p, 0);
+        ASSERT_LT(p, n);
+        ++seen[static_cast<std::size_t>(p)];
+      }
+      EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
+      EXPECT_EQ(body.nodes().size(), static_cast<std::size_t>(2 * n - 1));
+      std::vector<int> in_leaf(static_cast<std::size_t>(n), 0);
+      std::vector<std::int32_t> ancestors;
+      const auto visit = [&](auto&& self, std::int32_t id) -> void {
+        const CompoundBody::Node& node = body.nodes()[static_cast<std::size_t>(id)];
+        ancestors.push_back(id);
+        if (node.left < 0) {
+          EXPECT_GE(node.count, 1);
+          for (std::int32_t i = node.first; i < node.first + node.count; ++i) {
+            const std::int32_t p = order[static_cast<std::size_t>(i)];
+            ++in_leaf[static_cast<std::size_t>(p)];
+            const CompoundPiece& piece = body.piece(p);
+            const auto& sphere = body.piece_sphere(p);
+            for (const Vec3& v : piece.polytope->vertices()) {
+              const Vec3 placed = piece.pose.apply(v);
+              EXPECT_LE(dist(placed, sphere.center), sphere.radius);
+              for (const std::int32_t anc : ancestors) {
+                const CompoundBody::Node& up = body.nodes()[static_cast<std::size_t>(anc)];
+                EXPECT_LE(dist(placed, up.center), up.radius) << "node " << anc << " piece " << p;
+              }
+            }
+            // The piece sphere itself inside each ancestor (what the pruning uses).
             for (const std::int32_t anc : ancestors) {
               const CompoundBody::Node& up = body.nodes()[static_cast<std::size_t>(anc)];
-              EXPECT_LE((placed - up.center).norm(), up.radius) << "node " << anc << " piece " << p;
+              EXPECT_LE(dist(sphere.center, up.center) + sphere.radius, up.radius * (1 + 1e-15));
             }
           }
-          // The piece sphere itself inside each ancestor (what the pruning uses).
-          for (const std::int32_t anc : ancestors) {
-            const CompoundBody::Node& up = body.nodes()[static_cast<std::size_t>(anc)];
-            EXPECT_LE((sphere.center - up.center).norm() + sphere.radius, up.radius * (1 + 1e-15));
-          }
+        } else {
+          EXPECT_EQ(node.count, 0);
+          self(self, node.left);
+          self(self, node.right);
         }
-      } else {
-        EXPECT_EQ(node.count, 0);
-        self(self, node.left);
-        self(self, node.right);
-      }
-      ancestors.pop_back();
-    };
-    visit(visit, 0);
-    EXPECT_TRUE(std::all_of(in_leaf.begin(), in_leaf.end(), [](int c) { return c == 1; }));
-    EXPECT_EQ(body.center(), body.nodes()[0].center);
-    // scale() is the largest coordinate of a placed vertex.
-    EXPECT_EQ(body.scale(), world_magnitude(body, Pose::identity()));
+        ancestors.pop_back();
+      };
+      visit(visit, 0);
+      EXPECT_TRUE(std::all_of(in_leaf.begin(), in_leaf.end(), [](int c) { return c == 1; }));
+      EXPECT_EQ(body.center(), body.nodes()[0].center);
+      // scale() is the largest coordinate of a placed vertex.
+      EXPECT_EQ(body.scale(), world_magnitude(body, Pose::identity()));
+    }
   }
 }
 
@@ -488,7 +522,8 @@ TEST(Compound, MemoryCountsSharedPolytopesOnce) {
                             {shared, Pose::from_translation(Vec3(3, 0, 0))},
                             {other, Pose::from_translation(Vec3(6, 0, 0))}});
   EXPECT_GT(one.memory_bytes(), shared->memory_bytes());
-  EXPECT_LT(three.memory_bytes(), one.memory_bytes() + shared->memory_bytes() + other->memory_bytes() + 4096);
+  EXPECT_LT(three.memory_bytes(),
+            one.memory_bytes() + shared->memory_bytes() + other->memory_bytes() + 4096);
   EXPECT_GE(three.memory_bytes(), shared->memory_bytes() + other->memory_bytes());
 }
 
@@ -509,38 +544,54 @@ TEST(Compound, BadInputNamesThePiece) {
     pieces[static_cast<std::size_t>(bad)] = piece;
     return [pieces] { CompoundBody body(pieces); };
   };
-  EXPECT_NE(message_of([] { CompoundBody body(std::vector<CompoundPiece>{}); }).find("no pieces"), std::string::npos);
-  EXPECT_NE(message_of(body_with(2, {nullptr, Pose::identity()})).find("piece 2: null polytope"), std::string::npos);
+  EXPECT_NE(message_of([] { CompoundBody body(std::vector<CompoundPiece>{}); }).find("no pieces"),
+            std::string::npos);
+  EXPECT_NE(message_of(body_with(2, {nullptr, Pose::identity()})).find("piece 2: null polytope"),
+            std::string::npos);
   Pose nan_pose;
   nan_pose.translation.x() = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(message_of(body_with(3, {poly, nan_pose})).find("piece 3: pose is not finite"), std::string::npos);
+  EXPECT_NE(message_of(body_with(3, {poly, nan_pose})).find("piece 3: pose is not finite"),
+            std::string::npos);
   Pose inf_pose;
   inf_pose.rotation(1, 2) = std::numeric_limits<double>::infinity();
-  EXPECT_NE(message_of(body_with(0, {poly, inf_pose})).find("piece 0: pose is not finite"), std::string::npos);
+  EXPECT_NE(message_of(body_with(0, {poly, inf_pose})).find("piece 0: pose is not finite"),
+            std::string::npos);
   const Pose scaled_pose(Mat3(Mat3::Identity() * 1.001), Vec3::Zero());
-  EXPECT_NE(message_of(body_with(1, {poly, scaled_pose})).find("piece 1: pose rotation is not orthonormal"),
+  EXPECT_NE(message_of(body_with(1, {poly, scaled_pose}))
+                .find("piece 1: pose rotation is not orthonormal"),
             std::string::npos);
   const Pose mirror(Mat3(Eigen::Vector3d(1, 1, -1).asDiagonal()), Vec3::Zero());
-  EXPECT_NE(message_of(body_with(4, {poly, mirror})).find("piece 4: pose rotation is a reflection"), std::string::npos);
+  EXPECT_NE(message_of(body_with(4, {poly, mirror})).find("piece 4: pose rotation is a reflection"),
+            std::string::npos);
   const Pose overflow = Pose::from_translation(Vec3(1.7e308, 0, 0));
-  const auto huge = std::make_shared<const ConvexPolytope>(test::scaled(test::points_on_sphere(rng, 10), 1e308));
-  EXPECT_NE(message_of(body_with(1, {huge, overflow})).find("piece 1: placed vertex overflows"), std::string::npos);
+  const auto huge =
+      std::make_shared<const ConvexPolytope>(test::scaled(test::points_on_sphere(rng, 10), 1e308));
+  EXPECT_NE(message_of(body_with(1, {huge, overflow})).find("piece 1: placed vertex overflows"),
+            std::string::npos);
 
   std::vector<Points> sets = {test::cube(1.0), test::cube(2.0), Points{}, test::cube(3.0)};
-  EXPECT_NE(message_of([&] { CompoundBody::from_point_sets(sets); }).find("piece 2: "), std::string::npos);
+  EXPECT_NE(message_of([&] { CompoundBody::from_point_sets(sets); }).find("piece 2: "),
+            std::string::npos);
   sets[2] = {Vec3(0, 0, 0), Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0)};
-  EXPECT_NE(message_of([&] { CompoundBody::from_point_sets(sets); }).find("piece 2: "), std::string::npos);
+  EXPECT_NE(message_of([&] { CompoundBody::from_point_sets(sets); }).find("piece 2: "),
+            std::string::npos);
 
-  const CompoundBody good = CompoundBody::from_point_sets(std::vector<Points>{test::cube(1.0), test::cube(2.0)});
+  const CompoundBody good =
+      CompoundBody::from_point_sets(std::vector<Points>{test::cube(1.0), test::cube(2.0)});
   EXPECT_EQ(good.piece_count(), 2);
-  EXPECT_NE(message_of([&] { distance(good, nan_pose, good, Pose::identity()); }).find("pose_a"), std::string::npos);
-  EXPECT_NE(message_of([&] { distance(good, Pose::identity(), good, inf_pose); }).find("pose_b"), std::string::npos);
-  EXPECT_NE(message_of([&] { distance_all_pairs(good, nan_pose, good, Pose::identity()); }).find("pose_a"),
+  EXPECT_NE(message_of([&] { distance(good, nan_pose, good, Pose::identity()); }).find("pose_a"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] { distance(good, Pose::identity(), good, inf_pose); }).find("pose_b"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] {
+              distance_all_pairs(good, nan_pose, good, Pose::identity());
+            }).find("pose_a"),
             std::string::npos);
   DistanceOptions bad_options;
   bad_options.max_iterations = 0;
-  EXPECT_NE(message_of([&] { distance(good, Pose::identity(), good, Pose::identity(), bad_options); })
-                .find("max_iterations"),
+  EXPECT_NE(message_of([&] {
+              distance(good, Pose::identity(), good, Pose::identity(), bad_options);
+            }).find("max_iterations"),
             std::string::npos);
 }
 
