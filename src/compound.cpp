@@ -10,11 +10,13 @@
 // body's pose; a box in the body's frame would have to be re-fitted (or
 // tested as an oriented box) for every pose. bench/compound_bench.cpp holds
 // the measured comparison (BM_Cold against BM_ColdBoxes, the same cold
-// branch and bound on boxes re-fitted by |R| h): on round pieces spheres
-// tested half the pairs and ran 1.2-1.4 times faster at 50 and 200 pieces
-// a body; on long thin pieces (aspect 8) both ran within 5% at 50 and 200
-// pieces, spheres testing fewer pairs at 200, and boxes were 1.25 times
-// faster at 10 pieces.
+// branch and bound on boxes re-fitted by |R| h; medians of 3 repetitions on
+// 2 cores at load 5-6, CPU time per query, spheres / boxes):
+//   round pieces, 10 / 50 / 200 a body:  1.43 / 1.26, 5.70 / 6.83, 8.32 / 13.3 us
+//   long pieces (aspect 8):               2.63 / 3.02, 4.92 / 5.81, 10.9 / 12.8 us
+// Spheres tested fewer pairs in every case but long pieces at 10 (5.2 against
+// 4.6) and won from 50 pieces on; an earlier run had boxes ahead at 10 long
+// pieces (2.0 against 2.6 us), so at 10 pieces the two are within noise.
 //
 // Soundness of the pruning. A node pair is skipped only when its computed
 // lower bound, minus a slack for the rounding of that bound, exceeds the best
