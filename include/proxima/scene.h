@@ -57,6 +57,8 @@ struct SceneOptions {
   // pairs included). Must be finite and >= 0.
   double margin = 0.0;
   DistanceOptions distance;
+  // The tree by default: broad_phase_bench measured it 2.5 to 4.5 times
+  // faster than sweep and prune (one sorted axis) at 1,000 and 10,000 bodies.
   BroadPhase broad_phase = BroadPhase::dynamic_aabb_tree;
   // Narrow-phase threads: 1 runs in the caller's thread, 0 in the caller's
   // TBB arena, n > 1 in a dedicated arena (as distance_batch).
