@@ -76,6 +76,7 @@ struct Options {
   std::uint64_t seed = 1;
   double fcl_budget_seconds = kDefaultFclBudgetSeconds;
   FclSolver fcl_solver = FclSolver::libccd;
+  FclBoxes fcl_boxes = FclBoxes::fcl;
   std::string out_dir = "out";
 };
 
@@ -211,7 +212,8 @@ SizeResult run_size(int n, const Options& options) {
   std::vector<BodyId> ids;
   ids.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) ids.push_back(scene.add(scenario.body_shape(i), poses[static_cast<std::size_t>(i)]));
-  FclScene fcl(scenario.shapes(), scenario.shape_of(), poses, kMargin, options.fcl_solver);
+  FclScene fcl(scenario.shapes(), scenario.shape_of(), poses, kMargin, options.fcl_solver,
+               options.fcl_boxes);
 
   SizeResult r;
   r.bodies = n;
@@ -277,19 +279,21 @@ void print_size(const SizeResult& r, const Options& options) {
   std::cout << "\nN = " << r.bodies << " bodies, cube " << fixed(r.cube_size, 1) << ", margin "
             << kMargin << ", " << r.steps << " steps (setup " << fixed(r.setup_seconds, 1)
             << " s)\n";
-  std::cout << "  system                         steps   median ms    p90 ms   mean ms"
+  std::cout << "  system                               steps   median ms    p90 ms   mean ms"
                "   candidates/step   close/step   intersecting/step\n";
   auto row = [](const char* name, const Series& s) {
     char line[256];
-    std::snprintf(line, sizeof(line), "  %-30s %5zu %11.3f %9.3f %9.3f %17.1f %12.1f %19.1f\n",
+    std::snprintf(line, sizeof(line), "  %-36s %5zu %11.3f %9.3f %9.3f %17.1f %12.1f %19.1f\n",
                   name, s.ms.size(), quantile(s.ms, 0.5), quantile(s.ms, 0.9), mean(s.ms),
                   mean(s.candidates), mean(s.close), mean(s.intersecting));
     std::cout << line;
   };
   row("proxima Scene (1 thread)", r.proxima);
-  row(options.fcl_solver == FclSolver::libccd ? "FCL DynamicAABBTree + libccd"
-                                              : "FCL DynamicAABBTree + GJK",
-      r.fcl);
+  const std::string fcl_name =
+      std::string("FCL DynamicAABBTree + ") +
+      (options.fcl_solver == FclSolver::libccd ? "libccd" : "GJK") +
+      (options.fcl_boxes == FclBoxes::tight ? " (tight)" : "");
+  row(fcl_name.c_str(), r.fcl);
   if (common_steps < r.proxima.ms.size()) {
     std::cout << "  FCL ran the first " << common_steps << " of " << r.steps
               << " steps (its time budget, --fcl-budget " << fixed(options.fcl_budget_seconds, 0)
@@ -353,7 +357,7 @@ bool write_csv(const std::vector<SizeResult>& results, const Options& options) {
               << r.total.mismatches() << '\n';
     };
     row("proxima", r.proxima);
-    row("fcl", r.fcl);
+    row(options.fcl_boxes == FclBoxes::tight ? "fcl_tight_boxes" : "fcl", r.fcl);
     for (std::size_t k = 0; k < r.proxima.ms.size(); ++k) {
       steps << r.bodies << ',' << k << ',' << r.proxima.ms[k] << ',';
       if (k < common) steps << r.fcl.ms[k];
@@ -371,11 +375,14 @@ bool write_csv(const std::vector<SizeResult>& results, const Options& options) {
 
 void usage(std::ostream& out) {
   out << "usage: scene_bench [--bodies N[,N...]]... [--steps S] [--quick] [--seed K]\n"
-         "                   [--fcl-budget SECONDS] [--fcl-solver libccd|gjk] [--out DIR]\n"
+         "                   [--fcl-budget SECONDS] [--fcl-solver libccd|gjk]\n"
+         "                   [--fcl-boxes fcl|tight] [--out DIR]\n"
          "  --bodies      scene sizes, repeatable or comma-separated (default 1000,10000)\n"
          "  --steps       steps per size (default 1000; --quick: 50)\n"
          "  --fcl-budget  FCL stops after this much CPU time per size (default 240)\n"
          "  --fcl-solver  FCL's GJK solver in the callback (default libccd, its faster one)\n"
+         "  --fcl-boxes   FCL's world boxes: fcl (computeAABB, default) or tight (the hull's\n"
+         "                transformed vertices; shows how much FCL's loose boxes cost it)\n"
          "  --out         directory of the CSV files (default out; \"\" writes none)\n"
          "example: scene_bench --bodies 1000 --steps 200\n";
 }
@@ -442,6 +449,15 @@ bool parse(int argc, char** argv, Options& o) {
         o.fcl_solver = FclSolver::indep;
       } else {
         std::cerr << "scene_bench: --fcl-solver is libccd or gjk, got '" << v << "'\n";
+        return false;
+      }
+    } else if (arg == "--fcl-boxes" && value(v)) {
+      if (v == "fcl") {
+        o.fcl_boxes = FclBoxes::fcl;
+      } else if (v == "tight") {
+        o.fcl_boxes = FclBoxes::tight;
+      } else {
+        std::cerr << "scene_bench: --fcl-boxes is fcl or tight, got '" << v << "'\n";
         return false;
       }
     } else if (arg == "--out" && value(v)) {

@@ -23,7 +23,9 @@
 // - FCL's boxes: CollisionObject::computeAABB boxes a rotated object by the
 //   bounding sphere of its local box (centre plus or minus the local box's
 //   half diagonal in every axis), looser than the object's own box; that is
-//   what FCL users get and it adds candidate pairs, counted as such.
+//   what FCL users get and it adds candidate pairs, counted as such. The
+//   FclBoxes::tight variant replaces it by the tight box of the transformed
+//   vertices, to show how much of the difference the loose box makes.
 // - The solver: GST_LIBCCD by default. In `proxima paper`'s cold queries
 //   (bench/results/cpp-2core/cold.csv) it is FCL's faster solver from 16 to
 //   4096 vertices (2.6 us against 3.6 us for GST_INDEP at 32 vertices, 5.2
@@ -40,12 +42,14 @@
 //   flags included, afterwards (as paper.cpp does for every peer): once per
 //   step, not per pair.
 // - set_poses() is setTransform plus computeAABB (setTransform alone does
-//   not move the object's box) for every object; step() is update()
-//   (refits the tree to the new boxes and rebalances it) and distance().
+//   not move the object's box; FclBoxes::tight: fcl::computeBV of the
+//   Convex instead) for every object; step() is update() (refits the tree
+//   to the new boxes and rebalances it) and distance().
 #include "peers/fcl_scene.h"
 
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/shape/convex.h>
+#include <fcl/geometry/shape/utility.h>
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
 
@@ -87,6 +91,17 @@ fcl::Transform3d to_fcl(const Pose& pose) {
   tf.translation() = pose.translation;
   return tf;
 }
+
+// A CollisionObject whose world box can be set to the tight box of its
+// transformed vertices (FclBoxes::tight): FCL keeps the box in a protected
+// member and offers no setter.
+class FclObject : public fcl::CollisionObjectd {
+ public:
+  using fcl::CollisionObjectd::CollisionObjectd;
+  void compute_tight_aabb(const fcl::Convexd& convex) {
+    fcl::computeBV(convex, getTransform(), aabb);
+  }
+};
 
 // What the callback needs: the request, the margin, where the pairs go.
 struct CallbackData {
@@ -154,12 +169,22 @@ bool close_pair_callback(fcl::CollisionObjectd* o1, fcl::CollisionObjectd* o2, v
 struct FclScene::Impl {
   double margin = 0.0;
   FclSolver solver = FclSolver::libccd;
+  FclBoxes boxes = FclBoxes::fcl;
   std::vector<std::shared_ptr<fcl::Convexd>> convexes;
+  std::vector<int> shape_of;
   std::vector<int> ids;  // user data of object i points at ids[i] == i
-  std::vector<std::unique_ptr<fcl::CollisionObjectd>> objects;
+  std::vector<std::unique_ptr<FclObject>> objects;
   fcl::DynamicAABBTreeCollisionManagerd manager;
   std::vector<FclClosePair> pairs;
   FclSceneStats stats;
+
+  void compute_box(std::size_t i) {
+    if (boxes == FclBoxes::tight) {
+      objects[i]->compute_tight_aabb(*convexes[static_cast<std::size_t>(shape_of[i])]);
+    } else {
+      objects[i]->computeAABB();
+    }
+  }
 
   fcl::DistanceRequestd request() const {
     fcl::DistanceRequestd r;
@@ -171,7 +196,7 @@ struct FclScene::Impl {
 
 FclScene::FclScene(std::span<const std::shared_ptr<const ConvexPolytope>> shapes,
                    std::span<const int> shape_of, std::span<const Pose> poses, double margin,
-                   FclSolver solver)
+                   FclSolver solver, FclBoxes boxes)
     : impl_(std::make_unique<Impl>()) {
   if (!std::isfinite(margin) || margin < 0.0) {
     throw InvalidInput("FclScene: margin must be finite and >= 0");
@@ -183,6 +208,7 @@ FclScene::FclScene(std::span<const std::shared_ptr<const ConvexPolytope>> shapes
   Impl& s = *impl_;
   s.margin = margin;
   s.solver = solver;
+  s.boxes = boxes;
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     if (!shapes[k]) throw InvalidInput("FclScene: shape " + std::to_string(k) + " is null");
     s.convexes.push_back(make_convex(*shapes[k], k));
@@ -202,12 +228,13 @@ FclScene::FclScene(std::span<const std::shared_ptr<const ConvexPolytope>> shapes
       throw InvalidInput("FclScene: pose of body " + std::to_string(i) + " is not finite");
     }
     s.ids[i] = static_cast<int>(i);
-    auto object = std::make_unique<fcl::CollisionObjectd>(s.convexes[static_cast<std::size_t>(k)],
-                                                          to_fcl(poses[i]));
-    object->computeAABB();
+    s.shape_of.push_back(k);
+    auto object =
+        std::make_unique<FclObject>(s.convexes[static_cast<std::size_t>(k)], to_fcl(poses[i]));
     object->setUserData(&s.ids[i]);
     raw.push_back(object.get());
     s.objects.push_back(std::move(object));
+    s.compute_box(i);
   }
   const FclFloatingPoint fp;
   s.manager.registerObjects(raw);
@@ -232,7 +259,7 @@ void FclScene::set_poses(std::span<const Pose> poses) {
       throw InvalidInput("FclScene: pose of body " + std::to_string(i) + " is not finite");
     }
     s.objects[i]->setTransform(to_fcl(poses[i]));
-    s.objects[i]->computeAABB();
+    s.compute_box(i);
   }
 }
 

@@ -37,6 +37,18 @@
 
 namespace proxima::bench {
 
+// How each object's world box is computed every step.
+enum class FclBoxes {
+  // CollisionObject::computeAABB, what FCL users get: for a rotated object,
+  // the bounding sphere of its local box (centre +- the local box's half
+  // diagonal), up to sqrt(3) times wider than the body.
+  fcl,
+  // The tight box of the transformed hull vertices (fcl::computeBV), set
+  // through a CollisionObject subclass: not something FCL's API offers for
+  // a CollisionObject, but it shows how much of the difference is the box.
+  tight,
+};
+
 // One pair of bodies within the margin, as FCL reports it.
 struct FclClosePair {
   int a = -1;  // body indices, a < b
@@ -64,7 +76,7 @@ class FclScene {
   // needs dimension 3).
   FclScene(std::span<const std::shared_ptr<const ConvexPolytope>> shapes,
            std::span<const int> shape_of, std::span<const Pose> poses, double margin,
-           FclSolver solver = FclSolver::libccd);
+           FclSolver solver = FclSolver::libccd, FclBoxes boxes = FclBoxes::fcl);
   ~FclScene();
   FclScene(const FclScene&) = delete;
   FclScene& operator=(const FclScene&) = delete;
@@ -72,7 +84,8 @@ class FclScene {
   int body_count() const;
   double margin() const;
 
-  // Moves every body: setTransform and computeAABB on each object. Throws
+  // Moves every body: setTransform and the box (computeAABB, or the tight
+  // box) on each object. Throws
   // InvalidInput when the count differs from body_count().
   void set_poses(std::span<const Pose> poses);
   // manager.update() and manager.distance(): the close pairs in the order
