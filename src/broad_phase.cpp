@@ -222,10 +222,20 @@ constexpr double kFatFraction = 0.25;
 Aabb merged(const Aabb& a, const Aabb& b) { return {a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; }
 
 // Half the surface area: the insertion cost of the surface-area heuristic
-// (the chance that a random ray or box hits the node grows with it).
-double half_area(const Aabb& b) {
+// (the chance that a random ray or box hits the node grows with it). The
+// half perimeter (Box2D v3's choice) cannot overflow, but made the tree's
+// steps slower at 1,000 bodies in broad_phase_bench (450 against 270 us);
+// the products overflow to inf only in scenes spanning more than ~1e154, and
+// growth() below keeps inf - inf from becoming NaN there.
+double cost_of(const Aabb& b) {
   const Vec3 e = b.hi - b.lo;
   return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+}
+
+// after - before for costs after >= before; 0 when both are infinite
+// (overflowed areas), where the difference would be NaN.
+double growth(double after, double before) {
+  return std::isinf(after) && std::isinf(before) ? 0.0 : after - before;
 }
 
 bool contains(const Aabb& outer, const Aabb& inner) {
@@ -388,13 +398,13 @@ class AabbTree final : public PairFinder {
     std::int32_t sibling = root_;
     while (!at(sibling).leaf()) {
       const Node& node = at(sibling);
-      const double combined = half_area(merged(node.box, box));
+      const double combined = cost_of(merged(node.box, box));
       const double here = 2.0 * combined;
-      const double inherited = 2.0 * (combined - half_area(node.box));
+      const double inherited = 2.0 * growth(combined, cost_of(node.box));
       const auto descend_cost = [&](std::int32_t child) {
         const Node& c = at(child);
-        const double with_leaf = half_area(merged(c.box, box));
-        return (c.leaf() ? with_leaf : with_leaf - half_area(c.box)) + inherited;
+        const double with_leaf = cost_of(merged(c.box, box));
+        return (c.leaf() ? with_leaf : growth(with_leaf, cost_of(c.box))) + inherited;
       };
       const double cost_left = descend_cost(node.left);
       const double cost_right = descend_cost(node.right);

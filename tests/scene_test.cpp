@@ -354,6 +354,35 @@ TEST(Scene, TouchingIntersectingAndMarginPairsByHand) {
   }
 }
 
+TEST(Scene, ScenesSpanningMoreThanTheSquareRootOfTheDoubleRange) {
+  // Regression: the tree's insertion cost was a box area; for bodies at
+  // -1e160 and +1e160 the areas of the merged boxes overflowed to inf, and
+  // inf - inf made NaN (a crash under the traps). Far out, the contact band
+  // 64 u R is wide: cubes 4 apart at 1e160 are touching, and step() must say
+  // what the twin says.
+  const auto cube = std::make_shared<const ConvexPolytope>(test::cube(2.0));
+  for (const double far : {1e100, 1e160, 1e200, 1e300}) {
+    for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
+      SceneOptions options;
+      options.broad_phase = bp;
+      Scene scene(options);
+      for (int i = 0; i < 6; ++i) {
+        scene.add(cube, Pose::from_translation(Vec3(i % 2 == 0 ? -far : far, far, 3.0 * i)));
+      }
+      const std::span<const ClosePair> pairs = scene.step();
+      const std::vector<ClosePair> twin = scene.close_pairs_all_pairs();
+      ASSERT_EQ(pairs.size(), twin.size()) << far << " " << to_string(bp);
+      for (std::size_t k = 0; k < pairs.size(); ++k) {
+        EXPECT_EQ(pairs[k].a, twin[k].a);
+        EXPECT_EQ(pairs[k].b, twin[k].b);
+        EXPECT_EQ(pairs[k].result.status, twin[k].result.status);
+      }
+      // Each side's three cubes touch each other at that magnitude.
+      EXPECT_EQ(pairs.size(), 6u) << far << " " << to_string(bp);
+    }
+  }
+}
+
 TEST(Scene, RemovedIdsAreReusedWithFreshCaches) {
   Rng rng(5);
   SceneOptions options;
