@@ -9,15 +9,15 @@
 // stream so that it never mixes with them.
 #include "scene_demo.h"
 
-#include "paper/scene_scenario.h"
-#include "proxima/scene.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "paper/scene_scenario.h"
+#include "proxima/scene.h"
 
 namespace proxima::cli {
 namespace {
@@ -77,8 +77,8 @@ int run_scene_demo(const SceneDemoOptions& options, std::ostream& out, std::ostr
 
   const int every = options.every > 0 ? options.every : std::max(1, options.steps / kDefaultRows);
   out << "proxima scene-demo: " << options.bodies << " bodies (random convex polytopes of "
-      << so.min_points << "-" << so.max_points << " points, radius " << bench::kBodyRadius
-      << ", " << so.shape_pool << " distinct hulls), cube " << format("%.1f", scenario.cube_size())
+      << so.min_points << "-" << so.max_points << " points, radius " << bench::kBodyRadius << ", "
+      << so.shape_pool << " distinct hulls), cube " << format("%.1f", scenario.cube_size())
       << ", margin " << options.margin << ", " << options.steps << " steps, seed " << options.seed
       << ", threads " << options.threads << "\n";
   out << "  step  candidates  close  intersecting  queries  ms\n";

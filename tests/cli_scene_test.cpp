@@ -6,10 +6,6 @@
 // of the same seeded scene run in-process through proxima::Scene and its
 // all-pairs twin; bad options exit 2, bad values 1.
 #include <gtest/gtest.h>
-
-#include "paper/scene_scenario.h"
-#include "proxima/scene.h"
-
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -19,6 +15,9 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "paper/scene_scenario.h"
+#include "proxima/scene.h"
 
 namespace {
 
@@ -42,7 +41,8 @@ struct CliRun {
 // standard output when `with_stderr`.
 CliRun run_cli(const std::string& args, bool with_stderr = false) {
   CliRun run;
-  const std::string command = std::string("'") + kCliPath + "' " + args + (with_stderr ? " 2>&1" : "");
+  const std::string command =
+      std::string("'") + kCliPath + "' " + args + (with_stderr ? " 2>&1" : "");
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) {
     ADD_FAILURE() << "popen failed: " << command;
@@ -50,7 +50,8 @@ CliRun run_cli(const std::string& args, bool with_stderr = false) {
   }
   std::array<char, 4096> buffer;
   std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.out.append(buffer.data(), n);
   const int status = pclose(pipe);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return run;
@@ -110,15 +111,17 @@ std::map<int, std::array<int, 2>> library_counts(int bodies, int steps, double m
   proxima::Scene scene(options);
   std::vector<proxima::Pose> poses = scenario.step(0);
   std::vector<proxima::BodyId> ids;
-  for (int i = 0; i < bodies; ++i) ids.push_back(scene.add(scenario.body_shape(i), poses[static_cast<std::size_t>(i)]));
+  for (int i = 0; i < bodies; ++i)
+    ids.push_back(scene.add(scenario.body_shape(i), poses[static_cast<std::size_t>(i)]));
   std::map<int, std::array<int, 2>> counts;
   for (int k = 0; k < steps; ++k) {
     scenario.step(k, poses);
     for (std::size_t i = 0; i < ids.size(); ++i) scene.set_pose(ids[i], poses[i]);
     const auto pairs = scene.step();
-    const auto intersecting = std::count_if(pairs.begin(), pairs.end(), [](const proxima::ClosePair& p) {
-      return p.result.status == proxima::Status::intersecting;
-    });
+    const auto intersecting =
+        std::count_if(pairs.begin(), pairs.end(), [](const proxima::ClosePair& p) {
+          return p.result.status == proxima::Status::intersecting;
+        });
     counts[k] = {static_cast<int>(pairs.size()), static_cast<int>(intersecting)};
   }
   return counts;
@@ -148,7 +151,9 @@ TEST(CliSceneDemo, RowsParseAndMatchTheLibrary) {
   EXPECT_GT(close_seen, 0);  // the scene is dense enough to have close pairs
   double median = -1;
   double p90 = -1;
-  ASSERT_EQ(std::sscanf(d.summary.c_str(), "summary: 13 steps, median %lf ms/step, p90 %lf", &median, &p90), 2)
+  ASSERT_EQ(std::sscanf(d.summary.c_str(), "summary: 13 steps, median %lf ms/step, p90 %lf",
+                        &median, &p90),
+            2)
       << d.summary;
   EXPECT_GE(median, 0.0);
   EXPECT_GE(p90, median);
@@ -174,7 +179,8 @@ TEST(CliSceneDemo, TwoThreadsSameCounts) {
 TEST(CliSceneDemo, BadValuesExitOneUsageErrorsExitTwo) {
   REQUIRE_CLI();
   for (const char* margin : {"-0.5", "nan", "inf"}) {
-    const CliRun run = run_cli(std::string("scene-demo --bodies 10 --steps 2 --margin ") + margin, true);
+    const CliRun run =
+        run_cli(std::string("scene-demo --bodies 10 --steps 2 --margin ") + margin, true);
     EXPECT_EQ(run.exit_code, 1) << margin << ": " << run.out;
     EXPECT_NE(run.out.find("--margin"), std::string::npos) << run.out;
   }

@@ -6,16 +6,17 @@
 // inside its cube, at the density asked for, at the speeds asked for) and
 // FCL's broad-phase scene (its close pairs equal those of its own all-pairs
 // twin and those of proxima's distance query run on every pair).
-#include <gtest/gtest.h>
-
 #include "paper/scene_scenario.h"
-#include "peers/fcl_scene.h"
-#include "proxima/distance.h"
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
+
+#include "peers/fcl_scene.h"
+#include "proxima/distance.h"
 
 namespace {
 
@@ -114,13 +115,13 @@ TEST(SceneScenario, BodiesStayInTheCubeAtTheirSpeeds) {
       const double moved = (t - previous[i].translation).norm();
       ASSERT_LE(moved, o.max_speed * (1 + 1e-9));
       fastest = std::max(fastest, moved);
-      const double turned = Eigen::AngleAxisd(current[i].rotation *
-                                              previous[i].rotation.transpose())
-                                .angle();
+      const double turned =
+          Eigen::AngleAxisd(current[i].rotation * previous[i].rotation.transpose()).angle();
       ASSERT_LE(turned, o.max_angular_speed * (1 + 1e-6) + 1e-12);
-      ASSERT_NEAR((current[i].rotation.transpose() * current[i].rotation - proxima::Mat3::Identity())
-                      .norm(),
-                  0.0, 1e-12);
+      ASSERT_NEAR(
+          (current[i].rotation.transpose() * current[i].rotation - proxima::Mat3::Identity())
+              .norm(),
+          0.0, 1e-12);
     }
     std::swap(previous, current);
   }
@@ -252,8 +253,7 @@ TEST(FclScene, ClosePairsEqualAllPairsTwinAndProximaDistance) {
 
     // Against proxima: FCL stops at its absolute distance_tolerance 1e-6.
     const auto reference = proxima_all_pairs(s, poses, o.margin);
-    const auto diff =
-        proxima::bench::compare_close_pairs(pairs, reference, o.margin, 1e-6, 1e-6);
+    const auto diff = proxima::bench::compare_close_pairs(pairs, reference, o.margin, 1e-6, 1e-6);
     EXPECT_EQ(diff.mismatches(), 0) << "step " << k << ": only FCL " << diff.only_fcl
                                     << ", only proxima " << diff.only_reference << ", boundary "
                                     << diff.boundary << ", distances " << diff.distance_mismatches;

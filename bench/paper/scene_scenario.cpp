@@ -135,8 +135,8 @@ SceneScenario::SceneScenario(const SceneScenarioOptions& options) : options_(opt
   for (int i = 0; i < options_.bodies; ++i) {
     shape_of_.push_back(uniform_int(rng, 0, options_.shape_pool - 1));
     Body b;
-    b.start_position = Vec3(uniform(rng, 0, cube_size_), uniform(rng, 0, cube_size_),
-                            uniform(rng, 0, cube_size_));
+    b.start_position =
+        Vec3(uniform(rng, 0, cube_size_), uniform(rng, 0, cube_size_), uniform(rng, 0, cube_size_));
     b.start_rotation = random_rotation(rng);
     b.velocity = uniform(rng, 0, options_.max_speed) * random_unit_vector(rng);
     b.rotation_axis = random_unit_vector(rng);

@@ -67,9 +67,8 @@ namespace {
 // [n, i0, ..., i(n-1), n, ...]), the same conversion as fcl_peer.cpp.
 std::shared_ptr<fcl::Convexd> make_convex(const ConvexPolytope& p, std::size_t shape) {
   if (p.dimension() != 3) {
-    throw InvalidInput("FclScene: shape " + std::to_string(shape) +
-                       " is not solid (dimension " + std::to_string(p.dimension()) +
-                       "); fcl::Convex needs dimension 3");
+    throw InvalidInput("FclScene: shape " + std::to_string(shape) + " is not solid (dimension " +
+                       std::to_string(p.dimension()) + "); fcl::Convex needs dimension 3");
   }
   auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
   vertices->reserve(static_cast<std::size_t>(p.vertex_count()));
@@ -129,7 +128,9 @@ class FclFloatingPoint {
   std::fenv_t saved_{};
 };
 
-int body_index(const fcl::CollisionObjectd* o) { return *static_cast<const int*>(o->getUserData()); }
+int body_index(const fcl::CollisionObjectd* o) {
+  return *static_cast<const int*>(o->getUserData());
+}
 
 // One fcl::distance between two objects into a fresh result
 // (DistanceResult::update keeps the minimum over calls). Returns whether
@@ -309,15 +310,17 @@ PairSetDifference compare_close_pairs(std::span<const FclClosePair> fcl,
                                       double relative_tolerance, double absolute_tolerance,
                                       std::vector<std::array<int, 2>>* mismatched) {
   auto tolerance = [&](double d) { return relative_tolerance * d + absolute_tolerance; };
-  auto near_margin = [&](double d) { return std::abs(std::max(d, 0.0) - margin) <= tolerance(margin); };
+  auto near_margin = [&](double d) {
+    return std::abs(std::max(d, 0.0) - margin) <= tolerance(margin);
+  };
   PairSetDifference diff;
   std::size_t i = 0;
   std::size_t j = 0;
   while (i < fcl.size() || j < reference.size()) {
     const bool take_fcl =
         j == reference.size() ||
-        (i < fcl.size() && (fcl[i].a != reference[j].a ? fcl[i].a < reference[j].a
-                                                       : fcl[i].b < reference[j].b));
+        (i < fcl.size() &&
+         (fcl[i].a != reference[j].a ? fcl[i].a < reference[j].a : fcl[i].b < reference[j].b));
     const bool same = i < fcl.size() && j < reference.size() && fcl[i].a == reference[j].a &&
                       fcl[i].b == reference[j].b;
     if (same) {

@@ -126,10 +126,10 @@ struct PairSetDifference {
   int common = 0;
   int only_fcl = 0;
   int only_reference = 0;
-  int boundary = 0;               // of only_fcl + only_reference, within tolerance of the margin
-  int distance_mismatches = 0;    // common pairs whose distances disagree
-  double worst_absolute = 0.0;    // largest |max(fcl, 0) - reference| over common pairs
-  double worst_relative = 0.0;    // largest of those divided by the reference distance (> 0 only)
+  int boundary = 0;             // of only_fcl + only_reference, within tolerance of the margin
+  int distance_mismatches = 0;  // common pairs whose distances disagree
+  double worst_absolute = 0.0;  // largest |max(fcl, 0) - reference| over common pairs
+  double worst_relative = 0.0;  // largest of those divided by the reference distance (> 0 only)
   int mismatches() const { return only_fcl + only_reference - boundary + distance_mismatches; }
 };
 
