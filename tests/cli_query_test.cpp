@@ -10,18 +10,15 @@
 
 #include "proxima/distance.h"
 #include "proxima/polytope.h"
+#include "support/run_cli.h"
 
 #include <Eigen/Geometry>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <random>
 #include <sstream>
@@ -33,70 +30,14 @@ namespace {
 using Json = nlohmann::json;
 using proxima::kUnitRoundoff;
 using proxima::Vec3;
+using proxima::test::CliRun;
+using proxima::test::run_cli;
+using proxima::test::shell_quote;
+using proxima::test::TempFile;
 
 // DESIGN.md's accuracy standard for a distance d among coordinates of
 // magnitude up to R: |distance - d*| <= 1e-12 d* + 64 u R.
 double accuracy_bound(double d, double r) { return 1e-12 * d + 64.0 * kUnitRoundoff * r; }
-
-#ifdef PROXIMA_CLI_PATH
-const char* const kCliPath = PROXIMA_CLI_PATH;
-#else
-const char* const kCliPath = nullptr;
-#endif
-
-#define REQUIRE_CLI()                                                 \
-  do {                                                                \
-    if (kCliPath == nullptr) GTEST_SKIP() << "built without the CLI"; \
-  } while (false)
-
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-// A file in the temp directory, removed when the test is done with it.
-class TempFile {
- public:
-  explicit TempFile(const std::string& contents) {
-    static int counter = 0;
-    path_ =
-        (std::filesystem::temp_directory_path() / ("proxima_cli_test_" + std::to_string(getpid()) +
-                                                   "_" + std::to_string(counter++) + ".jsonl"))
-            .string();
-    std::ofstream(path_, std::ios::binary) << contents;
-  }
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile() { std::filesystem::remove(path_); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out;  // standard output; standard error goes to the test log
-};
-
-// Runs `proxima <args>` through the shell (so args may redirect stdin).
-CliRun run_cli(const std::string& args) {
-  CliRun run;
-  const std::string command = shell_quote(kCliPath) + " " + args;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    ADD_FAILURE() << "popen failed: " << command;
-    return run;
-  }
-  std::array<char, 4096> buffer;
-  std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
 
 // The number literals of one JSON line, outside strings, as written.
 std::vector<std::string> number_tokens(const std::string& line) {

@@ -6,11 +6,9 @@
 // of the same seeded scene run in-process through proxima::Scene and its
 // all-pairs twin; bad options exit 2, bad values 1.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
-#include <cstdio>
 #include <map>
 #include <sstream>
 #include <string>
@@ -18,44 +16,12 @@
 
 #include "paper/scene_scenario.h"
 #include "proxima/scene.h"
+#include "support/run_cli.h"
 
 namespace {
 
-#ifdef PROXIMA_CLI_PATH
-const char* const kCliPath = PROXIMA_CLI_PATH;
-#else
-const char* const kCliPath = nullptr;
-#endif
-
-#define REQUIRE_CLI()                                                 \
-  do {                                                                \
-    if (kCliPath == nullptr) GTEST_SKIP() << "built without the CLI"; \
-  } while (false)
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-};
-
-// Runs `proxima <args>` through the shell; standard error is captured with
-// standard output when `with_stderr`.
-CliRun run_cli(const std::string& args, bool with_stderr = false) {
-  CliRun run;
-  const std::string command =
-      std::string("'") + kCliPath + "' " + args + (with_stderr ? " 2>&1" : "");
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    ADD_FAILURE() << "popen failed: " << command;
-    return run;
-  }
-  std::array<char, 4096> buffer;
-  std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+using proxima::test::CliRun;
+using proxima::test::run_cli;
 
 struct Row {
   int step = -1;

@@ -12,11 +12,9 @@
 #include "proxima/distance.h"
 #include "proxima/io.h"
 #include "proxima/polytope.h"
+#include "support/run_cli.h"
 
 #include <Eigen/Geometry>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -39,69 +37,14 @@ using Json = nlohmann::json;
 using proxima::ConvexPolytope;
 using proxima::kUnitRoundoff;
 using proxima::Vec3;
+using proxima::test::CliRun;
+using proxima::test::run_cli;
+using proxima::test::shell_quote;
+using proxima::test::TempPath;
 
 // DESIGN.md's accuracy standard for a distance d among coordinates of
 // magnitude up to R: |distance - d*| <= 1e-12 d* + 64 u R.
 double accuracy_bound(double d, double r) { return 1e-12 * d + 64.0 * kUnitRoundoff * r; }
-
-#ifdef PROXIMA_CLI_PATH
-const char* const kCliPath = PROXIMA_CLI_PATH;
-#else
-const char* const kCliPath = nullptr;
-#endif
-
-#define REQUIRE_CLI()                                                 \
-  do {                                                                \
-    if (kCliPath == nullptr) GTEST_SKIP() << "built without the CLI"; \
-  } while (false)
-
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-// A path in the temp directory with the given extension, removed at the end.
-class TempPath {
- public:
-  explicit TempPath(const std::string& extension) {
-    static int counter = 0;
-    path_ = (std::filesystem::temp_directory_path() /
-             ("proxima_cli_tools_test_" + std::to_string(getpid()) + "_" + std::to_string(counter++) + extension))
-                .string();
-  }
-  TempPath(const TempPath&) = delete;
-  TempPath& operator=(const TempPath&) = delete;
-  ~TempPath() { std::filesystem::remove(path_); }
-  const std::string& path() const { return path_; }
-  std::string quoted() const { return shell_quote(path_); }
-
- private:
-  std::string path_;
-};
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-};
-
-// Runs `proxima <args>` through the shell; standard error is captured with
-// standard output when `with_stderr`.
-CliRun run_cli(const std::string& args, bool with_stderr = false) {
-  CliRun run;
-  const std::string command = shell_quote(kCliPath) + " " + args + (with_stderr ? " 2>&1" : "");
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    ADD_FAILURE() << "popen failed: " << command;
-    return run;
-  }
-  std::array<char, 4096> buffer;
-  std::size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
 
 std::string g17(double x) {
   std::array<char, 40> buffer{};
