@@ -34,7 +34,6 @@
 //   30 to 80 ns of about 1.1 us per cube-cube query, same answers.
 #include "peers/fcl_peer.h"
 
-#include <fcl/geometry/shape/convex.h>
 #include <fcl/narrowphase/detail/gjk_solver_indep.h>
 #include <fcl/narrowphase/distance.h>
 
@@ -44,35 +43,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "peers/fcl_convex.h"
+
 namespace proxima::bench {
-namespace {
-
-std::shared_ptr<fcl::Convexd> make_convex(const ConvexPolytope& p) {
-  if (p.dimension() != 3) {
-    throw std::invalid_argument("FclPeer: fcl::Convex needs a solid polytope (dimension 3)");
-  }
-  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
-  vertices->reserve(static_cast<std::size_t>(p.vertex_count()));
-  for (const Vec3& v : p.vertices()) vertices->push_back(v);
-  auto faces = std::make_shared<std::vector<int>>();
-  for (int f = 0; f < p.face_count(); ++f) {
-    const auto polygon = p.face(f);
-    faces->push_back(static_cast<int>(polygon.size()));
-    for (const std::int32_t v : polygon) faces->push_back(v);
-  }
-  auto convex = std::make_shared<fcl::Convexd>(vertices, p.face_count(), faces);
-  convex->computeLocalAABB();
-  return convex;
-}
-
-fcl::Transform3d to_fcl(const Pose& pose) {
-  fcl::Transform3d tf = fcl::Transform3d::Identity();
-  tf.linear() = pose.rotation;
-  tf.translation() = pose.translation;
-  return tf;
-}
-
-}  // namespace
 
 struct FclPeer::Impl {
   FclSolver solver;
@@ -86,7 +59,7 @@ struct FclPeer::Impl {
   std::vector<fcl::Transform3d> tf_b;
 
   Impl(const ConvexPolytope& pa, const ConvexPolytope& pb, FclSolver s)
-      : solver(s), a(make_convex(pa)), b(make_convex(pb)) {
+      : solver(s), a(fcl_convex(pa, "FclPeer: body a")), b(fcl_convex(pb, "FclPeer: body b")) {
     request.enable_nearest_points = true;
     request.gjk_solver_type = s == FclSolver::libccd ? fcl::GST_LIBCCD : fcl::GST_INDEP;
     tracking_solver.gjk_tolerance = request.distance_tolerance;
@@ -138,8 +111,8 @@ void FclPeer::load_poses(std::span<const Pose> poses_a, std::span<const Pose> po
     throw std::invalid_argument("FclPeer: pose sequences differ in length");
   impl_->tf_a.clear();
   impl_->tf_b.clear();
-  for (const Pose& p : poses_a) impl_->tf_a.push_back(to_fcl(p));
-  for (const Pose& p : poses_b) impl_->tf_b.push_back(to_fcl(p));
+  for (const Pose& p : poses_a) impl_->tf_a.push_back(fcl_transform(p));
+  for (const Pose& p : poses_b) impl_->tf_b.push_back(fcl_transform(p));
 }
 
 std::size_t FclPeer::pose_count() const { return impl_->tf_a.size(); }

@@ -60,36 +60,10 @@
 #include <string>
 #include <utility>
 
+#include "peers/fcl_convex.h"
+
 namespace proxima::bench {
 namespace {
-
-// fcl::Convexd from the hull's vertices and face polygons (FCL's face list
-// [n, i0, ..., i(n-1), n, ...]), the same conversion as fcl_peer.cpp.
-std::shared_ptr<fcl::Convexd> make_convex(const ConvexPolytope& p, std::size_t shape) {
-  if (p.dimension() != 3) {
-    throw InvalidInput("FclScene: shape " + std::to_string(shape) + " is not solid (dimension " +
-                       std::to_string(p.dimension()) + "); fcl::Convex needs dimension 3");
-  }
-  auto vertices = std::make_shared<std::vector<fcl::Vector3d>>();
-  vertices->reserve(static_cast<std::size_t>(p.vertex_count()));
-  for (const Vec3& v : p.vertices()) vertices->push_back(v);
-  auto faces = std::make_shared<std::vector<int>>();
-  for (int f = 0; f < p.face_count(); ++f) {
-    const auto polygon = p.face(f);
-    faces->push_back(static_cast<int>(polygon.size()));
-    for (const std::int32_t v : polygon) faces->push_back(v);
-  }
-  auto convex = std::make_shared<fcl::Convexd>(vertices, p.face_count(), faces);
-  convex->computeLocalAABB();
-  return convex;
-}
-
-fcl::Transform3d to_fcl(const Pose& pose) {
-  fcl::Transform3d tf = fcl::Transform3d::Identity();
-  tf.linear() = pose.rotation;
-  tf.translation() = pose.translation;
-  return tf;
-}
 
 // A CollisionObject whose world box can be set to the tight box of its
 // transformed vertices (FclBoxes::tight): FCL keeps the box in a protected
@@ -212,7 +186,7 @@ FclScene::FclScene(std::span<const std::shared_ptr<const ConvexPolytope>> shapes
   s.boxes = boxes;
   for (std::size_t k = 0; k < shapes.size(); ++k) {
     if (!shapes[k]) throw InvalidInput("FclScene: shape " + std::to_string(k) + " is null");
-    s.convexes.push_back(make_convex(*shapes[k], k));
+    s.convexes.push_back(fcl_convex(*shapes[k], "FclScene: shape " + std::to_string(k)));
   }
   const std::size_t n = shape_of.size();
   s.ids.resize(n);
@@ -230,8 +204,8 @@ FclScene::FclScene(std::span<const std::shared_ptr<const ConvexPolytope>> shapes
     }
     s.ids[i] = static_cast<int>(i);
     s.shape_of.push_back(k);
-    auto object =
-        std::make_unique<FclObject>(s.convexes[static_cast<std::size_t>(k)], to_fcl(poses[i]));
+    auto object = std::make_unique<FclObject>(s.convexes[static_cast<std::size_t>(k)],
+                                              fcl_transform(poses[i]));
     object->setUserData(&s.ids[i]);
     raw.push_back(object.get());
     s.objects.push_back(std::move(object));
@@ -259,7 +233,7 @@ void FclScene::set_poses(std::span<const Pose> poses) {
     if (!poses[i].is_finite()) {
       throw InvalidInput("FclScene: pose of body " + std::to_string(i) + " is not finite");
     }
-    s.objects[i]->setTransform(to_fcl(poses[i]));
+    s.objects[i]->setTransform(fcl_transform(poses[i]));
     s.compute_box(i);
   }
 }
