@@ -11,6 +11,7 @@
 //
 //   build/<dir>/bench/gjk_bench --benchmark_min_time=0.2
 #include "proxima/gjk.h"
+#include "support/random.h"
 
 #include <benchmark/benchmark.h>
 
@@ -29,29 +30,12 @@ using proxima::DistanceOptions;
 using proxima::DistanceResult;
 using proxima::Mat3;
 using proxima::Pose;
-using proxima::Quat;
 using proxima::Vec3;
 
-using Rng = std::mt19937_64;
-
-// Portable uniform draws (the std distributions are implementation-defined,
-// and the inputs should be the same on every machine).
-double uniform(Rng& rng, double lo, double hi) {
-  return lo + (hi - lo) * (static_cast<double>(rng() >> 11) * 0x1p-53);
-}
-Vec3 random_unit(Rng& rng) {
-  for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    const double n2 = p.squaredNorm();
-    if (n2 > 1e-4 && n2 <= 1.0) return p / std::sqrt(n2);
-  }
-}
-Mat3 random_rotation(Rng& rng) {
-  for (;;) {
-    const Quat q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0) return q.normalized().toRotationMatrix();
-  }
-}
+using proxima::bench::points_on_sphere;
+using proxima::bench::random_rotation;
+using proxima::bench::random_unit_vector;
+using proxima::bench::Rng;
 
 struct Pair {
   std::unique_ptr<ConvexPolytope> a;
@@ -64,10 +48,8 @@ const Pair& bodies(int n) {
   auto it = cache.find(n);
   if (it == cache.end()) {
     Rng rng(0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(n));
-    std::vector<Vec3> pa;
-    std::vector<Vec3> pb;
-    for (int i = 0; i < n; ++i) pa.push_back(random_unit(rng));
-    for (int i = 0; i < n; ++i) pb.push_back(random_unit(rng));
+    const std::vector<Vec3> pa = points_on_sphere(rng, n);
+    const std::vector<Vec3> pb = points_on_sphere(rng, n);
     Pair p{std::make_unique<ConvexPolytope>(pa), std::make_unique<ConvexPolytope>(pb)};
     it = cache.emplace(n, std::move(p)).first;
   }
@@ -90,7 +72,7 @@ std::vector<Query> random_poses(const Pair& p, int count) {
   Rng rng(12345);
   std::vector<Query> out;
   for (int i = 0; i < count; ++i) {
-    const Pose pose(random_rotation(rng), Vec3(3.0 * random_unit(rng)));
+    const Pose pose(random_rotation(rng), Vec3(3.0 * random_unit_vector(rng)));
     out.push_back({pose, contact_tolerance(p, pose)});
   }
   return out;

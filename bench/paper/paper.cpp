@@ -53,6 +53,7 @@
 #include "peers/fcl_peer.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
+#include "support/random.h"
 
 #ifndef PROXIMA_PLOT_SCRIPT
 #define PROXIMA_PLOT_SCRIPT "scripts/plot_paper.py"
@@ -62,7 +63,6 @@ namespace proxima::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Rng = std::mt19937_64;
 using Points = std::vector<Vec3>;
 
 double seconds_since(Clock::time_point t0) {
@@ -84,42 +84,6 @@ double thread_cpu_ns() {
 // Seeded inputs. Only integer draws and basic IEEE operations feed the
 // coordinates (std::uniform_real_distribution is implementation-defined), so
 // the bodies are the same on every machine.
-
-double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
-double uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
-double log_uniform(Rng& rng, double lo, double hi) {
-  return std::exp(uniform(rng, std::log(lo), std::log(hi)));
-}
-
-// Uniform on the sphere: rejection in the cube keeps the distribution
-// uniform without a normal deviate.
-Vec3 random_unit_vector(Rng& rng) {
-  for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    const double n2 = p.squaredNorm();
-    if (n2 > 1e-4 && n2 <= 1.0) return p / std::sqrt(n2);
-  }
-}
-
-// Uniform rotation: a uniform unit quaternion (rejection in the 4-cube).
-Mat3 random_rotation(Rng& rng) {
-  for (;;) {
-    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    const double n2 = q.squaredNorm();
-    if (n2 > 1e-4 && n2 <= 1.0) {
-      const Eigen::Vector4d u = q / std::sqrt(n2);
-      return Quat(u[0], u[1], u[2], u[3]).toRotationMatrix();
-    }
-  }
-}
-
-Points points_on_sphere(Rng& rng, int n) {
-  Points pts;
-  pts.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) pts.push_back(random_unit_vector(rng));
-  return pts;
-}
 
 Points cube(double edge) {
   const double h = edge / 2;

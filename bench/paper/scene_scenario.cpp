@@ -8,10 +8,10 @@
 #include <random>
 #include <string>
 
+#include "support/random.h"
+
 namespace proxima::bench {
 namespace {
-
-using Rng = std::mt19937_64;
 
 // Upper ends of the options: far beyond any run on these machines; they only
 // keep a typo from asking for terabytes.
@@ -23,46 +23,13 @@ constexpr int kMaxPoints = 100'000;
 // features, not so flat that a shape is a plate.
 constexpr double kBoxMinAspect = 0.4;
 
-// Uniform in [0, 1): the top 53 bits of the generator as a fraction
-// (std::uniform_real_distribution is implementation-defined).
-double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
-double uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
-int uniform_int(Rng& rng, int lo, int hi) {
-  return lo + static_cast<int>(rng() % static_cast<std::uint64_t>(hi - lo + 1));
-}
-
-// Uniform on the sphere by rejection in the cube (no normal deviate needed).
-Vec3 random_unit_vector(Rng& rng) {
-  for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    const double n2 = p.squaredNorm();
-    if (n2 > 1e-4 && n2 <= 1.0) return p / std::sqrt(n2);
-  }
-}
-
-// Uniform rotation: a uniform unit quaternion by rejection in the 4-cube.
-Quat random_rotation(Rng& rng) {
-  for (;;) {
-    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    const double n2 = q.squaredNorm();
-    if (n2 > 1e-4 && n2 <= 1.0) {
-      const Eigen::Vector4d u = q / std::sqrt(n2);
-      return Quat(u[0], u[1], u[2], u[3]);
-    }
-  }
-}
-
 // Half the shapes are round (points on the sphere of radius kBodyRadius), half
 // boxy (points uniform in a box whose corners lie on that sphere), so the
 // hulls run from many small faces to few large ones.
 std::vector<Vec3> random_shape_points(Rng& rng, int n) {
+  if (rng() % 2 == 0) return points_on_sphere(rng, n, kBodyRadius);
   std::vector<Vec3> points;
   points.reserve(static_cast<std::size_t>(n));
-  if (rng() % 2 == 0) {
-    for (int i = 0; i < n; ++i) points.push_back(kBodyRadius * random_unit_vector(rng));
-    return points;
-  }
   Vec3 half(uniform(rng, kBoxMinAspect, 1.0), uniform(rng, kBoxMinAspect, 1.0),
             uniform(rng, kBoxMinAspect, 1.0));
   half *= kBodyRadius / half.norm();
@@ -137,7 +104,7 @@ SceneScenario::SceneScenario(const SceneScenarioOptions& options) : options_(opt
     Body b;
     b.start_position =
         Vec3(uniform(rng, 0, cube_size_), uniform(rng, 0, cube_size_), uniform(rng, 0, cube_size_));
-    b.start_rotation = random_rotation(rng);
+    b.start_rotation = random_quaternion(rng);
     b.velocity = uniform(rng, 0, options_.max_speed) * random_unit_vector(rng);
     b.rotation_axis = random_unit_vector(rng);
     b.angular_speed = uniform(rng, 0, options_.max_angular_speed);
