@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "proxima/batch.h"
+#include "support/random.h"
 
 namespace proxima {
 namespace {
@@ -28,28 +29,10 @@ namespace {
 constexpr std::size_t kPairs = 100000;
 constexpr int kPoolSize = 64;
 
-// Portable draws (the distributions of <random> are implementation-defined):
-// 53 random bits to [0, 1).
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * uniform01(rng);
-}
-
-Vec3 random_unit(std::mt19937_64& rng) {
-  for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    if (p.squaredNorm() > 1e-4 && p.squaredNorm() <= 1.0) return p.normalized();
-  }
-}
-
-Quat random_quaternion(std::mt19937_64& rng) {
-  for (;;) {
-    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0)
-      return Quat(q[0], q[1], q[2], q[3]).normalized();
-  }
-}
+// Portable draws (the distributions of <random> are implementation-defined).
+using bench::random_quaternion;
+using bench::random_unit_vector;
+using bench::uniform;
 
 struct Scene {
   std::vector<std::unique_ptr<ConvexPolytope>> pool;
@@ -66,7 +49,7 @@ const Scene& scene() {
       const int n = 20 + static_cast<int>(rng() % 81);
       std::vector<Vec3> pts;
       for (int j = 0; j < n; ++j) {
-        pts.push_back(i % 2 == 0 ? random_unit(rng)
+        pts.push_back(i % 2 == 0 ? random_unit_vector(rng)
                                  : Vec3(uniform(rng, -0.55, 0.55), uniform(rng, -0.55, 0.55),
                                         uniform(rng, -0.55, 0.55)));
       }
@@ -77,12 +60,13 @@ const Scene& scene() {
       const Vec3 centre(uniform(rng, -100, 100), uniform(rng, -100, 100), uniform(rng, -100, 100));
       const Pose a(random_quaternion(rng), centre);
       const Pose b(random_quaternion(rng),
-                   Vec3(centre + uniform(rng, 2.0, 3.5) * random_unit(rng)));
+                   Vec3(centre + uniform(rng, 2.0, 3.5) * random_unit_vector(rng)));
       // Frame 1: each body turned by 0.01 rad about a random axis and moved
       // by 0.01.
       const auto moved = [&](const Pose& p) {
-        return Pose(Mat3(Eigen::AngleAxisd(0.01, random_unit(rng)).toRotationMatrix() * p.rotation),
-                    Vec3(p.translation + 0.01 * random_unit(rng)));
+        return Pose(
+            Mat3(Eigen::AngleAxisd(0.01, random_unit_vector(rng)).toRotationMatrix() * p.rotation),
+            Vec3(p.translation + 0.01 * random_unit_vector(rng)));
       };
       out.poses_a[0].push_back(a);
       out.poses_b[0].push_back(b);

@@ -28,6 +28,7 @@
 
 #include "../src/broad_phase.h"
 #include "proxima/scene.h"
+#include "support/random.h"
 
 namespace proxima {
 namespace {
@@ -38,24 +39,9 @@ constexpr double kMargin = 0.1;
 // density of tests/scene_test.cpp); grown with the cube root of the count.
 constexpr double kSideAt120 = 10.0;
 
-double uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
-double uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * uniform01(rng);
-}
-Vec3 random_unit(std::mt19937_64& rng) {
-  for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    if (p.squaredNorm() > 1e-4 && p.squaredNorm() <= 1.0) return p.normalized();
-  }
-}
-Quat random_quaternion(std::mt19937_64& rng) {
-  for (;;) {
-    const Eigen::Vector4d q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1),
-                            uniform(rng, -1, 1));
-    if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0)
-      return Quat(q[0], q[1], q[2], q[3]).normalized();
-  }
-}
+using bench::random_quaternion;
+using bench::random_unit_vector;
+using bench::uniform;
 
 const std::vector<std::shared_ptr<const ConvexPolytope>>& pool() {
   static const auto bodies = [] {
@@ -67,7 +53,7 @@ const std::vector<std::shared_ptr<const ConvexPolytope>>& pool() {
       std::vector<Vec3> pts;
       for (int j = 0; j < n; ++j) {
         pts.push_back(
-            i % 2 == 0 ? Vec3(radius * random_unit(rng))
+            i % 2 == 0 ? Vec3(radius * random_unit_vector(rng))
                        : Vec3(radius * 0.6 *
                               Vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))));
       }
@@ -92,8 +78,9 @@ struct Motion {
       bodies.push_back(pool()[rng() % kPoolSize]);
       poses.emplace_back(random_quaternion(rng),
                          Vec3(uniform(rng, 0, side), uniform(rng, 0, side), uniform(rng, 0, side)));
-      velocity.push_back(uniform(rng, 0, 0.02) * random_unit(rng));
-      spin.push_back(Eigen::AngleAxisd(uniform(rng, 0, 0.02), random_unit(rng)).toRotationMatrix());
+      velocity.push_back(uniform(rng, 0, 0.02) * random_unit_vector(rng));
+      spin.push_back(
+          Eigen::AngleAxisd(uniform(rng, 0, 0.02), random_unit_vector(rng)).toRotationMatrix());
     }
   }
 

@@ -11,6 +11,7 @@
 // Polytopes: N = 8, 64, 512, 4096, 10000 points on the unit sphere, seeded.
 #include "proxima/polytope.h"
 #include "proxima/support.h"
+#include "support/random.h"
 
 #include <benchmark/benchmark.h>
 
@@ -24,23 +25,13 @@
 namespace proxima {
 namespace {
 
-using Rng = std::mt19937_64;
-
-double uniform(Rng& rng, double lo, double hi) { return lo + (hi - lo) * static_cast<double>(rng() >> 11) * 0x1p-53; }
-
-Vec3 random_unit(Rng& rng) {
-  for (;;) {
-    const Vec3 d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
-    const double n = d.squaredNorm();
-    if (n > 1e-4 && n <= 1.0) return d / std::sqrt(n);
-  }
-}
+using bench::random_unit_vector;
+using bench::Rng;
+using bench::uniform;
 
 std::vector<Vec3> sphere_points(int n, std::uint64_t seed) {
   Rng rng(seed);
-  std::vector<Vec3> pts;
-  for (int i = 0; i < n; ++i) pts.push_back(random_unit(rng));
-  return pts;
+  return bench::points_on_sphere(rng, n);
 }
 
 std::vector<Vec3> cube_points(int n, std::uint64_t seed) {
@@ -63,7 +54,7 @@ const std::vector<Vec3>& random_directions() {
   static const std::vector<Vec3> dirs = [] {
     Rng rng(7);
     std::vector<Vec3> d;
-    for (std::size_t i = 0; i < kDirections; ++i) d.push_back(random_unit(rng));
+    for (std::size_t i = 0; i < kDirections; ++i) d.push_back(random_unit_vector(rng));
     return d;
   }();
   return dirs;
