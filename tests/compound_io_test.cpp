@@ -5,12 +5,10 @@
 // a group that cannot be hulled, and a hand-made cloud with a bad group
 // layout, are FileErrors naming the file and the group.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <array>
 #include <charconv>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -18,35 +16,15 @@
 #include "proxima/distance.h"
 #include "proxima/io.h"
 #include "support/generators.h"
+#include "support/temp_dir.h"
 
 namespace proxima {
 namespace {
 
-namespace fs = std::filesystem;
 using test::Points;
 using test::Rng;
 
-class CompoundIoTest : public testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("proxima_compound_io_test_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  std::string write(const std::string& name, const std::string& bytes) const {
-    const std::string path = (dir_ / name).string();
-    std::ofstream out(path, std::ios::binary);
-    out << bytes;
-    return path;
-  }
-  fs::path dir_;
-};
+class CompoundIoTest : public test::TempDirTest {};
 
 // Shortest text that reads back as exactly `v`.
 std::string text(double v) {
