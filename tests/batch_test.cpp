@@ -12,7 +12,6 @@
 #include <gtest/gtest.h>
 #include <oneapi/tbb/task_arena.h>
 
-#include <bit>
 #include <cfenv>
 #include <chrono>
 #include <cstdint>
@@ -27,11 +26,14 @@
 #include "../src/parallel_ranges.h"
 #include "proxima/distance.h"
 #include "support/generators.h"
+#include "support/same_bits.h"
 
 namespace proxima {
 namespace {
 
 using test::Rng;
+using test::same_bits;
+using test::same_feature;
 
 // A scene of `n` pairs drawn from a pool of shared polytopes (20 to 100
 // random points each, on a sphere or in a cube), with random poses spread so
@@ -74,16 +76,6 @@ void step(Rng& rng, std::vector<Pose>& poses) {
     p = Pose(Mat3(test::random_small_rotation(rng, 0.01) * p.rotation),
              Vec3(p.translation + 0.01 * test::random_unit_vector(rng)));
   }
-}
-
-bool same_bits(double x, double y) {
-  return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y);
-}
-bool same_bits(const Vec3& x, const Vec3& y) {
-  return same_bits(x[0], y[0]) && same_bits(x[1], y[1]) && same_bits(x[2], y[2]);
-}
-bool same_feature(const Feature& x, const Feature& y) {
-  return x.type == y.type && x.vertices == y.vertices && x.face == y.face;
 }
 
 void expect_same_result(const DistanceResult& x, const DistanceResult& y, std::size_t k) {

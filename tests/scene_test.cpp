@@ -9,7 +9,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -19,11 +18,14 @@
 
 #include "proxima/distance.h"
 #include "support/generators.h"
+#include "support/same_bits.h"
 
 namespace proxima {
 namespace {
 
 using test::Rng;
+using test::same_bits;
+using test::same_feature;
 
 // A random body for a scene: mostly round or boxy clouds of 20 to 200
 // points, sometimes a degenerate shape (needle, polygon, segment, point,
@@ -84,16 +86,6 @@ Pose random_pose(Rng& rng, double side, const Vec3& offset) {
 Pose moved(Rng& rng, const Pose& p) {
   return {Mat3(test::random_small_rotation(rng, 0.03) * p.rotation),
           Vec3(p.translation + test::uniform(rng, 0, 0.04) * test::random_unit_vector(rng))};
-}
-
-bool same_bits(double x, double y) {
-  return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y);
-}
-bool same_bits(const Vec3& x, const Vec3& y) {
-  return same_bits(x[0], y[0]) && same_bits(x[1], y[1]) && same_bits(x[2], y[2]);
-}
-bool same_feature(const Feature& x, const Feature& y) {
-  return x.type == y.type && x.vertices == y.vertices && x.face == y.face;
 }
 
 // Scenes fed the same calls: both broad phases, 1 and 2 threads. They must
