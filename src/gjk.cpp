@@ -223,6 +223,15 @@ Reduction solve_segment(const Points& p, int i, int j) {
   r.lambda[0] = num_i / den;
   r.lambda[1] = num_j / den;
   r.v = r.lambda[0] * wi + r.lambda[1] * wj;
+  // v is orthogonal to t in exact arithmetic; the sum's rounding (u |w|) is
+  // not, and along a needle's axis it tilts the next search direction by
+  // u |w| / |v|: the support values of the needle's ends then differ by
+  // that times its length, more than its thickness, and the support point is
+  // an end of the segment itself (DistanceRegression.PointOnTheSurfaceOfANeedle
+  // stopped 1.7e-9 inside a needle 1e-9 thick that way). The component along
+  // t is removed; what is left is across the needle, where it is harmless.
+  const double tt = t.squaredNorm();
+  if (tt > 0.0) r.v -= (r.v.dot(t) / tt) * t;
   r.vv = r.v.squaredNorm();
   return r;
 }

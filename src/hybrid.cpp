@@ -162,15 +162,54 @@ bool valid_id(std::int32_t id, int count) { return id >= 0 && id < count; }
 // u R / d: enough to pick wrong support points on a needle or a sliver. A
 // face normal or the cross product of two edges is accurate to a few u
 // whatever d is, so those are used where the pair is vertex-face or
-// edge-edge; XB - XA where it is exact enough (vertex-vertex, vertex-edge).
+// edge-edge; XB - XA where it is exact (vertex-vertex).
+//
+// What matters for the support search is the error of the direction along
+// the bodies' long dimensions: tilted by e, a direction moves the support
+// value of a vertex a length L away by e L, and on a needle of thickness h
+// the wrong end of the needle wins once e L > h. Two such errors are removed
+// by projection, which is exact in theory (the true direction is orthogonal
+// to the edge or to the face's edges):
+//  * vertex-edge: XB - XA is orthogonal to the edge; its rounding is not.
+//    Removing its component along the edge leaves an error across the edge
+//    only, which a support value sees times the body's thickness.
+//  * vertex-face: the cross product of a sliver's edges is off by u / sin
+//    (sin: the face's smallest angle) in a direction that tilts it along the
+//    face; its component along the longest edge is removed, as in
+//    crossing_candidate (closest_point.h).
+// (DistanceRegression.PointOnTheSurfaceOfANeedle: a point on an edge of a
+// needle 1.6 long and 1e-9 thick stopped on the needle's inner diagonal at
+// 1.7e-9 with lower bound 0, the direction's 3e-7 tilt along the axis
+// making the diagonal's own ends the support points.)
+Vec3 across(const Vec3& x, const Vec3& edge) {
+  const double ee = edge.squaredNorm();
+  return ee > 0.0 ? Vec3(x - (x.dot(edge) / ee) * edge) : x;
+}
+
+// The normal of triangle t (unnormalized, either orientation), without its
+// rounding component along the longest edge (see search_direction).
+Vec3 face_direction(const std::array<Vec3, 4>& t) {
+  const Vec3 e0 = t[1] - t[0];
+  const Vec3 e1 = t[2] - t[0];
+  const Vec3 e2 = t[2] - t[1];
+  const double l0 = e0.squaredNorm();
+  const double l1 = e1.squaredNorm();
+  const double l2 = e2.squaredNorm();
+  const Vec3& longest = l0 >= l1 ? (l0 >= l2 ? e0 : e2) : (l1 >= l2 ? e1 : e2);
+  return across(e0.cross(e1), longest);
+}
+
 Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb, const Vec3& w, double d) {
   Vec3 n;
   if (fa.n == 1 && fb.n == 3) {
-    n = (fb.p[1] - fb.p[0]).cross(fb.p[2] - fb.p[0]);
+    n = face_direction(fb.p);
   } else if (fa.n == 3 && fb.n == 1) {
-    n = (fa.p[1] - fa.p[0]).cross(fa.p[2] - fa.p[0]);
+    n = face_direction(fa.p);
   } else if (fa.n == 2 && fb.n == 2) {
     n = (fa.p[1] - fa.p[0]).cross(fb.p[1] - fb.p[0]);
+  } else if (fa.n + fb.n == 3) {
+    // Vertex-edge: the edge has length above the kernel's tolerance.
+    n = across(w, fa.n == 2 ? Vec3(fa.p[1] - fa.p[0]) : Vec3(fb.p[1] - fb.p[0]));
   } else {
     return w / d;
   }

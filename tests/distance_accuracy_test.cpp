@@ -984,5 +984,89 @@ TEST(DistanceRegression, PointNearANeedle) {
   EXPECT_TRUE(run_named("point_near_needle", a, b));
 }
 
+TEST(DistanceRegression, PointOnTheSurfaceOfANeedle) {
+  // Found while testing compound bodies (2026-11-22): hull A is a needle
+  // (8 points, 1.6 long, about 1e-9 thick: every face a sliver of sine
+  // 2e-9 to 6e-8). The hybrid's closest point of A to a body B lies on A's
+  // edge [3 4] up to rounding, but a one-point polytope at that point
+  // queried against A came back separated at 1.7e-9 (64 u R is 1.7e-14)
+  // with lower bound 0, from all three algorithms: each stopped on the
+  // needle's inner diagonal [0 1], 1.7e-9 inside A, because the direction
+  // from the point to a segment (XB - XA in the hybrid, the segment's
+  // closest point to the origin in GJK) carried a rounding tilt of 3e-7
+  // along the needle's axis, enough to make the diagonal's own ends the
+  // support points. Fixed by removing the direction's component along the
+  // edge (and a sliver normal's along its longest edge).
+  const Points a{Vec3(0.64570826897257039, 1.0916144697291843, -2.3653994057992471),
+                Vec3(0.26093063673681099, -0.34264654060582755, -1.4723259974216281),
+                Vec3(0.40649011539237856, 0.19992732624482967, -1.8101712634469185),
+                Vec3(0.30015071866601672, -0.19645344783991581, -1.5633562661371294),
+                Vec3(0.41957581180478987, 0.24870432648957028, -1.8405433102119573),
+                Vec3(0.42596359466299316, 0.27251483882812022, -1.8553694352701549),
+                Vec3(0.6383927211929038, 1.0643457221086727, -2.3484199325477353),
+                Vec3(0.32908813721908725, -0.088589033091828806, -1.6305203564892963)};
+  const Points b{Vec3(2.0906222377249106, -0.9092490457813569, -3.7248656828888445),
+                Vec3(1.8152240608591552, -0.31843705773102737, -3.7363319564783675),
+                Vec3(1.8898489869539294, -0.5483587601509452, -3.3044976449903212),
+                Vec3(2.0392667377217468, -1.0577862859468361, -4.1792750991192671),
+                Vec3(0.76847997780858623, -0.89646580205225534, -4.0919684834729946),
+                Vec3(1.9184228561566516, -1.3301445055116932, -3.8280657960945303),
+                Vec3(0.84599015254432963, -1.3783600987658717, -3.3294697676048752),
+                Vec3(1.0231322361558197, -0.88012886059826734, -3.2933276778303773),
+                Vec3(1.0932849052567679, -0.75859553139976255, -3.4135985609408022)};
+  EXPECT_TRUE(run_named("needle_vs_body", a, b));
+  // The reported point, and the one the query returns now: both on A.
+  const ConvexPolytope hull_a(a);
+  const ConvexPolytope hull_b(b);
+  const Vec3 found = distance(hull_a, Pose(), hull_b, Pose()).point_a;
+  ExactOracle oracle;
+  for (const Vec3& p : {Vec3(0.40812459482325075, 0.20601984426821252, -1.8139649010790968), found}) {
+    // The expected answer itself: d* is within the band (the point is on A
+    // up to rounding), so touching is right and separated is wrong.
+    const std::optional<ExactDistance> exact = oracle.distance({p}, a);
+    ASSERT_TRUE(exact);
+    EXPECT_TRUE(sqrt_at_most(exact->distance_squared, kBandUlps * kUnitRoundoff * max_abs_coordinate(a)));
+    EXPECT_TRUE(run_named("point_on_needle_edge", {p}, a));
+    EXPECT_TRUE(run_named("needle_edge_point", a, {p}));
+  }
+}
+
+TEST(DistanceRegression, PointsOnTheSurfacesOfThinHulls) {
+  // The family of PointOnTheSurfaceOfANeedle: a point on a random hull
+  // triangle (inside it, on one of its edges or at a vertex, rounded to
+  // doubles) against the hull, for needles and slivers down to 1e-12 thick
+  // and for round bodies, turned and moved at random. d* is at most a few
+  // u R, so every answer must be touching within the band.
+  Rng rng(31);
+  AccuracySuite suite("points_on_surfaces");
+  const char* const kinds[] = {"point_on_needle", "point_on_sliver", "point_on_sphere"};
+  for (int i = 0; i < count(90); ++i) {
+    const int kind = i % 3;
+    Points shape = kind == 0   ? needle(rng, 2.0, log_uniform(rng, 1e-12, 1e-3), uniform_int(rng, 4, 12))
+                   : kind == 1 ? sliver(rng, log_uniform(rng, 1e-12, 1e-3))
+                               : points_on_sphere(rng, uniform_int(rng, 4, 20));
+    shape = transformed(shape, random_rotation(rng), uniform(rng, 0, 3) * random_unit_vector(rng));
+    const ConvexPolytope hull(shape);
+    const std::vector<std::array<std::int32_t, 3>> triangles = hull.triangles();
+    if (triangles.empty()) continue;  // rounded flat: no faces to sample
+    const auto& t = triangles[static_cast<std::size_t>(uniform_int(rng, 0, static_cast<int>(triangles.size()) - 1))];
+    std::array<double, 3> w = {uniform(rng, 0.01, 1), uniform(rng, 0.01, 1), uniform(rng, 0.01, 1)};
+    const int where = uniform_int(rng, 0, 2);  // 0: inside, 1: on an edge, 2: at a vertex
+    if (where >= 1) w[static_cast<std::size_t>(uniform_int(rng, 0, 2))] = 0;
+    if (where == 2) w = {1, 0, 0};
+    const double sum = w[0] + w[1] + w[2];
+    Vec3 p = Vec3::Zero();
+    for (std::size_t k = 0; k < 3; ++k) p += (w[k] / sum) * hull.vertex(t[k]);
+    suite.run({kinds[kind], {p}, shape, {}, {}});
+  }
+  for (const char* kind : kinds) {
+    const Tally& t = suite.tally(kind);
+    EXPECT_GT(t.cases, 0) << kind;
+    EXPECT_EQ(t.violations, 0) << kind;
+    // The generator's promise: every point is on its hull within the band.
+    EXPECT_EQ(t.intersecting_or_touching + t.in_band, t.cases) << kind;
+  }
+}
+
 }  // namespace
 }  // namespace proxima::test
