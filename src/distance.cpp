@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace proxima {
@@ -25,6 +26,14 @@ constexpr double kContactUlps = 64.0;
 // u R_bound: the lower bound's own rounding is a few u R, so a larger gap
 // means the answer was not certified at machine precision.
 constexpr double kCertificateUlps = 32.0;
+
+// Largest coordinate magnitude (bounded as below) accepted. The algorithms
+// take differences of coordinates and map B into A's frame (|R y + t| up
+// to sqrt(3) |y| + |t|), and the hybrid and GJK then work in units of a
+// power of two near that magnitude; beyond 2^1018 (2.8e306) those
+// intermediate values can overflow to inf, and differences of infinities
+// are NaN. Such input is refused by name instead of answered with NaN.
+constexpr double kMaxMagnitude = 0x1p1018;
 
 void check_pose(const Pose& pose, const char* name) {
   if (!pose.is_finite()) [[unlikely]] {
@@ -71,12 +80,21 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
     throw InvalidInput("distance: options.max_iterations must be at least 1");
   }
 
-  const Pose b_in_a = pose_a.inverse() * pose_b;
   // The contact band 64 u R + Ae, first with a cheap bound on R. A distance
   // found inside that band but above 0 may still be outside the band of the
   // exact R; then the exact R is computed and the query resumed from its own
   // cache with the exact band, so that "separated" means d > 64 u R exactly.
   const double r_bound = std::max(world_magnitude_bound(a, pose_a), world_magnitude_bound(b, pose_b));
+  if (!(r_bound <= kMaxMagnitude)) [[unlikely]] {
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
+                  "beyond the supported %.3g where differences of coordinates may overflow",
+                  world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
+                  kMaxMagnitude);
+    throw InvalidInput(what);
+  }
+  const Pose b_in_a = pose_a.inverse() * pose_b;
   const double band_bound = kContactUlps * kUnitRoundoff * r_bound + options.absolute_tolerance;
 
   DistanceCache cold;

@@ -791,9 +791,14 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
 // A's centroid towards B's, i.e. the point of C least far along the
 // centroids' difference (a point of C near the closest one when the bodies
 // are apart).
+//
+// The direction is taken in the unit's scale: the supports dot it with the
+// vertices, and at coordinates from 1e155 on the raw difference of
+// centroids times a vertex overflowed to inf and -inf, whose sum is NaN
+// (DistanceRegression.ScalesFrom1eMinus300To1e300).
 template <class Support>
 Simplex cold_start(const Frame& frame, Support& support, Vec3& direction) {
-  direction = frame.b_in_a.apply(frame.b.centroid()) - frame.a.centroid();
+  direction = (frame.b_in_a.apply(frame.b.centroid()) - frame.a.centroid()) * frame.inv_unit;
   if (!(direction.squaredNorm() > 0.0)) direction = Vec3::UnitX();
   Simplex s;
   s.p[0] = support(direction);
@@ -839,7 +844,7 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   } else {
     solve(simplex);
     direction = -simplex.v;
-    if (!(direction.squaredNorm() > 0.0)) direction = frame.b_in_a.apply(b.centroid()) - a.centroid();
+    if (!(direction.squaredNorm() > 0.0)) direction = (frame.b_in_a.apply(b.centroid()) - a.centroid()) * frame.inv_unit;
   }
 
   const DistanceResult result = run_gjk(frame, options, contact_tolerance, simplex, iterations, direction, support);

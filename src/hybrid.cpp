@@ -41,6 +41,21 @@ namespace {
 // accuracy standard.
 constexpr double kGapUlps = 16.0;
 
+// Range of R (the largest coordinate magnitude in A's frame) in which the
+// algorithm runs on the given coordinates. Squared lengths overflow from
+// R ~ 1e154 on (inf - inf: NaN) and underflow to subnormals or 0 from
+// R ~ 1e-154 down (answers off by 1e-5, then distances of 0); the kernels'
+// length^4 and length^6 terms are only valid for extents within 1e-75 ..
+// 1e75 (closest_point.h). Outside this range every coordinate is
+// multiplied by the power of two that brings R into [1/2, 1): exact, so the
+// answer is the same one the unscaled algorithm would give in exact range.
+// 2^+-64 leaves a wide margin both ways and sends the paper's stress cases
+// (cubes at 1e39, tetrahedra of 1e-23) and the accuracy suite's 1e-20 ..
+// 1e20 scales through the scaled path too, where the tests compare them
+// with the oracle. DistanceRegression.ScalesFrom1eMinus300To1e300 pins it.
+constexpr double kMinUnscaled = 0x1p-64;
+constexpr double kMaxUnscaled = 0x1p64;
+
 // A feature of one body: up to three hull vertex ids (a fourth slot for the
 // support point being added), with their positions in A's frame.
 struct FeatureSet {
@@ -285,17 +300,30 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
   return out;
 }
 
-}  // namespace
-
-DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                               const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
+// The algorithm on coordinates multiplied by `scale`, a power of two, when
+// kScaled (see hybrid_distance); `r_local` and `contact_tolerance` are in
+// those units already, and the result is returned in the caller's units.
+// The unscaled instance is the hot path and multiplies by nothing.
+template <bool kScaled>
+DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                          const DistanceOptions& options, double contact_tolerance, DistanceCache& cache,
+                          double r_local, double scale) {
   const Mat3& rot = b_in_a.rotation;
   const Vec3& tr = b_in_a.translation;
-  const auto b_point = [&](std::int32_t v) -> Vec3 { return rot * b.vertex(v) + tr; };
-  const auto a_point = [&](std::int32_t v) -> Vec3 { return a.vertex(v); };
-
-  // R in A's frame: B's coordinates are bounded by |t| + |y| <= |t|_inf + sqrt(3) scale_B per axis.
-  const double r_local = std::max(a.scale(), tr.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
+  const auto b_point = [&](std::int32_t v) -> Vec3 {
+    if constexpr (kScaled) {
+      return (rot * b.vertex(v) + tr) * scale;
+    } else {
+      return rot * b.vertex(v) + tr;
+    }
+  };
+  const auto a_point = [&](std::int32_t v) -> Vec3 {
+    if constexpr (kScaled) {
+      return a.vertex(v) * scale;
+    } else {
+      return a.vertex(v);
+    }
+  };
   const double ulp_r = kUnitRoundoff * r_local;
   // Features shorter or flatter than a few u R are reduced (closest_point.h).
   const KernelTolerance<double> tol = kernel_tolerance(r_local);
@@ -309,7 +337,9 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
                     load_feature(cache.vertices_b, b.vertex_count(), fb, b_point);
   if (!warm) {
     // Cold start: the support points along the line of centres.
-    const Vec3 towards_b = rot * b.centroid() + tr - a.centroid();
+    // In scaled units too: its dot products with vertices must not overflow.
+    Vec3 towards_b = rot * b.centroid() + tr - a.centroid();
+    if constexpr (kScaled) towards_b *= scale;
     const Vec3 dir = towards_b.squaredNorm() > 0.0 ? towards_b : Vec3::UnitX();
     hint_a = support_hill_climb(a, dir, hint_a);
     hint_b = support_hill_climb(b, -(rot.transpose() * dir), hint_b);
@@ -402,7 +432,30 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
   for (int i = 0; i < fb.n && i < 3; ++i) cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
   cache.hint_a = hint_a;
   cache.hint_b = hint_b;
+  if constexpr (kScaled) {
+    const double unit = 1.0 / scale;  // exact: a power of two
+    result.point_a *= unit;
+    result.point_b *= unit;
+    result.distance *= unit;
+    result.lower_bound *= unit;
+  }
   return result;
+}
+
+}  // namespace
+
+DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                               const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
+  // R in A's frame: B's coordinates are bounded by |t| + |y| <= |t|_inf + sqrt(3) scale_B per axis.
+  const double r_local = std::max(a.scale(), b_in_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
+  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) || !std::isfinite(r_local))
+      [[likely]] {
+    return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
+  }
+  int exponent = 0;
+  std::frexp(r_local, &exponent);
+  const double scale = std::ldexp(1.0, -exponent);
+  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale, scale);
 }
 
 }  // namespace proxima
