@@ -7,6 +7,10 @@
 //
 // The tracking targets of the hybrid (60 ns at any N, N = 4096 within 1.5 x
 // of N = 8) are read off the median rows of Tracking*/hybrid.
+//
+// TrackingOverlap and TrackingTouching measure tracked queries of pairs in
+// contact (most close pairs of a scene of moving bodies): the contact
+// classification (touching or intersecting) is part of their cost.
 #include "proxima/distance.h"
 
 #include <benchmark/benchmark.h>
@@ -18,7 +22,9 @@
 namespace proxima {
 namespace {
 
-std::vector<Vec3> sphere_points(int n, std::uint32_t seed) {
+using Points = std::vector<Vec3>;
+
+Points sphere_points(int n, std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g;
   std::vector<Vec3> pts;
@@ -86,6 +92,84 @@ void run(benchmark::State& state, Algorithm algorithm, bool tracking, const std:
                                                     benchmark::Counter::kAvgIterations);
 }
 
+// Contact pairs, N = 20 ... 200 (the vertex counts of scene bodies).
+//
+// Overlap: two unit spheres whose centres are 1.6 apart (they overlap by a
+// fifth of their diameter); B wobbles on a circle of radius 0.1 around that
+// place and spins slowly, 0.01 radian per step.
+std::vector<Pose> overlap_sequence() {
+  std::vector<Pose> poses;
+  poses.reserve(kSteps);
+  const Vec3 axis = Vec3(1, 2, 3).normalized();
+  for (int i = 0; i < kSteps; ++i) {
+    const double t = 2.0 * M_PI * i / kSteps * 20.0;
+    poses.emplace_back(Quat(Eigen::AngleAxisd(0.01 * i, axis)),
+                       Vec3(1.6, 0.1 * std::cos(t), 0.1 * std::sin(t)));
+  }
+  return poses;
+}
+
+// Touching: spheres cut flat at z = -0.5 (A flipped, cut at z = +0.5); B
+// rests on A's flat face (translation z = 1 exactly, so the faces are
+// coplanar in exact arithmetic) and slides in x, y while spinning about z
+// (a rotation about z keeps z exact): distance 0, face on face.
+Points flat_bottomed(int n, std::uint32_t seed, double side) {
+  Points pts = sphere_points(n, seed);
+  for (Vec3& p : pts) {
+    if (side * p.z() > 0.5) p.z() = side * 0.5;
+  }
+  return pts;
+}
+
+std::vector<Pose> touching_sequence() {
+  std::vector<Pose> poses;
+  poses.reserve(kSteps);
+  for (int i = 0; i < kSteps; ++i) {
+    const double t = 2.0 * M_PI * i / kSteps * 20.0;
+    poses.emplace_back(Quat(Eigen::AngleAxisd(0.01 * i, Vec3::UnitZ())),
+                       Vec3(0.1 * std::cos(t), 0.1 * std::sin(t), 1.0));
+  }
+  return poses;
+}
+
+void run_contact(benchmark::State& state, Algorithm algorithm, const ConvexPolytope& a, const ConvexPolytope& b,
+                 const std::vector<Pose>& poses, Status expected) {
+  DistanceOptions options;
+  options.algorithm = algorithm;
+  DistanceCache cache;
+  std::size_t i = 0;
+  long iterations = 0;
+  long unexpected = 0;
+  for (auto _ : state) {
+    const DistanceResult r = distance(a, Pose::identity(), b, poses[i], options, &cache);
+    benchmark::DoNotOptimize(r.distance);
+    iterations += r.iterations;
+    unexpected += r.status != expected ? 1 : 0;
+    if (++i == poses.size()) i = 0;
+  }
+  state.counters["iter/query"] = benchmark::Counter(static_cast<double>(iterations),
+                                                    benchmark::Counter::kAvgIterations);
+  // Share of queries whose status is not the scenario's: 0 expected.
+  state.counters["other_status"] = benchmark::Counter(static_cast<double>(unexpected),
+                                                      benchmark::Counter::kAvgIterations);
+}
+
+void TrackingOverlap(benchmark::State& s, Algorithm alg) {
+  static const auto poses = overlap_sequence();
+  const int n = static_cast<int>(s.range(0));
+  const ConvexPolytope a(sphere_points(n, 1));
+  const ConvexPolytope b(sphere_points(n, 2));
+  run_contact(s, alg, a, b, poses, Status::intersecting);
+}
+
+void TrackingTouching(benchmark::State& s, Algorithm alg) {
+  static const auto poses = touching_sequence();
+  const int n = static_cast<int>(s.range(0));
+  const ConvexPolytope a(flat_bottomed(n, 1, 1.0));
+  const ConvexPolytope b(flat_bottomed(n, 2, -1.0));
+  run_contact(s, alg, a, b, poses, Status::touching);
+}
+
 const std::vector<Pose>& translations() {
   static const auto poses = translation_sequence();
   return poses;
@@ -113,6 +197,14 @@ PROXIMA_DISTANCE_BENCH(TrackingTranslation);
 PROXIMA_DISTANCE_BENCH(NoTrackingTranslation);
 PROXIMA_DISTANCE_BENCH(TrackingRotation);
 PROXIMA_DISTANCE_BENCH(Cold);
+
+#define PROXIMA_CONTACT_BENCH(fn)                                                 \
+  BENCHMARK_CAPTURE(fn, hybrid, Algorithm::hybrid)->Arg(20)->Arg(64)->Arg(200);   \
+  BENCHMARK_CAPTURE(fn, gjk, Algorithm::gjk)->Arg(20)->Arg(64)->Arg(200);         \
+  BENCHMARK_CAPTURE(fn, enhanced_gjk, Algorithm::enhanced_gjk)->Arg(20)->Arg(64)->Arg(200)
+
+PROXIMA_CONTACT_BENCH(TrackingOverlap);
+PROXIMA_CONTACT_BENCH(TrackingTouching);
 
 }  // namespace
 }  // namespace proxima

@@ -11,7 +11,9 @@
 #include "proxima/hybrid.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -47,12 +49,28 @@ double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
   return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * p.scale();
 }
 
+// The largest coordinate magnitude of vertex y placed at `pose`.
+double placed_magnitude(const Vec3& y, const Pose& pose) { return pose.apply(y).cwiseAbs().maxCoeff(); }
+
 // The largest coordinate magnitude of the placed vertices themselves: the R
 // of the accuracy standard. O(N), so only computed when a distance falls
 // between the band of this R and the band of the bound above.
 double world_magnitude(const ConvexPolytope& p, const Pose& pose) {
   double r = 0.0;
-  for (const Vec3& y : p.vertices()) r = std::max(r, pose.apply(y).cwiseAbs().maxCoeff());
+  for (const Vec3& y : p.vertices()) r = std::max(r, placed_magnitude(y, pose));
+  return r;
+}
+
+// A lower bound on world_magnitude(p, pose) from a few vertices (ids out of
+// range skipped), computed as world_magnitude computes them: a distance
+// inside the band of this R is inside the band of the exact R. O(1).
+template <std::size_t kCount>
+double world_magnitude_floor(const ConvexPolytope& p, const Pose& pose,
+                             const std::array<std::int32_t, kCount>& ids) {
+  double r = 0.0;
+  for (const std::int32_t id : ids) {
+    if (id >= 0 && id < p.vertex_count()) r = std::max(r, placed_magnitude(p.vertex(id), pose));
+  }
   return r;
 }
 
@@ -100,7 +118,18 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   DistanceCache cold;
   DistanceCache& c = cache != nullptr ? *cache : cold;
   DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
-  if (result.status == Status::touching && result.distance > 0.0) {
+  // Most contacts (overlapping bodies) end with a distance of a few
+  // roundings: inside the band of a lower bound on R taken from the cached
+  // features and support hints, where the exact R could not change the
+  // answer, and it is not computed.
+  const auto band_floor = [&] {
+    const std::array ids_a = {c.vertices_a[0], c.vertices_a[1], c.vertices_a[2], c.hint_a};
+    const std::array ids_b = {c.vertices_b[0], c.vertices_b[1], c.vertices_b[2], c.hint_b};
+    const double r_floor =
+        std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
+    return kContactUlps * kUnitRoundoff * r_floor + options.absolute_tolerance;
+  };
+  if (result.status == Status::touching && result.distance > 0.0 && result.distance > band_floor()) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
     const double band = kContactUlps * kUnitRoundoff * r_exact + options.absolute_tolerance;
     if (band < band_bound && result.distance > band) result = run(a, b, b_in_a, options, band, c);
@@ -110,11 +139,25 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   // is within the band: touching; a polytope inside A - B holding a ball of
   // the band's radius around the origin: intersecting); undecided within the
   // iteration cap counts as touching, the distance being in the band anyway.
+  // Tracking: the search's last tetrahedron around the origin is kept in the
+  // cache; if it still holds the origin deeper than the band, intersection
+  // is certified without a search (the same certificate the search ends
+  // with). Otherwise the search starts from the search's last simplex.
   if (options.algorithm == Algorithm::hybrid && result.status == Status::touching) {
-    DistanceCache contact_cache;
-    contact_cache.hint_a = c.hint_a;
-    contact_cache.hint_b = c.hint_b;
-    const DistanceResult contact = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, contact_cache);
+    DistanceResult contact;
+    if (encloses_origin_deeply(a, b, b_in_a, band_bound, c.contact_a, c.contact_b)) {
+      contact.status = Status::intersecting;
+      contact.iterations = 0;
+    } else {
+      DistanceCache contact_cache;
+      contact_cache.hint_a = c.hint_a;
+      contact_cache.hint_b = c.hint_b;
+      contact_cache.vertices_a = c.contact_a;
+      contact_cache.vertices_b = c.contact_b;
+      contact = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, contact_cache);
+      c.contact_a = contact_cache.vertices_a;
+      c.contact_b = contact_cache.vertices_b;
+    }
     if (contact.status == Status::intersecting) {
       const Vec3 middle = 0.5 * (result.point_a + result.point_b);
       result.status = Status::intersecting;

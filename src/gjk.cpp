@@ -448,6 +448,31 @@ struct HillClimbSupport {
   }
 };
 
+// The origin's depth inside the tetrahedron (p0, p1, p2, p3): its smallest
+// distance to the four face planes, each oriented outwards by the centroid
+// and computed as classify_contact computes a face (below). Negative when the
+// origin is outside; the lowest double when the tetrahedron is flat (no face
+// can be oriented). Depth above the contact band certifies intersection:
+// the tetrahedron's points are points of C.
+double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
+  const std::array<const Vec3*, 4> p = {&p0, &p1, &p2, &p3};
+  const Vec3 inner = 0.25 * (p0 + p1 + p2 + p3);
+  double depth = std::numeric_limits<double>::max();
+  for (const auto& f : kOppositeFace) {
+    const Vec3& pi = *p[idx(f[0])];
+    Vec3 nrm = face_normal(*p[idx(f[1])] - pi, *p[idx(f[2])] - pi).n;
+    double side = nrm.dot(pi - inner);
+    if (side < 0.0) {
+      nrm = -nrm;
+      side = -side;
+    }
+    const double len = nrm.norm();
+    if (!(side > 0.0) || !(len > 0.0)) return std::numeric_limits<double>::lowest();
+    depth = std::min(depth, (nrm / len).dot(pi));
+  }
+  return depth;
+}
+
 // ---------------------------------------------------------------------------
 // Contact classification. GJK reaches the contact band in one of two ways:
 // a tetrahedron of C that strictly encloses the origin, or a closest point
@@ -476,12 +501,23 @@ struct ContactFace {
   double offset = 0.0;         // normal.x == offset on the face; the origin's depth below it
 };
 
+// When it certifies intersection, `deep` receives a tetrahedron of P's points
+// (with their vertex pairs) that holds the origin deeper than tol by itself,
+// if one exists (P itself when it is a tetrahedron; otherwise the deepest of
+// the cones from a vertex of P over its faces, which tile P): a tracked
+// query re-checks it in O(1) (encloses_origin_deeply). deep[0].ia stays -1
+// when there is none.
 template <class Support>
-Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations, int max_iterations) {
+Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations, int max_iterations,
+                        Points& deep) {
   tol = std::max(tol, 0.0);
+  std::array<SupportPoint, kMaxContactVertices> sp;
   std::array<Vec3, kMaxContactVertices> p;
   int n = 0;
-  for (int k = 0; k < s.size; ++k) p[idx(n++)] = s.p[idx(k)].w;
+  for (int k = 0; k < s.size; ++k) {
+    sp[idx(n)] = s.p[idx(k)];
+    p[idx(n++)] = s.p[idx(k)].w;
+  }
 
   while (n < 4) {
     Vec3 d = Vec3::UnitX();
@@ -506,6 +542,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
     const SupportPoint w = support(d);
     ++iterations;
     if (d.dot(w.w) <= tol) return Status::touching;
+    sp[idx(n)] = w;
     p[idx(n++)] = w.w;
   }
 
@@ -539,7 +576,25 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
     for (int f = 1; f < nf; ++f) {
       if (faces[idx(f)].offset < faces[idx(best)].offset) best = f;
     }
-    if (faces[idx(best)].offset > tol) return Status::intersecting;
+    if (faces[idx(best)].offset > tol) {
+      if (n == 4) {
+        deep = {sp[0], sp[1], sp[2], sp[3]};
+        return Status::intersecting;
+      }
+      double deepest = tol;
+      for (int r = 0; r < n; ++r) {
+        for (int f = 0; f < nf; ++f) {
+          const auto& v = faces[idx(f)].v;
+          if (v[0] == r || v[1] == r || v[2] == r) continue;
+          const double depth = origin_depth(p[idx(r)], p[idx(v[0])], p[idx(v[1])], p[idx(v[2])]);
+          if (depth > deepest) {
+            deepest = depth;
+            deep = {sp[idx(r)], sp[idx(v[0])], sp[idx(v[1])], sp[idx(v[2])]};
+          }
+        }
+      }
+      return Status::intersecting;
+    }
     if (n == kMaxContactVertices) return Status::touching;
     if (iterations >= max_iterations) return Status::iteration_cap;
     const Vec3 normal = faces[idx(best)].normal;
@@ -549,6 +604,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
 
     // Add w: remove the faces it sees, close the hole with a cone over the
     // horizon (the edges of exactly one removed face).
+    sp[idx(n)] = w;
     p[idx(n)] = w.w;
     std::array<std::array<int, 3>, kMaxContactEdges> edges;  // lo, hi, count
     int ne = 0;
@@ -693,9 +749,11 @@ Feature witness_feature(const ConvexPolytope& poly, const std::array<std::int32_
 // `simplex` is solved on entry (at least one point); `iterations` counts the
 // support evaluations made so far; `direction` is the search direction used
 // so far (from A towards B), the normal reported when no better one exists.
+// `deep` receives the contact classification's tetrahedron around the origin
+// when it certifies intersection (classify_contact).
 template <class Support>
 DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, double contact_tolerance,
-                       Simplex& simplex, int iterations, Vec3 direction, Support& support) {
+                       Simplex& simplex, int iterations, Vec3 direction, Support& support, Points& deep) {
   const double tol = contact_tolerance * frame.inv_unit;
   double lower = 0.0;  // certified lower bound, scaled units
   double w_max2 = 0.0;
@@ -732,7 +790,7 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
 
   Status status = Status::separated;
   if (contact) {
-    status = classify_contact(simplex, tol, support, iterations, options.max_iterations);
+    status = classify_contact(simplex, tol, support, iterations, options.max_iterations, deep);
     // A touching contact whose tetrahedron encloses the origin (by rounding,
     // or within the band): the origin is within tol of a face of it (else
     // the classification would have certified depth), so that face's
@@ -815,7 +873,8 @@ DistanceResult gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
   BruteForceSupport support{frame};
   Vec3 direction;
   Simplex simplex = cold_start(frame, support, direction);
-  return run_gjk(frame, options, contact_tolerance, simplex, 1, direction, support);
+  Points deep;
+  return run_gjk(frame, options, contact_tolerance, simplex, 1, direction, support, deep);
 }
 
 DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
@@ -847,8 +906,18 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
     if (!(direction.squaredNorm() > 0.0)) direction = (frame.b_in_a.apply(b.centroid()) - a.centroid()) * frame.inv_unit;
   }
 
-  const DistanceResult result = run_gjk(frame, options, contact_tolerance, simplex, iterations, direction, support);
-  // run_gjk reduced `simplex` in place to the final one.
+  Points deep;
+  const DistanceResult result =
+      run_gjk(frame, options, contact_tolerance, simplex, iterations, direction, support, deep);
+  // run_gjk reduced `simplex` in place to the final one. An intersection
+  // certified by a tetrahedron around the origin caches that tetrahedron
+  // instead: while the bodies overlap by more than the band, the next query
+  // starts from it enclosing the origin and certifies it again without a
+  // support search.
+  if (result.status == Status::intersecting && deep[0].ia >= 0) {
+    simplex.p = deep;
+    simplex.size = 4;
+  }
   for (std::size_t k = 0; k < 4; ++k) {
     const bool used = static_cast<int>(k) < simplex.size;
     cache.vertices_a[k] = used ? simplex.p[k].ia : -1;
@@ -857,6 +926,20 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   cache.hint_a = support.hint_a;
   cache.hint_b = support.hint_b;
   return result;
+}
+
+bool encloses_origin_deeply(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                            double contact_tolerance, const std::array<std::int32_t, 4>& ids_a,
+                            const std::array<std::int32_t, 4>& ids_b) {
+  for (std::size_t k = 0; k < 4; ++k) {
+    if (ids_a[k] < 0 || ids_a[k] >= a.vertex_count() || ids_b[k] < 0 || ids_b[k] >= b.vertex_count()) return false;
+  }
+  // In the units of the GJK simplex, like the contact classification: the
+  // same points, the same faces, the same certificate.
+  const Frame frame(a, b, b_in_a);
+  const double tol = std::max(contact_tolerance, 0.0) * frame.inv_unit;
+  const auto w = [&](std::size_t k) { return frame.point(ids_a[k], ids_b[k]).w; };
+  return origin_depth(w(0), w(1), w(2), w(3)) > tol;
 }
 
 }  // namespace proxima

@@ -12,6 +12,9 @@
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
+#include <array>
+#include <cstdint>
+
 namespace proxima {
 
 DistanceResult gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
@@ -20,5 +23,14 @@ DistanceResult gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
 DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b,
                                      const Pose& b_in_a, const DistanceOptions& options,
                                      double contact_tolerance, DistanceCache& cache);
+
+// Whether the Minkowski-difference points a_k - b_k, k = 0..3 (hull vertex
+// ids; a tetrahedron cached by a contact classification) hold the origin
+// deeper than contact_tolerance: then the hulls intersect, certified (the
+// same certificate as Enhanced GJK's contact search). False for ids out of
+// range and for a flat or shallow tetrahedron. O(1).
+bool encloses_origin_deeply(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                            double contact_tolerance, const std::array<std::int32_t, 4>& ids_a,
+                            const std::array<std::int32_t, 4>& ids_b);
 
 }  // namespace proxima

@@ -148,8 +148,15 @@ struct DistanceCache {
   // face lookup.
   std::int32_t face_a = -1;
   std::int32_t face_b = -1;
+  // The hybrid's contact classification (touching or intersecting): the
+  // vertex pairs (a_k in A, b_k in B) of its last tetrahedron of points
+  // a_k - b_k that held the origin deeper than the contact band, or of its
+  // last simplex, -1 where unused. While the bodies overlap the next query
+  // re-certifies that tetrahedron in O(1) instead of searching again.
+  std::array<std::int32_t, 4> contact_a = {-1, -1, -1, -1};
+  std::array<std::int32_t, 4> contact_b = {-1, -1, -1, -1};
 
-  bool is_cold() const { return vertices_a[0] < 0 && hint_a < 0; }
+  bool is_cold() const { return vertices_a[0] < 0 && hint_a < 0 && contact_a[0] < 0; }
   void reset() { *this = DistanceCache{}; }
 };
 
