@@ -2,8 +2,8 @@
 // 4096 vertices (points on a sphere, seeded), on translation and rotation
 // sequences. Time per query is the benchmark's time per iteration.
 //
-//   ./build/release/bench/distance_bench --benchmark_repetitions=5 \
-//       --benchmark_report_aggregates_only=true
+//   ./build/release/bench/distance_bench --benchmark_repetitions=5
+//       --benchmark_report_aggregates_only=true   (one command line)
 //
 // The tracking targets of the hybrid (60 ns at any N, N = 4096 within 1.5 x
 // of N = 8) are read off the median rows of Tracking*/hybrid.
