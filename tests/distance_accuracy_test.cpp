@@ -1089,7 +1089,9 @@ TEST(DistanceRegression, ScalesFrom1eMinus300To1e300) {
   const Points b0 = points_on_sphere(rng, 12);
   int cases = 0;
   int near_cases = 0;
-  for (int e = -300; e <= 300; e += 25) {
+  // Every 25 decades; every 75 under ASan, where the oracle is slow.
+  constexpr int kDecades = kCountDivisor == 1 ? 25 : 75;
+  for (int e = -300; e <= 300; e += kDecades) {
     const double s = std::pow(10.0, e);
     const Points a = scaled(a0, s);
     const Points b = scaled(b0, s);
