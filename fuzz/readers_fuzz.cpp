@@ -66,6 +66,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       require(polytope.vertex_count() >= 1, "a hull has a vertex");
       require(polytope.vertex_count() + polytope.interior_point_count() == static_cast<int>(cloud.points.size()),
               "every input point is a hull vertex or counted as interior");
+      if (!cloud.group_offsets.empty()) {  // OBJ groups: one convex piece each
+        const proxima::LoadedCompound compound = proxima::compound_from_cloud(cloud);
+        require(compound.body.piece_count() == static_cast<int>(cloud.group_offsets.size()),
+                "one compound piece per group");
+      }
     } catch (const proxima::InvalidInput&) {
       // Refused input: the expected outcome for most mutants.
     }
