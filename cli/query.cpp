@@ -10,11 +10,6 @@
 // the answer to a good one.
 #include "query.h"
 
-#include "proxima/distance.h"
-#include "proxima/polytope.h"
-
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <atomic>
 #include <charconv>
@@ -23,6 +18,7 @@
 #include <exception>
 #include <functional>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -30,6 +26,9 @@
 #include <thread>
 #include <utility>
 #include <vector>
+
+#include "proxima/distance.h"
+#include "proxima/polytope.h"
 
 namespace proxima::cli {
 namespace {
@@ -251,15 +250,13 @@ void read_body(const Json& query, const std::string& name, std::vector<Vec3>& ve
   if (q != body->end() && !q->is_null()) {
     double wxyz[4];
     read_numbers(*q, name + ".rotation", 4, "4 numbers [w, x, y, z]", wxyz);
-    // Normalize by the largest component first: the squared norm of
-    // [1e300, 0, 0, 0] overflows and that of [1e-200, 0, 0, 0] underflows to
-    // zero, yet both are the identity. After the division the largest
-    // component is 1 and the squared norm lies in [1, 4].
-    double largest = 0.0;
-    for (const double c : wxyz) largest = std::max(largest, std::abs(c));
-    if (largest == 0.0) fail(name + ".rotation has zero norm: it is not a rotation");
-    rotation = Quat(wxyz[0] / largest, wxyz[1] / largest, wxyz[2] / largest, wxyz[3] / largest);
-    rotation.normalize();
+    // Normalized at any magnitude, a zero quaternion refused: the pose
+    // contract's own function (proxima/pose.h), as in Python.
+    try {
+      rotation = unit_quaternion(Quat(wxyz[0], wxyz[1], wxyz[2], wxyz[3]), name + ".rotation");
+    } catch (const InvalidInput& e) {
+      fail(e.what());
+    }
   }
   Vec3 translation = Vec3::Zero();
   const auto t = body->find("translation");

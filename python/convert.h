@@ -11,6 +11,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstddef>
@@ -30,14 +31,6 @@ namespace py = pybind11;
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 using Int32Array = py::array_t<std::int32_t>;
-
-// How far a 4x4 pose may be from a rigid motion and still be taken as one:
-// max |R^T R - I| and max |bottom row - (0 0 0 1)|. Poses often arrive
-// through float32 (graphics and mesh tools), whose rounding leaves R^T R off
-// by a few 1e-7; a scale, shear or projective row any larger than this is a
-// mistake, not rounding, and would be silently wrong: the query inverts the
-// pose by transposing R.
-inline constexpr double kRigidTolerance = 1e-6;
 
 [[noreturn]] inline void value_error(const std::string& message) { throw py::value_error(message); }
 
@@ -85,30 +78,28 @@ py::array_t<double> matrix_array(const Eigen::Matrix<double, kRows, kCols>& m) {
   return out;
 }
 
-// Rejects a finite matrix that is not a proper rotation (a non-finite one is
-// left to the C++ query, whose InvalidInput says so).
-inline void check_rigid(const Mat3& r, const Eigen::Vector4d& bottom, const std::string& name) {
-  if (!r.allFinite() || !bottom.allFinite()) return;
-  const double off_rigid = (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff();
-  const double off_bottom = (bottom - Eigen::Vector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff();
-  if (off_bottom > kRigidTolerance)
-    value_error(name + ": the bottom row of a pose matrix must be (0, 0, 0, 1)");
-  if (off_rigid > kRigidTolerance || r.determinant() < 0) {
-    value_error(name + ": the rotation part is not a rotation (max |R^T R - I| = " +
-                std::to_string(off_rigid) + ", det = " + std::to_string(r.determinant()) +
-                "); proxima takes rigid motions only");
-  }
-}
-
+// A 4x4 matrix under the rigid-pose contract (proxima/pose.h): every entry
+// finite (the bottom row too), the bottom row (0, 0, 0, 1) within the
+// contract's tolerance, the rest checked (and re-orthonormalized when
+// needed) by checked_pose, whose refusal (InvalidInput) names `name`.
 inline Pose pose_from_matrix(const double* m, const std::string& name) {
+  for (int k = 0; k < 16; ++k) {
+    if (!is_finite_bits(m[k])) {
+      throw InvalidInput(name + " is not finite (NaN or infinite entry at row " +
+                         std::to_string(k / 4) + ", column " + std::to_string(k % 4) + ")");
+    }
+  }
+  const double off_bottom =
+      std::max({std::abs(m[12]), std::abs(m[13]), std::abs(m[14]), std::abs(m[15] - 1.0)});
+  if (off_bottom > kRotationTolerance)
+    value_error(name + ": the bottom row of a pose matrix must be (0, 0, 0, 1)");
   Mat3 r;
   Vec3 t;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) r(i, j) = m[4 * i + j];
     t[i] = m[4 * i + 3];
   }
-  check_rigid(r, Eigen::Vector4d(m[12], m[13], m[14], m[15]), name);
-  return {r, t};
+  return checked_pose(Pose(r, t), name);
 }
 
 inline Pose pose_from_quaternion(py::handle q_obj, py::handle t_obj, const std::string& name) {
@@ -116,11 +107,10 @@ inline Pose pose_from_quaternion(py::handle q_obj, py::handle t_obj, const std::
   if (q.ndim() != 1 || q.shape(0) != 4) {
     value_error(name + ": the quaternion must be 4 numbers (w, x, y, z), got shape " + shape_of(q));
   }
-  const Quat quat(q.at(0), q.at(1), q.at(2), q.at(3));
-  // Eigen leaves a zero quaternion unnormalized, which would be a zero
-  // "rotation": refuse it here (a NaN one is left to the query's check).
-  if (quat.coeffs().squaredNorm() == 0.0) value_error(name + ": the quaternion is zero");
-  return {quat, to_vec3(t_obj, name + " translation")};
+  // Normalized at any magnitude; a zero or non-finite quaternion is refused
+  // (InvalidInput naming `name`), as in the CLI: the same function.
+  const Quat unit = unit_quaternion(Quat(q.at(0), q.at(1), q.at(2), q.at(3)), name);
+  return {unit.toRotationMatrix(), to_vec3(t_obj, name + " translation")};
 }
 
 // A pose argument: None (identity), a proxima.Pose, a 4x4 matrix or a

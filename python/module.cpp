@@ -73,9 +73,8 @@ PYBIND11_MODULE(proxima, m) {
   py::class_<Pose>(m, "Pose", "A rigid motion: x -> rotation @ x + translation.")
       .def(py::init<>(), "The identity.")
       .def(py::init([](py::object rotation, py::object translation) {
-             const Mat3 r = to_mat3(rotation, "rotation");
-             check_rigid(r, Eigen::Vector4d(0, 0, 0, 1), "rotation");
-             return Pose(r, to_vec3(translation, "translation"));
+             return checked_pose(Pose(to_mat3(rotation, "rotation"), to_vec3(translation, "translation")),
+                                 "rotation");
            }),
            py::arg("rotation"), py::arg("translation"),
            "From a 3x3 rotation matrix and a translation.")

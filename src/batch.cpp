@@ -36,10 +36,8 @@ void check_size(std::size_t size, std::size_t expected, const char* name) {
 
 void check_poses(std::span<const Pose> poses, const char* name) {
   for (std::size_t k = 0; k < poses.size(); ++k) {
-    if (!poses[k].is_finite()) {
-      throw InvalidInput("distance_batch: " + std::string(name) + "[" + at(k) +
-                         "] is not finite (NaN or infinite rotation or translation)");
-    }
+    check_pose(poses[k],
+               [&] { return "distance_batch: " + std::string(name) + "[" + at(k) + "]"; });
   }
 }
 

@@ -132,18 +132,7 @@ CompoundBody::CompoundBody(std::vector<CompoundPiece> pieces) : pieces_(std::mov
   for (std::size_t i = 0; i < n; ++i) {
     const CompoundPiece& piece = pieces_[i];
     if (!piece.polytope) throw InvalidInput(piece_prefix(i) + "null polytope");
-    if (!piece.pose.is_finite()) {
-      throw InvalidInput(piece_prefix(i) +
-                         "pose is not finite (NaN or infinite rotation or translation)");
-    }
-    const Mat3& r = piece.pose.rotation;
-    const double skew = (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff();
-    if (!(skew <= kOrthonormalTolerance)) {
-      throw InvalidInput(piece_prefix(i) + "pose rotation is not orthonormal (|R^T R - I| = " +
-                         std::to_string(skew) + ")");
-    }
-    if (r.determinant() < 0.0)
-      throw InvalidInput(piece_prefix(i) + "pose rotation is a reflection (determinant -1)");
+    pieces_[i].pose = checked_pose(piece.pose, [&] { return piece_prefix(i) + "pose"; });
 
     // The piece's sphere and its share of the scale from its placed
     // vertices themselves: exact R, and a radius that holds every vertex
@@ -290,13 +279,6 @@ std::size_t CompoundBody::memory_bytes() const {
 }
 
 namespace {
-
-void check_pose(const Pose& pose, const char* name) {
-  if (!pose.is_finite()) [[unlikely]] {
-    throw InvalidInput(std::string("distance: ") + name +
-                       " is not finite (NaN or infinite rotation or translation)");
-  }
-}
 
 // Upper bound on the largest world coordinate of a body placed at `pose`:
 // |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale.
@@ -513,15 +495,15 @@ class Search {
 
 CompoundResult distance(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                         const Pose& pose_b, const DistanceOptions& options, CompoundCache* cache) {
-  check_pose(pose_a, "pose_a");
-  check_pose(pose_b, "pose_b");
-  return Search(a, pose_a, b, pose_b, options, cache).run();
+  return Search(a, checked_pose(pose_a, "distance: pose_a"), b,
+                checked_pose(pose_b, "distance: pose_b"), options, cache)
+      .run();
 }
 
 CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                                   const Pose& pose_b, const DistanceOptions& options) {
-  check_pose(pose_a, "pose_a");
-  check_pose(pose_b, "pose_b");
+  check_pose(pose_a, "distance_all_pairs: pose_a");
+  check_pose(pose_b, "distance_all_pairs: pose_b");
   CompoundResult best;
   bool have_best = false;
   for (std::int32_t pa = 0; pa < a.piece_count(); ++pa) {

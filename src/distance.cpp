@@ -7,15 +7,15 @@
 // its answer back to the world frame.
 #include "proxima/distance.h"
 
-#include "proxima/gjk.h"
-#include "proxima/hybrid.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <string>
+
+#include "proxima/gjk.h"
+#include "proxima/hybrid.h"
 
 namespace proxima {
 namespace {
@@ -37,12 +37,6 @@ constexpr double kCertificateUlps = 32.0;
 // are NaN. Such input is refused by name instead of answered with NaN.
 constexpr double kMaxMagnitude = 0x1p1018;
 
-void check_pose(const Pose& pose, const char* name) {
-  if (!pose.is_finite()) [[unlikely]] {
-    throw InvalidInput(std::string("distance: ") + name + " is not finite (NaN or infinite rotation or translation)");
-  }
-}
-
 // Upper bound on the largest coordinate magnitude of a body placed at `pose`:
 // |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale. O(1).
 double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
@@ -50,7 +44,9 @@ double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
 }
 
 // The largest coordinate magnitude of vertex y placed at `pose`.
-double placed_magnitude(const Vec3& y, const Pose& pose) { return pose.apply(y).cwiseAbs().maxCoeff(); }
+double placed_magnitude(const Vec3& y, const Pose& pose) {
+  return pose.apply(y).cwiseAbs().maxCoeff();
+}
 
 // The largest coordinate magnitude of the placed vertices themselves: the R
 // of the accuracy standard. O(N), so only computed when a distance falls
@@ -77,22 +73,28 @@ double world_magnitude_floor(const ConvexPolytope& p, const Pose& pose,
 DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                    const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
   switch (options.algorithm) {
-    case Algorithm::gjk: return gjk_distance(a, b, b_in_a, options, contact_tolerance);
-    case Algorithm::enhanced_gjk: return enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, cache);
-    case Algorithm::hybrid: break;
+    case Algorithm::gjk:
+      return gjk_distance(a, b, b_in_a, options, contact_tolerance);
+    case Algorithm::enhanced_gjk:
+      return enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, cache);
+    case Algorithm::hybrid:
+      break;
   }
   return hybrid_distance(a, b, b_in_a, options, contact_tolerance, cache);
 }
 
 }  // namespace
 
-DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                        const Pose& pose_b, const DistanceOptions& options, DistanceCache* cache) {
-  check_pose(pose_a, "pose_a");
-  check_pose(pose_b, "pose_b");
+DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const ConvexPolytope& b,
+                        const Pose& given_pose_b, const DistanceOptions& options,
+                        DistanceCache* cache) {
+  const Pose pose_a = checked_pose(given_pose_a, "distance: pose_a");
+  const Pose pose_b = checked_pose(given_pose_b, "distance: pose_b");
   if (!(options.relative_tolerance >= 0.0) || !(options.absolute_tolerance >= 0.0) ||
       !std::isfinite(options.relative_tolerance) || !std::isfinite(options.absolute_tolerance)) {
-    throw InvalidInput("distance: options.relative_tolerance and options.absolute_tolerance must be finite and >= 0");
+    throw InvalidInput(
+        "distance: options.relative_tolerance and options.absolute_tolerance must be finite and >= "
+        "0");
   }
   if (options.max_iterations < 1) {
     throw InvalidInput("distance: options.max_iterations must be at least 1");
@@ -102,14 +104,16 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   // found inside that band but above 0 may still be outside the band of the
   // exact R; then the exact R is computed and the query resumed from its own
   // cache with the exact band, so that "separated" means d > 64 u R exactly.
-  const double r_bound = std::max(world_magnitude_bound(a, pose_a), world_magnitude_bound(b, pose_b));
+  const double r_bound =
+      std::max(world_magnitude_bound(a, pose_a), world_magnitude_bound(b, pose_b));
   if (!(r_bound <= kMaxMagnitude)) [[unlikely]] {
     char what[200];
-    std::snprintf(what, sizeof what,
-                  "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
-                  "beyond the supported %.3g where differences of coordinates may overflow",
-                  world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
-                  kMaxMagnitude);
+    std::snprintf(
+        what, sizeof what,
+        "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
+        "beyond the supported %.3g where differences of coordinates may overflow",
+        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
+        kMaxMagnitude);
     throw InvalidInput(what);
   }
   const Pose b_in_a = pose_a.inverse() * pose_b;
@@ -129,7 +133,8 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
         std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
     return kContactUlps * kUnitRoundoff * r_floor + options.absolute_tolerance;
   };
-  if (result.status == Status::touching && result.distance > 0.0 && result.distance > band_floor()) {
+  if (result.status == Status::touching && result.distance > 0.0 &&
+      result.distance > band_floor()) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
     const double band = kContactUlps * kUnitRoundoff * r_exact + options.absolute_tolerance;
     if (band < band_bound && result.distance > band) result = run(a, b, b_in_a, options, band, c);
@@ -174,8 +179,8 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   // GJK from its own cold start, and the closer of the two pairs of points
   // (both lie in the hulls) is kept with the larger of the two lower bounds.
   if (options.algorithm == Algorithm::hybrid && result.status == Status::separated &&
-      result.distance - result.lower_bound >
-          options.relative_tolerance * result.distance + kCertificateUlps * kUnitRoundoff * r_bound) {
+      result.distance - result.lower_bound > options.relative_tolerance * result.distance +
+                                                 kCertificateUlps * kUnitRoundoff * r_bound) {
     DistanceCache second_cache;
     DistanceResult second = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, second_cache);
     const double lower = std::max(result.lower_bound, second.lower_bound);

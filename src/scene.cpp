@@ -105,13 +105,6 @@ struct Scene::Impl {
     return bodies[slot(id)];
   }
 
-  static void check_pose(const Pose& pose, const char* what, const std::string& which) {
-    if (!pose.is_finite()) {
-      throw InvalidInput(std::string("Scene::") + what + ": pose of " + which +
-                         " is not finite (NaN or infinite rotation or translation)");
-    }
-  }
-
   BodyId take_id() {
     if (!free_ids.empty()) {
       const BodyId id = free_ids.back();
@@ -240,17 +233,16 @@ Scene& Scene::operator=(Scene&&) noexcept = default;
 
 BodyId Scene::add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose) {
   if (!body) throw InvalidInput("Scene::add: the convex body is null");
-  Impl::check_pose(pose, "add", "the new convex body");
   Impl::Body b;
+  b.pose = checked_pose(pose, "Scene::add: pose of the new convex body");
   if (impl_->compound_count > 0) b.compound = Impl::wrap(body);
   b.convex = std::move(body);
-  b.pose = pose;
   return impl_->insert(std::move(b));
 }
 
 BodyId Scene::add(std::shared_ptr<const CompoundBody> body, const Pose& pose) {
   if (!body) throw InvalidInput("Scene::add: the compound body is null");
-  Impl::check_pose(pose, "add", "the new compound body");
+  const Pose checked = checked_pose(pose, "Scene::add: pose of the new compound body");
   if (impl_->compound_count == 0) {
     // From now on convex bodies may meet a compound: give each its wrapper.
     for (Impl::Body& other : impl_->bodies) {
@@ -259,7 +251,7 @@ BodyId Scene::add(std::shared_ptr<const CompoundBody> body, const Pose& pose) {
   }
   Impl::Body b;
   b.compound = std::move(body);
-  b.pose = pose;
+  b.pose = checked;
   const BodyId id = impl_->insert(std::move(b));
   ++impl_->compound_count;
   return id;
@@ -267,8 +259,8 @@ BodyId Scene::add(std::shared_ptr<const CompoundBody> body, const Pose& pose) {
 
 void Scene::set_pose(BodyId id, const Pose& pose) {
   impl_->live_body(id, "set_pose");
-  Impl::check_pose(pose, "set_pose", name(id));
-  impl_->bodies[slot(id)].pose = pose;
+  impl_->bodies[slot(id)].pose =
+      checked_pose(pose, [&] { return "Scene::set_pose: pose of " + name(id); });
 }
 
 void Scene::remove(BodyId id) {

@@ -364,7 +364,7 @@ TEST(CliQuery, BadFieldsAreNamedAndTheRunGoesOn) {
       {R"({"a": [[0,0,0]], "b": {"vertices": [[1,0,0]]}})", "a is not an object (it is an array)"},
       {R"({"a": {"vertices": [[0,0,0]]}})", "missing \"b\""},
       {R"({"a": {"vertices": [[0,0,0]], "rotation": [0,0,0,0]}, "b": {"vertices": [[1,0,0]]}})",
-       "a.rotation has zero norm: it is not a rotation"},
+       "a.rotation: the quaternion is zero: it is not a rotation"},
       {R"({"a": {"vertices": [[0,0,0]], "rotation": [1,0,0]}, "b": {"vertices": [[1,0,0]]}})",
        "a.rotation is not an array of 4 numbers [w, x, y, z] (it has 3 elements)"},
       {R"({"a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[1,0,0]], "translation": [0,null,0]}})",

@@ -592,10 +592,10 @@ TEST(Compound, BadInputNamesThePiece) {
             std::string::npos);
   const Pose scaled_pose(Mat3(Mat3::Identity() * 1.001), Vec3::Zero());
   EXPECT_NE(message_of(body_with(1, {poly, scaled_pose}))
-                .find("piece 1: pose rotation is not orthonormal"),
+                .find("piece 1: pose: rotation is not orthonormal"),
             std::string::npos);
   const Pose mirror(Mat3(Eigen::Vector3d(1, 1, -1).asDiagonal()), Vec3::Zero());
-  EXPECT_NE(message_of(body_with(4, {poly, mirror})).find("piece 4: pose rotation is a reflection"),
+  EXPECT_NE(message_of(body_with(4, {poly, mirror})).find("piece 4: pose: rotation is a reflection"),
             std::string::npos);
   const Pose overflow = Pose::from_translation(Vec3(1.7e308, 0, 0));
   const auto huge =

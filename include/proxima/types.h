@@ -1,9 +1,11 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Layer 1: the vocabulary every other layer speaks. Eigen aliases, poses,
-// feature ids, statuses and the error type for bad input.
+// Layer 1: the vocabulary every other layer speaks. Eigen aliases and poses
+// (pose.h), feature ids, statuses and results.
 #pragma once
+
+#include "proxima/pose.h"
 
 #include <Eigen/Geometry>
 
@@ -15,52 +17,6 @@
 #include <string>
 
 namespace proxima {
-
-using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
-using Quat = Eigen::Quaterniond;
-using Isometry3 = Eigen::Isometry3d;
-
-// Unit roundoff of double, u = 2^-53. The accuracy standard of DESIGN.md is
-// written in units of u times the largest coordinate magnitude R.
-inline constexpr double kUnitRoundoff = 0x1p-53;
-
-// A rigid motion. Accepts an Eigen isometry or a (quaternion, translation)
-// pair; the quaternion is normalized on construction so that a caller's
-// slightly denormalized input does not scale the body.
-struct Pose {
-  Mat3 rotation = Mat3::Identity();
-  Vec3 translation = Vec3::Zero();
-
-  Pose() = default;
-  Pose(const Mat3& r, const Vec3& t) : rotation(r), translation(t) {}
-  Pose(const Quat& q, const Vec3& t) : rotation(q.normalized().toRotationMatrix()), translation(t) {}
-  Pose(const Isometry3& iso) : rotation(iso.linear()), translation(iso.translation()) {}  // NOLINT(google-explicit-constructor)
-
-  static Pose identity() { return {}; }
-  static Pose from_translation(const Vec3& t) { return {Mat3::Identity(), t}; }
-
-  Vec3 apply(const Vec3& p) const { return rotation * p + translation; }
-  Pose inverse() const { return {Mat3(rotation.transpose()), Vec3(-(rotation.transpose() * translation))}; }
-  // (this * other).apply(p) == this->apply(other.apply(p))
-  Pose operator*(const Pose& other) const {
-    return {Mat3(rotation * other.rotation), Vec3(rotation * other.translation + translation)};
-  }
-  // No NaN or infinity in any entry. Tests the exponent bits (all ones for
-  // both) with integer operations: branch-free, and no floating-point
-  // comparison that could raise FE_INVALID under a caller's traps.
-  bool is_finite() const {
-    constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL;
-    std::uint64_t non_finite = 0;
-    for (int i = 0; i < 9; ++i) {
-      non_finite |= static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(rotation.data()[i]) & kExponent) == kExponent);
-    }
-    for (int i = 0; i < 3; ++i) {
-      non_finite |= static_cast<std::uint64_t>((std::bit_cast<std::uint64_t>(translation[i]) & kExponent) == kExponent);
-    }
-    return non_finite == 0;
-  }
-};
 
 // Which kind of boundary piece of a hull realizes a closest point.
 enum class FeatureType : std::uint8_t { vertex, edge, face };
@@ -170,13 +126,6 @@ struct DistanceResult {
   Feature feature_a;
   Feature feature_b;
   int iterations = 0;
-};
-
-// Thrown for bad input (no points, NaN coordinates, non-finite poses). The
-// message names what is wrong and where (e.g. the vertex index).
-class InvalidInput : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
 };
 
 }  // namespace proxima

@@ -1,0 +1,163 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 1: rigid poses and the one contract every caller's pose meets, in
+// one place. The C++ queries, CompoundBody, Scene, batch queries, Python and
+// the CLI all check poses here, so they accept the same poses and refuse
+// the others with the same words.
+//
+// A pose is accepted when
+//   - every entry of its rotation and translation is finite,
+//   - its rotation is orthonormal within kRotationTolerance:
+//     max |(R^T R - I)_ij| <= 1e-6 (rotations that went through float32,
+//     as poses from graphics and mesh tools do, are off by a few 1e-7),
+//   - det R > 0 (a rotation, not a reflection).
+// An accepted rotation that is not orthonormal to machine precision (more
+// than kOrthonormalUlps u off) is replaced by the rotation of its
+// quaternion before any use, so that every answer is exact for a rigid
+// motion within 1e-6 of the given one (the queries invert a pose by its
+// transpose, which is only right for an orthonormal R).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <concepts>
+#include <cstdint>
+#include <stdexcept>
+#include <string_view>
+#include <utility>
+
+namespace proxima {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Quat = Eigen::Quaterniond;
+using Isometry3 = Eigen::Isometry3d;
+
+// Unit roundoff of double, u = 2^-53. The accuracy standard of DESIGN.md is
+// written in units of u times the largest coordinate magnitude R.
+inline constexpr double kUnitRoundoff = 0x1p-53;
+
+// The contract's tolerance on max |(R^T R - I)_ij| (see the top of this file).
+inline constexpr double kRotationTolerance = 1e-6;
+
+// Rotations built from a unit quaternion, an angle-axis or a product of a
+// few of them are orthonormal to a few u; beyond 32 u a rotation is
+// re-orthonormalized (pose_test pins both sides).
+inline constexpr double kOrthonormalUlps = 32.0;
+
+// Thrown for bad input (no points, NaN coordinates, non-rigid poses). The
+// message names what is wrong and where (e.g. the vertex index).
+class InvalidInput : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// True when x is neither NaN nor infinite. Tests the exponent bits (all ones
+// for both) with integer operations: no floating-point comparison that could
+// raise FE_INVALID under a caller's traps.
+inline bool is_finite_bits(double x) {
+  constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL;
+  return (std::bit_cast<std::uint64_t>(x) & kExponent) != kExponent;
+}
+
+// The unit quaternion of q, at any magnitude: q is first divided by its
+// largest component (exact scaling of the direction), so that neither
+// 1e200 (1, 0, 0, 1) (whose squared norm overflows) nor 3e-162 (1, 0, 0, 1)
+// (whose squared norm is subnormal and has lost its digits) loses its
+// rotation. Throws InvalidInput naming `what` for a zero or non-finite q:
+// neither is a rotation, and neither is silently taken as the identity.
+Quat unit_quaternion(const Quat& q, std::string_view what = "quaternion");
+
+// A rigid motion x -> rotation x + translation.
+struct Pose {
+  Mat3 rotation = Mat3::Identity();
+  Vec3 translation = Vec3::Zero();
+
+  Pose() = default;
+  // As given; checked against the contract where a query uses it.
+  Pose(const Mat3& r, const Vec3& t) : rotation(r), translation(t) {}
+  // Normalized by unit_quaternion: throws InvalidInput for a zero or
+  // non-finite quaternion.
+  Pose(const Quat& q, const Vec3& t)
+      : rotation(unit_quaternion(q, "Pose").toRotationMatrix()), translation(t) {}
+  Pose(const Isometry3& iso)
+      : rotation(iso.linear()),
+        translation(iso.translation()) {}  // NOLINT(google-explicit-constructor)
+
+  static Pose identity() { return {}; }
+  static Pose from_translation(const Vec3& t) { return {Mat3::Identity(), t}; }
+
+  Vec3 apply(const Vec3& p) const { return rotation * p + translation; }
+  Pose inverse() const {
+    return {Mat3(rotation.transpose()), Vec3(-(rotation.transpose() * translation))};
+  }
+  // (this * other).apply(p) == this->apply(other.apply(p))
+  Pose operator*(const Pose& other) const {
+    return {Mat3(rotation * other.rotation), Vec3(rotation * other.translation + translation)};
+  }
+  // No NaN or infinity in any entry (integer tests of the exponent bits).
+  bool is_finite() const {
+    bool finite = true;
+    for (int i = 0; i < 9; ++i) finite &= is_finite_bits(rotation.data()[i]);
+    for (int i = 0; i < 3; ++i) finite &= is_finite_bits(translation[i]);
+    return finite;
+  }
+};
+
+namespace detail {
+// The slow side of checked_pose: throws the contract's refusal, or returns
+// the pose with its rotation re-orthonormalized.
+Pose checked_pose_slow(const Pose& pose, std::string_view what);
+}  // namespace detail
+
+namespace detail {
+// True when `pose` needs nothing: finite, orthonormal to kOrthonormalUlps u
+// and det > 0. O(1), the common case of every query.
+inline bool is_rigid(const Pose& pose) {
+  // Finiteness first, by bits: a comparison of a NaN would raise FE_INVALID
+  // under a caller's traps before the refusal could be thrown.
+  if (!pose.is_finite()) [[unlikely]]
+    return false;
+  const Mat3& r = pose.rotation;
+  // The six distinct entries of R^T R - I.
+  const Vec3 c0 = r.col(0), c1 = r.col(1), c2 = r.col(2);
+  const double skew = std::max({std::abs(c0.squaredNorm() - 1.0), std::abs(c1.squaredNorm() - 1.0),
+                                std::abs(c2.squaredNorm() - 1.0), std::abs(c0.dot(c1)),
+                                std::abs(c0.dot(c2)), std::abs(c1.dot(c2))});
+  return skew <= kOrthonormalUlps * kUnitRoundoff && c0.cross(c1).dot(c2) > 0.0;
+}
+}  // namespace detail
+
+// The pose to use for `pose` under the contract above: `pose` itself when its
+// rotation is orthonormal to kOrthonormalUlps u (the common case, O(1)),
+// else the re-orthonormalized pose when within kRotationTolerance; otherwise
+// throws InvalidInput "<what> is not finite ...", "<what>: rotation is not
+// orthonormal ..." or "<what>: rotation is a reflection ...".
+inline Pose checked_pose(const Pose& pose, std::string_view what) {
+  if (detail::is_rigid(pose)) [[likely]]
+    return pose;
+  return detail::checked_pose_slow(pose, what);
+}
+
+// The same, with the name built only when needed (`what()` returns a
+// string): for callers on a hot path whose name is not a literal.
+template <class What>
+requires std::invocable<What> Pose checked_pose(const Pose& pose, What&& what) {
+  if (detail::is_rigid(pose)) [[likely]]
+    return pose;
+  return detail::checked_pose_slow(pose, what());
+}
+
+// Throws as checked_pose does; for callers that only validate (the pose is
+// checked again, and re-orthonormalized if needed, by the query that uses it).
+inline void check_pose(const Pose& pose, std::string_view what) { (void)checked_pose(pose, what); }
+template <class What>
+requires std::invocable<What>
+void check_pose(const Pose& pose, What&& what) {
+  (void)checked_pose(pose, std::forward<What>(what));
+}
+
+}  // namespace proxima
