@@ -85,11 +85,15 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 
 }  // namespace
 
-DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const ConvexPolytope& b,
-                        const Pose& given_pose_b, const DistanceOptions& options,
-                        DistanceCache* cache) {
-  const Pose pose_a = checked_pose(given_pose_a, "distance: pose_a");
-  const Pose pose_b = checked_pose(given_pose_b, "distance: pose_b");
+DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                        const Pose& pose_b, const DistanceOptions& options, DistanceCache* cache) {
+  // The poses as the contract takes them (proxima/pose.h): the caller's own
+  // when rigid to machine precision, else once more with re-orthonormalized
+  // copies (which are), or the contract's refusal.
+  if (!detail::is_rigid(pose_a) || !detail::is_rigid(pose_b)) [[unlikely]] {
+    return distance(a, checked_pose(pose_a, "distance: pose_a"), b,
+                    checked_pose(pose_b, "distance: pose_b"), options, cache);
+  }
   if (!(options.relative_tolerance >= 0.0) || !(options.absolute_tolerance >= 0.0) ||
       !std::isfinite(options.relative_tolerance) || !std::isfinite(options.absolute_tolerance)) {
     throw InvalidInput(

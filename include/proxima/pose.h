@@ -117,17 +117,39 @@ namespace detail {
 // True when `pose` needs nothing: finite, orthonormal to kOrthonormalUlps u
 // and det > 0. O(1), the common case of every query.
 inline bool is_rigid(const Pose& pose) {
-  // Finiteness first, by bits: a comparison of a NaN would raise FE_INVALID
-  // under a caller's traps before the refusal could be thrown.
-  if (!pose.is_finite()) [[unlikely]]
+  // Bounds first, on the bits: every rotation entry below 4 in magnitude
+  // and every translation entry finite (NaN and infinity have all exponent
+  // bits set), so that the arithmetic below raises no FE_INVALID (inf * 0,
+  // inf - inf) under a caller's traps. For a magnitude's bits e and a
+  // limit's bits L, e + (2^63 - L) has its top bit set exactly when e >= L:
+  // one and, one add and one or per entry, which the compiler vectorizes.
+  const double* m = pose.rotation.data();  // column-major: column k at m + 3 k
+  constexpr std::uint64_t kMagnitude = 0x7fffffffffffffffULL;
+  constexpr std::uint64_t kTop = 0x8000000000000000ULL;
+  constexpr std::uint64_t kFour = 0x4010000000000000ULL;      // the bits of 4.0
+  constexpr std::uint64_t kInfinity = 0x7ff0000000000000ULL;  // the bits of +inf
+  std::uint64_t out_of_range = 0;
+  for (int k = 0; k < 9; ++k)
+    out_of_range |= (std::bit_cast<std::uint64_t>(m[k]) & kMagnitude) + (kTop - kFour);
+  for (int k = 0; k < 3; ++k) {
+    out_of_range |=
+        (std::bit_cast<std::uint64_t>(pose.translation[k]) & kMagnitude) + (kTop - kInfinity);
+  }
+  if ((out_of_range & kTop) != 0) [[unlikely]]
     return false;
-  const Mat3& r = pose.rotation;
-  // The six distinct entries of R^T R - I.
-  const Vec3 c0 = r.col(0), c1 = r.col(1), c2 = r.col(2);
-  const double skew = std::max({std::abs(c0.squaredNorm() - 1.0), std::abs(c1.squaredNorm() - 1.0),
-                                std::abs(c2.squaredNorm() - 1.0), std::abs(c0.dot(c1)),
-                                std::abs(c0.dot(c2)), std::abs(c1.dot(c2))});
-  return skew <= kOrthonormalUlps * kUnitRoundoff && c0.cross(c1).dot(c2) > 0.0;
+  // The six distinct entries of R^T R - I, and the sign of det R; written
+  // out, since this runs twice in every query.
+  const auto dot = [m](int i, int j) {
+    return m[3 * i] * m[3 * j] + m[3 * i + 1] * m[3 * j + 1] + m[3 * i + 2] * m[3 * j + 2];
+  };
+  const double d00 = std::abs(dot(0, 0) - 1.0), d11 = std::abs(dot(1, 1) - 1.0),
+               d22 = std::abs(dot(2, 2) - 1.0);
+  const double d01 = std::abs(dot(0, 1)), d02 = std::abs(dot(0, 2)), d12 = std::abs(dot(1, 2));
+  const double skew =
+      std::max(std::max(std::max(d00, d11), std::max(d22, d01)), std::max(d02, d12));
+  const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                     m[2] * (m[3] * m[7] - m[4] * m[6]);
+  return skew <= kOrthonormalUlps * kUnitRoundoff && det > 0.0;
 }
 }  // namespace detail
 
