@@ -13,29 +13,24 @@
 //   binary floats are checked for NaN and infinity on their bit patterns,
 //   before any arithmetic or conversion touches them (a signalling NaN would
 //   raise FE_INVALID when converted from float to double).
-#include "proxima/io.h"
-
-#include <tiny_obj_loader.h>
-
 #include <algorithm>
 #include <array>
 #include <bit>
 #include <cctype>
 #include <cerrno>
-#include <cfenv>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <istream>
 #include <limits>
 #include <memory>
-#include <stdexcept>
-#include <streambuf>
-#include <system_error>
 #include <set>
+#include <stdexcept>
+#include <system_error>
 #include <utility>
+
+#include "proxima/io.h"
 
 namespace proxima {
 
@@ -50,7 +45,8 @@ std::string compose_message(const std::string& file, std::int64_t line, std::int
 
 }  // namespace
 
-FileError::FileError(std::string file, std::int64_t line, std::int64_t byte_offset, std::string problem)
+FileError::FileError(std::string file, std::int64_t line, std::int64_t byte_offset,
+                     std::string problem)
     : InvalidInput(compose_message(file, line, byte_offset, problem)),
       file_(std::move(file)),
       line_(line),
@@ -69,14 +65,22 @@ FileError FileError::in_file(std::string file, std::string problem) {
 
 const char* to_string(MeshFormat format) {
   switch (format) {
-    case MeshFormat::obj: return "obj";
-    case MeshFormat::off: return "off";
-    case MeshFormat::stl_ascii: return "stl_ascii";
-    case MeshFormat::stl_binary: return "stl_binary";
-    case MeshFormat::ply_ascii: return "ply_ascii";
-    case MeshFormat::ply_binary_le: return "ply_binary_le";
-    case MeshFormat::xyz: return "xyz";
-    case MeshFormat::unknown: return "unknown";
+    case MeshFormat::obj:
+      return "obj";
+    case MeshFormat::off:
+      return "off";
+    case MeshFormat::stl_ascii:
+      return "stl_ascii";
+    case MeshFormat::stl_binary:
+      return "stl_binary";
+    case MeshFormat::ply_ascii:
+      return "ply_ascii";
+    case MeshFormat::ply_binary_le:
+      return "ply_binary_le";
+    case MeshFormat::xyz:
+      return "xyz";
+    case MeshFormat::unknown:
+      return "unknown";
   }
   return "unknown";
 }
@@ -84,7 +88,8 @@ const char* to_string(MeshFormat format) {
 namespace {
 
 // Point ids are std::int32_t downstream (hull input_index, group offsets).
-constexpr std::size_t kMaxPoints = static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
+constexpr std::size_t kMaxPoints =
+    static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max());
 
 // A token quoted in a message is cut to this many characters: a corrupt file
 // can put megabytes of junk on one "line", and the message must stay short.
@@ -142,13 +147,6 @@ std::string_view strip_bom(std::string_view text) {
 
 std::string_view strip_comment(std::string_view line) { return line.substr(0, line.find('#')); }
 
-std::string_view trim(std::string_view s) {
-  const std::size_t b = s.find_first_not_of(" \t\v\f\r\n");
-  if (b == std::string_view::npos) return {};
-  const std::size_t e = s.find_last_not_of(" \t\v\f\r\n");
-  return s.substr(b, e - b + 1);
-}
-
 // The file being read: its name for messages.
 struct Source {
   std::string name;
@@ -159,11 +157,14 @@ struct Source {
   [[noreturn]] void fail_byte(std::size_t offset, const std::string& problem) const {
     throw FileError::at_byte(name, static_cast<std::int64_t>(offset), problem);
   }
-  [[noreturn]] void fail(const std::string& problem) const { throw FileError::in_file(name, problem); }
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw FileError::in_file(name, problem);
+  }
 };
 
 void push_point(const Source& src, std::vector<Vec3>& points, const Vec3& p) {
-  if (points.size() >= kMaxPoints) src.fail("more than " + std::to_string(kMaxPoints) + " vertices");
+  if (points.size() >= kMaxPoints)
+    src.fail("more than " + std::to_string(kMaxPoints) + " vertices");
   points.push_back(p);
 }
 
@@ -171,7 +172,6 @@ void push_point(const Source& src, std::vector<Vec3>& points, const Vec3& p) {
 // Text: lines, tokens, numbers.
 
 // Splits text into lines at "\n", "\r\n" or a lone "\r" (old Mac files).
-// tinyobjloader splits OBJ the same way, which the OBJ cross-check relies on.
 // A NUL byte means the file is not text: refused with its line.
 class LineReader {
  public:
@@ -181,12 +181,15 @@ class LineReader {
     if (pos_ >= text_.size()) return false;
     ++number_;
     std::size_t end = pos_;
-    while (end < text_.size() && text_[end] != '\n' && text_[end] != '\r' && text_[end] != '\0') ++end;
-    if (end < text_.size() && text_[end] == '\0') src_.fail_line(number_, "NUL byte: this is not a text file");
+    while (end < text_.size() && text_[end] != '\n' && text_[end] != '\r' && text_[end] != '\0')
+      ++end;
+    if (end < text_.size() && text_[end] == '\0')
+      src_.fail_line(number_, "NUL byte: this is not a text file");
     *line = text_.substr(pos_, end - pos_);
     pos_ = end;
     if (pos_ < text_.size() && text_[pos_] == '\r') ++pos_;
-    if (pos_ < text_.size() && text_[pos_] == '\n' && (pos_ == end || text_[pos_ - 1] == '\r')) ++pos_;
+    if (pos_ < text_.size() && text_[pos_] == '\n' && (pos_ == end || text_[pos_ - 1] == '\r'))
+      ++pos_;
     return true;
   }
 
@@ -232,7 +235,8 @@ enum class NumberStatus : std::uint8_t { ok, not_a_number, out_of_range };
 // Decimal text to the nearest double (std::from_chars: correctly rounded,
 // independent of the C locale). A leading '+' is allowed, as in C's strtod.
 NumberStatus parse_double(std::string_view token, double* value) {
-  if (token.size() > 1 && token[0] == '+' && token[1] != '+' && token[1] != '-') token.remove_prefix(1);
+  if (token.size() > 1 && token[0] == '+' && token[1] != '+' && token[1] != '-')
+    token.remove_prefix(1);
   const char* end = token.data() + token.size();
   const auto [ptr, ec] = std::from_chars(token.data(), end, *value);
   if (ptr != end || token.empty()) return NumberStatus::not_a_number;
@@ -253,22 +257,27 @@ std::string coordinate_label(int axis, std::size_t vertex) {
 
 // Coordinate `axis` of vertex `vertex` from a text token; refuses (with the
 // line) anything that is not a finite double.
-double text_coordinate(const Source& src, std::int64_t line, std::string_view token, int axis, std::size_t vertex) {
+double text_coordinate(const Source& src, std::int64_t line, std::string_view token, int axis,
+                       std::size_t vertex) {
   double v = 0.0;
   switch (parse_double(token, &v)) {
     case NumberStatus::not_a_number:
-      src.fail_line(line, "non-numeric token " + quote(token) + " where the " + coordinate_label(axis, vertex) +
-                              " was expected");
+      src.fail_line(line, "non-numeric token " + quote(token) + " where the " +
+                              coordinate_label(axis, vertex) + " was expected");
     case NumberStatus::out_of_range:
       src.fail_line(line, "coordinate " + quote(token) + " (" + coordinate_label(axis, vertex) +
                               ") is outside the range of double");
-    case NumberStatus::ok: break;
+    case NumberStatus::ok:
+      break;
   }
   // std::isnan / std::isinf classify without an ordered comparison, so they
   // raise no FE_INVALID on a NaN.
-  if (std::isnan(v)) src.fail_line(line, "NaN coordinate " + quote(token) + " (" + coordinate_label(axis, vertex) + ")");
+  if (std::isnan(v))
+    src.fail_line(line,
+                  "NaN coordinate " + quote(token) + " (" + coordinate_label(axis, vertex) + ")");
   if (std::isinf(v)) {
-    src.fail_line(line, "infinite coordinate " + quote(token) + " (" + coordinate_label(axis, vertex) + ")");
+    src.fail_line(
+        line, "infinite coordinate " + quote(token) + " (" + coordinate_label(axis, vertex) + ")");
   }
   return v;
 }
@@ -280,8 +289,8 @@ Vec3 text_point(const Source& src, std::int64_t line, Tokens tokens, std::size_t
   for (int axis = 0; axis < 3; ++axis) {
     std::string_view token;
     if (!tokens.next(&token)) {
-      src.fail_line(line, "expected 3 coordinates for vertex " + std::to_string(vertex) + " (0-based), found " +
-                              std::to_string(axis));
+      src.fail_line(line, "expected 3 coordinates for vertex " + std::to_string(vertex) +
+                              " (0-based), found " + std::to_string(axis));
     }
     p[axis] = text_coordinate(src, line, token, axis, vertex);
   }
@@ -302,14 +311,18 @@ std::uint64_t load_le(std::string_view bytes, std::size_t offset, std::size_t si
 // A binary coordinate: refuses NaN and infinity from the bit pattern (all
 // exponent bits set), before the value is converted or compared. `label()`
 // names the coordinate; it is only built for a message.
+// `base` is the file offset of bytes[0], for messages (STL is read from a
+// file in chunks).
 template <class Label>
-double binary_float(const Source& src, std::string_view bytes, std::size_t offset, bool is_double, Label&& label) {
+double binary_float(const Source& src, std::string_view bytes, std::size_t offset, bool is_double,
+                    Label&& label, std::size_t base = 0) {
   if (is_double) {
     const std::uint64_t bits = load_le(bytes, offset, 8);
     constexpr std::uint64_t kExponent = 0x7ffULL << 52;
     constexpr std::uint64_t kMantissa = (1ULL << 52) - 1;
     if ((bits & kExponent) == kExponent) {
-      src.fail_byte(offset, std::string((bits & kMantissa) != 0 ? "NaN" : "infinite") + " coordinate (" + label() + ")");
+      src.fail_byte(base + offset, std::string((bits & kMantissa) != 0 ? "NaN" : "infinite") +
+                                       " coordinate (" + label() + ")");
     }
     return std::bit_cast<double>(bits);
   }
@@ -317,7 +330,8 @@ double binary_float(const Source& src, std::string_view bytes, std::size_t offse
   constexpr std::uint32_t kExponent = 0xffU << 23;
   constexpr std::uint32_t kMantissa = (1U << 23) - 1;
   if ((bits & kExponent) == kExponent) {
-    src.fail_byte(offset, std::string((bits & kMantissa) != 0 ? "NaN" : "infinite") + " coordinate (" + label() + ")");
+    src.fail_byte(base + offset, std::string((bits & kMantissa) != 0 ? "NaN" : "infinite") +
+                                     " coordinate (" + label() + ")");
   }
   return static_cast<double>(std::bit_cast<float>(bits));
 }
@@ -325,156 +339,167 @@ double binary_float(const Source& src, std::string_view bytes, std::size_t offse
 // ---------------------------------------------------------------------------
 // Exact duplicates, merged for STL (each facet repeats its corners).
 
-// The distinct points of `corners`, each at its first appearance, in file
-// order: sort (point, index) records by point then index, so that equal
-// points sit together with the earliest first, keep the first of each run,
-// and put the kept ones back in file order. O(n log n) whatever the values
-// (a hash table could be made to degrade by crafted input). The points are
-// finite, so < orders them strictly, and -0.0 == +0.0 merges the two zeros.
-std::vector<Vec3> merge_duplicates(const Source& src, const std::vector<Vec3>& corners) {
-  struct Record {
-    std::array<double, 3> p;
-    std::size_t index;
-  };
-  std::vector<Record> records(corners.size());
-  for (std::size_t i = 0; i < corners.size(); ++i) records[i] = {{corners[i].x(), corners[i].y(), corners[i].z()}, i};
-  std::sort(records.begin(), records.end(), [](const Record& a, const Record& b) {
-    for (std::size_t k = 0; k < 3; ++k) {
-      if (a.p[k] != b.p[k]) return a.p[k] < b.p[k];
-    }
-    return a.index < b.index;
+// Corners of STL facets, three per triangle, as read: float triples for
+// binary STL (converting them to double for storage would double the
+// memory of the largest files), doubles for ASCII STL.
+using FloatCorner = std::array<float, 3>;
+using DoubleCorner = std::array<double, 3>;
+
+// The distinct corners, each at its first appearance, in file order, as
+// cloud.points, and the triangles over them as cloud.triangles: sort corner
+// indices by corner then index, so that equal corners sit together with the
+// earliest first; each corner then takes the id of the first of its run, and
+// ids are given in file order. O(n log n) whatever the values (a hash table
+// could be made to degrade by crafted input), and only 4 bytes per corner
+// beyond the corners themselves. The corners are finite, so < orders them
+// strictly, and -0.0 == +0.0 merges the two zeros.
+template <class Corner>
+void merge_corners(const Source& src, std::vector<Corner> corners, PointCloud& cloud) {
+  if (corners.size() / 3 > kMaxPoints)
+    src.fail("more than " + std::to_string(kMaxPoints) + " triangles");
+  std::vector<std::uint32_t> order(corners.size());  // corners.size() <= 3 * kMaxPoints < 2^32
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    if (corners[a] != corners[b]) return corners[a] < corners[b];
+    return a < b;
   });
-  std::vector<bool> keep(corners.size(), false);
-  std::size_t kept = 0;
-  for (std::size_t k = 0; k < records.size(); ++k) {
-    if (k == 0 || records[k].p != records[k - 1].p) {
-      keep[records[k].index] = true;
-      ++kept;
+  // first[c]: the first corner equal to c (first[c] <= c).
+  std::vector<std::uint32_t> first(corners.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    first[order[k]] =
+        k > 0 && corners[order[k]] == corners[order[k - 1]] ? first[order[k - 1]] : order[k];
+  }
+  order = {};
+  // In place, in file order: first[c] becomes c's point id (first[c] < c is
+  // already an id by then).
+  std::size_t distinct = 0;
+  for (std::size_t c = 0; c < corners.size(); ++c) distinct += first[c] == c ? 1 : 0;
+  if (distinct > kMaxPoints)
+    src.fail("more than " + std::to_string(kMaxPoints) + " distinct vertices");
+  cloud.points.reserve(distinct);
+  for (std::size_t c = 0; c < corners.size(); ++c) {
+    if (first[c] == c) {
+      first[c] = static_cast<std::uint32_t>(cloud.points.size());
+      cloud.points.emplace_back(corners[c][0], corners[c][1], corners[c][2]);
+    } else {
+      first[c] = first[first[c]];
     }
   }
-  if (kept > kMaxPoints) src.fail("more than " + std::to_string(kMaxPoints) + " distinct vertices");
-  std::vector<Vec3> points;
-  points.reserve(kept);
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    if (keep[i]) points.push_back(corners[i]);
+  corners = {};
+  cloud.triangles.resize(first.size() / 3);
+  for (std::size_t t = 0; t < cloud.triangles.size(); ++t) {
+    for (std::size_t k = 0; k < 3; ++k)
+      cloud.triangles[t][k] = static_cast<std::int32_t>(first[3 * t + k]);
   }
-  return points;
 }
 
 // ---------------------------------------------------------------------------
-// OBJ.
-//
-// Two passes that must agree. Our own pass reads every `v` line strictly
-// (line numbers, correctly rounded numbers, non-numeric tokens and NaN
-// refused). tinyobjloader then parses the file for its structure: the order
-// of vertices and `g` / `o` statements, which become the groups. Its numbers
-// are not used: its parser computes mantissa * 5^e then ldexp, which is not
-// correctly rounded, and it turns a non-numeric token into 0 silently. Both
-// passes classify a line as a vertex the same way ('v' then a blank, after
-// leading blanks), so they count the same vertices; a difference is a bug
-// here, reported as std::logic_error (not as bad input).
+// OBJ: `v` lines are the vertices (global to the file), `f` lines the faces
+// (polygons of 1-based vertex indices, negative ones counting back from the
+// last vertex read; `v/vt/vn` forms keep the v), `g` and `o` statements group
+// what follows. Every other statement (vn, vt, l, p, s, usemtl, mtllib, ...)
+// is skipped. A line is classified by its first token, after leading blanks.
 
-// A read-only istream over bytes in memory, without copying them.
-class MemoryBuffer : public std::streambuf {
- public:
-  explicit MemoryBuffer(std::string_view bytes) {
-    // std::streambuf wants char*; the get area is only ever read.
-    char* begin = const_cast<char*>(bytes.data());
-    setg(begin, begin, begin + bytes.size());
+struct ObjStatement {
+  std::string name;
+  std::size_t vertices = 0;   // vertices read before it
+  std::size_t triangles = 0;  // triangles read before it
+};
+
+// One corner of an `f` line: the vertex index before the first '/', as a
+// 0-based index into the `vertices` read so far.
+std::int32_t obj_face_corner(const Source& src, std::int64_t line, std::string_view token,
+                             std::size_t vertices) {
+  const std::string_view index = token.substr(0, token.find('/'));
+  std::int64_t value = 0;
+  const char* end = index.data() + index.size();
+  const auto [ptr, ec] = std::from_chars(index.data(), end, value);
+  if (index.empty() || ptr != end || ec != std::errc()) {
+    src.fail_line(line, "face vertex " + quote(token) + " is not an integer vertex index");
   }
-};
-
-// tinyobjloader parses every number again with its own conversion, and some
-// inputs that we accept make it compute an invalid operation ("0e999" gives
-// 0 * inf there). Those values are discarded; their floating-point exception
-// flags (and traps, when a caller such as our test main enables them) must
-// not leak to the caller. feholdexcept saves the environment and goes
-// non-stop; fesetenv restores the environment with its flags as they were.
-class FloatingPointHold {
- public:
-  FloatingPointHold() { std::feholdexcept(&saved_); }
-  ~FloatingPointHold() { std::fesetenv(&saved_); }
-  FloatingPointHold(const FloatingPointHold&) = delete;
-  FloatingPointHold& operator=(const FloatingPointHold&) = delete;
-
- private:
-  std::fenv_t saved_{};
-};
-
-struct ObjEvents {
-  std::size_t vertices = 0;
-  std::vector<std::pair<std::string, std::size_t>> groups;  // name, vertices before it
-};
-
-bool is_obj_vertex_line(std::string_view line, std::string_view* rest) {
-  const std::size_t b = line.find_first_not_of(" \t");
-  if (b == std::string_view::npos || line.size() - b < 2) return false;
-  if (line[b] != 'v' || (line[b + 1] != ' ' && line[b + 1] != '\t')) return false;
-  *rest = line.substr(b + 2);
-  return true;
+  const auto count = static_cast<std::int64_t>(vertices);
+  const std::int64_t resolved = value > 0 ? value - 1 : count + value;
+  if (value == 0 || resolved < 0 || resolved >= count) {
+    src.fail_line(line, "face vertex index " + quote(index) + " does not name one of the " +
+                            std::to_string(vertices) + " vertices read so far" +
+                            (value == 0 ? " (OBJ indices start at 1)" : ""));
+  }
+  return static_cast<std::int32_t>(resolved);
 }
 
-PointCloud read_obj(const Source& src, std::string_view text) {
-  PointCloud cloud;
-  LineReader lines(src, text);
-  std::string_view line;
-  while (lines.next(&line)) {
-    std::string_view rest;
-    if (!is_obj_vertex_line(line, &rest)) continue;
-    push_point(src, cloud.points, text_point(src, lines.number(), Tokens(strip_comment(rest)), cloud.points.size()));
-  }
-
-  ObjEvents events;
-  tinyobj::callback_t callback;
-  callback.vertex_cb = [](void* user, tinyobj::real_t, tinyobj::real_t, tinyobj::real_t, tinyobj::real_t) {
-    ++static_cast<ObjEvents*>(user)->vertices;
-  };
-  callback.group_cb = [](void* user, const char** names, int count) {
-    auto* ev = static_cast<ObjEvents*>(user);
-    std::string name;
-    for (int i = 0; i < count; ++i) {
-      if (i > 0) name += ' ';
-      name += names[i];
-    }
-    ev->groups.emplace_back(std::move(name), ev->vertices);
-  };
-  callback.object_cb = [](void* user, const char* name) {
-    auto* ev = static_cast<ObjEvents*>(user);
-    ev->groups.emplace_back(std::string(trim(name)), ev->vertices);
-  };
-  std::string warning;
-  std::string error;
-  bool ok = false;
-  {
-    MemoryBuffer buffer(text);
-    std::istream stream(&buffer);
-    const FloatingPointHold hold;
-    ok = tinyobj::LoadObjWithCallback(stream, callback, &events, nullptr, &warning, &error);
-  }
-  if (!ok) src.fail("tinyobjloader: " + std::string(trim(error)));
-  if (events.vertices != cloud.points.size()) {
-    throw std::logic_error("OBJ reader: tinyobjloader saw " + std::to_string(events.vertices) +
-                           " vertices, the line scan " + std::to_string(cloud.points.size()) + " in " + src.name);
-  }
-
-  // Groups: a statement with no vertex since the previous one renames it; the
-  // vertices before the first statement form a group ""; an empty trailing
-  // group is dropped. So the groups cover the points, each non-empty.
-  for (auto& [name, offset] : events.groups) {
-    if (!cloud.group_offsets.empty() && static_cast<std::size_t>(cloud.group_offsets.back()) == offset) {
-      cloud.group_names.back() = std::move(name);
+// The statements become groups over `count(statement)` items (triangles for a
+// file with faces, points otherwise): a statement with nothing since the
+// previous one renames it; what comes before the first statement forms a
+// group ""; an empty trailing group is dropped. So the groups cover the
+// items, each non-empty.
+template <class Count>
+void obj_groups(std::vector<ObjStatement>& statements, std::size_t total, Count&& count,
+                PointCloud& cloud) {
+  for (ObjStatement& statement : statements) {
+    const std::size_t offset = count(statement);
+    if (!cloud.group_offsets.empty() &&
+        static_cast<std::size_t>(cloud.group_offsets.back()) == offset) {
+      cloud.group_names.back() = std::move(statement.name);
       continue;
     }
     if (cloud.group_offsets.empty() && offset > 0) {
       cloud.group_names.emplace_back();
       cloud.group_offsets.push_back(0);
     }
-    cloud.group_names.push_back(std::move(name));
+    cloud.group_names.push_back(std::move(statement.name));
     cloud.group_offsets.push_back(static_cast<std::int32_t>(offset));
   }
-  if (!cloud.group_offsets.empty() && static_cast<std::size_t>(cloud.group_offsets.back()) == cloud.points.size()) {
+  if (!cloud.group_offsets.empty() &&
+      static_cast<std::size_t>(cloud.group_offsets.back()) == total) {
     cloud.group_names.pop_back();
     cloud.group_offsets.pop_back();
+  }
+}
+
+PointCloud read_obj(const Source& src, std::string_view text) {
+  PointCloud cloud;
+  std::vector<ObjStatement> statements;
+  std::vector<std::int32_t> polygon;
+  LineReader lines(src, text);
+  std::string_view line;
+  while (lines.next(&line)) {
+    Tokens tokens(strip_comment(line));
+    std::string_view keyword;
+    if (!tokens.next(&keyword)) continue;
+    const std::int64_t at = lines.number();
+    if (keyword == "v") {
+      push_point(src, cloud.points, text_point(src, at, tokens, cloud.points.size()));
+    } else if (keyword == "f") {
+      polygon.clear();
+      std::string_view token;
+      while (tokens.next(&token))
+        polygon.push_back(obj_face_corner(src, at, token, cloud.points.size()));
+      if (polygon.size() < 3) {
+        src.fail_line(at, "face with " + std::to_string(polygon.size()) +
+                              " vertices (a face needs at least 3)");
+      }
+      for (std::size_t k = 1; k + 1 < polygon.size(); ++k) {
+        if (cloud.triangles.size() >= kMaxPoints)
+          src.fail_line(at, "more than " + std::to_string(kMaxPoints) + " triangles");
+        cloud.triangles.push_back({polygon[0], polygon[k], polygon[k + 1]});
+      }
+    } else if (keyword == "g" || keyword == "o") {
+      std::string name;
+      std::string_view word;
+      while (tokens.next(&word)) {
+        if (!name.empty()) name += ' ';
+        name += word;
+      }
+      statements.push_back({std::move(name), cloud.points.size(), cloud.triangles.size()});
+    }
+  }
+  if (cloud.triangles.empty()) {
+    obj_groups(
+        statements, cloud.points.size(), [](const ObjStatement& s) { return s.vertices; }, cloud);
+  } else {
+    obj_groups(
+        statements, cloud.triangles.size(), [](const ObjStatement& s) { return s.triangles; },
+        cloud);
   }
   cloud.format = MeshFormat::obj;
   return cloud;
@@ -508,13 +533,16 @@ int off_keyword(std::string_view token) {
 PointCloud read_off(const Source& src, std::string_view text) {
   LineReader lines(src, text);
   std::string_view line;
-  if (!next_content_line(lines, &line)) src.fail("empty mesh (no vertices): the file has no OFF header");
+  if (!next_content_line(lines, &line))
+    src.fail("empty mesh (no vertices): the file has no OFF header");
   Tokens header(line);
   std::string_view keyword;
   header.next(&keyword);
   const int kind = off_keyword(keyword);
   if (kind == 0) src.fail_line(lines.number(), "OFF header expected, found " + quote(keyword));
-  if (kind < 0) src.fail_line(lines.number(), "unsupported OFF variant " + quote(keyword) + " (only 3-D OFF is read)");
+  if (kind < 0)
+    src.fail_line(lines.number(),
+                  "unsupported OFF variant " + quote(keyword) + " (only 3-D OFF is read)");
 
   std::string_view count_token;
   if (!header.next(&count_token)) {
@@ -527,17 +555,21 @@ PointCloud read_off(const Source& src, std::string_view text) {
   if (count_token == "BINARY") src.fail_line(lines.number(), "binary OFF is not supported");
   std::uint64_t count = 0;
   if (!parse_count(count_token, &count)) {
-    src.fail_line(lines.number(), "OFF vertex count " + quote(count_token) + " is not a non-negative integer");
+    src.fail_line(lines.number(),
+                  "OFF vertex count " + quote(count_token) + " is not a non-negative integer");
   }
   const std::int64_t count_line = lines.number();
-  if (count > kMaxPoints) src.fail_line(count_line, "OFF header announces " + std::to_string(count) + " vertices, more than " + std::to_string(kMaxPoints));
+  if (count > kMaxPoints)
+    src.fail_line(count_line, "OFF header announces " + std::to_string(count) +
+                                  " vertices, more than " + std::to_string(kMaxPoints));
 
   PointCloud cloud;
   cloud.points.reserve(std::min<std::size_t>(count, lines.bytes_left() / kMinTextVertexBytes));
   while (cloud.points.size() < count) {
     if (!next_content_line(lines, &line)) {
-      src.fail_line(lines.number(), "the OFF header (line " + std::to_string(count_line) + ") announces " +
-                                        std::to_string(count) + " vertices, but the file ends after " +
+      src.fail_line(lines.number(), "the OFF header (line " + std::to_string(count_line) +
+                                        ") announces " + std::to_string(count) +
+                                        " vertices, but the file ends after " +
                                         std::to_string(cloud.points.size()));
     }
     cloud.points.push_back(text_point(src, lines.number(), Tokens(line), cloud.points.size()));
@@ -554,7 +586,9 @@ PointCloud read_xyz(const Source& src, std::string_view text) {
   LineReader lines(src, text);
   std::string_view line;
   while (next_content_line(lines, &line)) {
-    push_point(src, cloud.points, text_point(src, lines.number(), Tokens(line, Separators::blanks_and_commas), cloud.points.size()));
+    push_point(src, cloud.points,
+               text_point(src, lines.number(), Tokens(line, Separators::blanks_and_commas),
+                          cloud.points.size()));
   }
   cloud.format = MeshFormat::xyz;
   return cloud;
@@ -583,40 +617,70 @@ bool stl_is_binary(std::string_view bytes) {
   return bytes.find('\0') != std::string_view::npos;
 }
 
-PointCloud read_stl_binary(const Source& src, std::string_view bytes) {
-  if (bytes.size() < kStlPreambleBytes) {
-    src.fail_byte(bytes.size(), "truncated binary STL: expected at least " + std::to_string(kStlPreambleBytes) +
-                                    " bytes (header and triangle count), got " + std::to_string(bytes.size()));
+// The preamble's announced triangle count, checked against the file's size.
+std::uint64_t stl_binary_count(const Source& src, std::string_view preamble,
+                               std::uint64_t file_bytes) {
+  if (file_bytes < kStlPreambleBytes) {
+    src.fail_byte(file_bytes,
+                  "truncated binary STL: expected at least " + std::to_string(kStlPreambleBytes) +
+                      " bytes (header and triangle count), got " + std::to_string(file_bytes));
   }
-  const std::uint64_t n = load_le(bytes, kStlHeaderBytes, 4);
+  const std::uint64_t n = load_le(preamble, kStlHeaderBytes, 4);
   const std::uint64_t expected = kStlPreambleBytes + kStlTriangleBytes * n;
-  if (expected != bytes.size()) {
-    const std::string what = expected > bytes.size() ? "truncated binary STL: " : "binary STL size mismatch: ";
-    src.fail_byte(std::min<std::uint64_t>(expected, bytes.size()),
+  if (expected != file_bytes) {
+    const std::string what =
+        expected > file_bytes ? "truncated binary STL: " : "binary STL size mismatch: ";
+    src.fail_byte(std::min<std::uint64_t>(expected, file_bytes),
                   what + "the header announces " + std::to_string(n) + " triangles, expected " +
-                      std::to_string(expected) + " bytes (84 + 50 * " + std::to_string(n) + "), got " +
-                      std::to_string(bytes.size()));
+                      std::to_string(expected) + " bytes (84 + 50 * " + std::to_string(n) +
+                      "), got " + std::to_string(file_bytes));
   }
-  std::vector<Vec3> corners;
-  corners.reserve(3 * static_cast<std::size_t>(n));  // n is bounded by the file's size, checked above
-  for (std::size_t t = 0; t < n; ++t) {
-    const std::size_t first_corner = kStlPreambleBytes + kStlTriangleBytes * t + 12;  // after the normal
-    for (std::size_t k = 0; k < 3; ++k) {
-      Vec3 p;
-      for (int axis = 0; axis < 3; ++axis) {
-        const std::size_t offset = first_corner + 12 * k + 4 * static_cast<std::size_t>(axis);
-        p[axis] = binary_float(src, bytes, offset, false, [&] {
-          return std::string(axis_name(axis)) + " of corner " + std::to_string(k) + " of triangle " +
-                 std::to_string(t) + " (0-based)";
-        });
+  return n;
+}
+
+// The n triangles of a binary STL whose size was checked; fetch(offset,
+// size) gives the bytes [offset, offset + size) of the file, read in chunks
+// so that a file need not be held in memory beside its corners.
+template <class Fetch>
+PointCloud read_stl_binary_triangles(const Source& src, std::uint64_t n, Fetch&& fetch) {
+  constexpr std::size_t kChunkTriangles = 1 << 14;
+  std::vector<FloatCorner> corners;
+  corners.reserve(
+      3 * static_cast<std::size_t>(n));  // n is bounded by the file's size, checked by the caller
+  for (std::size_t t0 = 0; t0 < n; t0 += kChunkTriangles) {
+    const std::size_t count = std::min<std::size_t>(kChunkTriangles, n - t0);
+    const std::size_t base = kStlPreambleBytes + kStlTriangleBytes * t0;
+    const std::string_view chunk = fetch(base, kStlTriangleBytes * count);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t t = t0 + i;
+      const std::size_t first_corner = kStlTriangleBytes * i + 12;  // after the normal
+      for (std::size_t k = 0; k < 3; ++k) {
+        FloatCorner p{};
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+          const std::size_t offset = first_corner + 12 * k + 4 * axis;
+          // A float read as double: exact, and back to float exact too.
+          p[axis] = static_cast<float>(binary_float(
+              src, chunk, offset, false,
+              [&] {
+                return std::string(axis_name(static_cast<int>(axis))) + " of corner " +
+                       std::to_string(k) + " of triangle " + std::to_string(t) + " (0-based)";
+              },
+              base));
+        }
+        corners.push_back(p);
       }
-      corners.push_back(p);
     }
   }
   PointCloud cloud;
-  cloud.points = merge_duplicates(src, corners);
+  merge_corners(src, std::move(corners), cloud);
   cloud.format = MeshFormat::stl_binary;
   return cloud;
+}
+
+PointCloud read_stl_binary(const Source& src, std::string_view bytes) {
+  const std::uint64_t n = stl_binary_count(src, bytes, bytes.size());
+  return read_stl_binary_triangles(
+      src, n, [&](std::size_t offset, std::size_t size) { return bytes.substr(offset, size); });
 }
 
 // solid / facet normal / outer loop / vertex x3 / endloop / endfacet /
@@ -628,7 +692,7 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
   State state = State::outside;
   std::int64_t facet_line = 0;
   int facet_corners = 0;
-  std::vector<Vec3> corners;
+  std::vector<DoubleCorner> corners;
   LineReader lines(src, text);
   std::string_view line;
   while (lines.next(&line)) {
@@ -637,7 +701,8 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
     if (!tokens.next(&keyword)) continue;
     const std::int64_t at = lines.number();
     const auto unexpected = [&](const char* expected) {
-      src.fail_line(at, "unexpected " + quote(keyword) + " in ASCII STL (expected " + expected + ")");
+      src.fail_line(at,
+                    "unexpected " + quote(keyword) + " in ASCII STL (expected " + expected + ")");
     };
     switch (state) {
       case State::outside:
@@ -660,17 +725,20 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
         break;
       case State::facet: {
         std::string_view word;
-        if (!iequals(keyword, "outer") || !tokens.next(&word) || !iequals(word, "loop")) unexpected("'outer loop'");
+        if (!iequals(keyword, "outer") || !tokens.next(&word) || !iequals(word, "loop"))
+          unexpected("'outer loop'");
         state = State::loop;
         break;
       }
       case State::loop:
         if (iequals(keyword, "vertex")) {
-          corners.push_back(text_point(src, at, tokens, corners.size()));
+          const Vec3 p = text_point(src, at, tokens, corners.size());
+          corners.push_back({p.x(), p.y(), p.z()});
           ++facet_corners;
         } else if (iequals(keyword, "endloop")) {
           if (facet_corners != 3) {
-            src.fail_line(at, "the facet at line " + std::to_string(facet_line) + " has " + std::to_string(facet_corners) +
+            src.fail_line(at, "the facet at line " + std::to_string(facet_line) + " has " +
+                                  std::to_string(facet_corners) +
                                   " vertices; STL facets are triangles (3)");
           }
           state = State::loop_done;
@@ -688,10 +756,11 @@ PointCloud read_stl_ascii(const Source& src, std::string_view text) {
     }
   }
   if (state == State::facet || state == State::loop || state == State::loop_done) {
-    src.fail_line(lines.number(), "the file ends inside the facet opened at line " + std::to_string(facet_line));
+    src.fail_line(lines.number(),
+                  "the file ends inside the facet opened at line " + std::to_string(facet_line));
   }
   PointCloud cloud;
-  cloud.points = merge_duplicates(src, corners);
+  merge_corners(src, std::move(corners), cloud);
   cloud.format = MeshFormat::stl_ascii;
   return cloud;
 }
@@ -703,11 +772,21 @@ enum class PlyType : std::uint8_t { int8, uint8, int16, uint16, int32, uint32, f
 
 bool ply_type(std::string_view name, PlyType* type) {
   static constexpr std::array<std::pair<std::string_view, PlyType>, 16> kNames = {{
-      {"char", PlyType::int8},     {"int8", PlyType::int8},       {"uchar", PlyType::uint8},
-      {"uint8", PlyType::uint8},   {"short", PlyType::int16},     {"int16", PlyType::int16},
-      {"ushort", PlyType::uint16}, {"uint16", PlyType::uint16},   {"int", PlyType::int32},
-      {"int32", PlyType::int32},   {"uint", PlyType::uint32},     {"uint32", PlyType::uint32},
-      {"float", PlyType::float32}, {"float32", PlyType::float32}, {"double", PlyType::float64},
+      {"char", PlyType::int8},
+      {"int8", PlyType::int8},
+      {"uchar", PlyType::uint8},
+      {"uint8", PlyType::uint8},
+      {"short", PlyType::int16},
+      {"int16", PlyType::int16},
+      {"ushort", PlyType::uint16},
+      {"uint16", PlyType::uint16},
+      {"int", PlyType::int32},
+      {"int32", PlyType::int32},
+      {"uint", PlyType::uint32},
+      {"uint32", PlyType::uint32},
+      {"float", PlyType::float32},
+      {"float32", PlyType::float32},
+      {"double", PlyType::float64},
       {"float64", PlyType::float64},
   }};
   for (const auto& [n, t] : kNames) {
@@ -722,19 +801,25 @@ bool ply_type(std::string_view name, PlyType* type) {
 std::size_t ply_size(PlyType t) {
   switch (t) {
     case PlyType::int8:
-    case PlyType::uint8: return 1;
+    case PlyType::uint8:
+      return 1;
     case PlyType::int16:
-    case PlyType::uint16: return 2;
+    case PlyType::uint16:
+      return 2;
     case PlyType::int32:
     case PlyType::uint32:
-    case PlyType::float32: return 4;
-    case PlyType::float64: return 8;
+    case PlyType::float32:
+      return 4;
+    case PlyType::float64:
+      return 8;
   }
   return 1;
 }
 
 bool ply_is_float(PlyType t) { return t == PlyType::float32 || t == PlyType::float64; }
-bool ply_is_signed(PlyType t) { return t == PlyType::int8 || t == PlyType::int16 || t == PlyType::int32; }
+bool ply_is_signed(PlyType t) {
+  return t == PlyType::int8 || t == PlyType::int16 || t == PlyType::int32;
+}
 
 struct PlyProperty {
   std::string name;
@@ -774,7 +859,8 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
     const std::int64_t at = ++header.lines;
     if (line.find('\0') != std::string_view::npos) src.fail_line(at, "NUL byte in the PLY header");
     if (at == 1) {
-      if (line != "ply") src.fail_line(1, "not a PLY file: the first line is " + quote(line) + ", expected 'ply'");
+      if (line != "ply")
+        src.fail_line(1, "not a PLY file: the first line is " + quote(line) + ", expected 'ply'");
       continue;
     }
     Tokens tokens(line);
@@ -788,28 +874,33 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
     if (word == "format") {
       std::string_view encoding;
       std::string_view version;
-      if (!tokens.next(&encoding) || !tokens.next(&version)) src.fail_line(at, "PLY format line incomplete");
+      if (!tokens.next(&encoding) || !tokens.next(&version))
+        src.fail_line(at, "PLY format line incomplete");
       if (encoding == "ascii") {
         header.binary = false;
       } else if (encoding == "binary_little_endian") {
         header.binary = true;
       } else if (encoding == "binary_big_endian") {
-        src.fail_line(at, "PLY binary_big_endian is not supported (ascii and binary_little_endian are)");
+        src.fail_line(
+            at, "PLY binary_big_endian is not supported (ascii and binary_little_endian are)");
       } else {
         src.fail_line(at, "unknown PLY format " + quote(encoding));
       }
-      if (version != "1.0") src.fail_line(at, "unsupported PLY version " + quote(version) + " (expected 1.0)");
+      if (version != "1.0")
+        src.fail_line(at, "unsupported PLY version " + quote(version) + " (expected 1.0)");
       have_format = true;
     } else if (word == "element") {
       PlyElement element;
       std::string_view name;
       std::string_view count;
-      if (!tokens.next(&name) || !tokens.next(&count)) src.fail_line(at, "PLY element line needs a name and a count");
+      if (!tokens.next(&name) || !tokens.next(&count))
+        src.fail_line(at, "PLY element line needs a name and a count");
       if (!parse_count(count, &element.count)) {
         src.fail_line(at, "PLY element count " + quote(count) + " is not a non-negative integer");
       }
       element.name = std::string(name);
-      if (!element_names.insert(element.name).second) src.fail_line(at, "duplicate PLY element " + quote(name));
+      if (!element_names.insert(element.name).second)
+        src.fail_line(at, "duplicate PLY element " + quote(name));
       element.line = at;
       header.elements.push_back(std::move(element));
       property_names.clear();
@@ -821,10 +912,13 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
       if (type == "list") {
         property.is_list = true;
         std::string_view count_type;
-        if (!tokens.next(&count_type) || !tokens.next(&type)) src.fail_line(at, "PLY list property needs two types");
-        if (!ply_type(count_type, &property.count_type)) src.fail_line(at, "unknown PLY type " + quote(count_type));
+        if (!tokens.next(&count_type) || !tokens.next(&type))
+          src.fail_line(at, "PLY list property needs two types");
+        if (!ply_type(count_type, &property.count_type))
+          src.fail_line(at, "unknown PLY type " + quote(count_type));
         if (ply_is_float(property.count_type)) {
-          src.fail_line(at, "PLY list length type " + quote(count_type) + " is not an integer type");
+          src.fail_line(at,
+                        "PLY list length type " + quote(count_type) + " is not an integer type");
         }
       }
       if (!ply_type(type, &property.type)) src.fail_line(at, "unknown PLY type " + quote(type));
@@ -833,7 +927,8 @@ PlyHeader read_ply_header(const Source& src, std::string_view bytes) {
       property.name = std::string(name);
       // Names are unique per element (a set, not a scan: a header of a
       // million properties must not take quadratic time).
-      if (!property_names.insert(property.name).second) src.fail_line(at, "duplicate PLY property " + quote(name));
+      if (!property_names.insert(property.name).second)
+        src.fail_line(at, "duplicate PLY property " + quote(name));
       header.elements.back().properties.push_back(std::move(property));
     } else {
       src.fail_line(at, "unknown PLY header keyword " + quote(word) + " (is end_header missing?)");
@@ -865,14 +960,16 @@ VertexLayout ply_vertex_layout(const Source& src, const PlyHeader& header) {
     const auto it = std::find_if(vertex.properties.begin(), vertex.properties.end(),
                                  [&](const PlyProperty& p) { return p.name == axis_name(axis); });
     if (it == vertex.properties.end()) {
-      src.fail_line(vertex.line, "PLY vertex element has no property '" + std::string(axis_name(axis)) + "'");
+      src.fail_line(vertex.line,
+                    "PLY vertex element has no property '" + std::string(axis_name(axis)) + "'");
     }
     if (it->is_list) src.fail_line(vertex.line, "PLY vertex property '" + it->name + "' is a list");
-    layout.xyz[static_cast<std::size_t>(axis)] = static_cast<std::size_t>(it - vertex.properties.begin());
+    layout.xyz[static_cast<std::size_t>(axis)] =
+        static_cast<std::size_t>(it - vertex.properties.begin());
   }
   if (vertex.count > kMaxPoints) {
-    src.fail_line(vertex.line, "PLY header announces " + std::to_string(vertex.count) + " vertices, more than " +
-                                   std::to_string(kMaxPoints));
+    src.fail_line(vertex.line, "PLY header announces " + std::to_string(vertex.count) +
+                                   " vertices, more than " + std::to_string(kMaxPoints));
   }
   return layout;
 }
@@ -881,17 +978,20 @@ VertexLayout ply_vertex_layout(const Source& src, const PlyHeader& header) {
 // can take.
 std::size_t ply_min_instance_bytes(const PlyElement& element) {
   std::size_t bytes = 0;
-  for (const PlyProperty& p : element.properties) bytes += p.is_list ? ply_size(p.count_type) : ply_size(p.type);
+  for (const PlyProperty& p : element.properties)
+    bytes += p.is_list ? ply_size(p.count_type) : ply_size(p.type);
   return bytes;
 }
 
 bool ply_has_list(const PlyElement& element) {
-  return std::any_of(element.properties.begin(), element.properties.end(), [](const PlyProperty& p) { return p.is_list; });
+  return std::any_of(element.properties.begin(), element.properties.end(),
+                     [](const PlyProperty& p) { return p.is_list; });
 }
 
 class PlyBinaryReader {
  public:
-  PlyBinaryReader(const Source& src, std::string_view bytes, std::size_t pos) : src_(src), bytes_(bytes), pos_(pos) {}
+  PlyBinaryReader(const Source& src, std::string_view bytes, std::size_t pos)
+      : src_(src), bytes_(bytes), pos_(pos) {}
 
   std::size_t left() const { return bytes_.size() - pos_; }
   std::size_t pos() const { return pos_; }
@@ -901,9 +1001,10 @@ class PlyBinaryReader {
   void check_fits(const PlyElement& element) const {
     const std::size_t least = ply_min_instance_bytes(element);
     if (least > 0 && element.count > left() / least) {
-      src_.fail_byte(bytes_.size(), "truncated PLY: the header announces " + std::to_string(element.count) + " '" +
-                                        element.name + "' elements of at least " + std::to_string(least) +
-                                        " bytes each, but only " + std::to_string(left()) + " bytes follow");
+      src_.fail_byte(bytes_.size(),
+                     "truncated PLY: the header announces " + std::to_string(element.count) + " '" +
+                         element.name + "' elements of at least " + std::to_string(least) +
+                         " bytes each, but only " + std::to_string(left()) + " bytes follow");
     }
   }
 
@@ -927,7 +1028,8 @@ class PlyBinaryReader {
       Vec3 p = Vec3::Zero();
       for (std::size_t k = 0; k < element.properties.size(); ++k) {
         const PlyProperty& property = element.properties[k];
-        const auto axis = static_cast<int>(std::find(layout.xyz.begin(), layout.xyz.end(), k) - layout.xyz.begin());
+        const auto axis = static_cast<int>(std::find(layout.xyz.begin(), layout.xyz.end(), k) -
+                                           layout.xyz.begin());
         if (axis == 3) {
           skip_property(element, i, property);
           continue;
@@ -943,8 +1045,9 @@ class PlyBinaryReader {
  private:
   void need(std::size_t n, const PlyElement& element, std::uint64_t index) const {
     if (n > left()) {
-      src_.fail_byte(bytes_.size(), "truncated PLY: the data ends inside '" + element.name + "' element " +
-                                        std::to_string(index) + " (0-based) of " + std::to_string(element.count));
+      src_.fail_byte(bytes_.size(), "truncated PLY: the data ends inside '" + element.name +
+                                        "' element " + std::to_string(index) + " (0-based) of " +
+                                        std::to_string(element.count));
     }
   }
 
@@ -985,7 +1088,8 @@ class PlyBinaryReader {
     if (raw > left() / item) {
       src_.fail_byte(at, "truncated PLY: list '" + p.name + "' of '" + element.name + "' element " +
                              std::to_string(index) + " (0-based) announces " + std::to_string(raw) +
-                             " items, more than the " + std::to_string(left()) + " bytes left can hold");
+                             " items, more than the " + std::to_string(left()) +
+                             " bytes left can hold");
     }
     pos_ += static_cast<std::size_t>(raw) * item;
   }
@@ -1018,7 +1122,8 @@ class PlyTextReader {
     for (std::size_t i = 0; i < element.count; ++i) {
       Vec3 p = Vec3::Zero();
       for (std::size_t k = 0; k < element.properties.size(); ++k) {
-        const auto axis = static_cast<int>(std::find(layout.xyz.begin(), layout.xyz.end(), k) - layout.xyz.begin());
+        const auto axis = static_cast<int>(std::find(layout.xyz.begin(), layout.xyz.end(), k) -
+                                           layout.xyz.begin());
         if (axis == 3) {
           skip_property(element, i, element.properties[k]);
           continue;
@@ -1045,8 +1150,9 @@ class PlyTextReader {
       ++pos_;
     }
     if (pos_ == bytes_.size()) {
-      src_.fail_line(last_line_, "the ASCII PLY data ends inside '" + element.name + "' element " + std::to_string(index) +
-                                " (0-based) of the " + std::to_string(element.count) + " the header announces");
+      src_.fail_line(last_line_, "the ASCII PLY data ends inside '" + element.name + "' element " +
+                                     std::to_string(index) + " (0-based) of the " +
+                                     std::to_string(element.count) + " the header announces");
     }
     const std::size_t b = pos_;
     last_line_ = line_;
@@ -1063,7 +1169,8 @@ class PlyTextReader {
     if (!p.is_list) return;
     std::uint64_t items = 0;
     if (!parse_count(token, &items)) {
-      src_.fail_line(line_, "PLY list length " + quote(token) + " of '" + p.name + "' is not a non-negative integer");
+      src_.fail_line(line_, "PLY list length " + quote(token) + " of '" + p.name +
+                                "' is not a non-negative integer");
     }
     for (std::uint64_t j = 0; j < items; ++j) next(element, index);
   }
@@ -1097,8 +1204,8 @@ PointCloud read_ply(const Source& src, std::string_view bytes) {
 // Format from the extension, or from the content.
 
 bool is_obj_statement(std::string_view word) {
-  static constexpr std::array<std::string_view, 11> kWords = {"v",      "vn", "vt", "vp", "f", "g",
-                                                              "o",      "s",  "l",  "usemtl", "mtllib"};
+  static constexpr std::array<std::string_view, 11> kWords = {
+      "v", "vn", "vt", "vp", "f", "g", "o", "s", "l", "usemtl", "mtllib"};
   return std::find(kWords.begin(), kWords.end(), word) != kWords.end();
 }
 
@@ -1112,7 +1219,8 @@ bool all_numbers(Tokens tokens, int n) {
 }
 
 MeshFormat sniff_format(std::string_view bytes) {
-  if (bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n") return MeshFormat::ply_ascii;
+  if (bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n")
+    return MeshFormat::ply_ascii;
   // Binary STL only by the exact size rule here: without a .stl extension,
   // a size mismatch says nothing about the format.
   if (bytes.size() >= kStlPreambleBytes &&
@@ -1138,8 +1246,9 @@ MeshFormat sniff_format(std::string_view bytes) {
 
 MeshFormat format_from_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); });
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](char c) {
+    return static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  });
   if (ext == ".obj") return MeshFormat::obj;
   if (ext == ".off") return MeshFormat::off;
   if (ext == ".stl") return MeshFormat::stl_binary;  // ASCII or binary: decided by stl_is_binary
@@ -1150,14 +1259,21 @@ MeshFormat format_from_extension(const std::string& path) {
 
 PointCloud read_as(const Source& src, std::string_view bytes, MeshFormat format) {
   switch (format) {
-    case MeshFormat::obj: return read_obj(src, strip_bom(bytes));
-    case MeshFormat::off: return read_off(src, strip_bom(bytes));
-    case MeshFormat::stl_ascii: return read_stl_ascii(src, strip_bom(bytes));
-    case MeshFormat::stl_binary: return read_stl_binary(src, bytes);
+    case MeshFormat::obj:
+      return read_obj(src, strip_bom(bytes));
+    case MeshFormat::off:
+      return read_off(src, strip_bom(bytes));
+    case MeshFormat::stl_ascii:
+      return read_stl_ascii(src, strip_bom(bytes));
+    case MeshFormat::stl_binary:
+      return read_stl_binary(src, bytes);
     case MeshFormat::ply_ascii:
-    case MeshFormat::ply_binary_le: return read_ply(src, bytes);
-    case MeshFormat::xyz: return read_xyz(src, strip_bom(bytes));
-    case MeshFormat::unknown: break;
+    case MeshFormat::ply_binary_le:
+      return read_ply(src, bytes);
+    case MeshFormat::xyz:
+      return read_xyz(src, strip_bom(bytes));
+    case MeshFormat::unknown:
+      break;
   }
   src.fail("unknown format: the content is not recognized as OBJ, OFF, STL, PLY or XYZ");
 }
@@ -1168,15 +1284,123 @@ PointCloud finish(const Source& src, PointCloud cloud) {
   return cloud;
 }
 
+[[noreturn]] void fail_too_large(const Source& src, const std::string& what, std::uint64_t limit) {
+  src.fail("file too large: " + what + " more than the limit of " + std::to_string(limit) +
+           " bytes (ReadOptions::max_file_bytes)");
+}
+
+// ---------------------------------------------------------------------------
+// Convexity of the input surface (see surface_is_convex in io.h).
+
+// The hull vertex of largest d.x, by hill climbing from `start` along the
+// hull's edges: on a convex polytope a local maximum is global.
+int climb(const ConvexPolytope& hull, const Vec3& d, int start) {
+  int v = start;
+  double best = d.dot(hull.vertex(v));
+  for (bool moved = true; moved;) {
+    moved = false;
+    for (const std::int32_t w : hull.neighbors(v)) {
+      const double value = d.dot(hull.vertex(w));
+      if (value > best) {
+        best = value;
+        v = w;
+        moved = true;
+      }
+    }
+  }
+  return v;
+}
+
+class SurfaceTest {
+ public:
+  explicit SurfaceTest(const ConvexPolytope& hull)
+      : hull_(hull), tolerance_(kConvexSurfaceTolerance * hull.scale()) {
+    planes_.reserve(static_cast<std::size_t>(hull.face_count()));
+    for (int f = 0; f < hull.face_count(); ++f) planes_.push_back(hull.face_plane(f));
+  }
+
+  // Whether all of `corners` lie within the tolerance of one facet's plane.
+  // Fast path: the facets around the hull vertex extreme in the direction
+  // `hint` (the triangle's normal); then every facet.
+  template <std::size_t N>
+  bool on_one_facet(const std::array<Vec3, N>& corners, const Vec3& hint) {
+    if (hint != Vec3::Zero()) {
+      start_ = climb(hull_, hint, start_);
+      const auto faces = hull_.adjacency_faces();
+      const auto b =
+          static_cast<std::size_t>(hull_.adjacency_offsets()[static_cast<std::size_t>(start_)]);
+      const auto e =
+          static_cast<std::size_t>(hull_.adjacency_offsets()[static_cast<std::size_t>(start_) + 1]);
+      for (std::size_t k = b; k < e; ++k) {
+        if (faces[k] >= 0 && on_plane(planes_[static_cast<std::size_t>(faces[k])], corners))
+          return true;
+      }
+    }
+    return std::any_of(planes_.begin(), planes_.end(),
+                       [&](const Plane& plane) { return on_plane(plane, corners); });
+  }
+
+ private:
+  // The corners are in the hull, so at or below every facet's plane up to
+  // rounding: being above -tolerance is being on it.
+  template <std::size_t N>
+  bool on_plane(const Plane& plane, const std::array<Vec3, N>& corners) const {
+    return std::all_of(corners.begin(), corners.end(), [&](const Vec3& p) {
+      return plane.normal.dot(p) - plane.offset >= -tolerance_;
+    });
+  }
+
+  const ConvexPolytope& hull_;
+  double tolerance_;
+  std::vector<Plane> planes_;
+  int start_ = 0;
+};
+
 }  // namespace
 
-PointCloud read_points_from_memory(std::string_view bytes, MeshFormat format, const std::string& name) {
+bool surface_is_convex(const ConvexPolytope& hull, std::span<const Vec3> points,
+                       std::span<const std::array<std::int32_t, 3>> triangles) {
+  if (hull.dimension() < 3) return true;
+  SurfaceTest test(hull);
+  if (!triangles.empty()) {
+    for (const auto& t : triangles) {
+      for (const std::int32_t i : t) {
+        if (i < 0 || static_cast<std::size_t>(i) >= points.size()) {
+          throw InvalidInput("surface_is_convex: triangle index " + std::to_string(i) +
+                             " outside the " + std::to_string(points.size()) + " points");
+        }
+      }
+      const std::array<Vec3, 3> c = {points[static_cast<std::size_t>(t[0])],
+                                     points[static_cast<std::size_t>(t[1])],
+                                     points[static_cast<std::size_t>(t[2])]};
+      if (!test.on_one_facet(c, (c[1] - c[0]).cross(c[2] - c[0]))) return false;
+    }
+    return true;
+  }
+  std::vector<bool> is_vertex(points.size(), false);
+  for (const std::int32_t i : hull.input_index()) {
+    if (i >= 0 && static_cast<std::size_t>(i) < points.size())
+      is_vertex[static_cast<std::size_t>(i)] = true;
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!is_vertex[i] &&
+        !test.on_one_facet(std::array<Vec3, 1>{points[i]}, points[i] - hull.centroid()))
+      return false;
+  }
+  return true;
+}
+
+PointCloud read_points_from_memory(std::string_view bytes, MeshFormat format,
+                                   const std::string& name, const ReadOptions& options) {
   const Source src{name};
+  if (bytes.size() > options.max_file_bytes) {
+    fail_too_large(src, std::to_string(bytes.size()) + " bytes,", options.max_file_bytes);
+  }
   if (format == MeshFormat::unknown) format = sniff_format(bytes);
   return finish(src, read_as(src, bytes, format));
 }
 
-PointCloud read_points(const std::string& path) {
+PointCloud read_points(const std::string& path, const ReadOptions& options) {
   const Source src{path};
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
@@ -1185,32 +1409,74 @@ PointCloud read_points(const std::string& path) {
     src.fail("cannot open: " + (missing ? std::string("no such file") : ec.message()));
   }
   if (std::filesystem::is_directory(status)) src.fail("cannot open: is a directory");
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
+  const std::uint64_t limit = options.max_file_bytes;
+  std::uint64_t file_bytes = 0;
+  const bool regular = std::filesystem::is_regular_file(status);
+  if (regular) {
+    file_bytes = std::filesystem::file_size(path, ec);
+    if (ec) src.fail("cannot read the size: " + ec.message());
+    if (file_bytes > limit) fail_too_large(src, std::to_string(file_bytes) + " bytes,", limit);
+  }
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"),
+                                                             &std::fclose);
   if (!file) src.fail(std::string("cannot open: ") + std::strerror(errno));
+  MeshFormat format = format_from_extension(path);
+
+  // Binary STL from a regular file is read in chunks: the largest files
+  // are binary STL, and their corners alone take 36 bytes per triangle.
+  if (regular && format == MeshFormat::stl_binary && file_bytes >= kStlPreambleBytes) {
+    std::string preamble(kStlPreambleBytes, '\0');
+    if (std::fread(preamble.data(), 1, preamble.size(), file.get()) != preamble.size())
+      src.fail("read error");
+    if (kStlPreambleBytes + kStlTriangleBytes * load_le(preamble, kStlHeaderBytes, 4) ==
+        file_bytes) {
+      const std::uint64_t n = stl_binary_count(src, preamble, file_bytes);
+      std::string chunk;
+      std::uint64_t at = kStlPreambleBytes;
+      PointCloud cloud =
+          read_stl_binary_triangles(src, n, [&](std::size_t offset, std::size_t size) {
+            if (offset != at) throw std::logic_error("binary STL chunks out of order");
+            chunk.resize(size);
+            if (std::fread(chunk.data(), 1, size, file.get()) != size)
+              src.fail_byte(offset, "read error (the file shrank?)");
+            at += size;
+            return std::string_view(chunk);
+          });
+      return finish(src, std::move(cloud));
+    }
+    std::rewind(file.get());
+  }
+
   std::string bytes;
-  std::array<char, 1 << 16> chunk{};
+  if (regular) bytes.reserve(static_cast<std::size_t>(file_bytes));
+  std::array<char, 1 << 16> buffer{};
   std::size_t got = 0;
-  while ((got = std::fread(chunk.data(), 1, chunk.size(), file.get())) > 0) bytes.append(chunk.data(), got);
+  while ((got = std::fread(buffer.data(), 1, buffer.size(), file.get())) > 0) {
+    if (got > limit - bytes.size()) fail_too_large(src, "read", limit);
+    bytes.append(buffer.data(), got);
+  }
   if (std::ferror(file.get()) != 0) src.fail("read error");
 
-  MeshFormat format = format_from_extension(path);
   if (format == MeshFormat::stl_binary && !stl_is_binary(bytes)) format = MeshFormat::stl_ascii;
   if (format == MeshFormat::unknown) {
     format = sniff_format(bytes);
     if (format == MeshFormat::unknown) {
-      src.fail("unknown format: the extension " + quote(std::filesystem::path(path).extension().string()) +
+      src.fail("unknown format: the extension " +
+               quote(std::filesystem::path(path).extension().string()) +
                " is none of .obj .off .stl .ply .xyz .txt .pts, and the content is not recognized");
     }
   }
   return finish(src, read_as(src, bytes, format));
 }
 
-LoadedPolytope load_convex(const std::string& path) {
-  PointCloud cloud = read_points(path);
+LoadedPolytope load_convex(const std::string& path, const ReadOptions& options) {
+  PointCloud cloud = read_points(path, options);
   try {
     ConvexPolytope polytope(cloud.points);
     const int interior = polytope.interior_point_count();
-    return LoadedPolytope{std::move(polytope), static_cast<int>(cloud.points.size()), interior, interior == 0};
+    const bool convex = surface_is_convex(polytope, cloud.points, cloud.triangles);
+    return LoadedPolytope{std::move(polytope), static_cast<int>(cloud.points.size()), interior,
+                          convex};
   } catch (const FileError&) {
     throw;
   } catch (const InvalidInput& e) {
@@ -1229,27 +1495,73 @@ LoadedCompound compound_from_cloud(const PointCloud& cloud) {
                                                std::to_string(cloud.group_names.size()) + " and " +
                                                std::to_string(cloud.group_offsets.size()) + ")");
   }
+  for (std::size_t t = 0; t < cloud.triangles.size(); ++t) {
+    for (const std::int32_t i : cloud.triangles[t]) {
+      if (i < 0 || i >= point_count) {
+        throw FileError::in_file(cloud.source, "triangle " + std::to_string(t) +
+                                                   " has vertex index " + std::to_string(i) +
+                                                   ", outside the " + std::to_string(point_count) +
+                                                   " points");
+      }
+    }
+  }
+  // With faces, groups are ranges of triangles; otherwise of points.
+  const bool by_triangles = !cloud.triangles.empty() && !cloud.group_offsets.empty();
+  const auto item_count =
+      by_triangles ? static_cast<std::int64_t>(cloud.triangles.size()) : point_count;
   const std::size_t groups = std::max<std::size_t>(cloud.group_offsets.size(), 1);
   std::vector<CompoundPiece> pieces;
   std::vector<LoadedPiece> reports;
   pieces.reserve(groups);
   reports.reserve(groups);
+  std::vector<std::int32_t> local(by_triangles ? cloud.points.size() : 0,
+                                  -1);  // point -> index in the piece
   for (std::size_t g = 0; g < groups; ++g) {
     const bool grouped = !cloud.group_offsets.empty();
     const std::string name = grouped ? cloud.group_names[g] : std::string();
     const std::string label = "group " + std::to_string(g) + " '" + name + "'";
     const std::int64_t begin = grouped ? cloud.group_offsets[g] : 0;
-    const std::int64_t end = grouped && g + 1 < groups ? cloud.group_offsets[g + 1] : point_count;
-    if ((g == 0 && begin != 0) || begin < 0 || end > point_count || begin >= end) {
-      throw FileError::in_file(cloud.source, label + ": bad point range [" + std::to_string(begin) + ", " +
-                                                 std::to_string(end) + ") of " + std::to_string(point_count) +
-                                                 " points (groups must be non-empty, in order, from 0)");
+    const std::int64_t end = grouped && g + 1 < groups ? cloud.group_offsets[g + 1] : item_count;
+    if ((g == 0 && begin != 0) || begin < 0 || end > item_count || begin >= end) {
+      throw FileError::in_file(
+          cloud.source, label + ": bad " + (by_triangles ? "triangle" : "point") + " range [" +
+                            std::to_string(begin) + ", " + std::to_string(end) + ") of " +
+                            std::to_string(item_count) + (by_triangles ? " triangles" : " points") +
+                            " (groups must be non-empty, in order, from 0)");
     }
-    const std::span<const Vec3> points(cloud.points.data() + begin, static_cast<std::size_t>(end - begin));
+    std::vector<Vec3> own_points;
+    std::vector<std::array<std::int32_t, 3>> own_triangles;
+    std::span<const Vec3> points;
+    std::span<const std::array<std::int32_t, 3>> triangles;
+    if (by_triangles) {
+      // The vertices the group's faces reference, in order of first reference.
+      std::vector<std::int32_t> used;
+      for (std::int64_t t = begin; t < end; ++t) {
+        std::array<std::int32_t, 3> tri{};
+        for (std::size_t k = 0; k < 3; ++k) {
+          const auto i = static_cast<std::size_t>(cloud.triangles[static_cast<std::size_t>(t)][k]);
+          if (local[i] < 0) {
+            local[i] = static_cast<std::int32_t>(own_points.size());
+            own_points.push_back(cloud.points[i]);
+            used.push_back(static_cast<std::int32_t>(i));
+          }
+          tri[k] = local[i];
+        }
+        own_triangles.push_back(tri);
+      }
+      for (const std::int32_t i : used) local[static_cast<std::size_t>(i)] = -1;
+      points = own_points;
+      triangles = own_triangles;
+    } else {
+      points =
+          std::span<const Vec3>(cloud.points.data() + begin, static_cast<std::size_t>(end - begin));
+      if (!grouped) triangles = cloud.triangles;
+    }
     try {
       auto polytope = std::make_shared<const ConvexPolytope>(points);
       const int interior = polytope->interior_point_count();
-      reports.push_back({name, static_cast<int>(points.size()), interior, interior == 0});
+      const bool convex = surface_is_convex(*polytope, points, triangles);
+      reports.push_back({name, static_cast<int>(points.size()), interior, convex});
       pieces.push_back({std::move(polytope), Pose::identity()});
     } catch (const InvalidInput& e) {
       throw FileError::in_file(cloud.source, label + ": " + e.what());
@@ -1264,6 +1576,8 @@ LoadedCompound compound_from_cloud(const PointCloud& cloud) {
   }
 }
 
-LoadedCompound load_compound(const std::string& path) { return compound_from_cloud(read_points(path)); }
+LoadedCompound load_compound(const std::string& path, const ReadOptions& options) {
+  return compound_from_cloud(read_points(path, options));
+}
 
 }  // namespace proxima

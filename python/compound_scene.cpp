@@ -113,7 +113,9 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("input_points", &LoadedPiece::input_points, "Points of the group.")
       .def_readonly("interior_points", &LoadedPiece::interior_points,
                     "Points of the group that are not hull vertices.")
-      .def_readonly("input_was_convex", &LoadedPiece::input_was_convex, "interior_points == 0.");
+      .def_readonly("input_was_convex", &LoadedPiece::input_was_convex,
+                    "Whether the group's surface is convex (its faces lie on its hull's facets; "
+                    "without faces, its points on the hull's boundary).");
 
   py::class_<LoadedCompound>(m, "LoadedCompound",
                              "A compound body read from a file, per-piece reports.")
@@ -123,7 +125,10 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("pieces", &LoadedCompound::pieces, "List of LoadedPiece, one per piece.");
 
   m.def(
-      "load_compound", [](const std::string& path) { return read_file(path, load_compound); },
+      "load_compound",
+      [](const std::string& path) {
+        return read_file(path, [](const std::string& p) { return load_compound(p); });
+      },
       py::arg("path"),
       "Reads a mesh file as a compound body: one convex piece per OBJ group; a non-convex group "
       "is hulled and reported in its LoadedPiece.");

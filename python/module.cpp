@@ -244,10 +244,16 @@ PYBIND11_MODULE(proxima, m) {
       .def_readonly("input_points", &LoadedPolytope::input_points, "Points read from the file.")
       .def_readonly("interior_points", &LoadedPolytope::interior_points,
                     "Input points that are not hull vertices (inside, on a face, or repeated).")
-      .def_readonly("input_was_convex", &LoadedPolytope::input_was_convex, "interior_points == 0.");
+      .def_readonly("input_was_convex", &LoadedPolytope::input_was_convex,
+                    "Whether the input surface is convex: every face (OBJ, STL) lies on a hull "
+                    "facet, or, for a point cloud, every point is on the hull's boundary (see "
+                    "surface_is_convex in proxima/io.h).");
 
   m.def(
-      "load_convex", [](const std::string& path) { return read_file(path, load_convex); },
+      "load_convex",
+      [](const std::string& path) {
+        return read_file(path, [](const std::string& p) { return load_convex(p); });
+      },
       py::arg("path"),
       "Reads a mesh file and builds the hull of all its points; reports a non-convex input rather "
       "than failing.");
