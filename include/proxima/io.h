@@ -127,7 +127,9 @@ PointCloud read_points_from_memory(std::string_view bytes, MeshFormat format,
                                    const std::string& name, const ReadOptions& options = {});
 
 // Whether the input's surface is convex, i.e. already the boundary of its
-// hull. With faces (OBJ `f`, STL facets): every triangle lies on the hull's
+// hull (`points` are the hull's input, `triangles` index them; an index
+// outside them throws InvalidInput). With faces (OBJ `f`, STL facets; a
+// vertex no face uses does not count): every triangle lies on the hull's
 // boundary, in the plane of one hull facet: all three of its corners within
 // kConvexSurfaceTolerance * hull.scale() of that facet's plane (they are in
 // the hull, so then the triangle lies in the facet). A folded or dented
