@@ -164,6 +164,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
       ->capture_default_str();
   distance->add_flag("--json", distance_command.json, "One JSON object instead of the table");
+  distance
+      ->add_option("--max-file-size", distance_command.max_file_bytes,
+                   "Refuse an input file larger than this many bytes")
+      ->capture_default_str();
   distance->footer(
       "Example:\n"
       "  proxima distance a.obj b.stl --pose-b 0 0 2 0.7071067811865476 0 0 0.7071067811865476 "
@@ -182,6 +186,9 @@ int main(int argc, char** argv) {
           },
           "FILE.obj|FILE.off"));
   hull->add_flag("--json", hull_command.json, "One JSON object instead of the table");
+  hull->add_option("--max-file-size", hull_command.max_file_bytes,
+                   "Refuse an input file larger than this many bytes")
+      ->capture_default_str();
   hull->footer("Example:\n  proxima hull body.stl --out hull.off");
 
   CLI::App* scene_demo = app.add_subcommand(

@@ -72,8 +72,10 @@ struct LoadedFile {
 // read_points, then the hull of every point (what load_convex does), keeping
 // the format read for the report. A hull failure becomes a FileError naming
 // the file, like load_convex's.
-LoadedFile load_file(const std::string& path) {
-  PointCloud cloud = read_points(path);
+LoadedFile load_file(const std::string& path, std::uint64_t max_file_bytes) {
+  ReadOptions options;
+  options.max_file_bytes = max_file_bytes;
+  PointCloud cloud = read_points(path, options);
   try {
     ConvexPolytope polytope(cloud.points);
     return LoadedFile{std::move(polytope), cloud.format, static_cast<int>(cloud.points.size())};
@@ -175,6 +177,13 @@ std::string body_text(const std::string& path, const LoadedFile& body) {
   return s.str();
 }
 
+// One line of JSON. File names are bytes, not necessarily UTF-8, and
+// nlohmann's dump throws on invalid UTF-8 (a name with byte 0xff lost the
+// whole answer): such bytes are written as U+FFFD instead.
+std::string json_line(const Json& j) {
+  return j.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
 void row(std::ostream& out, const std::string& name, const std::string& value) {
   out << std::left << std::setw(14) << name << value << "\n";
 }
@@ -266,8 +275,8 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
   std::optional<LoadedFile> a;
   std::optional<LoadedFile> b;
   try {
-    a.emplace(load_file(command.file_a));
-    b.emplace(load_file(command.file_b));
+    a.emplace(load_file(command.file_a, command.max_file_bytes));
+    b.emplace(load_file(command.file_b, command.max_file_bytes));
   } catch (const InvalidInput& e) {
     err << "proxima distance: " << e.what() << "\n";
     return kExitFailure;
@@ -297,7 +306,7 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
     j["normal"] = point_json(r.normal);
     j["feature_a"] = feature_json(r.feature_a, a->polytope);
     j["feature_b"] = feature_json(r.feature_b, b->polytope);
-    out << j.dump() << "\n";
+    out << json_line(j);
   } else {
     row(out, "A", body_text(command.file_a, *a));
     row(out, "B", body_text(command.file_b, *b));
@@ -324,7 +333,7 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
   std::optional<LoadedFile> body;
   std::optional<ExportSummary> exported;
   try {
-    body.emplace(load_file(command.file));
+    body.emplace(load_file(command.file, command.max_file_bytes));
     if (!command.out_file.empty()) {
       exported = write_hull(body->polytope, command.out_file, export_format(command.out_file), command.file);
     }
@@ -358,7 +367,7 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
       e["note"] = exported->note.empty() ? Json(nullptr) : Json(exported->note);
       j["export"] = e;
     }
-    out << j.dump() << "\n";
+    out << json_line(j);
   } else {
     row(out, "file", command.file + " (" + to_string(body->format) + ")");
     row(out, "input points", std::to_string(body->input_points));

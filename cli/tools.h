@@ -6,12 +6,14 @@
 // the arguments; these run the commands and return the exit code.
 #pragma once
 
-#include "proxima/types.h"
-
+#include <cstdint>
 #include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
+
+#include "proxima/io.h"
+#include "proxima/types.h"
 
 namespace proxima::cli {
 
@@ -24,6 +26,7 @@ struct DistanceCommand {
   std::vector<std::string> pose_b;
   DistanceOptions options;
   bool json = false;
+  std::uint64_t max_file_bytes = kDefaultMaxFileBytes;  // per input file (ReadOptions)
 };
 
 // Loads both files, runs one cold query, prints a table or one JSON object
@@ -35,6 +38,7 @@ struct HullCommand {
   std::string file;
   std::string out_file;  // empty: no export; otherwise .obj or .off (any case)
   bool json = false;
+  std::uint64_t max_file_bytes = kDefaultMaxFileBytes;  // ReadOptions
 };
 
 // Hull statistics of one file (table or JSON) and optionally its export as

@@ -6,9 +6,6 @@
 // report, an allocation beyond -malloc_limit_mb, a hang, a floating-point
 // trap (invalid operation, division by zero), or a broken invariant of the
 // result is a bug. Built and run by scripts/fuzz.
-#include "proxima/io.h"
-#include "proxima/polytope.h"
-
 #include <array>
 #include <cfenv>
 #include <cstdint>
@@ -16,13 +13,16 @@
 #include <cstdlib>
 #include <string_view>
 
+#include "proxima/io.h"
+#include "proxima/polytope.h"
+
 namespace {
 
 using proxima::MeshFormat;
 
-constexpr std::array<MeshFormat, 8> kFormats = {MeshFormat::obj,        MeshFormat::off,       MeshFormat::stl_ascii,
-                                                MeshFormat::stl_binary, MeshFormat::ply_ascii, MeshFormat::ply_binary_le,
-                                                MeshFormat::xyz,        MeshFormat::unknown};
+constexpr std::array<MeshFormat, 8> kFormats = {
+    MeshFormat::obj,       MeshFormat::off,           MeshFormat::stl_ascii, MeshFormat::stl_binary,
+    MeshFormat::ply_ascii, MeshFormat::ply_binary_le, MeshFormat::xyz,       MeshFormat::unknown};
 
 void require(bool ok, const char* what) {
   if (!ok) {
@@ -37,14 +37,23 @@ void check_cloud(const proxima::PointCloud& cloud, MeshFormat asked) {
   require(!cloud.points.empty(), "a cloud that was read has points");
   require(cloud.source == "fuzz", "source is the name given");
   require(cloud.format != MeshFormat::unknown, "the format read is known");
-  require(asked == MeshFormat::unknown || cloud.format == asked || (is_ply(asked) && is_ply(cloud.format)),
+  require(asked == MeshFormat::unknown || cloud.format == asked ||
+              (is_ply(asked) && is_ply(cloud.format)),
           "the format read is the one asked for");
   for (const proxima::Vec3& p : cloud.points) require(p.allFinite(), "points are finite");
+  for (const auto& t : cloud.triangles) {
+    for (const std::int32_t i : t)
+      require(i >= 0 && static_cast<std::size_t>(i) < cloud.points.size(),
+              "triangle indices in range");
+  }
   require(cloud.group_names.size() == cloud.group_offsets.size(), "one offset per group name");
+  // Groups range over the triangles when there are any, else over the points.
+  const std::size_t items = cloud.triangles.empty() ? cloud.points.size() : cloud.triangles.size();
   for (std::size_t g = 0; g < cloud.group_offsets.size(); ++g) {
     require((cloud.group_offsets[g] == 0) == (g == 0), "groups start at 0");
-    require(static_cast<std::size_t>(cloud.group_offsets[g]) < cloud.points.size(), "groups are non-empty");
-    require(g == 0 || cloud.group_offsets[g - 1] < cloud.group_offsets[g], "group offsets increase");
+    require(static_cast<std::size_t>(cloud.group_offsets[g]) < items, "groups are non-empty");
+    require(g == 0 || cloud.group_offsets[g - 1] < cloud.group_offsets[g],
+            "group offsets increase");
   }
 }
 
@@ -64,8 +73,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       check_cloud(cloud, format);
       const proxima::ConvexPolytope polytope(cloud.points);
       require(polytope.vertex_count() >= 1, "a hull has a vertex");
-      require(polytope.vertex_count() + polytope.interior_point_count() == static_cast<int>(cloud.points.size()),
+      require(polytope.vertex_count() + polytope.interior_point_count() ==
+                  static_cast<int>(cloud.points.size()),
               "every input point is a hull vertex or counted as interior");
+      proxima::surface_is_convex(polytope, cloud.points, cloud.triangles);
       if (!cloud.group_offsets.empty()) {  // OBJ groups: one convex piece each
         const proxima::LoadedCompound compound = proxima::compound_from_cloud(cloud);
         require(compound.body.piece_count() == static_cast<int>(cloud.group_offsets.size()),

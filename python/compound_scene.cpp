@@ -83,10 +83,23 @@ void bind_compound_and_scene(py::module_& m) {
       .def_static(
           "from_file",
           [](const std::string& path) {
-            return read_file(path, [](const std::string& p) { return load_compound(p).body; });
+            LoadedCompound loaded =
+                read_file(path, [](const std::string& p) { return load_compound(p); });
+            std::string names;
+            for (const LoadedPiece& piece : loaded.pieces) {
+              if (!piece.input_was_convex)
+                names += (names.empty() ? "'" : ", '") + piece.name + "'";
+            }
+            if (!names.empty()) {
+              warn_non_convex(path + ": not convex: group(s) " + names +
+                              " (each piece is the hull of its group's points)");
+            }
+            return std::move(loaded.body);
           },
           py::arg("path"),
-          "One piece per OBJ group/object (a file without groups is one piece), each hulled.")
+          "One piece per OBJ group/object (a file without groups is one piece), each hulled. A "
+          "group whose surface is not convex warns NonConvexInputWarning naming it; load_compound "
+          "returns the per-group report instead, without a warning.")
       .def_property_readonly("piece_count", &CompoundBody::piece_count, "Number of pieces.")
       .def(
           "piece",
@@ -113,7 +126,9 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("input_points", &LoadedPiece::input_points, "Points of the group.")
       .def_readonly("interior_points", &LoadedPiece::interior_points,
                     "Points of the group that are not hull vertices.")
-      .def_readonly("input_was_convex", &LoadedPiece::input_was_convex, "interior_points == 0.");
+      .def_readonly("input_was_convex", &LoadedPiece::input_was_convex,
+                    "Whether the group's surface is convex (its faces lie on its hull's facets; "
+                    "without faces, its points on the hull's boundary).");
 
   py::class_<LoadedCompound>(m, "LoadedCompound",
                              "A compound body read from a file, per-piece reports.")
@@ -123,10 +138,13 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("pieces", &LoadedCompound::pieces, "List of LoadedPiece, one per piece.");
 
   m.def(
-      "load_compound", [](const std::string& path) { return read_file(path, load_compound); },
+      "load_compound",
+      [](const std::string& path) {
+        return read_file(path, [](const std::string& p) { return load_compound(p); });
+      },
       py::arg("path"),
       "Reads a mesh file as a compound body: one convex piece per OBJ group; a non-convex group "
-      "is hulled and reported in its LoadedPiece.");
+      "is hulled and reported in its LoadedPiece.input_was_convex (no warning).");
 
   py::class_<CompoundCache>(
       m, "CompoundCache",

@@ -240,6 +240,15 @@ auto read_file(const std::string& path, Read read) {
   }
 }
 
+// A loader that returns only the body (ConvexPolytope.from_file,
+// CompoundBody.from_file) reports a non-convex input as the CLI's table does,
+// with a proxima.NonConvexInputWarning (a UserWarning): the body is the hull
+// of all points all the same. Under warnings-as-errors the warning raises.
+inline void warn_non_convex(const std::string& message) {
+  const py::object category = py::module_::import("proxima").attr("NonConvexInputWarning");
+  if (PyErr_WarnEx(category.ptr(), message.c_str(), 1) != 0) throw py::error_already_set();
+}
+
 inline int check_index(int i, int count, const char* what) {
   if (i < 0 || i >= count) {
     throw py::index_error(std::string(what) + " " + std::to_string(i) + " out of range [0, " +

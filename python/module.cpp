@@ -69,6 +69,12 @@ PYBIND11_MODULE(proxima, m) {
       "A mesh file that cannot be read; the message names the file, the line or byte offset and "
       "the problem.";
 
+  m.attr("NonConvexInputWarning") = py::reinterpret_steal<py::object>(PyErr_NewExceptionWithDoc(
+      "proxima.NonConvexInputWarning",
+      "Warned by ConvexPolytope.from_file and CompoundBody.from_file when the file's surface "
+      "is not convex (see LoadedPolytope.input_was_convex): the hull of all points is used.",
+      PyExc_UserWarning, nullptr));
+
   // --- Pose -----------------------------------------------------------------
   py::class_<Pose>(m, "Pose", "A rigid motion: x -> rotation @ x + translation.")
       .def(py::init<>(), "The identity.")
@@ -138,12 +144,24 @@ PYBIND11_MODULE(proxima, m) {
       .def_static(
           "from_file",
           [](const std::string& path) {
-            return read_file(path, [](const std::string& p) { return load_convex(p).polytope; });
+            LoadedPolytope loaded =
+                read_file(path, [](const std::string& p) { return load_convex(p); });
+            if (!loaded.input_was_convex) {
+              warn_non_convex(
+                  path + ": not convex (" + std::to_string(loaded.interior_points) + " of " +
+                  std::to_string(loaded.input_points) +
+                  " points are not hull vertices; the surface is not the hull's boundary), "
+                  "the hull of all points is used");
+            }
+            return std::move(loaded.polytope);
           },
           py::arg("path"),
           "The hull of the points of a mesh file (OBJ, OFF, STL, PLY, XYZ). Raises FileError "
           "(ValueError) for a bad "
-          "file and FileNotFoundError for a missing one.")
+          "file and FileNotFoundError for a missing one. A non-convex input (its surface is not "
+          "its hull's boundary, as LoadedPolytope.input_was_convex defines it) warns "
+          "NonConvexInputWarning, as the CLI reports 'not convex', and gives the hull; "
+          "load_convex returns the report instead, without a warning.")
       .def_property_readonly("dimension", &ConvexPolytope::dimension,
                              "0 (point), 1 (segment), 2 (polygon), 3 (solid).")
       .def_property_readonly(
@@ -243,13 +261,20 @@ PYBIND11_MODULE(proxima, m) {
       .def_readonly("input_points", &LoadedPolytope::input_points, "Points read from the file.")
       .def_readonly("interior_points", &LoadedPolytope::interior_points,
                     "Input points that are not hull vertices (inside, on a face, or repeated).")
-      .def_readonly("input_was_convex", &LoadedPolytope::input_was_convex, "interior_points == 0.");
+      .def_readonly("input_was_convex", &LoadedPolytope::input_was_convex,
+                    "Whether the input surface is convex: every face (OBJ, STL) lies on a hull "
+                    "facet, or, for a point cloud, every point is on the hull's boundary (see "
+                    "surface_is_convex in proxima/io.h).");
 
   m.def(
-      "load_convex", [](const std::string& path) { return read_file(path, load_convex); },
+      "load_convex",
+      [](const std::string& path) {
+        return read_file(path, [](const std::string& p) { return load_convex(p); });
+      },
       py::arg("path"),
-      "Reads a mesh file and builds the hull of all its points; reports a non-convex input rather "
-      "than failing.");
+      "Reads a mesh file and builds the hull of all its points; reports a non-convex input in "
+      "LoadedPolytope.input_was_convex (the CLI's 'convex' field) rather than failing or "
+      "warning.");
   m.def(
       "read_points",
       [](const std::string& path) {

@@ -447,6 +447,51 @@ TEST(CliTools, BadInputExitsOneNamingTheFile) {
   EXPECT_NE(run.out.find("/nonexistent-dir-4711/hull.obj"), std::string::npos) << run.out;
 }
 
+// Issue 9: a file name that is not UTF-8 (byte 0xff) made nlohmann's dump
+// throw in `--json` output, and the answer was lost. The byte is now
+// written as U+FFFD and the JSON parses.
+TEST(CliTools, JsonSurvivesAFileNameThatIsNotUtf8) {
+  REQUIRE_CLI();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("proxima_cli_test_" + std::to_string(getpid()) + "_\xff.obj"))
+                               .string();
+  write_obj(path, box(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  const TempPath other(".obj");
+  write_obj(other.path(), box(Vec3(3, 0, 0), Vec3(4, 1, 1)));
+  const std::string replaced = "_\xef\xbf\xbd.obj";  // U+FFFD in UTF-8
+  const CliRun hull = run_cli("hull " + shell_quote(path) + " --json");
+  const CliRun distance =
+      run_cli("distance " + shell_quote(path) + " " + other.quoted() + " --json");
+  std::filesystem::remove(path);
+  ASSERT_EQ(hull.exit_code, 0) << hull.out;
+  EXPECT_NE(parse_json(hull).at("file").get<std::string>().find(replaced), std::string::npos);
+  EXPECT_EQ(parse_json(hull).at("vertices"), 8);
+  ASSERT_EQ(distance.exit_code, 0) << distance.out;
+  EXPECT_NE(parse_json(distance).at("a").at("file").get<std::string>().find(replaced),
+            std::string::npos);
+  EXPECT_NEAR(parse_json(distance).at("distance").get<double>(), 2.0, accuracy_bound(2.0, 4.0));
+}
+
+// Issue 9: `proxima hull /dev/zero` grew until bad_alloc. --max-file-size
+// (default 1 GiB) bounds what is read.
+TEST(CliTools, MaxFileSizeRefusesLargerFiles) {
+  REQUIRE_CLI();
+  const TempPath file(".obj");
+  write_obj(file.path(), box(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  CliRun run = run_cli("hull " + file.quoted() + " --max-file-size 20", true);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.out.find(file.path() + ": file too large"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("limit of 20 bytes"), std::string::npos) << run.out;
+  run = run_cli("distance " + file.quoted() + " " + file.quoted() + " --max-file-size 20", true);
+  EXPECT_EQ(run.exit_code, 1);
+  if (std::filesystem::exists("/dev/zero")) {
+    run = run_cli("hull /dev/zero --max-file-size 1000000", true);
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.out.find("/dev/zero: file too large"), std::string::npos) << run.out;
+  }
+  EXPECT_EQ(run_cli("hull " + file.quoted() + " --max-file-size 100000 --json").exit_code, 0);
+}
+
 TEST(CliTools, UsageErrorsExitTwo) {
   REQUIRE_CLI();
   const TempPath good(".obj");

@@ -46,7 +46,7 @@ TEST_F(CompoundIoTest, GroupsBecomePiecesInFileOrder) {
   const Points p1 = test::points_in_cube(rng, 40);
   const Points p2 = test::translated(test::cube(1.0), Vec3(3, 0, 0));
   const std::string obj = "# three parts\n" + obj_vertices(p0) + "o middle part\n" +
-                          obj_vertices(p1) + "g right\n" + obj_vertices(p2) + "f 1 2 3\n";
+                          obj_vertices(p1) + "g right\n" + obj_vertices(p2);
   const LoadedCompound loaded = load_compound(write("parts.obj", obj));
   ASSERT_EQ(loaded.body.piece_count(), 3);
   ASSERT_EQ(loaded.pieces.size(), 3u);
@@ -71,6 +71,85 @@ TEST_F(CompoundIoTest, GroupsBecomePiecesInFileOrder) {
   EXPECT_EQ(r.piece_a, 2);
   EXPECT_EQ(r.distance, distance(ConvexPolytope(p2), Pose(), probe, Pose()).distance);
   EXPECT_EQ(r.distance, distance_all_pairs(loaded.body, Pose(), probe_body, Pose()).distance);
+}
+
+// Issue 9: in OBJ the vertices are global and `g`/`o` group the faces. The
+// reader took each group's points from the `v` lines after its statement, so
+// a file that lists every vertex first, then each group's faces, became one
+// piece of every point (its hull spanning both parts). Each piece is now
+// made of the vertices its faces reference, relative indices included.
+TEST_F(CompoundIoTest, VerticesFirstThenFacesSplitByGroup) {
+  const Points left = test::cube(1.0);
+  const Points right = test::translated(test::cube(1.0), Vec3(5, 0, 0));
+  // Each cube's hull triangles, as 1-based OBJ indices (from the hull).
+  const auto faces = [](const Points& pts, int first, bool relative, int total) {
+    const ConvexPolytope hull(pts);
+    std::string out;
+    for (const auto& t : hull.triangles()) {
+      out += "f";
+      for (const std::int32_t k : t) {
+        const int index = first + hull.input_index()[static_cast<std::size_t>(k)];
+        out += ' ';
+        out += std::to_string(relative ? index - total - 1 : index);
+        out += "/1/1";
+      }
+      out += "\n";
+    }
+    return out;
+  };
+  const std::string obj = obj_vertices(left) + obj_vertices(right) +
+                          "vt 0 0\nvn 0 0 1\ng left part\n" + faces(left, 1, false, 16) +
+                          "o right\n" + faces(right, 9, true, 16);
+  const LoadedCompound loaded = load_compound(write("split.obj", obj));
+  ASSERT_EQ(loaded.body.piece_count(), 2);
+  EXPECT_EQ(loaded.pieces[0].name, "left part");
+  EXPECT_EQ(loaded.pieces[1].name, "right");
+  EXPECT_EQ(loaded.pieces[0].input_points, 8);
+  EXPECT_EQ(loaded.pieces[1].input_points, 8);
+  EXPECT_TRUE(loaded.pieces[0].input_was_convex);
+  EXPECT_TRUE(loaded.pieces[1].input_was_convex);
+  EXPECT_EQ(loaded.body.piece(0).polytope->vertex_count(), 8);
+  EXPECT_EQ(loaded.body.piece(1).polytope->vertex_count(), 8);
+  EXPECT_LT(loaded.body.piece(0).polytope->vertices()[0].x(), 2.0);
+  EXPECT_GT(loaded.body.piece(1).polytope->vertices()[0].x(), 2.0);
+}
+
+TEST_F(CompoundIoTest, AFoldedGroupIsReportedNotConvex) {
+  const Points pts = test::cube(1.0);
+  const ConvexPolytope hull(pts);
+  std::string cube_faces;
+  for (const auto& t : hull.triangles()) {
+    cube_faces += "f";
+    for (const std::int32_t k : t)
+      cube_faces += " " + std::to_string(hull.input_index()[static_cast<std::size_t>(k)] + 1);
+    cube_faces += "\n";
+  }
+  // Three corners with no coordinate in common lie on no face of the cube:
+  // their triangle cuts through it.
+  std::string fold;
+  for (int i = 0; i < 8 && fold.empty(); ++i) {
+    for (int j = 0; j < 8 && fold.empty(); ++j) {
+      for (int k = 0; k < 8 && fold.empty(); ++k) {
+        const auto& p = pts;
+        bool shared = i == j || j == k || i == k;
+        for (int axis = 0; axis < 3; ++axis) {
+          shared = shared || (p[i][axis] == p[j][axis] && p[j][axis] == p[k][axis]);
+        }
+        if (!shared)
+          fold = "f " + std::to_string(i + 1) + " " + std::to_string(j + 1) + " " +
+                 std::to_string(k + 1) + "\n";
+      }
+    }
+  }
+  ASSERT_FALSE(fold.empty());
+  const std::string obj =
+      obj_vertices(pts) + "g whole\n" + cube_faces + "g folded\n" + cube_faces + fold;
+  const LoadedCompound loaded = load_compound(write("folded.obj", obj));
+  ASSERT_EQ(loaded.pieces.size(), 2u);
+  EXPECT_EQ(loaded.pieces[1].name, "folded");
+  EXPECT_TRUE(loaded.pieces[0].input_was_convex);
+  EXPECT_FALSE(loaded.pieces[1].input_was_convex);
+  EXPECT_EQ(loaded.pieces[1].interior_points, 0);
 }
 
 TEST_F(CompoundIoTest, FileWithoutGroupsIsOnePiece) {

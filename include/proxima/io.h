@@ -5,12 +5,15 @@
 // OBJ, the groups that a compound body is made of); the algorithms never see
 // files.
 //
-// Formats: Wavefront OBJ (`v` lines; `g`/`o` statements become groups), OFF
+// Formats: Wavefront OBJ (`v` and `f` lines; `g`/`o` statements group the
+// faces, see PointCloud), OFF
 // (and its C/N/ST variants, extra columns ignored), ASCII and binary STL,
 // PLY (ascii and binary_little_endian; the vertex element's x, y, z, any
 // other property skipped by its type, faces ignored) and plain XYZ (one point
 // per line, at least three numbers, extra columns ignored, `#` comments).
-// Faces are never used: the hull is recomputed from the points.
+// The hull is always recomputed from the points. Faces are read from OBJ
+// (`f`, polygons fan-triangulated) and STL (the facets), for the groups and
+// the convexity report; OFF and PLY faces are skipped.
 //
 // Every coordinate is parsed with a correctly rounded conversion, so a file
 // written with round-trip precision (17 significant digits) gives back the
@@ -21,37 +24,72 @@
 // Errors are FileError (an InvalidInput) with one message that names the
 // file, the line (text formats) or byte offset (binary formats) and the
 // problem. A header count never drives an allocation or a loop beyond what
-// the file's size can hold.
+// the file's size can hold, and no file larger than ReadOptions::
+// max_file_bytes is read (counted as read, so /dev/zero and pipes stop too).
 #pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "proxima/compound.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
-#include <cstdint>
-#include <string>
-#include <string_view>
-#include <vector>
-
 namespace proxima {
 
-enum class MeshFormat : std::uint8_t { obj, off, stl_ascii, stl_binary, ply_ascii, ply_binary_le, xyz, unknown };
+enum class MeshFormat : std::uint8_t {
+  obj,
+  off,
+  stl_ascii,
+  stl_binary,
+  ply_ascii,
+  ply_binary_le,
+  xyz,
+  unknown
+};
 
 const char* to_string(MeshFormat format);
 
 struct PointCloud {
   std::vector<Vec3> points;
-  MeshFormat format = MeshFormat::unknown;  // the format actually read (sniffed when asked with unknown)
-  std::string source;                       // the path or name given to the reader
-  // OBJ groups (`g` and `o` statements), in file order: group i holds the
-  // points [group_offsets[i], group_offsets[i + 1]) (the last one runs to the
-  // end). Empty when the file has no groups; otherwise the groups cover every
-  // point, each is non-empty, group_offsets[0] == 0, and points read before
-  // the first statement form a group named "". A later statement with no
-  // points in between renames the group (so `o body` then `g part` is one
-  // group "part").
+  MeshFormat format =
+      MeshFormat::unknown;  // the format actually read (sniffed when asked with unknown)
+  std::string source;       // the path or name given to the reader
+  // The faces, fan-triangulated, as indices into `points`: OBJ `f` lines
+  // (indices resolved, negative ones relative to the vertices read so far)
+  // and STL facets (corners merged as above). Empty for OFF, PLY and XYZ,
+  // whose faces are not read, and for an OBJ file without `f` lines.
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  // OBJ groups (`g` and `o` statements), in file order. In OBJ the vertices
+  // are global and the statements group the faces, so:
+  // - with faces (`triangles` non-empty), group i holds the triangles
+  //   [group_offsets[i], group_offsets[i + 1]), and its piece is made of the
+  //   vertices those reference, wherever in the file they were listed (a
+  //   file listing every `v` first, then each group's faces, splits by
+  //   group). Vertices no face references belong to no group.
+  // - without faces (a point-cloud OBJ), group i holds the points
+  //   [group_offsets[i], group_offsets[i + 1]): the `v` lines after its
+  //   statement.
+  // The last group runs to the end. Empty when the file has no groups;
+  // otherwise the groups cover every triangle (or point), each is non-empty,
+  // group_offsets[0] == 0, and what comes before the first statement forms a
+  // group named "". A later statement with nothing in between renames the
+  // group (so `o body` then `g part` is one group "part").
   std::vector<std::string> group_names;
   std::vector<std::int32_t> group_offsets;
+};
+
+// What a reader may take. max_file_bytes bounds the bytes read from a file
+// or given in memory; more is refused with a FileError naming the limit
+// (before reading, for a regular file; as soon as it is passed, for a pipe
+// or a device such as /dev/zero).
+inline constexpr std::uint64_t kDefaultMaxFileBytes = std::uint64_t{1} << 30;  // 1 GiB
+struct ReadOptions {
+  std::uint64_t max_file_bytes = kDefaultMaxFileBytes;
 };
 
 // A read failure. what() is "<file>, line <n>: <problem>", "<file>, byte
@@ -79,32 +117,55 @@ class FileError : public InvalidInput {
 // Reads the points of a mesh file. The format comes from the extension
 // (.obj .off .stl .ply .xyz .txt .pts, any case; ASCII or binary STL and PLY
 // from the content); an unknown extension falls back to content sniffing.
-PointCloud read_points(const std::string& path);
+PointCloud read_points(const std::string& path, const ReadOptions& options = {});
 
 // The same from bytes in memory; `name` stands for the file in messages.
 // MeshFormat::unknown sniffs the content. stl_ascii and stl_binary read the
 // content as given; ply_ascii and ply_binary_le both accept either PLY
 // encoding (the header says which) and report the one read.
-PointCloud read_points_from_memory(std::string_view bytes, MeshFormat format, const std::string& name);
+PointCloud read_points_from_memory(std::string_view bytes, MeshFormat format,
+                                   const std::string& name, const ReadOptions& options = {});
+
+// Whether the input's surface is convex, i.e. already the boundary of its
+// hull (`points` are the hull's input, `triangles` index them; an index
+// outside them throws InvalidInput). With faces (OBJ `f`, STL facets; a
+// vertex no face uses does not count): every triangle lies on the hull's
+// boundary, in the plane of one hull facet: all three of its corners within
+// kConvexSurfaceTolerance * hull.scale() of that facet's plane (they are in
+// the hull, so then the triangle lies in the facet). A folded or dented
+// mesh fails even when every vertex is a hull vertex. Without faces (a point
+// cloud): every point is a hull vertex or within the same distance of the
+// hull's boundary (a point on a face counts as convex, one inside does not).
+// A hull of dimension below 3 is its own boundary: convex. The tolerance
+// absorbs rounding, in particular STL's float32 corners (relative error
+// 6e-8), and is far below real folds (the Panda's collision meshes fold by
+// up to 1 mm at a scale of 0.2 m, a relative 5e-3).
+inline constexpr double kConvexSurfaceTolerance = 1e-6;
+bool surface_is_convex(const ConvexPolytope& hull, std::span<const Vec3> points,
+                       std::span<const std::array<std::int32_t, 3>> triangles);
 
 struct LoadedPolytope {
   ConvexPolytope polytope;
-  int input_points = 0;     // points read from the file
-  int interior_points = 0;  // input points that are not hull vertices (inside, on a face, or repeated)
-  bool input_was_convex = true;  // interior_points == 0: every input point is a hull vertex
+  int input_points = 0;  // points read from the file
+  int interior_points =
+      0;  // input points that are not hull vertices (inside, on a face, or repeated)
+  bool input_was_convex =
+      true;  // surface_is_convex (see above): the input surface is its hull's boundary
 };
 
 // read_points, then the hull of all the points (groups are not split). A
 // non-convex input is reported, not refused.
-LoadedPolytope load_convex(const std::string& path);
+LoadedPolytope load_convex(const std::string& path, const ReadOptions& options = {});
 
 // What became of one group of a compound file: its name and how convex its
 // points were (the piece is their hull either way).
 struct LoadedPiece {
-  std::string name;         // the OBJ group's name; "" for points before the first group or a file without groups
-  int input_points = 0;     // points of the group
-  int interior_points = 0;  // of those, not hull vertices (inside, on a face, or repeated)
-  bool input_was_convex = true;  // interior_points == 0
+  std::string
+      name;  // the OBJ group's name; "" for points before the first group or a file without groups
+  int input_points =
+      0;  // points of the group (with faces: the distinct vertices its faces reference)
+  int interior_points = 0;       // of those, not hull vertices (inside, on a face, or repeated)
+  bool input_was_convex = true;  // surface_is_convex for the group's points and faces
 };
 
 struct LoadedCompound {
@@ -112,15 +173,17 @@ struct LoadedCompound {
   std::vector<LoadedPiece> pieces;  // parallel to body.pieces()
 };
 
-// read_points, then one convex piece per group (OBJ `g`/`o` groups; a file
-// without groups is one piece). A non-convex group is reported in its
+// read_points, then one convex piece per group (OBJ `g`/`o` groups, made of
+// the vertices their faces reference, see PointCloud; a file without groups
+// is one piece of all its points). A non-convex group is reported in its
 // LoadedPiece, not refused. A group whose points cannot build a polytope is
 // a FileError naming the file and the group.
-LoadedCompound load_compound(const std::string& path);
+LoadedCompound load_compound(const std::string& path, const ReadOptions& options = {});
 
 // The same from a point cloud already read (or built by hand): the groups of
-// `cloud` are checked (offsets increasing from 0, inside the points, one
-// name each) and hulled; errors name cloud.source and the group.
+// `cloud` are checked (offsets increasing from 0, inside the triangles or
+// the points, one name each; triangle indices inside the points) and
+// hulled; errors name cloud.source and the group.
 LoadedCompound compound_from_cloud(const PointCloud& cloud);
 
 }  // namespace proxima

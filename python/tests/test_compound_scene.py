@@ -125,7 +125,8 @@ def test_load_compound_reports_each_group(tmp_path):
     assert [p.input_points for p in loaded.pieces] == [9, 8]
     assert [p.input_was_convex for p in loaded.pieces] == [False, True]
     assert loaded.body.piece_count == 2
-    body = proxima.CompoundBody.from_file(str(path))
+    with pytest.warns(proxima.NonConvexInputWarning, match="group\\(s\\) 'left'"):
+        body = proxima.CompoundBody.from_file(str(path))
     r = proxima.distance(body, None, body, ((1, 0, 0, 0), (0, 0, 5)))
     assert abs(r.distance - 4.0) < 1e-12
     with pytest.raises(FileNotFoundError):

@@ -15,6 +15,7 @@ rows, caches). Randomness is seeded.
 import math
 import threading
 import time
+import warnings
 
 import numpy as np
 import pytest
@@ -475,13 +476,43 @@ def test_from_file(tmp_path):
     path = tmp_path / "cube.obj"
     lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in cube(2.0)] + ["v 0.1 0.2 0.3"]
     path.write_text("\n".join(lines) + "\n")
-    p = proxima.ConvexPolytope.from_file(str(path))
+    with pytest.warns(proxima.NonConvexInputWarning, match="cube.obj: not convex"):
+        p = proxima.ConvexPolytope.from_file(str(path))
     assert p.vertex_count == 8 and p.interior_point_count == 1 and p.face_count == 6
     loaded = proxima.load_convex(str(path))
     assert loaded.input_points == 9 and loaded.interior_points == 1 and not loaded.input_was_convex
     points = proxima.read_points(str(path))
     assert points.shape == (9, 3)
     np.testing.assert_array_equal(points[8], [0.1, 0.2, 0.3])
+
+
+# Issue 9: ConvexPolytope.from_file returned the hull of a non-convex file
+# without a word, where the CLI reports "not convex". It now warns
+# NonConvexInputWarning (a UserWarning); load_convex reports in its result.
+def test_non_convex_file_warns_convex_file_does_not(tmp_path):
+    corners = [(x, y, z) for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]
+    faces = [(1, 3, 4), (1, 4, 2), (5, 6, 8), (5, 8, 7), (1, 2, 6), (1, 6, 5),
+             (3, 7, 8), (3, 8, 4), (1, 5, 7), (1, 7, 3), (2, 4, 8), (2, 8, 6)]
+    text = "".join(f"v {x} {y} {z}\n" for x, y, z in corners)
+    text += "".join(f"f {a} {b} {c}\n" for a, b, c in faces)
+    convex = tmp_path / "cube.obj"
+    convex.write_text(text)
+    folded = tmp_path / "folded.obj"
+    folded.write_text(text + "f 1 4 6\n")  # through the inside: every vertex is on the hull
+    assert issubclass(proxima.NonConvexInputWarning, UserWarning)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert proxima.ConvexPolytope.from_file(str(convex)).vertex_count == 8
+        assert proxima.load_convex(str(convex)).input_was_convex
+        loaded = proxima.load_convex(str(folded))  # the report, no warning
+    assert not loaded.input_was_convex and loaded.interior_points == 0
+    with pytest.warns(proxima.NonConvexInputWarning, match="folded.obj: not convex"):
+        p = proxima.ConvexPolytope.from_file(str(folded))
+    assert p.vertex_count == 8
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(proxima.NonConvexInputWarning):
+            proxima.ConvexPolytope.from_file(str(folded))
 
 
 def test_file_errors(tmp_path):
