@@ -10,12 +10,6 @@
 // the very doubles computed.
 #include "tools.h"
 
-#include "proxima/distance.h"
-#include "proxima/io.h"
-#include "proxima/polytope.h"
-
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -26,13 +20,18 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <nlohmann/json.hpp>
 #include <span>
-#include <stdexcept>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
+
+#include "proxima/distance.h"
+#include "proxima/io.h"
+#include "proxima/polytope.h"
 
 namespace proxima::cli {
 namespace {
@@ -59,7 +58,9 @@ std::string number(double x) {
   return {buffer.data(), end};
 }
 
-std::string point_text(const Vec3& p) { return number(p.x()) + " " + number(p.y()) + " " + number(p.z()); }
+std::string point_text(const Vec3& p) {
+  return number(p.x()) + " " + number(p.y()) + " " + number(p.z());
+}
 
 Json point_json(const Vec3& p) { return Json::array({p.x(), p.y(), p.z()}); }
 
@@ -67,6 +68,7 @@ struct LoadedFile {
   ConvexPolytope polytope;
   MeshFormat format = MeshFormat::unknown;
   int input_points = 0;
+  bool convex = true;  // surface_is_convex: the input surface is its hull's boundary
 };
 
 // read_points, then the hull of every point (what load_convex does), keeping
@@ -78,7 +80,9 @@ LoadedFile load_file(const std::string& path, std::uint64_t max_file_bytes) {
   PointCloud cloud = read_points(path, options);
   try {
     ConvexPolytope polytope(cloud.points);
-    return LoadedFile{std::move(polytope), cloud.format, static_cast<int>(cloud.points.size())};
+    const bool convex = surface_is_convex(polytope, cloud.points, cloud.triangles);
+    return LoadedFile{std::move(polytope), cloud.format, static_cast<int>(cloud.points.size()),
+                      convex};
   } catch (const FileError&) {
     throw;
   } catch (const InvalidInput& e) {
@@ -94,8 +98,10 @@ double parse_number(const std::string& token, const std::string& option, int pos
   if (!token.empty() && token.front() == '+') ++first;  // from_chars takes no plus sign
   const auto [end, ec] = std::from_chars(first, last, value);
   const std::string where = option + " " + kNames[static_cast<std::size_t>(position)];
-  if (ec == std::errc::result_out_of_range) throw BadArgument(where + ": '" + token + "' is out of the range of double");
-  if (ec != std::errc() || end != last || first == last) throw BadArgument(where + ": '" + token + "' is not a number");
+  if (ec == std::errc::result_out_of_range)
+    throw BadArgument(where + ": '" + token + "' is out of the range of double");
+  if (ec != std::errc() || end != last || first == last)
+    throw BadArgument(where + ": '" + token + "' is not a number");
   if (!std::isfinite(value)) throw BadArgument(where + ": '" + token + "' is not finite");
   return value;
 }
@@ -105,15 +111,17 @@ double parse_number(const std::string& token, const std::string& option, int pos
 Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option) {
   if (tokens.empty()) return Pose::identity();
   std::array<double, 7> v{};
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = parse_number(tokens[i], option, static_cast<int>(i));
-  const Quat q(v[3], v[4], v[5], v[6]);
-  const double norm = q.norm();
-  // A quaternion whose norm underflows or overflows cannot be normalized
-  // into a rotation; every other non-zero one can.
-  if (!(norm > 0.0) || !std::isfinite(norm)) {
-    throw BadArgument(option + ": the quaternion (qw qx qy qz) must be non-zero and finite");
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = parse_number(tokens[i], option, static_cast<int>(i));
+  // The pose contract's quaternion (proxima/pose.h): normalized at any
+  // magnitude, a zero one refused in the same words as everywhere.
+  try {
+    return Pose(
+        unit_quaternion(Quat(v[3], v[4], v[5], v[6]), option + " (qw qx qy qz)").toRotationMatrix(),
+        Vec3(v[0], v[1], v[2]));
+  } catch (const InvalidInput& e) {
+    throw BadArgument(e.what());
   }
-  return Pose(q, Vec3(v[0], v[1], v[2]));
 }
 
 std::vector<std::int32_t> hull_ids(const Feature& f) {
@@ -124,7 +132,8 @@ std::vector<std::int32_t> hull_ids(const Feature& f) {
 
 std::vector<std::int32_t> input_ids(const Feature& f, const ConvexPolytope& p) {
   std::vector<std::int32_t> ids;
-  for (const std::int32_t v : hull_ids(f)) ids.push_back(p.input_index()[static_cast<std::size_t>(v)]);
+  for (const std::int32_t v : hull_ids(f))
+    ids.push_back(p.input_index()[static_cast<std::size_t>(v)]);
   return ids;
 }
 
@@ -149,7 +158,8 @@ Json feature_json(const Feature& f, const ConvexPolytope& p) {
 std::string feature_text(const Feature& f, const ConvexPolytope& p) {
   std::string s = to_string(f.type);
   if (f.face >= 0) s += " " + std::to_string(f.face);
-  s += ": hull vertices " + id_list(hull_ids(f)) + " (input points " + id_list(input_ids(f, p)) + ")";
+  s += ": hull vertices " + id_list(hull_ids(f)) + " (input points " + id_list(input_ids(f, p)) +
+       ")";
   return s;
 }
 
@@ -161,7 +171,7 @@ Json body_json(const std::string& path, const LoadedFile& body) {
   j["hull_vertices"] = body.polytope.vertex_count();
   j["dimension"] = body.polytope.dimension();
   j["points_inside"] = body.polytope.interior_point_count();
-  j["convex"] = body.polytope.interior_point_count() == 0;
+  j["convex"] = body.convex;
   return j;
 }
 
@@ -170,9 +180,14 @@ std::string body_text(const std::string& path, const LoadedFile& body) {
   s << path << " (" << to_string(body.format) << "): " << body.input_points << " points, "
     << body.polytope.vertex_count() << " hull vertices, dimension " << body.polytope.dimension();
   const int inside = body.polytope.interior_point_count();
-  if (inside > 0) {
-    s << "; not convex: " << inside << (inside == 1 ? " point is" : " points are")
-      << " inside the hull (or repeated), the hull of all points is used";
+  if (!body.convex) {
+    s << "; not convex: ";
+    if (inside > 0)
+      s << inside << (inside == 1 ? " point is" : " points are")
+        << " inside the hull (or repeated), ";
+    else
+      s << "the surface folds inward, ";
+    s << "the hull of all points is used";
   }
   return s.str();
 }
@@ -190,10 +205,14 @@ void row(std::ostream& out, const std::string& name, const std::string& value) {
 
 std::string hull_shape(int dimension) {
   switch (dimension) {
-    case 0: return "a point";
-    case 1: return "a segment";
-    case 2: return "a polygon";
-    default: return "a solid";
+    case 0:
+      return "a point";
+    case 1:
+      return "a segment";
+    case 2:
+      return "a polygon";
+    default:
+      return "a solid";
   }
 }
 
@@ -208,8 +227,8 @@ struct ExportSummary {
 // seen from outside. A polygon (dimension 2) has both sides as faces, so it
 // is written as two opposite polygons; a segment has no faces (OBJ gets one
 // `l` line element, OFF only the two vertices); a point is one vertex.
-ExportSummary write_hull(const ConvexPolytope& p, const std::string& path, const std::string& format,
-                         const std::string& source) {
+ExportSummary write_hull(const ConvexPolytope& p, const std::string& path,
+                         const std::string& format, const std::string& source) {
   std::ostringstream text;
   const bool obj = format == "obj";
   const int faces = p.face_count();
@@ -243,8 +262,9 @@ ExportSummary write_hull(const ConvexPolytope& p, const std::string& path, const
   if (p.dimension() == 2) {
     summary.note = "the hull is a polygon: written as two faces, one per side";
   } else if (p.dimension() == 1) {
-    summary.note = obj ? "the hull is a segment: its two end points and one line element, no faces"
-                       : "the hull is a segment: its two end points only (OFF has no line elements)";
+    summary.note =
+        obj ? "the hull is a segment: its two end points and one line element, no faces"
+            : "the hull is a segment: its two end points only (OFF has no line elements)";
   } else if (p.dimension() == 0) {
     summary.note = "the hull is a single point: one vertex, no faces";
   }
@@ -282,7 +302,8 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
     return kExitFailure;
   }
 
-  const DistanceResult r = distance(a->polytope, pose_a, b->polytope, pose_b, command.options, nullptr);
+  const DistanceResult r =
+      distance(a->polytope, pose_a, b->polytope, pose_b, command.options, nullptr);
   // Finite inputs whose products overflow (coordinates near 1e308) are the
   // only way to a non-finite answer; JSON cannot carry it and a table of
   // "inf" would look like an answer.
@@ -335,7 +356,8 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
   try {
     body.emplace(load_file(command.file, command.max_file_bytes));
     if (!command.out_file.empty()) {
-      exported = write_hull(body->polytope, command.out_file, export_format(command.out_file), command.file);
+      exported = write_hull(body->polytope, command.out_file, export_format(command.out_file),
+                            command.file);
     }
   } catch (const InvalidInput& e) {
     err << "proxima hull: " << e.what() << "\n";
@@ -356,7 +378,7 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
     j["bounding_radius"] = p.bounding_radius();
     j["centroid"] = point_json(p.centroid());
     j["points_inside"] = p.interior_point_count();
-    j["convex"] = p.interior_point_count() == 0;
+    j["convex"] = body->convex;
     j["memory_bytes"] = p.memory_bytes();
     if (exported) {
       Json e;
@@ -380,11 +402,14 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
     row(out, "centroid", point_text(p.centroid()));
     const int inside = p.interior_point_count();
     row(out, "points inside",
-        std::to_string(inside) + (inside == 0 ? "  (convex input)" : "  (not convex: inside the hull or repeated)"));
+        std::to_string(inside) + (inside > 0 ? "  (inside the hull or repeated)" : ""));
+    row(out, "convex input",
+        body->convex ? "yes (the input surface is its hull's boundary)"
+                     : "no (the hull of all points is used)");
     row(out, "memory", std::to_string(p.memory_bytes()) + " bytes");
     if (exported) {
-      std::string line = command.out_file + ": " + std::to_string(exported->vertices) + " vertices, " +
-                         std::to_string(exported->faces) + " faces";
+      std::string line = command.out_file + ": " + std::to_string(exported->vertices) +
+                         " vertices, " + std::to_string(exported->faces) + " faces";
       if (!exported->note.empty()) line += " (" + exported->note + ")";
       row(out, "written", line);
     }

@@ -7,15 +7,8 @@
 // come from the geometry of the written bodies (a known distance, known
 // hull counts) or from the library called in-process on the same points.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include "proxima/distance.h"
-#include "proxima/io.h"
-#include "proxima/polytope.h"
-#include "support/run_cli.h"
 
 #include <Eigen/Geometry>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -25,11 +18,17 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "proxima/distance.h"
+#include "proxima/io.h"
+#include "proxima/polytope.h"
+#include "support/run_cli.h"
 
 namespace {
 
@@ -67,7 +66,8 @@ void write_text(const std::string& path, const std::string& text) {
 // Vertices only; the readers recompute the hull from the points.
 void write_obj(const std::string& path, const std::vector<Vec3>& points) {
   std::string text = "# written by cli_tools_test\n";
-  for (const Vec3& p : points) text += "v " + g17(p.x()) + " " + g17(p.y()) + " " + g17(p.z()) + "\n";
+  for (const Vec3& p : points)
+    text += "v " + g17(p.x()) + " " + g17(p.y()) + " " + g17(p.z()) + "\n";
   write_text(path, text);
 }
 
@@ -106,7 +106,9 @@ void write_tetra_stl(const std::string& path) {
                            {kTetra[1], kTetra[3], kTetra[2]}}});
 }
 
-Vec3 vec(const Json& j) { return Vec3(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()); }
+Vec3 vec(const Json& j) {
+  return Vec3(j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>());
+}
 
 Json parse_json(const CliRun& run) {
   Json j = Json::parse(run.out, nullptr, /*allow_exceptions=*/false);
@@ -130,10 +132,12 @@ TEST(CliDistance, ObjCubeAndStlTetrahedronKnownDistance) {
   EXPECT_EQ(j.at("status"), "separated");
   EXPECT_NEAR(j.at("distance").get<double>(), expected, accuracy_bound(expected, 4.0));
   EXPECT_LE(j.at("lower_bound").get<double>(), j.at("distance").get<double>());
-  EXPECT_GE(j.at("lower_bound").get<double>(), expected * (1 - 1e-12) - accuracy_bound(expected, 4.0));
+  EXPECT_GE(j.at("lower_bound").get<double>(),
+            expected * (1 - 1e-12) - accuracy_bound(expected, 4.0));
   EXPECT_GE(j.at("iterations").get<int>(), 0);
   EXPECT_LE((vec(j.at("point_b")) - kApex).norm(), accuracy_bound(expected, 4.0));
-  EXPECT_LE((vec(j.at("point_a")) - Vec3(kApex.x(), kApex.y(), 1.0)).norm(), accuracy_bound(expected, 4.0));
+  EXPECT_LE((vec(j.at("point_a")) - Vec3(kApex.x(), kApex.y(), 1.0)).norm(),
+            accuracy_bound(expected, 4.0));
   EXPECT_LE((vec(j.at("normal")) - Vec3(0, 0, 1)).norm(), 1e-12);
   EXPECT_EQ(j.at("algorithm"), "hybrid");
 
@@ -153,7 +157,8 @@ TEST(CliDistance, ObjCubeAndStlTetrahedronKnownDistance) {
   const Json& fa = j.at("feature_a");
   EXPECT_EQ(fa.at("hull_vertices").size(), fa.at("input_indices").size());
   EXPECT_GE(fa.at("input_indices").size(), 1U);
-  for (const Json& index : fa.at("input_indices")) EXPECT_EQ(cube_points.at(index.get<std::size_t>()).z(), 1.0);
+  for (const Json& index : fa.at("input_indices"))
+    EXPECT_EQ(cube_points.at(index.get<std::size_t>()).z(), 1.0);
   if (fa.at("type") == "face") {
     EXPECT_TRUE(fa.at("face").is_number_integer());
   } else {
@@ -172,9 +177,10 @@ TEST(CliDistance, ObjCubeAndStlTetrahedronKnownDistance) {
   const auto at = table.out.find("distance      ");
   ASSERT_NE(at, std::string::npos) << table.out;
   EXPECT_NEAR(std::stod(table.out.substr(at + 14)), expected, accuracy_bound(expected, 4.0));
-  EXPECT_NE(table.out.find("feature B     vertex: hull vertices " + fb.at("hull_vertices").at(0).dump() +
-                           " (input points " + std::to_string(apex_index) + ")"),
-            std::string::npos)
+  EXPECT_NE(
+      table.out.find("feature B     vertex: hull vertices " + fb.at("hull_vertices").at(0).dump() +
+                     " (input points " + std::to_string(apex_index) + ")"),
+      std::string::npos)
       << table.out;
 }
 
@@ -207,7 +213,7 @@ TEST(CliDistance, PoseFlagsMatchTheLibrary) {
     std::array<double, 7> vb{};
     for (double& x : va) x = uniform(rng);
     for (double& x : vb) x = uniform(rng);
-    vb[0] += 8.0;  // mostly apart; some trials may still overlap
+    vb[0] += 8.0;                                     // mostly apart; some trials may still overlap
     if (trial == 5) vb = {0.5, 0.25, 0, 1, 0, 0, 0};  // overlapping: intersecting
     std::string flags;
     for (const auto* v : {&va, &vb}) {
@@ -217,8 +223,10 @@ TEST(CliDistance, PoseFlagsMatchTheLibrary) {
         flags += g17(x);
       }
     }
-    const proxima::Pose pose_a(proxima::Quat(va[3], va[4], va[5], va[6]), Vec3(va[0], va[1], va[2]));
-    const proxima::Pose pose_b(proxima::Quat(vb[3], vb[4], vb[5], vb[6]), Vec3(vb[0], vb[1], vb[2]));
+    const proxima::Pose pose_a(proxima::Quat(va[3], va[4], va[5], va[6]),
+                               Vec3(va[0], va[1], va[2]));
+    const proxima::Pose pose_b(proxima::Quat(vb[3], vb[4], vb[5], vb[6]),
+                               Vec3(vb[0], vb[1], vb[2]));
     const std::string algorithm = algorithms[static_cast<std::size_t>(trial) % algorithms.size()];
     proxima::DistanceOptions options;
     options.algorithm = algorithm == "gjk"            ? proxima::Algorithm::gjk
@@ -226,8 +234,8 @@ TEST(CliDistance, PoseFlagsMatchTheLibrary) {
                                                       : proxima::Algorithm::hybrid;
     const proxima::DistanceResult r = proxima::distance(a, pose_a, b, pose_b, options);
 
-    const CliRun run = run_cli("distance " + fa.quoted() + " " + fb.quoted() + flags + " --algorithm " +
-                               algorithm + " --json");
+    const CliRun run = run_cli("distance " + fa.quoted() + " " + fb.quoted() + flags +
+                               " --algorithm " + algorithm + " --json");
     ASSERT_EQ(run.exit_code, 0) << flags;
     const Json j = parse_json(run);
     EXPECT_EQ(j.at("status"), proxima::to_string(r.status)) << flags;
@@ -268,11 +276,42 @@ TEST(CliDistance, NonConvexInputIsReported) {
 
   const CliRun table = run_cli("distance " + file.quoted() + " " + other.quoted());
   ASSERT_EQ(table.exit_code, 0);
-  EXPECT_NE(table.out.find("not convex: 3 points are inside the hull"), std::string::npos) << table.out;
+  EXPECT_NE(table.out.find("not convex: 3 points are inside the hull"), std::string::npos)
+      << table.out;
 
   const CliRun hull = run_cli("hull " + file.quoted() + " --json");
   ASSERT_EQ(hull.exit_code, 0);
   EXPECT_EQ(parse_json(hull).at("points_inside"), 3);
+  EXPECT_EQ(parse_json(hull).at("convex"), false);
+}
+
+// Regression (issue 9): the CLI's "convex" counted interior points, so a
+// mesh whose vertices are all on its hull but whose faces fold inwards (the
+// Panda's collision meshes do, by up to 1 mm) was reported convex, unlike
+// load_convex. Both now use surface_is_convex.
+TEST(CliDistance, FoldedMeshIsReportedNotConvex) {
+  REQUIRE_CLI();
+  const TempPath folded(".obj");
+  const TempPath other(".obj");
+  {
+    std::ofstream out(folded.path());
+    for (int i = 0; i < 8; ++i)
+      out << "v " << (i & 1) << " " << ((i >> 1) & 1) << " " << ((i >> 2) & 1) << "\n";
+    // The cube's twelve outward triangles, and one through its inside.
+    out << "f 1 3 4\nf 1 4 2\nf 5 6 8\nf 5 8 7\nf 1 2 6\nf 1 6 5\nf 3 7 8\nf 3 8 4\nf 1 5 7\nf 1 7 "
+           "3\n"
+           "f 2 4 8\nf 2 8 6\nf 1 4 6\n";
+  }
+  write_obj(other.path(), box(Vec3(5, 0, 0), Vec3(6, 1, 1)));
+  const CliRun json = run_cli("distance " + folded.quoted() + " " + other.quoted() + " --json");
+  ASSERT_EQ(json.exit_code, 0);
+  const Json j = parse_json(json);
+  EXPECT_EQ(j.at("a").at("points_inside"), 0);
+  EXPECT_EQ(j.at("a").at("convex"), false);
+  EXPECT_EQ(j.at("b").at("convex"), true);
+  const CliRun table = run_cli("distance " + folded.quoted() + " " + other.quoted());
+  EXPECT_NE(table.out.find("not convex: the surface folds inward"), std::string::npos) << table.out;
+  const CliRun hull = run_cli("hull " + folded.quoted() + " --json");
   EXPECT_EQ(parse_json(hull).at("convex"), false);
 }
 
@@ -366,8 +405,9 @@ TEST(CliHull, ExportRoundTrip) {
         ASSERT_GE(face.size(), 3U);
         Vec3 normal = Vec3::Zero();  // Newell's normal of the polygon
         for (std::size_t k = 0; k < face.size(); ++k) {
-          normal += back.points.at(static_cast<std::size_t>(face[k]))
-                        .cross(back.points.at(static_cast<std::size_t>(face[(k + 1) % face.size()])));
+          normal +=
+              back.points.at(static_cast<std::size_t>(face[k]))
+                  .cross(back.points.at(static_cast<std::size_t>(face[(k + 1) % face.size()])));
         }
         normal.normalize();
         const double offset = normal.dot(back.points.at(static_cast<std::size_t>(face[0])));
@@ -387,11 +427,13 @@ TEST(CliHull, LowerDimensionalExports) {
   Json j = parse_json(run);
   EXPECT_EQ(j.at("dimension"), 2);
   EXPECT_EQ(j.at("faces"), 2);  // one per side
-  EXPECT_EQ(j.at("export").at("note").get<std::string>().find("polygon") != std::string::npos, true);
+  EXPECT_EQ(j.at("export").at("note").get<std::string>().find("polygon") != std::string::npos,
+            true);
   const auto faces = obj_faces(square_out.path());
   ASSERT_EQ(faces.size(), 2U);
   std::vector<int> reversed(faces[1].rbegin(), faces[1].rend());
-  std::rotate(reversed.begin(), std::find(reversed.begin(), reversed.end(), faces[0][0]), reversed.end());
+  std::rotate(reversed.begin(), std::find(reversed.begin(), reversed.end(), faces[0][0]),
+              reversed.end());
   EXPECT_EQ(faces[0], reversed);  // the two sides are the same polygon, opposite orientation
 
   const TempPath segment(".xyz");
@@ -401,21 +443,25 @@ TEST(CliHull, LowerDimensionalExports) {
   run = run_cli("hull " + segment.quoted() + " --out " + segment_obj.quoted());
   ASSERT_EQ(run.exit_code, 0);
   EXPECT_NE(run.out.find("segment"), std::string::npos) << run.out;
-  EXPECT_EQ(sorted(proxima::read_points(segment_obj.path()).points), sorted({Vec3(0, 0, 0), Vec3(3, 3, 3)}));
+  EXPECT_EQ(sorted(proxima::read_points(segment_obj.path()).points),
+            sorted({Vec3(0, 0, 0), Vec3(3, 3, 3)}));
   std::ifstream obj(segment_obj.path());
-  const std::string obj_text((std::istreambuf_iterator<char>(obj)), std::istreambuf_iterator<char>());
+  const std::string obj_text((std::istreambuf_iterator<char>(obj)),
+                             std::istreambuf_iterator<char>());
   EXPECT_NE(obj_text.find("\nl 1 2\n"), std::string::npos) << obj_text;
   run = run_cli("hull " + segment.quoted() + " --out " + segment_off.quoted() + " --json");
   ASSERT_EQ(run.exit_code, 0);
   EXPECT_EQ(parse_json(run).at("export").at("faces"), 0);
-  EXPECT_EQ(sorted(proxima::read_points(segment_off.path()).points), sorted({Vec3(0, 0, 0), Vec3(3, 3, 3)}));
+  EXPECT_EQ(sorted(proxima::read_points(segment_off.path()).points),
+            sorted({Vec3(0, 0, 0), Vec3(3, 3, 3)}));
 }
 
 TEST(CliTools, BadInputExitsOneNamingTheFile) {
   REQUIRE_CLI();
   const TempPath good(".obj");
   write_obj(good.path(), box(Vec3(0, 0, 0), Vec3(1, 1, 1)));
-  const std::string missing = (std::filesystem::temp_directory_path() / "proxima_no_such_mesh_4711.stl").string();
+  const std::string missing =
+      (std::filesystem::temp_directory_path() / "proxima_no_such_mesh_4711.stl").string();
 
   CliRun run = run_cli("distance " + good.quoted() + " " + shell_quote(missing), true);
   EXPECT_EQ(run.exit_code, 1);
@@ -432,13 +478,16 @@ TEST(CliTools, BadInputExitsOneNamingTheFile) {
   EXPECT_NE(run.out.find(bad.path() + ", line 2"), std::string::npos) << run.out;
 
   // Bad pose numbers are bad input too, named by option.
-  run = run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-b 0 0 x 1 0 0 0", true);
+  run =
+      run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-b 0 0 x 1 0 0 0", true);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.out.find("--pose-b z: 'x' is not a number"), std::string::npos) << run.out;
-  run = run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 0 0 0 0 0 0", true);
+  run =
+      run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 0 0 0 0 0 0", true);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.out.find("--pose-a"), std::string::npos) << run.out;
-  run = run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 nan 0 1 0 0 0", true);
+  run = run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 nan 0 1 0 0 0",
+                true);
   EXPECT_EQ(run.exit_code, 1);
 
   // An unwritable export path.
@@ -499,9 +548,9 @@ TEST(CliTools, UsageErrorsExitTwo) {
   const std::string g = good.quoted();
   for (const std::string& args : std::vector<std::string>{
            "", "nonsense", "distance", "distance " + g, "distance " + g + " " + g + " --bogus",
-        "distance " + g + " " + g + " --pose-a 1 2 3", "distance " + g + " " + g + " --algorithm best",
-        "hull", "hull " + g + " --out hull.stl", "hull " + g + " --frobnicate", "query --threads 0",
-        "query --threads two"}) {
+           "distance " + g + " " + g + " --pose-a 1 2 3",
+           "distance " + g + " " + g + " --algorithm best", "hull", "hull " + g + " --out hull.stl",
+           "hull " + g + " --frobnicate", "query --threads 0", "query --threads two"}) {
     EXPECT_EQ(run_cli(args, true).exit_code, 2) << args;
   }
 }
@@ -527,10 +576,19 @@ TEST(CliQueryThreads, SameBytesAsOneThread) {
   std::string text;
   for (int i = 0; i < 700; ++i) {
     switch (i % 11) {
-      case 3: text += "{\"id\":" + std::to_string(i) + ",\"a\":{\"vertices\":[[0,0,0]]}}\n"; break;  // no b
-      case 5: text += "not json at all\n"; break;
-      case 7: text += "\n"; break;  // blank: no answer
-      case 9: text += "{\"id\":\"s" + std::to_string(i) + "\",\"a\":{\"vertices\":[]},\"b\":{\"vertices\":[[1,2,3]]}}\n"; break;
+      case 3:
+        text += "{\"id\":" + std::to_string(i) + ",\"a\":{\"vertices\":[[0,0,0]]}}\n";
+        break;  // no b
+      case 5:
+        text += "not json at all\n";
+        break;
+      case 7:
+        text += "\n";
+        break;  // blank: no answer
+      case 9:
+        text += "{\"id\":\"s" + std::to_string(i) +
+                "\",\"a\":{\"vertices\":[]},\"b\":{\"vertices\":[[1,2,3]]}}\n";
+        break;
       default: {
         Json a = Json::array();
         Json b = Json::array();
@@ -548,8 +606,9 @@ TEST(CliQueryThreads, SameBytesAsOneThread) {
   EXPECT_EQ(std::count(one.out.begin(), one.out.end(), '\n'), 700 - 63);
   EXPECT_NE(one.out.find("\"status\":\"error\""), std::string::npos);
   EXPECT_NE(one.out.find("\"status\":\"separated\""), std::string::npos);
-  for (const std::string& args : std::vector<std::string>{"query " + file.quoted() + " --threads 2", "query --threads 2 < " + file.quoted(),
-                                  "query --threads 3 - < " + file.quoted(), "query < " + file.quoted()}) {
+  for (const std::string& args : std::vector<std::string>{
+           "query " + file.quoted() + " --threads 2", "query --threads 2 < " + file.quoted(),
+           "query --threads 3 - < " + file.quoted(), "query < " + file.quoted()}) {
     const CliRun run = run_cli(args);
     EXPECT_EQ(run.exit_code, 0) << args;
     EXPECT_EQ(run.out, one.out) << args;
