@@ -241,6 +241,73 @@ def test_float32_pose_is_accepted():
     assert r.status == "separated"
 
 
+@pytest.mark.parametrize("row, col", [(r, c) for r in range(4) for c in range(4)])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_entry_anywhere_in_a_4x4_pose_is_refused(row, col, bad):
+    # Story: the bottom row was only compared with (0, 0, 0, 1) when finite,
+    # so a NaN or an infinity there was accepted as the identity's row. Every
+    # path that takes a 4x4 matrix must refuse it, naming the entry.
+    a = proxima.ConvexPolytope(cube())
+    m = matrix(np.eye(3), [3.0, 0.0, 0.0])
+    m[row, col] = bad
+    where = f"row {row}, column {col}"
+    with pytest.raises(proxima.InvalidInput, match=f"pose_b is not finite.*{where}"):
+        proxima.distance(a, None, a, m)
+    with pytest.raises(proxima.InvalidInput, match=where):
+        proxima.Pose.from_matrix(m)
+    batch = np.tile(matrix(np.eye(3), [3.0, 0.0, 0.0]), (3, 1, 1))
+    batch[2] = m
+    with pytest.raises(proxima.InvalidInput, match=rf"poses_b\[2\] is not finite.*{where}"):
+        proxima.distance_batch(a, None, a, batch)
+    scene = proxima.Scene()
+    i = scene.add(a)
+    with pytest.raises(proxima.InvalidInput, match=where):
+        scene.set_pose(i, m)
+    with pytest.raises(proxima.InvalidInput, match=where):
+        scene.add(a, m)
+    assert len(scene) == 1
+
+
+@pytest.mark.parametrize("magnitude", [3e-162, 1e200, 1e-300, 1e300, 5e-324])
+def test_quaternion_of_any_magnitude_is_its_rotation(magnitude):
+    # Story: Python normalized a quaternion through its squared norm, which
+    # overflows for 1e200 (1, 0, 0, 1) (the rotation became the identity)
+    # and loses its digits for 3e-162 (1, 0, 0, 1) (a non-rigid matrix, det
+    # 0.84). Python and the CLI now both use proxima's unit_quaternion: the
+    # rotation is that of (1, 0, 0, 1), a quarter turn about z, bit for bit.
+    q = magnitude * np.array([1.0, 0.0, 0.0, 1.0])
+    unit = proxima.Pose.from_quaternion([1.0, 0.0, 0.0, 1.0], [0, 0, 0])
+    pose = proxima.Pose.from_quaternion(q, [0, 0, 0])
+    np.testing.assert_array_equal(pose.rotation, unit.rotation)
+    np.testing.assert_allclose(pose.rotation, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15)
+    assert np.linalg.det(pose.rotation) == pytest.approx(1.0, abs=1e-15)
+    # The same through every path that takes a (quaternion, translation) pair.
+    a = proxima.ConvexPolytope(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]]))
+    b = proxima.ConvexPolytope(np.array([[0.0, 0, 0]]))
+    # B's point at (0, 2, 0) is A's vertex (1, 0, 0) turned a quarter about z,
+    # plus (0, 1, 0): distance 1 exactly when the rotation is right.
+    r = proxima.distance(a, (q, (0, 0, 0)), b, ((1, 0, 0, 0), (0, 2, 0)))
+    assert r.distance == pytest.approx(1.0, abs=1e-15)
+    scene = proxima.Scene(margin=10.0)
+    i = scene.add(a, (q, (0, 0, 0)))
+    np.testing.assert_array_equal(scene.pose(i).rotation, unit.rotation)
+    body = proxima.CompoundBody([(a, (q, (0, 0, 0)))])
+    np.testing.assert_array_equal(body.piece(0)[1].rotation, unit.rotation)
+
+
+@pytest.mark.parametrize(
+    "q, words",
+    [((0, 0, 0, 0), "quaternion is zero"), ((0.0, -0.0, 0.0, -0.0), "quaternion is zero"),
+     ((np.nan, 0, 0, 1), "not finite"), ((1, np.inf, 0, 0), "not finite")])
+def test_zero_or_non_finite_quaternion_is_refused(q, words):
+    with pytest.raises(proxima.InvalidInput, match="pose: .*" + words):
+        proxima.Pose.from_quaternion(q, (0, 0, 0))
+    scene = proxima.Scene()
+    with pytest.raises(proxima.InvalidInput, match=words):
+        scene.add(proxima.ConvexPolytope(cube()), (q, (0, 0, 0)))
+    assert len(scene) == 0
+
+
 # --- caches and tracking -----------------------------------------------------
 
 
