@@ -3,8 +3,9 @@
 //
 // Layer 7: conversions between Python objects and proxima's C++ types,
 // shared by the binding files of the Python module (module.cpp,
-// compound_scene.cpp). Arrays in, arrays out (copies); a wrong shape or a
-// non-rigid pose raises ValueError naming the argument.
+// compound_scene.cpp). Arrays in, arrays out (copies); a wrong shape, a
+// complex or non-numeric array or a non-rigid pose raises ValueError naming
+// the argument.
 #pragma once
 
 #include <Python.h>
@@ -40,8 +41,19 @@ inline std::string shape_of(const py::array& a) {
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
+// Real numbers only: numpy's forcecast alone would take anything, and
+// silently drop the imaginary part of a complex array or parse strings. The
+// natural dtype of the argument (an array as given, or what numpy makes of a
+// sequence) is checked before the conversion: floating point or integer.
 inline DoubleArray as_double_array(py::handle obj, const std::string& name) {
-  auto a = DoubleArray::ensure(obj);
+  const py::array any = py::array::ensure(obj);
+  if (!any) value_error(name + ": expected an array of numbers");
+  const char kind = any.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    value_error(name + ": expected real numbers (float or integer), got an array of dtype " +
+                py::str(any.dtype()).cast<std::string>());
+  }
+  auto a = DoubleArray::ensure(any);
   if (!a) value_error(name + ": expected an array of numbers");
   return a;
 }
@@ -166,7 +178,8 @@ inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::stri
 // The K of a batch from whichever pose argument is a (K, 4, 4) array.
 inline py::ssize_t batch_size(py::handle obj) {
   if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj)) return -1;
-  auto m = DoubleArray::ensure(obj);
+  // No conversion here: the pose arguments are checked (dtype, shape) by to_poses.
+  const py::array m = py::array::ensure(obj);
   return m && m.ndim() == 3 ? m.shape(0) : -1;
 }
 

@@ -268,6 +268,50 @@ def test_non_finite_entry_anywhere_in_a_4x4_pose_is_refused(row, col, bad):
     assert len(scene) == 1
 
 
+def test_complex_arrays_are_refused_everywhere():
+    # Story: numpy's forcecast turned a complex array into its real part
+    # without a word, so (1 + 5j) became 1 in a point, a pose, a quaternion
+    # or a translation. Every array argument now checks its dtype first.
+    a = proxima.ConvexPolytope(cube())
+    pose = matrix(np.eye(3), [3.0, 0.0, 0.0])
+    words = "expected real numbers.*complex"
+    with pytest.raises(ValueError, match="points: " + words):
+        proxima.ConvexPolytope(cube().astype(complex))
+    with pytest.raises(ValueError, match="points: " + words):
+        proxima.ConvexPolytope([[0, 0, 0], [1, 0, 0], [0, 1j, 0]])  # a list with one complex
+    with pytest.raises(ValueError, match=r"pieces\[0\]: points: " + words):
+        proxima.CompoundBody([cube().astype(complex)])
+    with pytest.raises(ValueError, match="pose_b: " + words):
+        proxima.distance(a, None, a, pose.astype(complex))
+    with pytest.raises(ValueError, match="pose_b quaternion: " + words):
+        proxima.distance(a, None, a, (np.array([1, 0, 0, 0], dtype=complex), (3, 0, 0)))
+    with pytest.raises(ValueError, match="pose_b translation: " + words):
+        proxima.distance(a, None, a, ((1, 0, 0, 0), (3 + 1j, 0, 0)))
+    with pytest.raises(ValueError, match="matrix: " + words):
+        proxima.Pose.from_matrix(pose.astype(complex))
+    with pytest.raises(ValueError, match="rotation: " + words):
+        proxima.Pose(np.eye(3, dtype=complex), [0, 0, 0])
+    with pytest.raises(ValueError, match="translation: " + words):
+        proxima.Pose.from_translation(np.zeros(3, dtype=np.complex64))
+    with pytest.raises(ValueError, match="point: " + words):
+        proxima.Pose().apply(np.ones(3, dtype=complex))
+    with pytest.raises(ValueError, match="poses_b: " + words):
+        proxima.distance_batch(a, None, a, np.tile(pose, (2, 1, 1)).astype(complex))
+    scene = proxima.Scene()
+    i = scene.add(a)
+    with pytest.raises(ValueError, match="pose: " + words):
+        scene.set_pose(i, pose.astype(complex))
+    with pytest.raises(ValueError, match="poses: " + words):
+        scene.set_poses([i], pose[None].astype(complex))
+    np.testing.assert_array_equal(scene.pose(i).matrix(), np.eye(4))
+    # Strings are not numbers either (forcecast parsed them).
+    with pytest.raises(ValueError, match="points: expected real numbers.*<U"):
+        proxima.ConvexPolytope(cube().astype(str))
+    # Integers and float32 are real numbers.
+    assert proxima.ConvexPolytope(cube(2).astype(int)).vertex_count == 8
+    assert proxima.distance(a, None, a, pose.astype(np.float32)).distance == pytest.approx(2.0)
+
+
 @pytest.mark.parametrize("magnitude", [3e-162, 1e200, 1e-300, 1e300, 5e-324])
 def test_quaternion_of_any_magnitude_is_its_rotation(magnitude):
     # Story: Python normalized a quaternion through its squared norm, which
