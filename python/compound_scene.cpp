@@ -14,6 +14,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -31,6 +33,31 @@ namespace {
 
 using PyCompoundCache = Guarded<CompoundCache>;
 using PyScene = Guarded<Scene>;
+
+// Body ids from Python: integers only (forcecast would truncate 1.5 to 1),
+// within BodyId's range.
+std::vector<BodyId> to_body_ids(py::handle obj) {
+  const py::array any = py::array::ensure(obj);
+  if (!any || any.ndim() != 1) value_error("ids: expected a 1-D array of body ids");
+  const char kind = any.dtype().kind();
+  if (any.size() > 0 && kind != 'i' && kind != 'u') {
+    value_error("ids: expected integer body ids, got an array of dtype " +
+                py::str(any.dtype()).cast<std::string>());
+  }
+  const auto wide =
+      py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(any);
+  if (!wide) value_error("ids: expected a 1-D array of body ids");
+  std::vector<BodyId> ids(static_cast<std::size_t>(wide.shape(0)));
+  for (py::ssize_t k = 0; k < wide.shape(0); ++k) {
+    const std::int64_t id = wide.at(k);
+    if (id < std::numeric_limits<BodyId>::min() || id > std::numeric_limits<BodyId>::max()) {
+      throw InvalidInput("Scene.set_poses: ids[" + std::to_string(k) + "] = " + std::to_string(id) +
+                         " is not in the scene (never added, or removed); no body was moved");
+    }
+    ids[static_cast<std::size_t>(k)] = static_cast<BodyId>(id);
+  }
+  return ids;
+}
 
 // One piece argument: a ConvexPolytope, an (N, 3) array of points (hulled
 // here), or a (polytope or points, pose) pair.
@@ -307,17 +334,28 @@ void bind_compound_and_scene(py::module_& m) {
       .def(
           "set_poses",
           [](PyScene& s, py::object ids, py::object poses) {
-            const auto id_array =
-                py::array_t<BodyId, py::array::c_style | py::array::forcecast>::ensure(ids);
-            if (!id_array || id_array.ndim() != 1)
-              value_error("ids: expected a 1-D array of body ids");
-            const std::vector<Pose> list = to_poses(poses, id_array.shape(0), "poses");
+            const std::vector<BodyId> id_list = to_body_ids(ids);
+            std::vector<Pose> list =
+                to_poses(poses, static_cast<py::ssize_t>(id_list.size()), "poses");
             const InUse in_use(s, "Scene");
-            for (std::size_t k = 0; k < list.size(); ++k)
-              s.set_pose(id_array.at(static_cast<py::ssize_t>(k)), list[k]);
+            // All or nothing: every id and every pose is checked before the
+            // first body moves (a proxima.Pose object is checked here too).
+            for (std::size_t k = 0; k < id_list.size(); ++k) {
+              if (!s.contains(id_list[k])) {
+                throw InvalidInput("Scene.set_poses: ids[" + std::to_string(k) +
+                                   "] = " + std::to_string(id_list[k]) +
+                                   " is not in the scene (never added, or removed); no body was "
+                                   "moved");
+              }
+              list[k] = checked_pose(list[k], [&] {
+                return "Scene.set_poses: poses[" + std::to_string(k) + "] (no body was moved)";
+              });
+            }
+            for (std::size_t k = 0; k < id_list.size(); ++k) s.set_pose(id_list[k], list[k]);
           },
           py::arg("ids"), py::arg("poses"),
-          "Moves many bodies at once: ids (K,) and poses (K, 4, 4).")
+          "Moves many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing: an unknown "
+          "id or a bad pose raises before any body moves.")
       .def(
           "remove",
           [](PyScene& s, BodyId id) {
