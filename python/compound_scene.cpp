@@ -14,7 +14,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
+#include <limits>
 #include <memory>
+#include <optional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -26,6 +30,34 @@
 
 namespace proxima::python {
 namespace {
+
+using PyCompoundCache = Guarded<CompoundCache>;
+using PyScene = Guarded<Scene>;
+
+// Body ids from Python: integers only (forcecast would truncate 1.5 to 1),
+// within BodyId's range.
+std::vector<BodyId> to_body_ids(py::handle obj) {
+  const py::array any = py::array::ensure(obj);
+  if (!any || any.ndim() != 1) value_error("ids: expected a 1-D array of body ids");
+  const char kind = any.dtype().kind();
+  if (any.size() > 0 && kind != 'i' && kind != 'u') {
+    value_error("ids: expected integer body ids, got an array of dtype " +
+                py::str(any.dtype()).cast<std::string>());
+  }
+  const auto wide =
+      py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(any);
+  if (!wide) value_error("ids: expected a 1-D array of body ids");
+  std::vector<BodyId> ids(static_cast<std::size_t>(wide.shape(0)));
+  for (py::ssize_t k = 0; k < wide.shape(0); ++k) {
+    const std::int64_t id = wide.at(k);
+    if (id < std::numeric_limits<BodyId>::min() || id > std::numeric_limits<BodyId>::max()) {
+      throw InvalidInput("Scene.set_poses: ids[" + std::to_string(k) + "] = " + std::to_string(id) +
+                         " is not in the scene (never added, or removed); no body was moved");
+    }
+    ids[static_cast<std::size_t>(k)] = static_cast<BodyId>(id);
+  }
+  return ids;
+}
 
 // One piece argument: a ConvexPolytope, an (N, 3) array of points (hulled
 // here), or a (polytope or points, pose) pair.
@@ -146,19 +178,51 @@ void bind_compound_and_scene(py::module_& m) {
       "Reads a mesh file as a compound body: one convex piece per OBJ group; a non-convex group "
       "is hulled and reported in its LoadedPiece.input_was_convex (no warning).");
 
-  py::class_<CompoundCache>(
+  // Every method holds the cache's in-use flag: the compound distance uses
+  // the cache without the GIL.
+  py::class_<PyCompoundCache>(
       m, "CompoundCache",
       "Coherence between compound queries of one pair (the best piece pair and each near piece "
-      "pair's feature cache). A new cache is cold; one cache per pair of bodies.")
+      "pair's feature cache). A new cache is cold; one cache per pair of bodies, from one thread "
+      "at a time: using a cache while another thread's query is using it raises RuntimeError.")
       .def(py::init<>(), "A cold cache.")
-      .def_readonly("piece_a", &CompoundCache::piece_a, "Best piece on A of the last answer.")
-      .def_readonly("piece_b", &CompoundCache::piece_b, "Best piece on B of the last answer.")
       .def_property_readonly(
-          "near_pairs", [](const CompoundCache& c) { return c.near.size(); },
+          "piece_a",
+          [](const PyCompoundCache& c) {
+            const InUse in_use(c, "CompoundCache");
+            return c.piece_a;
+          },
+          "Best piece on A of the last answer.")
+      .def_property_readonly(
+          "piece_b",
+          [](const PyCompoundCache& c) {
+            const InUse in_use(c, "CompoundCache");
+            return c.piece_b;
+          },
+          "Best piece on B of the last answer.")
+      .def_property_readonly(
+          "near_pairs",
+          [](const PyCompoundCache& c) {
+            const InUse in_use(c, "CompoundCache");
+            return c.near.size();
+          },
           "Number of piece pairs whose feature caches are kept.")
-      .def("is_cold", &CompoundCache::is_cold, "True when the cache holds nothing.")
-      .def("reset", &CompoundCache::reset, "Makes the cache cold again.")
-      .def("__repr__", [](const CompoundCache& c) {
+      .def(
+          "is_cold",
+          [](const PyCompoundCache& c) {
+            const InUse in_use(c, "CompoundCache");
+            return c.is_cold();
+          },
+          "True when the cache holds nothing.")
+      .def(
+          "reset",
+          [](PyCompoundCache& c) {
+            const InUse in_use(c, "CompoundCache");
+            c.reset();
+          },
+          "Makes the cache cold again.")
+      .def("__repr__", [](const PyCompoundCache& c) {
+        const InUse in_use(c, "CompoundCache");
         return std::string("proxima.CompoundCache(") + (c.is_cold() ? "cold" : "warm") + ")";
       });
 
@@ -179,14 +243,16 @@ void bind_compound_and_scene(py::module_& m) {
   m.def(
       "distance",
       [](const CompoundBody& a, py::object pose_a, const CompoundBody& b, py::object pose_b,
-         CompoundCache* cache, const std::string& algorithm, double relative_tolerance,
+         PyCompoundCache* cache, const std::string& algorithm, double relative_tolerance,
          double absolute_tolerance, int max_iterations) {
         const DistanceOptions options =
             make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
         const Pose pa = to_pose(pose_a, "pose_a");
         const Pose pb = to_pose(pose_b, "pose_b");
+        std::optional<InUse> in_use;
+        if (cache != nullptr) in_use.emplace(*cache, "CompoundCache");
         py::gil_scoped_release release;
-        return distance(a, pa, b, pb, options, cache);
+        return distance(a, pa, b, pb, options, static_cast<CompoundCache*>(cache));
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
       py::arg("cache") = py::none(), py::arg("algorithm") = to_string(defaults.algorithm),
@@ -229,11 +295,15 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("warm_pairs", &SceneStats::warm_pairs,
                     "Candidate pairs that started from the previous step's cache.");
 
-  py::class_<Scene>(
+  // Every method holds the scene's in-use flag (step() and
+  // close_pairs_all_pairs() run without the GIL; anything else at the same
+  // time would race with them).
+  py::class_<PyScene>(
       m, "Scene",
       "Many bodies (ConvexPolytope or CompoundBody) moved by the caller; step() returns the "
       "pairs within the margin, with tracked distance queries (each pair's cache kept across "
-      "steps). Use from one thread at a time.")
+      "steps). Use from one thread at a time: a call while another thread's call is running "
+      "raises RuntimeError.")
       .def(py::init([](double margin, const std::string& broad_phase, int threads,
                        const std::string& algorithm, double relative_tolerance,
                        double absolute_tolerance, int max_iterations) {
@@ -243,7 +313,7 @@ void bind_compound_and_scene(py::module_& m) {
              options.threads = threads;
              options.distance =
                  make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
-             return Scene(options);
+             return PyScene(options);
            }),
            py::arg("margin") = 0.0, py::arg("broad_phase") = to_string(SceneOptions{}.broad_phase),
            py::arg("threads") = SceneOptions{}.threads,
@@ -256,53 +326,104 @@ void bind_compound_and_scene(py::module_& m) {
            "cores).")
       .def(
           "add",
-          [](Scene& s, std::shared_ptr<ConvexPolytope> body, py::object pose) {
-            return s.add(std::shared_ptr<const ConvexPolytope>(std::move(body)),
-                         to_pose(pose, "pose"));
+          [](PyScene& s, std::shared_ptr<ConvexPolytope> body, py::object pose) {
+            const Pose p = to_pose(pose, "pose");
+            const InUse in_use(s, "Scene");
+            return s.add(std::shared_ptr<const ConvexPolytope>(std::move(body)), p);
           },
           py::arg("body"), py::arg("pose") = py::none(), "Adds a ConvexPolytope; returns its id.")
       .def(
           "add",
-          [](Scene& s, std::shared_ptr<CompoundBody> body, py::object pose) {
-            return s.add(std::shared_ptr<const CompoundBody>(std::move(body)),
-                         to_pose(pose, "pose"));
+          [](PyScene& s, std::shared_ptr<CompoundBody> body, py::object pose) {
+            const Pose p = to_pose(pose, "pose");
+            const InUse in_use(s, "Scene");
+            return s.add(std::shared_ptr<const CompoundBody>(std::move(body)), p);
           },
           py::arg("body"), py::arg("pose") = py::none(), "Adds a CompoundBody; returns its id.")
       .def(
           "set_pose",
-          [](Scene& s, BodyId id, py::object pose) { s.set_pose(id, to_pose(pose, "pose")); },
+          [](PyScene& s, BodyId id, py::object pose) {
+            const Pose p = to_pose(pose, "pose");
+            const InUse in_use(s, "Scene");
+            s.set_pose(id, p);
+          },
           py::arg("id"), py::arg("pose"),
           "Moves body id (pose: 4x4, (quaternion, translation) or Pose).")
       .def(
           "set_poses",
-          [](Scene& s, py::object ids, py::object poses) {
-            const auto id_array =
-                py::array_t<BodyId, py::array::c_style | py::array::forcecast>::ensure(ids);
-            if (!id_array || id_array.ndim() != 1)
-              value_error("ids: expected a 1-D array of body ids");
-            const std::vector<Pose> list = to_poses(poses, id_array.shape(0), "poses");
-            for (std::size_t k = 0; k < list.size(); ++k)
-              s.set_pose(id_array.at(static_cast<py::ssize_t>(k)), list[k]);
+          [](PyScene& s, py::object ids, py::object poses) {
+            const std::vector<BodyId> id_list = to_body_ids(ids);
+            std::vector<Pose> list =
+                to_poses(poses, static_cast<py::ssize_t>(id_list.size()), "poses");
+            const InUse in_use(s, "Scene");
+            // All or nothing: every id and every pose is checked before the
+            // first body moves (a proxima.Pose object is checked here too).
+            for (std::size_t k = 0; k < id_list.size(); ++k) {
+              if (!s.contains(id_list[k])) {
+                throw InvalidInput("Scene.set_poses: ids[" + std::to_string(k) +
+                                   "] = " + std::to_string(id_list[k]) +
+                                   " is not in the scene (never added, or removed); no body was "
+                                   "moved");
+              }
+              list[k] = checked_pose(list[k], [&] {
+                return "Scene.set_poses: poses[" + std::to_string(k) + "] (no body was moved)";
+              });
+            }
+            for (std::size_t k = 0; k < id_list.size(); ++k) s.set_pose(id_list[k], list[k]);
           },
           py::arg("ids"), py::arg("poses"),
-          "Moves many bodies at once: ids (K,) and poses (K, 4, 4).")
-      .def("remove", &Scene::remove, py::arg("id"), "Removes body id (its id may be reused).")
-      .def("contains", &Scene::contains, py::arg("id"))
-      .def("__contains__", &Scene::contains)
-      .def("__len__", &Scene::body_count)
-      .def("pose", &Scene::pose, py::arg("id"), "The current pose of body id.")
+          "Moves many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing: an unknown "
+          "id or a bad pose raises before any body moves.")
+      .def(
+          "remove",
+          [](PyScene& s, BodyId id) {
+            const InUse in_use(s, "Scene");
+            s.remove(id);
+          },
+          py::arg("id"), "Removes body id (its id may be reused).")
+      .def(
+          "contains",
+          [](const PyScene& s, BodyId id) {
+            const InUse in_use(s, "Scene");
+            return s.contains(id);
+          },
+          py::arg("id"))
+      .def("__contains__",
+           [](const PyScene& s, BodyId id) {
+             const InUse in_use(s, "Scene");
+             return s.contains(id);
+           })
+      .def("__len__",
+           [](const PyScene& s) {
+             const InUse in_use(s, "Scene");
+             return s.body_count();
+           })
+      .def(
+          "pose",
+          [](const PyScene& s, BodyId id) {
+            const InUse in_use(s, "Scene");
+            return Pose(s.pose(id));
+          },
+          py::arg("id"), "The current pose of body id.")
       .def_property_readonly(
           "body_ids",
-          [](const Scene& s) {
+          [](const PyScene& s) {
+            const InUse in_use(s, "Scene");
             const std::vector<BodyId> ids = s.body_ids();
             return int32_array(ids);
           },
           "Live body ids, increasing, int32.")
       .def_property_readonly(
-          "margin", [](const Scene& s) { return s.options().margin; }, "The query margin.")
+          "margin",
+          [](const PyScene& s) {
+            const InUse in_use(s, "Scene");
+            return s.options().margin;
+          },
+          "The query margin.")
       .def(
           "step",
-          [](Scene& s) {
+          [](PyScene& s) {
+            const InUse in_use(s, "Scene");
             std::span<const ClosePair> pairs;
             {
               py::gil_scoped_release release;
@@ -313,10 +434,16 @@ void bind_compound_and_scene(py::module_& m) {
           "Broad phase and tracked narrow phase on the current poses: the list of ClosePair, "
           "sorted by (a, b).")
       .def_property_readonly(
-          "stats", [](const Scene& s) { return s.stats(); }, "SceneStats of the last step.")
+          "stats",
+          [](const PyScene& s) {
+            const InUse in_use(s, "Scene");
+            return s.stats();
+          },
+          "SceneStats of the last step.")
       .def(
           "close_pairs_all_pairs",
-          [](const Scene& s) {
+          [](const PyScene& s) {
+            const InUse in_use(s, "Scene");
             std::vector<ClosePair> pairs;
             {
               py::gil_scoped_release release;
@@ -325,7 +452,8 @@ void bind_compound_and_scene(py::module_& m) {
             return close_pair_list(pairs);
           },
           "The slow twin of step(): cold queries on every pair. For checks.")
-      .def("__repr__", [](const Scene& s) {
+      .def("__repr__", [](const PyScene& s) {
+        const InUse in_use(s, "Scene");
         return "proxima.Scene(bodies=" + std::to_string(s.body_count()) +
                ", margin=" + py::repr(py::float_(s.options().margin)).cast<std::string>() + ")";
       });

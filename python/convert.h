@@ -3,8 +3,10 @@
 //
 // Layer 7: conversions between Python objects and proxima's C++ types,
 // shared by the binding files of the Python module (module.cpp,
-// compound_scene.cpp). Arrays in, arrays out (copies); a wrong shape or a
-// non-rigid pose raises ValueError naming the argument.
+// compound_scene.cpp). Arrays in, arrays out (copies); a wrong shape, a
+// complex or non-numeric array or a non-rigid pose raises ValueError naming
+// the argument. Objects that one thread at a time may use (Scene,
+// DistanceCache, CompoundCache) carry an in-use flag (Guarded, InUse).
 #pragma once
 
 #include <Python.h>
@@ -12,13 +14,18 @@
 #include <pybind11/pybind11.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "proxima/io.h"
@@ -40,8 +47,19 @@ inline std::string shape_of(const py::array& a) {
   return s + (a.ndim() == 1 ? ",)" : ")");
 }
 
+// Real numbers only: numpy's forcecast alone would take anything, and
+// silently drop the imaginary part of a complex array or parse strings. The
+// natural dtype of the argument (an array as given, or what numpy makes of a
+// sequence) is checked before the conversion: floating point or integer.
 inline DoubleArray as_double_array(py::handle obj, const std::string& name) {
-  auto a = DoubleArray::ensure(obj);
+  const py::array any = py::array::ensure(obj);
+  if (!any) value_error(name + ": expected an array of numbers");
+  const char kind = any.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    value_error(name + ": expected real numbers (float or integer), got an array of dtype " +
+                py::str(any.dtype()).cast<std::string>());
+  }
+  auto a = DoubleArray::ensure(any);
   if (!a) value_error(name + ": expected an array of numbers");
   return a;
 }
@@ -166,7 +184,8 @@ inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::stri
 // The K of a batch from whichever pose argument is a (K, 4, 4) array.
 inline py::ssize_t batch_size(py::handle obj) {
   if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj)) return -1;
-  auto m = DoubleArray::ensure(obj);
+  // No conversion here: the pose arguments are checked (dtype, shape) by to_poses.
+  const py::array m = py::array::ensure(obj);
   return m && m.ndim() == 3 ? m.shape(0) : -1;
 }
 
@@ -325,6 +344,72 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   out["iterations"] = iterations;
   return out;
 }
+
+// --- One thread at a time -------------------------------------------------
+// A Scene, a DistanceCache and a CompoundCache are mutable state that one
+// thread at a time may use (the C++ contract). The calls that release the
+// GIL would let a second Python thread into the same object while the first
+// one runs, which corrupts memory. So each such object, as Python holds it,
+// is a Guarded<T>: T plus an in-use flag, and every call that uses it holds
+// an InUse for its duration; a second thread gets RuntimeError at once,
+// never a race. Cost: one atomic exchange and one store per call.
+template <class T>
+class Guarded : public T {
+ public:
+  using T::T;
+  Guarded() = default;
+  explicit Guarded(const T& value) : T(value) {}
+  // A copy (or a move) is a new object: not in use.
+  Guarded(const Guarded& other) requires std::copy_constructible<T> : T(other) {}
+  Guarded(Guarded&& other) noexcept requires std::move_constructible<T> : T(std::move(other)) {}
+  Guarded& operator=(const Guarded&) = delete;
+  Guarded& operator=(Guarded&&) = delete;
+  ~Guarded() = default;
+
+  std::atomic<bool>& in_use_flag() const { return in_use_; }
+
+ private:
+  mutable std::atomic<bool> in_use_{false};
+};
+
+// Holds a Guarded object's flag from construction to destruction; throws
+// RuntimeError when another thread holds it.
+class InUse {
+ public:
+  template <class T>
+  InUse(const Guarded<T>& object, const char* type_name) : flag_(&object.in_use_flag()) {
+    if (flag_->exchange(true, std::memory_order_acquire)) {
+      flag_ = nullptr;
+      throw_busy(type_name);
+    }
+  }
+  // The flag when it is free, else nothing (no throw).
+  template <class T>
+  static std::optional<InUse> try_hold(const Guarded<T>& object) {
+    std::atomic<bool>* flag = &object.in_use_flag();
+    if (flag->exchange(true, std::memory_order_acquire)) return std::nullopt;
+    return InUse(flag);
+  }
+  [[noreturn]] static void throw_busy(const char* type_name) {
+    throw std::runtime_error(std::string("proxima.") + type_name +
+                             " is being used by another thread (use it from one thread at a "
+                             "time, or give each thread its own)");
+  }
+  InUse(InUse&& other) noexcept : flag_(std::exchange(other.flag_, nullptr)) {}
+  InUse(const InUse&) = delete;
+  InUse& operator=(const InUse&) = delete;
+  InUse& operator=(InUse&&) = delete;
+  ~InUse() {
+    if (flag_ != nullptr) flag_->store(false, std::memory_order_release);
+  }
+  const std::atomic<bool>* flag() const { return flag_; }
+
+ private:
+  explicit InUse(std::atomic<bool>* flag) : flag_(flag) {}
+  std::atomic<bool>* flag_;
+};
+
+using PyDistanceCache = Guarded<DistanceCache>;
 
 // Registers CompoundBody, Scene and their companions (compound_scene.cpp).
 void bind_compound_and_scene(py::module_& m);

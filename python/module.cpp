@@ -22,7 +22,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -79,8 +81,9 @@ PYBIND11_MODULE(proxima, m) {
   py::class_<Pose>(m, "Pose", "A rigid motion: x -> rotation @ x + translation.")
       .def(py::init<>(), "The identity.")
       .def(py::init([](py::object rotation, py::object translation) {
-             return checked_pose(Pose(to_mat3(rotation, "rotation"), to_vec3(translation, "translation")),
-                                 "rotation");
+             return checked_pose(
+                 Pose(to_mat3(rotation, "rotation"), to_vec3(translation, "translation")),
+                 "rotation");
            }),
            py::arg("rotation"), py::arg("translation"),
            "From a 3x3 rotation matrix and a translation.")
@@ -284,11 +287,12 @@ PYBIND11_MODULE(proxima, m) {
       py::arg("path"), "The points of a mesh file (OBJ, OFF, STL, PLY, XYZ) as an (N, 3) array.");
 
   // --- Cache, features, results ---------------------------------------------
-  py::class_<DistanceCache>(
+  py::class_<PyDistanceCache>(
       m, "DistanceCache",
       "Coherence between queries of one pair, owned by the caller. A new cache is cold; "
       "passing the same cache to the next query of the same pair is tracking. Use one cache "
-      "per pair, from one thread at a time.")
+      "per pair, from one thread at a time: a query or reset() on a cache that a "
+      "distance_batch is using in another thread raises RuntimeError.")
       .def(py::init<>(), "A cold cache.")
       .def_readwrite("vertices_a", &DistanceCache::vertices_a,
                      "Feature (or simplex) vertex ids on A, -1 unused.")
@@ -297,9 +301,15 @@ PYBIND11_MODULE(proxima, m) {
       .def_readwrite("hint_a", &DistanceCache::hint_a, "Last support vertex on A (-1: none).")
       .def_readwrite("hint_b", &DistanceCache::hint_b, "Last support vertex on B (-1: none).")
       .def("is_cold", &DistanceCache::is_cold, "True when the cache holds nothing.")
-      .def("reset", &DistanceCache::reset, "Makes the cache cold again.")
-      .def("__copy__", [](const DistanceCache& c) { return c; })
-      .def("__repr__", [](const DistanceCache& c) {
+      .def(
+          "reset",
+          [](PyDistanceCache& c) {
+            const InUse in_use(c, "DistanceCache");
+            c.reset();
+          },
+          "Makes the cache cold again.")
+      .def("__copy__", [](const PyDistanceCache& c) { return PyDistanceCache(c); })
+      .def("__repr__", [](const PyDistanceCache& c) {
         return std::string("proxima.DistanceCache(") + (c.is_cold() ? "cold" : "warm") + ")";
       });
 
@@ -354,11 +364,17 @@ PYBIND11_MODULE(proxima, m) {
   m.def(
       "distance",
       [](const ConvexPolytope& a, py::object pose_a, const ConvexPolytope& b, py::object pose_b,
-         DistanceCache* cache, const std::string& algorithm, double relative_tolerance,
+         PyDistanceCache* cache, const std::string& algorithm, double relative_tolerance,
          double absolute_tolerance, int max_iterations) {
         const DistanceOptions options =
             make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
-        return distance(a, to_pose(pose_a, "pose_a"), b, to_pose(pose_b, "pose_b"), options, cache);
+        const Pose pa = to_pose(pose_a, "pose_a");
+        const Pose pb = to_pose(pose_b, "pose_b");
+        if (cache == nullptr) return distance(a, pa, b, pb, options, nullptr);
+        // The GIL is held throughout; the flag catches a distance_batch of
+        // another thread that is using this cache right now.
+        const InUse in_use(*cache, "DistanceCache");
+        return distance(a, pa, b, pb, options, cache);
       },
       py::arg("a"), py::arg("pose_a"), py::arg("b"), py::arg("pose_b"),
       py::arg("cache") = py::none(), py::arg("algorithm") = to_string(defaults.algorithm),
@@ -387,7 +403,6 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
         // Caches: copied in, run without the GIL, copied back. The list's
         // objects are held so that they outlive the call.
         std::vector<py::object> cache_objects;
-        std::vector<DistanceCache> cache_values;
         if (!caches.is_none()) {
           const py::sequence seq = py::reinterpret_borrow<py::sequence>(caches);
           if (py::len(seq) != n) {
@@ -396,19 +411,45 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
           }
           for (std::size_t i = 0; i < n; ++i) {
             py::object c = seq[i];
-            if (!py::isinstance<DistanceCache>(c))
+            if (!py::isinstance<PyDistanceCache>(c))
               value_error("caches[" + std::to_string(i) + "] is not a DistanceCache");
-            cache_values.push_back(c.cast<const DistanceCache&>());
             cache_objects.push_back(std::move(c));
           }
         }
         std::vector<DistanceResult> results(n);
         {
-          py::gil_scoped_release release;
-          distance_batch(a, pa, b, pb, results, cache_values, options, threads);
+          // Each cache is marked in use from its copy in to its copy back;
+          // no Python code runs in between. A cache listed twice is held
+          // once (its rows run on copies and the last row's copy is kept,
+          // as before): the set of our own flags is only built when a flag
+          // is found taken.
+          std::vector<InUse> in_use;
+          in_use.reserve(cache_objects.size());
+          std::unordered_set<const std::atomic<bool>*> ours;
+          std::vector<DistanceCache> cache_values;
+          cache_values.reserve(cache_objects.size());
+          for (const py::object& c : cache_objects) {
+            PyDistanceCache& cache = c.cast<PyDistanceCache&>();
+            if (std::optional<InUse> hold = InUse::try_hold(cache)) {
+              if (!ours.empty()) ours.insert(hold->flag());
+              in_use.push_back(std::move(*hold));
+            } else {
+              if (ours.empty()) {
+                for (const InUse& h : in_use) ours.insert(h.flag());
+              }
+              if (!ours.contains(&cache.in_use_flag())) InUse::throw_busy("DistanceCache");
+            }
+            cache_values.push_back(cache);
+          }
+          {
+            py::gil_scoped_release release;
+            distance_batch(a, pa, b, pb, results, cache_values, options, threads);
+          }
+          for (std::size_t i = 0; i < cache_objects.size(); ++i) {
+            static_cast<DistanceCache&>(cache_objects[i].cast<PyDistanceCache&>()) =
+                cache_values[i];
+          }
         }
-        for (std::size_t i = 0; i < cache_objects.size(); ++i)
-          cache_objects[i].cast<DistanceCache&>() = cache_values[i];
         return batch_dict(results);
       },
       py::arg("a"), py::arg("poses_a"), py::arg("b"), py::arg("poses_b"),

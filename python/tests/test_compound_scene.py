@@ -210,3 +210,50 @@ def test_scene_add_remove_and_errors():
         proxima.Scene(broad_phase="octree")
     with pytest.raises(ValueError, match="ids"):
         scene.set_poses(np.zeros((2, 2)), np.tile(np.eye(4), (2, 1, 1)))
+
+
+def test_set_poses_is_all_or_nothing():
+    # Story: set_poses moved the bodies one by one, so an unknown id (or a
+    # bad pose) late in the list raised after the first bodies had moved,
+    # leaving the scene half updated. Now every id and pose is checked first.
+    rng = np.random.default_rng(9)
+    hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
+    scene = proxima.Scene(margin=0.1)
+    a = scene.add(hull, ((1, 0, 0, 0), (0, 0, 0)))
+    b = scene.add(hull, ((1, 0, 0, 0), (10, 0, 0)))
+    scene.remove(b)
+    c = scene.add(hull, ((1, 0, 0, 0), (20, 0, 0)))
+    before = {i: scene.pose(i).matrix() for i in scene.body_ids}
+    moved = np.tile(np.eye(4), (3, 1, 1))
+    moved[:, :3, 3] = [[1, 1, 1], [2, 2, 2], [3, 3, 3]]
+
+    def unchanged():
+        for i, m in before.items():
+            np.testing.assert_array_equal(scene.pose(i).matrix(), m)
+
+    unknown = max(a, c) + 7
+    with pytest.raises(proxima.InvalidInput, match=rf"ids\[2\] = {unknown} is not in the scene.*no body was moved"):
+        scene.set_poses([a, c, unknown], moved)
+    unchanged()
+    with pytest.raises(proxima.InvalidInput, match="not in the scene"):
+        scene.set_poses(np.array([a, -1]), moved[:2])
+    unchanged()
+    with pytest.raises(proxima.InvalidInput, match="not in the scene"):
+        scene.set_poses(np.array([a, 2**40]), moved[:2])
+    unchanged()
+    bad = moved.copy()
+    bad[1, 3, 0] = np.nan
+    with pytest.raises(proxima.InvalidInput, match=r"poses\[1\] is not finite"):
+        scene.set_poses([a, c], bad[:2])
+    unchanged()
+    # A Pose object is checked too (from_translation does not check).
+    with pytest.raises(proxima.InvalidInput, match="no body was moved"):
+        scene.set_poses([a, c], proxima.Pose.from_translation([np.nan, 0, 0]))
+    unchanged()
+    # Ids are integers: 0.5 is not body 0 (forcecast truncated it).
+    with pytest.raises(ValueError, match="ids: expected integer body ids"):
+        scene.set_poses(np.array([a + 0.5]), moved[:1])
+    unchanged()
+    scene.set_poses([a, c], moved[:2])
+    np.testing.assert_array_equal(scene.pose(a).translation, [1, 1, 1])
+    np.testing.assert_array_equal(scene.pose(c).translation, [2, 2, 2])

@@ -13,8 +13,6 @@ rows, caches). Randomness is seeded.
 """
 
 import math
-import threading
-import time
 import warnings
 
 import numpy as np
@@ -242,6 +240,117 @@ def test_float32_pose_is_accepted():
     assert r.status == "separated"
 
 
+@pytest.mark.parametrize("row, col", [(r, c) for r in range(4) for c in range(4)])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_entry_anywhere_in_a_4x4_pose_is_refused(row, col, bad):
+    # Story: the bottom row was only compared with (0, 0, 0, 1) when finite,
+    # so a NaN or an infinity there was accepted as the identity's row. Every
+    # path that takes a 4x4 matrix must refuse it, naming the entry.
+    a = proxima.ConvexPolytope(cube())
+    m = matrix(np.eye(3), [3.0, 0.0, 0.0])
+    m[row, col] = bad
+    where = f"row {row}, column {col}"
+    with pytest.raises(proxima.InvalidInput, match=f"pose_b is not finite.*{where}"):
+        proxima.distance(a, None, a, m)
+    with pytest.raises(proxima.InvalidInput, match=where):
+        proxima.Pose.from_matrix(m)
+    batch = np.tile(matrix(np.eye(3), [3.0, 0.0, 0.0]), (3, 1, 1))
+    batch[2] = m
+    with pytest.raises(proxima.InvalidInput, match=rf"poses_b\[2\] is not finite.*{where}"):
+        proxima.distance_batch(a, None, a, batch)
+    scene = proxima.Scene()
+    i = scene.add(a)
+    with pytest.raises(proxima.InvalidInput, match=where):
+        scene.set_pose(i, m)
+    with pytest.raises(proxima.InvalidInput, match=where):
+        scene.add(a, m)
+    assert len(scene) == 1
+
+
+def test_complex_arrays_are_refused_everywhere():
+    # Story: numpy's forcecast turned a complex array into its real part
+    # without a word, so (1 + 5j) became 1 in a point, a pose, a quaternion
+    # or a translation. Every array argument now checks its dtype first.
+    a = proxima.ConvexPolytope(cube())
+    pose = matrix(np.eye(3), [3.0, 0.0, 0.0])
+    words = "expected real numbers.*complex"
+    with pytest.raises(ValueError, match="points: " + words):
+        proxima.ConvexPolytope(cube().astype(complex))
+    with pytest.raises(ValueError, match="points: " + words):
+        proxima.ConvexPolytope([[0, 0, 0], [1, 0, 0], [0, 1j, 0]])  # a list with one complex
+    with pytest.raises(ValueError, match=r"pieces\[0\]: points: " + words):
+        proxima.CompoundBody([cube().astype(complex)])
+    with pytest.raises(ValueError, match="pose_b: " + words):
+        proxima.distance(a, None, a, pose.astype(complex))
+    with pytest.raises(ValueError, match="pose_b quaternion: " + words):
+        proxima.distance(a, None, a, (np.array([1, 0, 0, 0], dtype=complex), (3, 0, 0)))
+    with pytest.raises(ValueError, match="pose_b translation: " + words):
+        proxima.distance(a, None, a, ((1, 0, 0, 0), (3 + 1j, 0, 0)))
+    with pytest.raises(ValueError, match="matrix: " + words):
+        proxima.Pose.from_matrix(pose.astype(complex))
+    with pytest.raises(ValueError, match="rotation: " + words):
+        proxima.Pose(np.eye(3, dtype=complex), [0, 0, 0])
+    with pytest.raises(ValueError, match="translation: " + words):
+        proxima.Pose.from_translation(np.zeros(3, dtype=np.complex64))
+    with pytest.raises(ValueError, match="point: " + words):
+        proxima.Pose().apply(np.ones(3, dtype=complex))
+    with pytest.raises(ValueError, match="poses_b: " + words):
+        proxima.distance_batch(a, None, a, np.tile(pose, (2, 1, 1)).astype(complex))
+    scene = proxima.Scene()
+    i = scene.add(a)
+    with pytest.raises(ValueError, match="pose: " + words):
+        scene.set_pose(i, pose.astype(complex))
+    with pytest.raises(ValueError, match="poses: " + words):
+        scene.set_poses([i], pose[None].astype(complex))
+    np.testing.assert_array_equal(scene.pose(i).matrix(), np.eye(4))
+    # Strings are not numbers either (forcecast parsed them).
+    with pytest.raises(ValueError, match="points: expected real numbers.*<U"):
+        proxima.ConvexPolytope(cube().astype(str))
+    # Integers and float32 are real numbers.
+    assert proxima.ConvexPolytope(cube(2).astype(int)).vertex_count == 8
+    assert proxima.distance(a, None, a, pose.astype(np.float32)).distance == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("magnitude", [3e-162, 1e200, 1e-300, 1e300, 5e-324])
+def test_quaternion_of_any_magnitude_is_its_rotation(magnitude):
+    # Story: Python normalized a quaternion through its squared norm, which
+    # overflows for 1e200 (1, 0, 0, 1) (the rotation became the identity)
+    # and loses its digits for 3e-162 (1, 0, 0, 1) (a non-rigid matrix, det
+    # 0.84). Python and the CLI now both use proxima's unit_quaternion: the
+    # rotation is that of (1, 0, 0, 1), a quarter turn about z, bit for bit.
+    q = magnitude * np.array([1.0, 0.0, 0.0, 1.0])
+    unit = proxima.Pose.from_quaternion([1.0, 0.0, 0.0, 1.0], [0, 0, 0])
+    pose = proxima.Pose.from_quaternion(q, [0, 0, 0])
+    np.testing.assert_array_equal(pose.rotation, unit.rotation)
+    np.testing.assert_allclose(pose.rotation, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15)
+    assert np.linalg.det(pose.rotation) == pytest.approx(1.0, abs=1e-15)
+    # The same through every path that takes a (quaternion, translation) pair.
+    a = proxima.ConvexPolytope(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]]))
+    b = proxima.ConvexPolytope(np.array([[0.0, 0, 0]]))
+    # B's point at (0, 2, 0) is A's vertex (1, 0, 0) turned a quarter about z,
+    # plus (0, 1, 0): distance 1 exactly when the rotation is right.
+    r = proxima.distance(a, (q, (0, 0, 0)), b, ((1, 0, 0, 0), (0, 2, 0)))
+    assert r.distance == pytest.approx(1.0, abs=1e-15)
+    scene = proxima.Scene(margin=10.0)
+    i = scene.add(a, (q, (0, 0, 0)))
+    np.testing.assert_array_equal(scene.pose(i).rotation, unit.rotation)
+    body = proxima.CompoundBody([(a, (q, (0, 0, 0)))])
+    np.testing.assert_array_equal(body.piece(0)[1].rotation, unit.rotation)
+
+
+@pytest.mark.parametrize(
+    "q, words",
+    [((0, 0, 0, 0), "quaternion is zero"), ((0.0, -0.0, 0.0, -0.0), "quaternion is zero"),
+     ((np.nan, 0, 0, 1), "not finite"), ((1, np.inf, 0, 0), "not finite")])
+def test_zero_or_non_finite_quaternion_is_refused(q, words):
+    with pytest.raises(proxima.InvalidInput, match="pose: .*" + words):
+        proxima.Pose.from_quaternion(q, (0, 0, 0))
+    scene = proxima.Scene()
+    with pytest.raises(proxima.InvalidInput, match=words):
+        scene.add(proxima.ConvexPolytope(cube()), (q, (0, 0, 0)))
+    assert len(scene) == 0
+
+
 # --- caches and tracking -----------------------------------------------------
 
 
@@ -372,36 +481,6 @@ def test_batch_errors(bodies):
         proxima.distance_batch(a, np.tile(np.eye(4), (500, 1, 1)), b, None, max_iterations=0, threads=2)
     with pytest.raises(ValueError, match="algorithm must be"):
         proxima.distance_batch(a, pa, b, pb, algorithm="epa")
-
-
-def test_batch_releases_the_gil(bodies):
-    # While one Python thread waits in distance_batch, another keeps running
-    # Python code; if the GIL were held through the C++ call, the main thread
-    # could not take a single step until it returned.
-    a, b = bodies
-    rng = np.random.default_rng(9)
-    # Large enough to last well over 0.05 s even on an idle machine (30,000
-    # cold queries took 0.049 s once tracked contacts made them cheaper).
-    pa, pb = random_scene(rng, 100000)
-    window = {}
-
-    def run():
-        window["start"] = time.perf_counter()
-        proxima.distance_batch(a, pa, b, pb, threads=1, algorithm="gjk")
-        window["end"] = time.perf_counter()
-
-    worker = threading.Thread(target=run)
-    stamps = []
-    worker.start()
-    while worker.is_alive():
-        time.sleep(0.001)  # leaves the CPU to the worker; waking up needs the GIL
-        stamps.append(time.perf_counter())
-    worker.join()
-    start, end = window["start"], window["end"]
-    assert end - start > 0.05, "batch too short to tell"
-    # Leave out the argument conversion at the start (GIL held, a few ms).
-    inside = [s for s in stamps if start + 0.5 * (end - start) < s < end]
-    assert len(inside) > 10
 
 
 # --- polytope -----------------------------------------------------------------
