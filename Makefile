@@ -1,5 +1,6 @@
 # proxima: the two commands of the README.
-#   make run   builds in release and runs the main job (proxima paper)
+#   make run   builds in release and runs the main job, the paper's experiments
+#              (bench/paper_experiments; PAPER_ARGS=--quick for the reduced run)
 #   make test  installs what is missing, builds, runs every test (release + sanitizers)
 JOBS ?= $(shell nproc)
 
@@ -25,8 +26,9 @@ dev: setup
 	cmake --preset dev >/dev/null
 	cmake --build --preset dev -j $(JOBS)
 
+PAPER_ARGS ?=
 run: release
-	./build/release/cli/proxima paper
+	./build/release/bench/paper_experiments $(PAPER_ARGS)
 
 test: release asan
 	@echo "== unit tests, release build =="

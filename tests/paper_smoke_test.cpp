@@ -1,4 +1,5 @@
-// proxima: smoke test of `proxima paper --quick` (issue 4), run in-process.
+// proxima: smoke test of the paper experiments (bench/paper_experiments --quick,
+// issue 4), run in-process.
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // It runs the whole quick mode (robustness against the exact reference, the

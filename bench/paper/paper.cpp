@@ -1132,7 +1132,7 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
     out << "ERROR: cannot create " << dir.string() << ": " << ec.message() << "\n";
     return 1;
   }
-  out << "proxima paper" << (options.quick ? " --quick" : "")
+  out << "paper_experiments" << (options.quick ? " --quick" : "")
       << ": the experiments of the paper, proxima against FCL "
       << "0.7 (libccd and its own GJK) and Bullet 3.24, " << std::thread::hardware_concurrency()
       << " hardware threads, load average " << fixed(load_at_start, 1) << "\n";
