@@ -185,6 +185,39 @@ std::string describe_parse_error(const std::string& line, const Json::exception&
   return message + ": " + readable_parse_message(ex.what());
 }
 
+// The deepest nesting of arrays and objects a query line may have. A query
+// needs 4 levels (the line, a body, its vertices, a point); the rest is room
+// for ids. nlohmann parses any depth, but its dump (the id is echoed) and
+// its comparisons recurse, and a line nested 100,000 deep overflowed the
+// stack and killed the run (issue 9).
+constexpr int kMaxJsonDepth = 64;
+
+// The 1-based column at which `line` opens its (kMaxJsonDepth + 1)-th
+// nested array or object, or 0 when it stays within the limit. Brackets
+// inside strings do not count. A linear scan that keeps one counter, run
+// before the parser so that a deep line never reaches it.
+std::size_t nesting_overflow_column(std::string_view line) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character, possibly a quote
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) return i + 1;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return 0;
+}
+
 double read_finite(const Json& v, const std::string& path_if_bad) {
   if (!v.is_number()) fail(path_if_bad + " is not a number (it is " + kind(v) + ")");
   const double x = v.get<double>();
@@ -342,6 +375,12 @@ ConvexPolytope build_hull(const std::vector<Vec3>& vertices, const std::string& 
 // answer.
 bool answer_line(const std::string& line, long line_number, const DistanceOptions& options,
                  Workspace& work, std::string& out) {
+  if (const std::size_t column = nesting_overflow_column(line); column != 0) {
+    append_error_answer(out, nullptr, line_number,
+                        "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
+                            " levels (at column " + std::to_string(column) + ")");
+    return false;
+  }
   Json query;
   try {
     query = Json::parse(line);
