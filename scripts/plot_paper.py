@@ -32,6 +32,7 @@ COLOURS = {
     "proxima Enhanced GJK": "#1f77b4",
     "proxima GJK": "#17becf",
     "FCL libccd": "#2ca02c",
+    "FCL libccd scaled": "#8c564b",
     "FCL GJK": "#9467bd",
     "Bullet GJK": "#ff7f0e",
 }

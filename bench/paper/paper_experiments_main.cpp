@@ -5,7 +5,7 @@
 // (build/<preset>/bench/paper_experiments): the paper's
 // experiments against the peers (FCL, libccd through FCL, Bullet), the job of
 // `make run`.
-//   paper_experiments [--quick] [--out DIR]
+//   paper_experiments [--quick [--full-robustness]] [--out DIR]
 // Before issue 9 this was `proxima paper`; it moved out of the shipped CLI so
 // that the installed `proxima` links none of the peers.
 //
@@ -24,6 +24,9 @@ int main(int argc, char** argv) {
       "proxima, FCL and Bullet; tables on the terminal, CSV files and PNG plots in --out"};
   proxima::bench::PaperOptions options;
   app.add_flag("--quick", options.quick, "Reduced run, under a minute");
+  app.add_flag(
+      "--full-robustness", options.full_robustness,
+      "With --quick: the robustness experiments on the full run's cases (half a minute more)");
   app.add_option("--out", options.out_dir, "Directory for the CSV files and plots")
       ->capture_default_str();
   app.footer("Example:\n  build/release/bench/paper_experiments --quick --out paper-out");
