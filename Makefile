@@ -4,7 +4,7 @@
 #   make test  installs what is missing, builds, runs every test (release + sanitizers)
 JOBS ?= $(shell nproc)
 
-.PHONY: all run test setup release asan dev bench fuzz clean
+.PHONY: all run test setup release asan dev bench fuzz clean results results-quick
 
 all: release
 
@@ -48,6 +48,16 @@ tsan: setup
 python: setup
 	cmake --preset release >/dev/null
 	cmake --build --preset release --target proxima_python -j $(JOBS)
+
+# Every measured figure from one command, on HEAD: the paper's experiments,
+# the scene benchmark and the micro-benchmarks, tables in
+# bench/results/latest/RESULTS.md with the commit, date, machine and load
+# (about 25 minutes on 2 cores; results-quick checks the chain in about 2).
+results: setup
+	/usr/bin/python3 scripts/results
+
+results-quick: setup
+	/usr/bin/python3 scripts/results --quick
 
 bench: release
 	@for b in build/release/bench/*_bench; do echo "== $$b =="; $$b; done
