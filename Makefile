@@ -52,7 +52,7 @@ python: setup
 # Every measured figure from one command, on HEAD: the paper's experiments,
 # the scene benchmark and the micro-benchmarks, tables in
 # bench/results/latest/RESULTS.md with the commit, date, machine and load
-# (about 25 minutes on 2 cores; results-quick checks the chain in about 2).
+# (about 20 minutes on 2 cores; results-quick checks the chain in about 1.5).
 results: setup
 	/usr/bin/python3 scripts/results
 
