@@ -101,7 +101,9 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
       const int cases = std::stoi(row.at("cases"));
       EXPECT_GT(cases, 0) << row.at("experiment") << " " << row.at("system");
       // The full run's case set: 100 orientations + 100 rotation runs x 10 steps.
-      if (options.full_robustness) EXPECT_EQ(cases, 1100) << row.at("experiment");
+      if (options.full_robustness) {
+        EXPECT_EQ(cases, 1100) << row.at("experiment");
+      }
       const std::string& system = row.at("system");
       if (system.rfind("proxima", 0) == 0) {
         const int within = std::stoi(row.at("within_standard"));
