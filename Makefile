@@ -1,9 +1,10 @@
 # proxima: the two commands of the README.
-#   make run   builds in release and runs the main job (proxima paper)
+#   make run   builds in release and runs the main job, the paper's experiments
+#              (bench/paper_experiments; PAPER_ARGS=--quick for the reduced run)
 #   make test  installs what is missing, builds, runs every test (release + sanitizers)
 JOBS ?= $(shell nproc)
 
-.PHONY: all run test setup release asan dev bench fuzz clean
+.PHONY: all run test setup release asan dev bench fuzz clean results results-quick
 
 all: release
 
@@ -25,8 +26,9 @@ dev: setup
 	cmake --preset dev >/dev/null
 	cmake --build --preset dev -j $(JOBS)
 
+PAPER_ARGS ?=
 run: release
-	./build/release/cli/proxima paper
+	./build/release/bench/paper_experiments $(PAPER_ARGS)
 
 test: release asan
 	@echo "== unit tests, release build =="
@@ -46,6 +48,16 @@ tsan: setup
 python: setup
 	cmake --preset release >/dev/null
 	cmake --build --preset release --target proxima_python -j $(JOBS)
+
+# Every measured figure from one command, on HEAD: the paper's experiments,
+# the scene benchmark and the micro-benchmarks, tables in
+# bench/results/latest/RESULTS.md with the commit, date, machine and load
+# (about 20 minutes on 2 cores; results-quick checks the chain in about 1.5).
+results: setup
+	/usr/bin/python3 scripts/results
+
+results-quick: setup
+	/usr/bin/python3 scripts/results --quick
 
 bench: release
 	@for b in build/release/bench/*_bench; do echo "== $$b =="; $$b; done

@@ -2,29 +2,19 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // Layer 7: the `proxima` command-line tool.
-//   proxima demo                                   the main job of `make run`
+//   proxima demo                                   two seeded bodies, every algorithm
 //   proxima query [FILE] [--algorithm NAME] ...    JSON Lines in, JSON Lines out
-//   proxima paper [--quick] [--out DIR]            the paper's experiments against the peers
 //   proxima distance A B [--pose-a ...] [--json]   distance between two mesh files
 //   proxima hull FILE [--out FILE.obj|.off]        hull statistics and export
-//   proxima scene-demo [--bodies N] [--steps S]    many moving bodies through proxima::Scene
+//
+// The paper's experiments and the scene demo, which measure the peers (FCL,
+// libccd, Bullet), are the benchmark executables bench/paper_experiments and
+// bench/scene_demo (bench/paper): the shipped tool links none of the peers.
 //
 // Exit codes: 0 when the run completed (a query line with an error answer is
 // still a completed run), 1 when the input cannot be read (bad file, bad
-// numbers), the demo fails or `paper` cannot write its files, 2 for usage
-// errors.
-#include "demo.h"
-#include "paper/paper.h"
-#include "query.h"
-#include "scene_demo.h"
-#include "tools.h"
-
-#include "proxima/types.h"
-
+// numbers) or the demo fails, 2 for usage errors.
 #include <CLI/CLI.hpp>
-
-#include <unistd.h>
-
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -34,6 +24,11 @@
 #include <iostream>
 #include <string>
 #include <vector>
+
+#include "demo.h"
+#include "proxima/types.h"
+#include "query.h"
+#include "tools.h"
 
 namespace {
 
@@ -53,7 +48,8 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
   return proxima::Algorithm::hybrid;
 }
 
-int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads) {
+int run_query_command(const std::string& file, const proxima::DistanceOptions& options,
+                      int threads) {
   // Answers go through std::cout only; untying it from C stdio lets it
   // buffer a whole answer line before the explicit flush.
   std::ios::sync_with_stdio(false);
@@ -99,7 +95,9 @@ int main(int argc, char** argv) {
       "  proxima distance a.obj b.stl --pose-b 0 0 2 1 0 0 0\n"
       "  proxima hull body.ply --out hull.obj\n"
       "  proxima query queries.jsonl --threads 2 > answers.jsonl\n"
-      "Exit codes: 0 ok, 1 bad input (unreadable file, bad numbers), 2 usage.");
+      "Exit codes: 0 ok, 1 bad input (unreadable file, bad numbers), 2 usage.\n"
+      "The paper's experiments and the scene demo are benchmark executables of the build tree\n"
+      "(bench/paper_experiments, bench/scene_demo), not part of the installed tool.");
 
   CLI::App* demo = app.add_subcommand(
       "demo", "Build two seeded polytopes, print their hulls and the distance by each algorithm");
@@ -132,16 +130,6 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, kMaxThreads))
       ->capture_default_str();
 
-  CLI::App* paper = app.add_subcommand(
-      "paper",
-      "Reproduce the paper's experiments (robustness, figures 1-3, cold queries) for proxima, FCL "
-      "and Bullet; tables on the terminal, CSV files and PNG plots in --out");
-  proxima::bench::PaperOptions paper_options;
-  paper->add_flag("--quick", paper_options.quick, "Reduced run, under a minute");
-  paper->add_option("--out", paper_options.out_dir, "Directory for the CSV files and plots")
-      ->capture_default_str();
-  paper->footer("Example:\n  proxima paper --quick --out paper-out");
-
   CLI::App* distance = app.add_subcommand(
       "distance",
       "Distance, closest points, normal and witness features between the convex hulls of two "
@@ -173,11 +161,12 @@ int main(int argc, char** argv) {
       "  proxima distance a.obj b.stl --pose-b 0 0 2 0.7071067811865476 0 0 0.7071067811865476 "
       "--json");
 
-  CLI::App* hull = app.add_subcommand(
-      "hull", "Hull statistics of a mesh file, and its export as OBJ or OFF");
+  CLI::App* hull =
+      app.add_subcommand("hull", "Hull statistics of a mesh file, and its export as OBJ or OFF");
   proxima::cli::HullCommand hull_command;
   hull->add_option("FILE", hull_command.file, "Mesh file (OBJ, OFF, STL, PLY, XYZ)")->required();
-  hull->add_option("--out", hull_command.out_file, "Write the hull here; the format from the extension")
+  hull->add_option("--out", hull_command.out_file,
+                   "Write the hull here; the format from the extension")
       ->check(CLI::Validator(
           [](const std::string& path) {
             return proxima::cli::export_format(path).empty()
@@ -191,34 +180,6 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   hull->footer("Example:\n  proxima hull body.stl --out hull.off");
 
-  CLI::App* scene_demo = app.add_subcommand(
-      "scene-demo",
-      "Run a seeded scene of moving random convex bodies through proxima::Scene and print "
-      "per-step statistics (candidate, close and intersecting pairs, time per step)");
-  proxima::cli::SceneDemoOptions scene_demo_options;
-  scene_demo->add_option("--bodies", scene_demo_options.bodies, "Number of bodies")
-      ->check(CLI::Range(1, 10000000))
-      ->capture_default_str();
-  scene_demo->add_option("--steps", scene_demo_options.steps, "Number of steps")
-      ->check(CLI::Range(1, 10000000))
-      ->capture_default_str();
-  scene_demo
-      ->add_option("--margin", scene_demo_options.margin,
-                   "Pairs at distance <= margin are reported (bodies have radius 1)")
-      ->capture_default_str();
-  scene_demo->add_option("--seed", scene_demo_options.seed, "Seed of the scene")->capture_default_str();
-  scene_demo
-      ->add_option("--threads", scene_demo_options.threads,
-                   "Narrow-phase threads (0: all cores)")
-      ->check(CLI::Range(0, kMaxThreads))
-      ->capture_default_str();
-  scene_demo
-      ->add_option("--every", scene_demo_options.every,
-                   "A statistics row every this many steps (0: about ten rows)")
-      ->check(CLI::Range(0, 10000000))
-      ->capture_default_str();
-  scene_demo->footer("Example:\n  proxima scene-demo --bodies 2000 --steps 100 --margin 0.05 --every 10");
-
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -229,7 +190,6 @@ int main(int argc, char** argv) {
 
   try {
     if (*demo) return proxima::cli::run_demo();
-    if (*paper) return proxima::bench::run_paper(paper_options, std::cout) == 0 ? kExitOk : kExitFailure;
     if (*query) {
       options.algorithm = parse_algorithm(algorithm);
       return run_query_command(file, options, threads);
@@ -239,10 +199,6 @@ int main(int argc, char** argv) {
       return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
     }
     if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);
-    if (*scene_demo) {
-      return proxima::cli::run_scene_demo(scene_demo_options, std::cout, std::cerr,
-                                          ::isatty(STDERR_FILENO) != 0);
-    }
   } catch (const std::exception& e) {
     std::cerr << "proxima: " << e.what() << "\n";
     return kExitFailure;

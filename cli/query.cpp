@@ -1,7 +1,9 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Layer 7: `proxima query`, the JSON Lines exchange (docs/query-format.md).
+// Layer 7: `proxima query`, the JSON Lines exchange (docs/query-format.md):
+// the query loop. What is wrong with a line is said by json_errors.h, the
+// answer lines are written by answer_writer.h.
 //
 // Each line is answered on its own: parse, validate every field with a
 // message that names where the problem is (`b.vertices[3][1]`), build both
@@ -12,178 +14,25 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <exception>
 #include <functional>
 #include <mutex>
-#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <string_view>
-#include <system_error>
 #include <thread>
 #include <utility>
 #include <vector>
 
+#include "answer_writer.h"
+#include "json_errors.h"
 #include "proxima/distance.h"
 #include "proxima/polytope.h"
 
 namespace proxima::cli {
 namespace {
-
-using Json = nlohmann::json;
-
-// What is wrong with one query line. The message names the place in the
-// query; the caller adds the line number.
-class QueryError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-[[noreturn]] void fail(const std::string& message) { throw QueryError(message); }
-
-// "(it is a string)" reads better than nlohmann's bare type name.
-std::string kind(const Json& v) {
-  switch (v.type()) {
-    case Json::value_t::null:
-      return "null";
-    case Json::value_t::object:
-      return "an object";
-    case Json::value_t::array:
-      return "an array";
-    case Json::value_t::string:
-      return "a string";
-    case Json::value_t::boolean:
-      return "a boolean";
-    case Json::value_t::binary:
-      return "binary data";
-    case Json::value_t::discarded:
-      return "discarded";
-    default:
-      return "a number";
-  }
-}
-
-std::string indexed(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-// nlohmann's messages start with "[json.exception.parse_error.101] "; the
-// tag means nothing to someone fixing their input file. Each line is parsed
-// on its own, so its "at line 1, column 7" would contradict our line number:
-// keep only the column.
-std::string readable_parse_message(std::string_view what) {
-  if (!what.empty() && what.front() == '[') {
-    const auto close = what.find("] ");
-    if (close != std::string_view::npos) what.remove_prefix(close + 2);
-  }
-  std::string message(what);
-  constexpr std::string_view kLineOne = "at line 1, column";
-  const auto at = message.find(kLineOne);
-  if (at != std::string::npos) message.replace(at, kLineOne.size(), "at column");
-  return message;
-}
-
-// Where in a line the JSON parser gave up, as a path like a.vertices[3][1].
-// The parser itself reports only a column. Replaying the line through this
-// SAX handler, which keeps nothing but the path to the current value, stops
-// at the same token; the path at that moment names the value being read.
-// Used only after a parse has failed, so good lines pay nothing for it.
-class ParsePathTracker final : public nlohmann::json_sax<Json> {
- public:
-  bool null() override { return value(); }
-  bool boolean(bool /*val*/) override { return value(); }
-  bool number_integer(number_integer_t /*val*/) override { return value(); }
-  bool number_unsigned(number_unsigned_t /*val*/) override { return value(); }
-  bool number_float(number_float_t /*val*/, const string_t& /*s*/) override { return value(); }
-  bool string(string_t& /*val*/) override { return value(); }
-  bool binary(binary_t& /*val*/) override { return value(); }
-  bool start_object(std::size_t /*elements*/) override {
-    value();
-    frames_.push_back(Frame{false, -1, {}});
-    return true;
-  }
-  bool key(string_t& val) override {
-    frames_.back().key = val;
-    return true;
-  }
-  bool end_object() override {
-    frames_.pop_back();
-    return true;
-  }
-  bool start_array(std::size_t /*elements*/) override {
-    value();
-    frames_.push_back(Frame{true, -1, {}});
-    return true;
-  }
-  bool end_array() override {
-    frames_.pop_back();
-    return true;
-  }
-  bool parse_error(std::size_t /*position*/, const std::string& /*last_token*/,
-                   const Json::exception& /*ex*/) override {
-    // The token that failed was never counted as a value, so in an array it
-    // is the element after the last one counted.
-    path_ = path(/*next_element=*/true);
-    return false;
-  }
-
-  const std::string& error_path() const { return path_; }
-
- private:
-  struct Frame {
-    bool is_array;
-    long index;       // arrays: index of the last value started
-    std::string key;  // objects: the last key read ("" before the first)
-  };
-
-  bool value() {
-    if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
-    return true;
-  }
-
-  std::string path(bool next_element) const {
-    std::string out;
-    for (std::size_t i = 0; i < frames_.size(); ++i) {
-      const Frame& f = frames_[i];
-      if (f.is_array) {
-        const long index = f.index + (next_element && i + 1 == frames_.size() ? 1 : 0);
-        if (index >= 0) {
-          out += '[';
-          out += std::to_string(index);
-          out += ']';
-        }
-      } else if (!f.key.empty()) {
-        if (!out.empty()) out += '.';
-        out += f.key;
-      }
-    }
-    return out;
-  }
-
-  std::vector<Frame> frames_;
-  std::string path_;
-};
-
-// The message for a line that is not valid JSON, naming where it broke.
-std::string describe_parse_error(const std::string& line, const Json::exception& ex) {
-  ParsePathTracker tracker;
-  Json::sax_parse(line, &tracker);
-  const std::string& where = tracker.error_path();
-  // 406 is nlohmann's "number overflow": a literal such as 1e999 that is
-  // valid JSON but does not fit a double. Name it like the other
-  // non-finite inputs, so the user sees the same message either way.
-  constexpr int kNumberOverflow = 406;
-  if (ex.id == kNumberOverflow) {
-    return (where.empty() ? std::string("a number") : where) + " is not a finite number (" +
-           readable_parse_message(ex.what()) + ")";
-  }
-  std::string message = "not valid JSON";
-  if (!where.empty()) message += " near " + where;
-  return message + ": " + readable_parse_message(ex.what());
-}
 
 double read_finite(const Json& v, const std::string& path_if_bad) {
   if (!v.is_number()) fail(path_if_bad + " is not a number (it is " + kind(v) + ")");
@@ -266,54 +115,6 @@ void read_body(const Json& query, const std::string& name, std::vector<Vec3>& ve
   pose = Pose(rotation, translation);
 }
 
-void append_number(std::string& out, double x) {
-  // "%.17g": 17 significant digits always identify a double uniquely, so the
-  // reader gets back the very double we computed. std::to_chars with the
-  // general format and precision 17 is defined as printf's %.17g, and unlike
-  // printf it never looks at the locale (a decimal comma would break JSON).
-  // 32 bytes hold the longest case, "-1.2345678901234567e-308".
-  char buffer[32];
-  const auto [end, ec] =
-      std::to_chars(buffer, buffer + sizeof(buffer), x, std::chars_format::general, 17);
-  if (ec != std::errc{}) throw std::logic_error("number formatting overflowed its buffer");
-  out.append(buffer, end);
-}
-
-void append_point(std::string& out, const Vec3& p) {
-  out += '[';
-  append_number(out, p.x());
-  out += ',';
-  append_number(out, p.y());
-  out += ',';
-  append_number(out, p.z());
-  out += ']';
-}
-
-void append_json_string(std::string& out, const std::string& s) {
-  // Messages may quote the input (nlohmann's "last read: '...'"), which can
-  // hold invalid UTF-8; replacing it keeps every answer line valid JSON.
-  out += Json(s).dump(-1, ' ', false, Json::error_handler_t::replace);
-}
-
-void append_id(std::string& out, const Json* id) {
-  // Echoed as parsed (nlohmann prints a double with its shortest exact
-  // representation, so the value is the one given); null when absent.
-  out += id != nullptr ? id->dump(-1, ' ', false, Json::error_handler_t::replace) : "null";
-}
-
-void append_error_answer(std::string& out, const Json* id, long line_number,
-                         const std::string& message) {
-  out += "{\"id\":";
-  append_id(out, id);
-  out += ",\"status\":\"error\",\"error\":";
-  std::string located = "line ";
-  located += std::to_string(line_number);
-  located += ": ";
-  located += message;
-  append_json_string(out, located);
-  out += '}';
-}
-
 // Largest absolute world coordinate of a hull: the R of DESIGN.md's
 // accuracy standard, for the contact band that classifies an iteration-cap
 // answer.
@@ -342,6 +143,12 @@ ConvexPolytope build_hull(const std::vector<Vec3>& vertices, const std::string& 
 // answer.
 bool answer_line(const std::string& line, long line_number, const DistanceOptions& options,
                  Workspace& work, std::string& out) {
+  if (const std::size_t column = nesting_overflow_column(line); column != 0) {
+    append_error_answer(out, nullptr, line_number,
+                        "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
+                            " levels (at column " + std::to_string(column) + ")");
+    return false;
+  }
   Json query;
   try {
     query = Json::parse(line);

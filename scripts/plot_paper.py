@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-# proxima: plots of `proxima paper` in the style of the paper's figures.
+# proxima: plots of the paper experiments (bench/paper_experiments) in the style of the paper's figures.
 # SPDX-License-Identifier: BSD-3-Clause
 #
 # Usage: /usr/bin/python3 scripts/plot_paper.py OUT_DIR
-# Reads the CSV files that `proxima paper` wrote into OUT_DIR and writes PNG
+# Reads the CSV files that bench/paper_experiments wrote into OUT_DIR and writes PNG
 # files next to them. Run it with Debian's interpreter: the python3 first on
 # PATH on these machines does not see python3-matplotlib.
 #
@@ -32,6 +32,7 @@ COLOURS = {
     "proxima Enhanced GJK": "#1f77b4",
     "proxima GJK": "#17becf",
     "FCL libccd": "#2ca02c",
+    "FCL libccd scaled": "#8c564b",
     "FCL GJK": "#9467bd",
     "Bullet GJK": "#ff7f0e",
 }

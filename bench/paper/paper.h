@@ -33,6 +33,10 @@ struct PaperOptions {
   // A reduced run (fewer cases, sizes and steps) that finishes in well under
   // a minute on 2 cores: the smoke test and a quick look.
   bool quick = false;
+  // With quick: the robustness experiments on the full run's case set all
+  // the same (2 x 1,100 cases, about half a minute in release), so that a
+  // check of the quick run sees every case the full run judges.
+  bool full_robustness = false;
   std::string out_dir = "out";
 };
 

@@ -1,6 +1,6 @@
 // proxima benchmarks: a seeded scene of many moving convex bodies, shared by
 // the scene benchmark (bench/scene_bench.cpp, proxima against FCL's
-// broad-phase manager) and `proxima scene-demo` (issue 6).
+// broad-phase manager) and the scene_demo executable (issue 6).
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // N bodies, each a random convex polytope of min_points..max_points points

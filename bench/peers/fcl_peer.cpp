@@ -14,7 +14,10 @@
 //   are part of the answer the experiments check. distance_tolerance stays at
 //   FCL's default 1e-6 (absolute): users get that unless they tune it, and at
 //   the unit scale of the timing experiments it lets FCL stop earlier than
-//   proxima's relative 1e-12, which favours FCL in the timings.
+//   proxima's relative 1e-12, which favours FCL in the timings. At other
+//   scales it means nothing (bodies of 1e-23 are all within 1e-6), so the
+//   libccd solver also runs with the same tolerance relative to the query's
+//   scale (FclSolver::libccd_scaled): its row measures the algorithm.
 // - Debian's libccd 2.1 has no separation-distance function of its own;
 //   FCL's GST_LIBCCD solver (GJK on libccd's simplex code) is the libccd GJK
 //   that users get, so it stands for libccd here.
@@ -37,6 +40,7 @@
 #include <fcl/narrowphase/detail/gjk_solver_indep.h>
 #include <fcl/narrowphase/distance.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -57,11 +61,18 @@ struct FclPeer::Impl {
   fcl::detail::GJKSolver_indep<double> tracking_solver;
   std::vector<fcl::Transform3d> tf_a;
   std::vector<fcl::Transform3d> tf_b;
+  // libccd_scaled: the largest vertex norm of each body (local frame) and
+  // the distance tolerance of each pose pair.
+  double radius_a = 0.0;
+  double radius_b = 0.0;
+  std::vector<double> tolerance;
 
   Impl(const ConvexPolytope& pa, const ConvexPolytope& pb, FclSolver s)
       : solver(s), a(fcl_convex(pa, "FclPeer: body a")), b(fcl_convex(pb, "FclPeer: body b")) {
     request.enable_nearest_points = true;
-    request.gjk_solver_type = s == FclSolver::libccd ? fcl::GST_LIBCCD : fcl::GST_INDEP;
+    request.gjk_solver_type = s == FclSolver::indep ? fcl::GST_INDEP : fcl::GST_LIBCCD;
+    for (const Vec3& v : pa.vertices()) radius_a = std::max(radius_a, v.norm());
+    for (const Vec3& v : pb.vertices()) radius_b = std::max(radius_b, v.norm());
     tracking_solver.gjk_tolerance = request.distance_tolerance;
     reset();
   }
@@ -83,6 +94,7 @@ struct FclPeer::Impl {
       return d;
     }
     fcl::DistanceResultd result;
+    if (solver == FclSolver::libccd_scaled) request.distance_tolerance = tolerance[i];
     fcl::distance(a.get(), tf_a[i], b.get(), tf_b[i], request, result);
     p1 = result.nearest_points[0];
     p2 = result.nearest_points[1];
@@ -96,14 +108,22 @@ FclPeer::FclPeer(const ConvexPolytope& a, const ConvexPolytope& b, FclSolver sol
 FclPeer::~FclPeer() = default;
 
 std::string FclPeer::name() const {
-  return impl_->solver == FclSolver::libccd ? "FCL libccd" : "FCL GJK";
+  switch (impl_->solver) {
+    case FclSolver::libccd:
+      return "FCL libccd";
+    case FclSolver::libccd_scaled:
+      return "FCL libccd scaled";
+    case FclSolver::indep:
+      break;
+  }
+  return "FCL GJK";
 }
 
 bool FclPeer::has_tracking() const { return impl_->solver == FclSolver::indep; }
 
 std::string FclPeer::tracking_note() const {
-  return impl_->solver == FclSolver::libccd ? "none (FCL's libccd solver ignores a cached guess)"
-                                            : "cached GJK guess of GJKSolver_indep (last simplex)";
+  return impl_->solver != FclSolver::indep ? "none (FCL's libccd solver ignores a cached guess)"
+                                           : "cached GJK guess of GJKSolver_indep (last simplex)";
 }
 
 void FclPeer::load_poses(std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
@@ -113,6 +133,12 @@ void FclPeer::load_poses(std::span<const Pose> poses_a, std::span<const Pose> po
   impl_->tf_b.clear();
   for (const Pose& p : poses_a) impl_->tf_a.push_back(fcl_transform(p));
   for (const Pose& p : poses_b) impl_->tf_b.push_back(fcl_transform(p));
+  impl_->tolerance.clear();
+  for (std::size_t i = 0; i < poses_a.size(); ++i) {
+    const double scale = std::max(poses_a[i].translation.norm() + impl_->radius_a,
+                                  poses_b[i].translation.norm() + impl_->radius_b);
+    impl_->tolerance.push_back(kFclScaledTolerance * scale);
+  }
 }
 
 std::size_t FclPeer::pose_count() const { return impl_->tf_a.size(); }

@@ -15,7 +15,7 @@
 //   callback      fcl::distance(o1, o2, request, result) on the candidate
 //                 pair (enable_nearest_points, GST_LIBCCD by default: FCL's
 //                 faster and more accurate solver on cold queries of 20 to
-//                 200 vertices in `proxima paper`, and a broad-phase callback
+//                 200 vertices in the paper experiments, and a broad-phase callback
 //                 is a cold query), records the pair when its distance is at
 //                 most the margin, and returns the margin as its running
 //                 bound so that FCL visits every pair of boxes closer than

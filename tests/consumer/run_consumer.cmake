@@ -1,6 +1,7 @@
 # Installs proxima from a build tree into a fresh prefix, configures and
 # builds tests/consumer against it with find_package(proxima CONFIG), and
-# runs the consumer. Run as a CTest test:
+# runs the consumer: once on proxima::proxima alone with Qhull, TBB and the
+# readers' parser hidden (Eigen is all it may need), once with proxima::io. Run as a CTest test:
 #   cmake -DPROXIMA_BINARY_DIR=<build> -DCONSUMER_SOURCE_DIR=<tests/consumer>
 #         -DWORK_DIR=<scratch> -DGENERATOR=<gen> -DCXX_COMPILER=<c++>
 #         -DCXX_FLAGS=<flags> -DLINKER_FLAGS=<flags> -DBUILD_TYPE=<type>
@@ -26,10 +27,32 @@ file(REMOVE_RECURSE "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
 run(install ${CMAKE_COMMAND} --install "${PROXIMA_BINARY_DIR}" --prefix "${prefix}"
     --component proxima_development)
-run(configure ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${WORK_DIR}/build" -G "${GENERATOR}"
-    "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
+# The installed headers include none of the private dependencies.
+file(GLOB_RECURSE headers "${prefix}/include/proxima/*")
+foreach(header IN LISTS headers)
+  file(STRINGS "${header}" private_includes REGEX "#[ \t]*include[ \t]*[<\"](tbb/|oneapi/|libqhull|tiny_obj)")
+  if(private_includes)
+    message(FATAL_ERROR "consumer test: ${header} includes a private dependency: ${private_includes}")
+  endif()
+endforeach()
+
+# 1. proxima::proxima alone, with Qhull, TBB and the readers' parser hidden
+#    from find_package: the package must need Eigen only.
+# 2. proxima::proxima and proxima::io.
+set(common_args "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
     "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}"
-    "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}")
-run(build ${CMAKE_COMMAND} --build "${WORK_DIR}/build")
-run(run "${WORK_DIR}/build/consumer")
-message(STATUS "consumer test: installed proxima found, built and run")
+    "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}" -DCMAKE_DISABLE_FIND_PACKAGE_Qhull=ON
+    -DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON)
+foreach(variant core io)
+  set(build "${WORK_DIR}/build-${variant}")
+  if(variant STREQUAL "core")
+    set(variant_args -DCONSUMER_WITH_IO=OFF)
+  else()
+    set(variant_args -DCONSUMER_WITH_IO=ON)
+  endif()
+  run("configure (${variant})" ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${build}" -G "${GENERATOR}"
+      ${common_args} ${variant_args})
+  run("build (${variant})" ${CMAKE_COMMAND} --build "${build}")
+  run("run (${variant})" "${build}/consumer")
+endforeach()
+message(STATUS "consumer test: installed proxima found, built and run (alone with Eigen, and with proxima::io)")

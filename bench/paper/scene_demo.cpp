@@ -1,8 +1,10 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Layer 7: `proxima scene-demo`. The scene of the scene benchmark
-// (bench/paper/scene_scenario.h) run through proxima::Scene alone: each
+// The `scene_demo` benchmark executable (bench/paper/scene_demo_main.cpp;
+// before issue 9 it was `proxima scene-demo`, but the scenario lives with the
+// benchmarks and the shipped CLI must not link them). The scene of the scene
+// benchmark (bench/paper/scene_scenario.h) run through proxima::Scene alone: each
 // step moves every body and asks for every pair within the margin. Rows are
 // plain whitespace-separated columns so that a script (and
 // tests/cli_scene_test.cpp) can read them; the progress line goes to its own
@@ -19,7 +21,7 @@
 #include "paper/scene_scenario.h"
 #include "proxima/scene.h"
 
-namespace proxima::cli {
+namespace proxima::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -27,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 // Statistics rows when the caller leaves `every` at 0.
 constexpr int kDefaultRows = 10;
 // Progress: rewritten at most this often on a terminal, a new line at most
-// this often otherwise (as `proxima paper` does in its long parts).
+// this often otherwise (as the `paper` executable does in its long parts).
 constexpr double kTerminalProgressSeconds = 0.2;
 constexpr double kLogProgressSeconds = 5.0;
 
@@ -55,14 +57,14 @@ int run_scene_demo(const SceneDemoOptions& options, std::ostream& out, std::ostr
   // The library would refuse these too, but in its own words (the
   // scenario's option names); a user typed --margin.
   if (!std::isfinite(options.margin) || options.margin < 0.0) {
-    throw InvalidInput("scene-demo: --margin must be finite and >= 0, got " +
+    throw InvalidInput("scene_demo: --margin must be finite and >= 0, got " +
                        format("%g", options.margin));
   }
-  bench::SceneScenarioOptions so;
+  SceneScenarioOptions so;
   so.bodies = options.bodies;
   so.seed = options.seed;
   so.margin = options.margin;
-  const bench::SceneScenario scenario(so);
+  const SceneScenario scenario(so);
 
   SceneOptions scene_options;
   scene_options.margin = options.margin;
@@ -76,11 +78,11 @@ int run_scene_demo(const SceneDemoOptions& options, std::ostream& out, std::ostr
   }
 
   const int every = options.every > 0 ? options.every : std::max(1, options.steps / kDefaultRows);
-  out << "proxima scene-demo: " << options.bodies << " bodies (random convex polytopes of "
-      << so.min_points << "-" << so.max_points << " points, radius " << bench::kBodyRadius << ", "
-      << so.shape_pool << " distinct hulls), cube " << format("%.1f", scenario.cube_size())
-      << ", margin " << options.margin << ", " << options.steps << " steps, seed " << options.seed
-      << ", threads " << options.threads << "\n";
+  out << "scene_demo: " << options.bodies << " bodies (random convex polytopes of " << so.min_points
+      << "-" << so.max_points << " points, radius " << kBodyRadius << ", " << so.shape_pool
+      << " distinct hulls), cube " << format("%.1f", scenario.cube_size()) << ", margin "
+      << options.margin << ", " << options.steps << " steps, seed " << options.seed << ", threads "
+      << options.threads << "\n";
   out << "  step  candidates  close  intersecting  queries  ms\n";
   out.flush();
 
@@ -149,4 +151,4 @@ int run_scene_demo(const SceneDemoOptions& options, std::ostream& out, std::ostr
   return 0;
 }
 
-}  // namespace proxima::cli
+}  // namespace proxima::bench
