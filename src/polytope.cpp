@@ -1293,6 +1293,12 @@ namespace {
 // (a convex polygon's fan from one vertex gives a ratio near n / pi), so only
 // slivers pay for the exact path.
 constexpr double kSliverRatio = 16.0;
+// Largest distance, in units of u times the face's largest coordinate
+// magnitude, that a face's own vertex may have from the plane built from
+// Newell's normal before face_plane takes the exact normal instead: well
+// inside the accuracy standard's 64 u R, and above the few u that evaluating
+// the distance itself costs.
+constexpr double kPlaneResidual = 8.0;
 }  // namespace
 
 Plane ConvexPolytope::face_plane(int f) const {
@@ -1300,52 +1306,61 @@ Plane ConvexPolytope::face_plane(int f) const {
   double max_abs = 0.0;
   for (const Index v : cycle) max_abs = std::max(max_abs, vertex(v).cwiseAbs().maxCoeff());
   const int exponent = magnitude_exponent(max_abs);
-  const Vec3 origin = times_pow2(vertex(cycle[0]), -exponent);
+  const auto local = [&](std::size_t i) { return times_pow2(vertex(cycle[i]), -exponent); };
+  const Vec3 origin = local(0);
   Vec3 normal = Vec3::Zero();
   Vec3 sum = Vec3::Zero();
+  double magnitude_sum = 0.0;
   for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const Vec3 p = times_pow2(vertex(cycle[i]), -exponent) - origin;
-    const Vec3 q = times_pow2(vertex(cycle[(i + 1) % cycle.size()]), -exponent) - origin;
+    const Vec3 p = local(i) - origin;
+    const Vec3 q = local((i + 1) % cycle.size()) - origin;
     normal += p.cross(q);
     sum += p;
+    magnitude_sum += p.norm() * q.norm();
   }
+  const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
   // Conditioning: the rounded Newell sum is off by about u sum |p_i||p_i+1|
   // (each cross product's error). When that bound exceeds kSliverRatio per
   // vertex times the normal (a sliver: nearly collinear vertices, which the
-  // exact hull of rounded data keeps as faces), take the normal exactly from a
-  // spread triangle of the face; faces are exactly planar (the cleaning
-  // proves it), so any non-collinear triangle of them has the face's normal.
-  double magnitude_sum = 0.0;
-  for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const Vec3 p = times_pow2(vertex(cycle[i]), -exponent) - origin;
-    const Vec3 q = times_pow2(vertex(cycle[(i + 1) % cycle.size()]), -exponent) - origin;
-    magnitude_sum += p.norm() * q.norm();
+  // exact hull of rounded data keeps as faces), or when a vertex of the face
+  // is farther than kPlaneResidual u from the resulting plane (coordinates
+  // here are below 1), the normal is taken exactly instead.
+  bool exact = !(magnitude_sum <= kSliverRatio * static_cast<double>(cycle.size()) * normal.norm());
+  if (!exact) {
+    const Vec3 unit = normal.normalized();
+    for (std::size_t i = 0; i < cycle.size() && !exact; ++i) {
+      exact = !(std::abs(unit.dot(local(i) - mean)) <= kPlaneResidual * kEpsilon);
+    }
   }
-  if (magnitude_sum > kSliverRatio * static_cast<double>(cycle.size()) * normal.norm()) {
-    // b farthest from the first vertex a, c farthest from the line a b, taken
-    // in cycle order so that (a, b, c) turns like the face.
+  if (exact) {
+    // From a spread triangle of the face (b farthest from the first vertex
+    // a, c farthest from the line a b, in double), taken in cycle order so
+    // that (a, b, c) turns like the face. Faces are exactly planar and
+    // strictly convex (the cleaning proves it), so any three of their
+    // vertices are exactly non-collinear and span the face's plane: the
+    // exact cross product, rounded, is the face's normal with its
+    // orientation, to a relative error of a few u, however thin the face.
     std::size_t ib = 1;
     double best = -1.0;
     for (std::size_t i = 1; i < cycle.size(); ++i) {
-      const double d = (times_pow2(vertex(cycle[i]), -exponent) - origin).squaredNorm();
+      const double d = (local(i) - origin).squaredNorm();
       if (d > best) best = d, ib = i;
     }
-    const Vec3 line = times_pow2(vertex(cycle[ib]), -exponent) - origin;
+    const Vec3 line = local(ib) - origin;
     std::size_t ic = ib == 1 ? 2 : 1;
     best = -1.0;
     for (std::size_t i = 1; i < cycle.size(); ++i) {
       if (i == ib) continue;
-      const double d = line.cross(times_pow2(vertex(cycle[i]), -exponent) - origin).squaredNorm();
+      const double d = line.cross(local(i) - origin).squaredNorm();
       if (d > best) best = d, ic = i;
     }
-    const Vec3 exact = exact_triangle_normal(vertex(cycle[0]), vertex(cycle[std::min(ib, ic)]),
-                                             vertex(cycle[std::max(ib, ic)]));
-    if (exact.dot(normal) > 0.0 || !(normal.norm() > 0.0)) normal = exact;  // else collinear: keep Newell's
+    normal = exact_triangle_normal(vertex(cycle[0]), vertex(cycle[std::min(ib, ic)]),
+                                   vertex(cycle[std::max(ib, ic)]));
   }
   const double length = normal.norm();
-  if (!(length > 0.0)) return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
+  if (!(length > 0.0))
+    return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
   normal /= length;
-  const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
   return {normal, std::ldexp(normal.dot(mean), exponent)};
 }
 
