@@ -41,9 +41,6 @@
 namespace proxima {
 namespace {
 
-using detail::Cycles;
-using detail::exact_triangle_normal;
-using detail::Frame;
 using detail::Adjacency;
 using detail::build_adjacency;
 using detail::clean_faces;
