@@ -7,1123 +7,57 @@
 //   1. validate (finite coordinates) and drop exact duplicates;
 //   2. find the affine dimension with exact orientation predicates, so that
 //      points that are coplanar (or collinear, or equal) as doubles give a
-//      polygon (a segment, a point) at any scale, without Qhull's joggling;
+//      polygon (a segment, a point) at any scale, without joggling;
 //   3. build the boundary: the two extreme points of a segment, a strict 2D
-//      hull for a polygon, Qhull's facets for a solid;
-//   4. clean a solid's facets with exact predicates (merge exactly coplanar
-//      neighbours, drop vertices that lie inside an edge), which also proves
-//      the result exactly convex, and derive the vertex adjacency, in
-//      rotational order, from the face cycles.
-// A solid is exact (planar faces, every edge strictly convex, only extreme
-// points as vertices, every input point inside) whenever Qhull's unmerged
-// triangulation is convex in exact arithmetic and contains every input point,
-// which the cleaning and contains_all check. Otherwise (rotated, rounded,
-// nearly flat data) an exact incremental hull replaces it, within a work
-// budget (inputs of a few hundred points always fit); past that budget the
-// faces are Qhull's merged facets, planar and convex only within its merge
-// tolerance, and may miss extreme points (a known gap).
+//      hull for a polygon, an exact randomized incremental hull (triangles)
+//      for a solid;
+//   4. clean a solid's triangles with exact predicates (merge exactly
+//      coplanar neighbours, drop vertices that lie inside an edge), which
+//      also proves the result exactly convex, and derive the vertex
+//      adjacency, in rotational order, from the face cycles.
+// A solid is always exact, for every input: planar faces, every edge
+// strictly convex, only extreme points as vertices, every input point inside.
 #include "proxima/polytope.h"
 
-#include <boost/multiprecision/cpp_int.hpp>
-#include <libqhull_r/qhull_ra.h>
-
 #include <algorithm>
-#include <bit>
-#include <cfenv>
-#include <climits>
+#include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <utility>
+#include <vector>
+
+#include "affine_frame.h"
+#include "face_cleaning.h"
+#include "half_edges.h"
+#include "incremental_hull.h"
+#include "polygon_hull.h"
+#include "pow2_scaling.h"
+#include "proxima/detail/exact_predicates.h"
 
 namespace proxima {
 namespace {
 
-using Index = std::int32_t;
-
-// ---------------------------------------------------------------------------
-// Exact orientation predicates
-// ---------------------------------------------------------------------------
-//
-// orient2d(a, b, c) = (a - c).x * (b - c).y - (a - c).y * (b - c).x, positive
-// when a, b, c turn counter-clockwise. side3d(a, b, c, d) = ((b - a) x (c - a))
-// . (d - a), positive when d lies on the side the right-hand normal of the
-// triangle a, b, c points to. Both are evaluated first in double with
-// Shewchuk's forward error bound ("Adaptive precision floating-point
-// arithmetic and fast robust geometric predicates", 1997, the A-level bounds
-// ccwerrboundA and o3derrboundA): if |det| exceeds the bound times the
-// permanent (the same expression with every term replaced by its absolute
-// value), the sign of the rounded determinant is the exact sign. Otherwise the
-// determinant is recomputed exactly in integers: every double is m * 2^e with
-// a 53-bit integer m, so shifting all inputs of one predicate to their
-// smallest exponent turns the determinant into an integer polynomial. When
-// those integers are small (integer or dyadic data: the usual source of exact
-// degeneracies) 128-bit arithmetic holds the determinant, else fixed 1024-bit
-// integers, else Boost.Multiprecision's cpp_int.
-//
-// Shewchuk's bound assumes no overflow and no underflow. Inputs larger than
-// kFilterMaxMagnitude skip the filter (a cubic term could overflow), and an
-// absolute slack kUnderflowSlack covers products that underflowed (each loses
-// at most 2^-1075, later multiplied by factors below 2^302).
+using detail::Adjacency;
+using detail::build_adjacency;
+using detail::clean_faces;
+using detail::Cycles;
+using detail::exact_incremental_hull;
+using detail::exact_triangle_normal;
+using detail::find_frame;
+using detail::Frame;
+using detail::Index;
+using detail::magnitude_exponent;
+using detail::max_abs_coordinate;
+using detail::polygon_hull;
+using detail::projection_axis;
+using detail::segment_ends;
+using detail::times_pow2;
 
 constexpr double kEpsilon = 0x1p-53;
-// Shewchuk's ccwerrboundA: relative error bound of the rounded orient2d.
-constexpr double kOrient2dErrorBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
-// Shewchuk's o3derrboundA: relative error bound of the rounded orient3d.
-constexpr double kOrient3dErrorBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
-// Largest coordinate magnitude for which the double filter cannot overflow:
-// differences stay below 2^301 and a product of three below 2^903.
-constexpr double kFilterMaxMagnitude = 0x1p300;
-// Absolute error that underflowed products can add to a filtered determinant
-// (far above the worst case 2^-1075 * 2^302 * 6). Determinants below it go to
-// the exact path: inputs smaller than about 2^-233 (1e-70) always do, which
-// is slower but still right.
-constexpr double kUnderflowSlack = 0x1p-700;
-
-using BigInt = boost::multiprecision::cpp_int;
-// Fixed 1024-bit integers, no allocation: enough for inputs below 2^300.
-using MediumInt = boost::multiprecision::number<boost::multiprecision::cpp_int_backend<
-    1024, 1024, boost::multiprecision::signed_magnitude, boost::multiprecision::unchecked, void>>;
-__extension__ using Int128 = __int128;
-
-// Doubles as integers q_i = x_i / 2^s sharing the smallest exponent s, exactly:
-// each x = m * 2^e with a 53-bit integer m (frexp, then scaling by 2^53).
-template <std::size_t N>
-struct CommonIntegers {
-  std::array<std::int64_t, N> mantissa{};
-  std::array<int, N> shift{};
-  int bits = 0;  // bit length of the largest |q_i|
-
-  explicit CommonIntegers(const std::array<double, N>& x) {
-    std::array<int, N> exponent{};
-    int smallest = INT_MAX;
-    for (std::size_t i = 0; i < N; ++i) {
-      if (x[i] == 0.0) continue;
-      int e = 0;
-      const double f = std::frexp(x[i], &e);  // x = f * 2^e, 0.5 <= |f| < 1
-      mantissa[i] = static_cast<std::int64_t>(std::ldexp(f, 53));  // exact: f has 53 bits
-      exponent[i] = e - 53;
-      smallest = std::min(smallest, exponent[i]);
-    }
-    for (std::size_t i = 0; i < N; ++i) {
-      if (mantissa[i] == 0) continue;
-      shift[i] = exponent[i] - smallest;
-      const auto magnitude = static_cast<std::uint64_t>(mantissa[i] < 0 ? -mantissa[i] : mantissa[i]);
-      bits = std::max(bits, static_cast<int>(std::bit_width(magnitude)) + shift[i]);
-    }
-  }
-  // Only when bits leaves room: the caller checks.
-  std::array<Int128, N> small() const {
-    std::array<Int128, N> out{};
-    for (std::size_t i = 0; i < N; ++i) out[i] = static_cast<Int128>(mantissa[i]) * (static_cast<Int128>(1) << shift[i]);
-    return out;
-  }
-  template <class T>
-  std::array<T, N> wide() const {
-    std::array<T, N> out;
-    for (std::size_t i = 0; i < N; ++i) {
-      if (mantissa[i] == 0) continue;
-      T magnitude = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
-      magnitude <<= static_cast<unsigned>(shift[i]);
-      out[i] = mantissa[i] < 0 ? T(-magnitude) : magnitude;
-    }
-    return out;
-  }
-};
-
-template <class T>
-int sign_of(const T& v) {
-  return v > 0 ? 1 : v < 0 ? -1 : 0;
-}
-
-// 128-bit limits: orient2d has degree 2, so inputs below 2^60 keep every
-// term below 2^123; orient3d has degree 3, so inputs below 2^40 keep every
-// term below 2^126.
-constexpr int kOrient2dSmallBits = 60;
-constexpr int kOrient3dSmallBits = 40;
-// 1024-bit limit: inputs below 2^300 keep every orient3d term below 2^906.
-// Beyond (exponents spread over more than about 250 binades) cpp_int.
-constexpr int kMediumBits = 300;
-
-template <class T>
-int orient2d_integer(const std::array<T, 6>& q) {
-  return sign_of(T((q[0] - q[4]) * (q[3] - q[5]) - (q[1] - q[5]) * (q[2] - q[4])));
-}
-
-int orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {
-  const CommonIntegers<6> q({ax, ay, bx, by, cx, cy});
-  if (q.bits <= kOrient2dSmallBits) return orient2d_integer(q.small());
-  if (q.bits <= kMediumBits) return orient2d_integer(q.template wide<MediumInt>());
-  return orient2d_integer(q.template wide<BigInt>());
-}
-
-// Sign of orient2d: +1 counter-clockwise, -1 clockwise, 0 collinear (exact).
-int orient2d(double ax, double ay, double bx, double by, double cx, double cy) {
-  const double m = std::max({std::abs(ax), std::abs(ay), std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
-  if (m <= kFilterMaxMagnitude) {
-    const double left = (ax - cx) * (by - cy);
-    const double right = (ay - cy) * (bx - cx);
-    const double det = left - right;
-    const double bound = kOrient2dErrorBound * (std::abs(left) + std::abs(right)) + kUnderflowSlack;
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-  }
-  return orient2d_exact(ax, ay, bx, by, cx, cy);
-}
-
-// Sign of Shewchuk's orient3d(a, b, c, d) on exact integers.
-template <class T>
-int orient3d_integer(const std::array<T, 12>& q) {
-  const T adx = q[0] - q[9], ady = q[1] - q[10], adz = q[2] - q[11];
-  const T bdx = q[3] - q[9], bdy = q[4] - q[10], bdz = q[5] - q[11];
-  const T cdx = q[6] - q[9], cdy = q[7] - q[10], cdz = q[8] - q[11];
-  return sign_of(T(adx * (bdy * cdz - bdz * cdy) + bdx * (cdy * adz - cdz * ady) + cdx * (ady * bdz - adz * bdy)));
-}
-
-int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const CommonIntegers<12> q({a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z(), d.x(), d.y(), d.z()});
-  if (q.bits <= kOrient3dSmallBits) return orient3d_integer(q.small());
-  if (q.bits <= kMediumBits) return orient3d_integer(q.template wide<MediumInt>());
-  return orient3d_integer(q.template wide<BigInt>());
-}
-
-// Sign of side3d (see above): +1 when d is on the normal side of triangle abc.
-int side3d(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double m = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff(),
-                             d.cwiseAbs().maxCoeff()});
-  if (m <= kFilterMaxMagnitude) {
-    // Shewchuk's orient3d(a, b, c, d), which is -side3d(a, b, c, d).
-    const double adx = a.x() - d.x(), ady = a.y() - d.y(), adz = a.z() - d.z();
-    const double bdx = b.x() - d.x(), bdy = b.y() - d.y(), bdz = b.z() - d.z();
-    const double cdx = c.x() - d.x(), cdy = c.y() - d.y(), cdz = c.z() - d.z();
-    const double bdycdz = bdy * cdz, bdzcdy = bdz * cdy;
-    const double cdyadz = cdy * adz, cdzady = cdz * ady;
-    const double adybdz = ady * bdz, adzbdy = adz * bdy;
-    const double det = adx * (bdycdz - bdzcdy) + bdx * (cdyadz - cdzady) + cdx * (adybdz - adzbdy);
-    const double permanent = (std::abs(bdycdz) + std::abs(bdzcdy)) * std::abs(adx) +
-                             (std::abs(cdyadz) + std::abs(cdzady)) * std::abs(bdx) +
-                             (std::abs(adybdz) + std::abs(adzbdy)) * std::abs(cdx);
-    const double bound = kOrient3dErrorBound * permanent + kUnderflowSlack;
-    if (det > bound) return -1;
-    if (-det > bound) return 1;
-  }
-  return -orient3d_exact(a, b, c, d);
-}
-
-// a, b, c on one line (exactly): (b - a) x (c - a) == 0, i.e. all three
-// coordinate projections are collinear.
-bool collinear3d(const Vec3& a, const Vec3& b, const Vec3& c) {
-  return orient2d(a.x(), a.y(), b.x(), b.y(), c.x(), c.y()) == 0 &&
-         orient2d(a.y(), a.z(), b.y(), b.z(), c.y(), c.z()) == 0 &&
-         orient2d(a.z(), a.x(), b.z(), b.x(), c.z(), c.x()) == 0;
-}
-
-// ---------------------------------------------------------------------------
-// Scaling helpers: heuristics (farthest points, Newell sums) run on copies
-// scaled by a power of two so that no square overflows whatever the input's
-// magnitude. Exact decisions always use the original doubles.
-// ---------------------------------------------------------------------------
-
-// The exponent e with max|x| < 2^e (0 for an all-zero input).
-int magnitude_exponent(double max_abs) {
-  if (max_abs == 0.0) return 0;
-  int e = 0;
-  std::frexp(max_abs, &e);
-  return e;
-}
-
-// p * 2^e per component, through ldexp: exact unless a component underflows,
-// and never through the factor 2^e itself, which overflows when |e| > 1023
-// (inputs near the largest doubles, or subnormal ones).
-Vec3 times_pow2(const Vec3& p, int e) { return {std::ldexp(p.x(), e), std::ldexp(p.y(), e), std::ldexp(p.z(), e)}; }
-
-double max_abs_coordinate(std::span<const Vec3> pts) {
-  double m = 0.0;
-  for (const Vec3& p : pts) m = std::max(m, p.cwiseAbs().maxCoeff());
-  return m;
-}
-
-// ---------------------------------------------------------------------------
-// Affine frame: dimension and well-spread base points
-// ---------------------------------------------------------------------------
-
-struct Frame {
-  int dimension = 0;
-  // Indices into the unique point list: p0, p1 (dimension >= 1), p2 (>= 2).
-  std::array<Index, 3> base = {0, 0, 0};
-};
-
-// Exact affine dimension of `pts` (distinct points). p1 is the point farthest
-// from p0 and p2 the point farthest from the line p0 p1 (both measured in
-// double, only to keep the later projections well conditioned); the decisions
-// "collinear" and "coplanar" are exact.
-Frame find_frame(std::span<const Vec3> pts, std::span<const Vec3> scaled) {
-  Frame frame;
-  const auto n = static_cast<Index>(pts.size());
-  if (n == 1) return frame;
-  const Vec3& s0 = scaled[0];
-  Index i1 = 1;
-  double best = -1.0;
-  for (Index i = 1; i < n; ++i) {
-    const double d = (scaled[static_cast<std::size_t>(i)] - s0).squaredNorm();
-    if (d > best) best = d, i1 = i;
-  }
-  frame.dimension = 1;
-  frame.base[1] = i1;
-  const Vec3& p0 = pts[0];
-  const Vec3& p1 = pts[static_cast<std::size_t>(i1)];
-  const Vec3 line = scaled[static_cast<std::size_t>(i1)] - s0;
-  Index i2 = -1;
-  best = -1.0;
-  for (Index i = 1; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (collinear3d(p0, p1, pts[k])) continue;
-    const double d = line.cross(scaled[k] - s0).squaredNorm();
-    if (d > best) best = d, i2 = i;
-  }
-  if (i2 < 0) return frame;
-  frame.dimension = 2;
-  frame.base[2] = i2;
-  const Vec3& p2 = pts[static_cast<std::size_t>(i2)];
-  for (Index i = 1; i < n; ++i) {
-    if (side3d(p0, p1, p2, pts[static_cast<std::size_t>(i)]) != 0) {
-      frame.dimension = 3;
-      break;
-    }
-  }
-  return frame;
-}
-
-// The direction of (b - a) x (c - a), computed exactly and then rounded: the
-// normal of a sliver triangle (the exact hull of rounded, nearly collinear
-// points keeps such faces) is lost to cancellation in double, but its exact
-// plane still has every input point below it. The three components share the
-// factor 2^(2s) of CommonIntegers, so their ratios are exact; each is cut to
-// its top 62 bits before conversion (relative error below 2^-60).
-Vec3 exact_triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
-  const CommonIntegers<9> q({a.x(), a.y(), a.z(), b.x(), b.y(), b.z(), c.x(), c.y(), c.z()});
-  const auto w = q.template wide<BigInt>();
-  const BigInt ux = w[3] - w[0], uy = w[4] - w[1], uz = w[5] - w[2];
-  const BigInt vx = w[6] - w[0], vy = w[7] - w[1], vz = w[8] - w[2];
-  const std::array<BigInt, 3> n = {uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx};
-  std::size_t bits = 0;
-  for (const BigInt& k : n) {
-    if (k != 0) bits = std::max(bits, static_cast<std::size_t>(boost::multiprecision::msb(abs(k))) + 1);
-  }
-  const std::size_t cut = bits > 62 ? bits - 62 : 0;
-  Vec3 out;
-  for (int k = 0; k < 3; ++k) {
-    const BigInt& v = n[static_cast<std::size_t>(k)];
-    const BigInt m = abs(v) >> static_cast<unsigned>(cut);
-    const double d = static_cast<double>(m.convert_to<std::uint64_t>());
-    out[k] = v < 0 ? -d : d;
-  }
-  return out;
-}
-
-// ---------------------------------------------------------------------------
-// Lower-dimensional hulls
-// ---------------------------------------------------------------------------
-
-// The extreme points of exactly collinear, distinct points: along the line,
-// any coordinate in which p0 and p1 differ is strictly monotone, so the
-// smallest and largest values of that coordinate are the ends.
-std::vector<Index> segment_ends(std::span<const Vec3> pts, const Frame& frame) {
-  const Vec3 d = pts[static_cast<std::size_t>(frame.base[1])] - pts[0];
-  int axis = 0;
-  d.cwiseAbs().maxCoeff(&axis);  // nonzero: p1 != p0 exactly, and the largest |d_k| > 0
-  Index lo = 0, hi = 0;
-  for (Index i = 1; i < static_cast<Index>(pts.size()); ++i) {
-    const double v = pts[static_cast<std::size_t>(i)][axis];
-    if (v < pts[static_cast<std::size_t>(lo)][axis]) lo = i;
-    if (v > pts[static_cast<std::size_t>(hi)][axis]) hi = i;
-  }
-  return {lo, hi};
-}
-
-// Which coordinate to drop when projecting the plane of p0, p1, p2: one where
-// the normal has a nonzero component, checked exactly, preferring the largest
-// (best conditioned). Projecting onto the other two axes, in cyclic order
-// (k+1, k+2), is then a bijection of the plane that maps counter-clockwise
-// (about the normal with positive k component) to counter-clockwise.
-int projection_axis(std::span<const Vec3> pts, std::span<const Vec3> scaled, const Frame& frame) {
-  const auto& b = frame.base;
-  const Vec3 normal = (scaled[static_cast<std::size_t>(b[1])] - scaled[static_cast<std::size_t>(b[0])])
-                          .cross(scaled[static_cast<std::size_t>(b[2])] - scaled[static_cast<std::size_t>(b[0])]);
-  std::array<int, 3> order = {0, 1, 2};
-  std::sort(order.begin(), order.end(), [&](int l, int r) { return std::abs(normal[l]) > std::abs(normal[r]); });
-  for (const int k : order) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    const Vec3& a = pts[static_cast<std::size_t>(b[0])];
-    const Vec3& c = pts[static_cast<std::size_t>(b[1])];
-    const Vec3& e = pts[static_cast<std::size_t>(b[2])];
-    if (orient2d(a[i], a[j], c[i], c[j], e[i], e[j]) != 0) return k;
-  }
-  return order[0];  // unreachable for a non-collinear base triangle
-}
-
-// Strict convex hull (extreme points only), counter-clockwise in the
-// projection that drops `axis`, by Andrew's monotone chain with the exact
-// orient2d. Exact for coplanar points; for points that are only nearly
-// coplanar (the Qhull fallback) it is the hull of their projection.
-std::vector<Index> polygon_hull(std::span<const Vec3> pts, int axis) {
-  const int i = (axis + 1) % 3, j = (axis + 2) % 3;
-  std::vector<Index> order(pts.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](Index v) {
-    const Vec3& p = pts[static_cast<std::size_t>(v)];
-    return std::pair<double, double>(p[i], p[j]);
-  };
-  std::sort(order.begin(), order.end(), [&](Index l, Index r) {
-    const auto kl = key(l), kr = key(r);
-    return kl != kr ? kl < kr : l < r;
-  });
-  // Points that project to one 2D point (only when not exactly coplanar):
-  // keep the first.
-  order.erase(std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }),
-              order.end());
-  const auto turns_left = [&](Index a, Index b, Index c) {
-    const Vec3& pa = pts[static_cast<std::size_t>(a)];
-    const Vec3& pb = pts[static_cast<std::size_t>(b)];
-    const Vec3& pc = pts[static_cast<std::size_t>(c)];
-    return orient2d(pa[i], pa[j], pb[i], pb[j], pc[i], pc[j]) > 0;
-  };
-  std::vector<Index> hull;
-  hull.reserve(order.size() + 1);
-  for (int pass = 0; pass < 2; ++pass) {  // lower chain, then upper chain
-    const std::size_t floor = hull.size();
-    for (const Index v : order) {
-      while (hull.size() >= floor + 2 && !turns_left(hull[hull.size() - 2], hull.back(), v)) hull.pop_back();
-      hull.push_back(v);
-    }
-    hull.pop_back();  // the last point starts the other chain
-    std::reverse(order.begin(), order.end());
-  }
-  return hull;
-}
-
-// ---------------------------------------------------------------------------
-// Half-edges over face cycles
-// ---------------------------------------------------------------------------
-
-// Face cycles in CSR form over vertex ids 0 .. vertex_count-1.
-struct Cycles {
-  std::vector<Index> offsets{0};
-  std::vector<Index> vertices;
-
-  Index count() const { return static_cast<Index>(offsets.size()) - 1; }
-  Index size(Index f) const { return offsets[static_cast<std::size_t>(f) + 1] - offsets[static_cast<std::size_t>(f)]; }
-  Index at(Index f, Index i) const {
-    return vertices[static_cast<std::size_t>(offsets[static_cast<std::size_t>(f)] + i)];
-  }
-  template <class Range>
-  void add(const Range& cycle) {
-    vertices.insert(vertices.end(), cycle.begin(), cycle.end());
-    offsets.push_back(static_cast<Index>(vertices.size()));
-  }
-};
-
-// Half-edge h of face f at position i runs at(f, i) -> at(f, i + 1); face f
-// is on its left. Half-edges are indexed by their slot in Cycles::vertices.
-// They are also sorted by (source, target) in `by_source` for lookups.
-class HalfEdges {
- public:
-  HalfEdges(const Cycles& cycles, Index vertex_count) : cycles_(cycles) {
-    const auto h_count = cycles.vertices.size();
-    face_.resize(h_count);
-    next_.resize(h_count);
-    prev_.resize(h_count);
-    for (Index f = 0; f < cycles.count(); ++f) {
-      const Index b = cycles.offsets[static_cast<std::size_t>(f)], n = cycles.size(f);
-      for (Index i = 0; i < n; ++i) {
-        const auto h = static_cast<std::size_t>(b + i);
-        face_[h] = f;
-        next_[h] = b + (i + 1) % n;
-        prev_[h] = b + (i + n - 1) % n;
-      }
-    }
-    // Counting sort by source, then by target within a source.
-    source_offsets_.assign(static_cast<std::size_t>(vertex_count) + 1, 0);
-    for (const Index v : cycles.vertices) ++source_offsets_[static_cast<std::size_t>(v) + 1];
-    std::partial_sum(source_offsets_.begin(), source_offsets_.end(), source_offsets_.begin());
-    by_source_.resize(h_count);
-    std::vector<Index> fill(source_offsets_.begin(), source_offsets_.end() - 1);
-    for (std::size_t h = 0; h < h_count; ++h) {
-      by_source_[static_cast<std::size_t>(fill[static_cast<std::size_t>(cycles.vertices[h])]++)] = static_cast<Index>(h);
-    }
-    for (Index v = 0; v < vertex_count; ++v) {
-      auto first = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v)];
-      auto last = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v) + 1];
-      std::sort(first, last, [&](Index l, Index r) { return target(l) < target(r); });
-      for (auto it = first; it != last && it + 1 != last; ++it) {
-        if (target(*it) == target(*(it + 1))) consistent_ = false;  // a directed edge twice
-      }
-    }
-    twin_.resize(h_count);
-    for (std::size_t h = 0; h < h_count; ++h) {
-      twin_[h] = find(target(static_cast<Index>(h)), source(static_cast<Index>(h)));
-      if (twin_[h] < 0) consistent_ = false;  // no reverse edge
-    }
-  }
-
-  // False when some directed edge appears twice or has no reverse: the
-  // cycles do not bound a closed oriented surface.
-  bool consistent() const { return consistent_; }
-
-  Index source(Index h) const { return cycles_.vertices[static_cast<std::size_t>(h)]; }
-  Index target(Index h) const { return cycles_.vertices[static_cast<std::size_t>(next_[static_cast<std::size_t>(h)])]; }
-  Index face(Index h) const { return face_[static_cast<std::size_t>(h)]; }
-  Index prev(Index h) const { return prev_[static_cast<std::size_t>(h)]; }
-  Index twin(Index h) const { return twin_[static_cast<std::size_t>(h)]; }
-
-  // The half-edge v -> w, or -1.
-  Index find(Index v, Index w) const {
-    const auto first = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v)];
-    const auto last = by_source_.begin() + source_offsets_[static_cast<std::size_t>(v) + 1];
-    const auto it = std::lower_bound(first, last, w, [&](Index h, Index t) { return target(h) < t; });
-    return it != last && target(*it) == w ? *it : -1;
-  }
-
-  std::span<const Index> outgoing(Index v) const {
-    const auto b = static_cast<std::size_t>(source_offsets_[static_cast<std::size_t>(v)]);
-    const auto e = static_cast<std::size_t>(source_offsets_[static_cast<std::size_t>(v) + 1]);
-    return std::span<const Index>(by_source_).subspan(b, e - b);
-  }
-
- private:
-  const Cycles& cycles_;
-  std::vector<Index> face_, next_, prev_, twin_;
-  std::vector<Index> source_offsets_, by_source_;
-  bool consistent_ = true;
-};
-
-struct Adjacency {
-  std::vector<Index> offsets, neighbors, faces;
-};
-
-// Vertex adjacency from face cycles, each vertex's neighbours in
-// counter-clockwise order seen from outside. Rotation: if v -> w is in face F
-// and u -> v precedes it in F, then v -> u is the next edge counter-clockwise
-// about v (for a counter-clockwise polygon the interior angle at v sweeps
-// from the outgoing to the incoming edge), and it lies in the face across
-// u -> v. Returns false if the cycles are not a closed surface whose every
-// vertex has one disk of faces around it.
-bool build_adjacency(const Cycles& cycles, Index vertex_count, Adjacency& out) {
-  const HalfEdges he(cycles, vertex_count);
-  if (!he.consistent()) return false;
-  out.offsets.assign(1, 0);
-  out.neighbors.clear();
-  out.faces.clear();
-  out.neighbors.reserve(cycles.vertices.size());
-  out.faces.reserve(cycles.vertices.size());
-  for (Index v = 0; v < vertex_count; ++v) {
-    const auto outgoing = he.outgoing(v);
-    if (outgoing.empty()) return false;  // a vertex on no face
-    const Index start = outgoing.front();
-    Index h = start;
-    for (std::size_t step = 0; step < outgoing.size(); ++step) {
-      if (step > 0 && h == start) return false;  // more than one fan around v
-      out.neighbors.push_back(he.target(h));
-      out.faces.push_back(he.face(h));
-      h = he.find(v, he.source(he.prev(h)));
-      if (h < 0) return false;
-    }
-    if (h != start) return false;
-    out.offsets.push_back(static_cast<Index>(out.neighbors.size()));
-  }
-  return true;
-}
-
-// ---------------------------------------------------------------------------
-// Solids: Qhull, then exact cleaning
-// ---------------------------------------------------------------------------
-
-// Qhull's arithmetic may raise invalid or divide-by-zero flags internally; a
-// caller with those exceptions trapped must not see them. Non-stop mode for
-// the duration, then the caller's environment back, flags included.
-class FloatingPointHold {
- public:
-  FloatingPointHold() { feholdexcept(&saved_); }
-  ~FloatingPointHold() { fesetenv(&saved_); }
-  FloatingPointHold(const FloatingPointHold&) = delete;
-  FloatingPointHold& operator=(const FloatingPointHold&) = delete;
-
- private:
-  fenv_t saved_{};
-};
-
-// Collects Qhull's messages (errors, precision warnings) instead of letting
-// them reach stderr.
-class MessageBuffer {
- public:
-  MessageBuffer() : file_(open_memstream(&data_, &size_)) {}
-  ~MessageBuffer() {
-    if (file_ != nullptr) std::fclose(file_);
-    std::free(data_);
-  }
-  MessageBuffer(const MessageBuffer&) = delete;
-  MessageBuffer& operator=(const MessageBuffer&) = delete;
-
-  FILE* file() const { return file_; }
-  std::string text() {
-    if (file_ == nullptr) return {};
-    std::fflush(file_);
-    return data_ == nullptr ? std::string() : std::string(data_, size_);
-  }
-
- private:
-  char* data_ = nullptr;
-  std::size_t size_ = 0;
-  FILE* file_ = nullptr;
-};
-
-// One Qhull run's state, freed on every exit path.
-struct QhullContext {
-  qhT qh;
-  explicit QhullContext(FILE* messages) { qh_zero(&qh, messages); }
-  ~QhullContext() {
-    qh_freeqhull(&qh, !qh_ALL);
-    int current_long = 0, total_long = 0;
-    qh_memfreeshort(&qh, &current_long, &total_long);
-  }
-  QhullContext(const QhullContext&) = delete;
-  QhullContext& operator=(const QhullContext&) = delete;
-};
-
-struct QhullOutcome {
-  int exit_code = 0;
-  std::string message;
-  Cycles faces;  // over unique-point ids, counter-clockwise seen from outside
-};
-
-template <class T>
-std::span<T* const> set_elements(setT* set) {
-  if (set == nullptr) return {};
-  std::size_t n = 0;
-  while (set->e[n].p != nullptr) ++n;
-  return {reinterpret_cast<T* const*>(&set->e[0].p), n};
-}
-
-// The vertex cycle of one Qhull facet, in Qhull's point ids. A simplicial
-// facet lists its three vertices; a merged one has explicit ridges (vertex
-// pairs in 3-d) that chain into its boundary. Oriented so that Newell's normal
-// agrees with the facet's outward normal. Empty on an inconsistent facet.
-std::vector<Index> facet_cycle(qhT* qh, facetT* facet) {
-  std::vector<vertexT*> cycle;
-  if (facet->simplicial) {
-    for (vertexT* v : set_elements<vertexT>(facet->vertices)) cycle.push_back(v);
-  } else {
-    // Both ends of every ridge, sorted by vertex: each vertex of the cycle
-    // must appear exactly twice, next to its two neighbours along it.
-    std::vector<std::pair<vertexT*, vertexT*>> ends;
-    for (ridgeT* r : set_elements<ridgeT>(facet->ridges)) {
-      const auto rv = set_elements<vertexT>(r->vertices);
-      if (rv.size() != 2) return {};
-      ends.emplace_back(rv[0], rv[1]);
-      ends.emplace_back(rv[1], rv[0]);
-    }
-    if (ends.size() < 6) return {};
-    const auto by_id = [](const auto& l, const auto& r) {
-      return l.first->id != r.first->id ? l.first->id < r.first->id : l.second->id < r.second->id;
-    };
-    std::sort(ends.begin(), ends.end(), by_id);
-    for (std::size_t k = 0; k < ends.size(); k += 2) {
-      if (ends[k].first != ends[k + 1].first || (k + 2 < ends.size() && ends[k + 2].first == ends[k].first)) return {};
-    }
-    const auto neighbours = [&](vertexT* v) {
-      const auto it = std::lower_bound(ends.begin(), ends.end(), v,
-                                       [](const auto& e, const vertexT* key) { return e.first->id < key->id; });
-      return std::pair<vertexT*, vertexT*>(it->second, (it + 1)->second);
-    };
-    vertexT* previous = ends[0].first;
-    vertexT* current = ends[0].second;
-    cycle.push_back(previous);
-    while (current != cycle.front() && cycle.size() <= ends.size() / 2) {
-      cycle.push_back(current);
-      const auto [a, b] = neighbours(current);
-      vertexT* following = a == previous ? b : a;
-      previous = current;
-      current = following;
-    }
-    if (current != cycle.front() || cycle.size() != ends.size() / 2) return {};
-  }
-  if (cycle.size() < 3) return {};
-  // Newell's normal in Qhull's own coordinates, against the facet normal.
-  double newell[3] = {0.0, 0.0, 0.0};
-  for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const double* p = cycle[i]->point;
-    const double* q = cycle[(i + 1) % cycle.size()]->point;
-    newell[0] += (p[1] - q[1]) * (p[2] + q[2]);
-    newell[1] += (p[2] - q[2]) * (p[0] + q[0]);
-    newell[2] += (p[0] - q[0]) * (p[1] + q[1]);
-  }
-  const double agreement = newell[0] * facet->normal[0] + newell[1] * facet->normal[1] + newell[2] * facet->normal[2];
-  if (agreement < 0.0) std::reverse(cycle.begin(), cycle.end());
-  std::vector<Index> ids;
-  ids.reserve(cycle.size());
-  for (vertexT* v : cycle) ids.push_back(static_cast<Index>(qh_pointid(qh, v->point)));
-  return ids;
-}
-
-// Runs Qhull on `coordinates` (x, y, z per point) with the given options and
-// returns its facets as vertex cycles. Qhull prints nothing: messages go to
-// the returned string.
-QhullOutcome run_qhull(std::vector<double> coordinates, const char* options) {
-  QhullOutcome outcome;
-  MessageBuffer messages;
-  if (messages.file() == nullptr) {
-    outcome.exit_code = qh_ERRother;
-    outcome.message = "cannot open a buffer for Qhull's messages";
-    return outcome;
-  }
-  const FloatingPointHold hold;
-  QhullContext context(messages.file());
-  qhT* qh = &context.qh;
-  std::string command = std::string("qhull ") + options;
-  outcome.exit_code = qh_new_qhull(qh, 3, static_cast<int>(coordinates.size() / 3), coordinates.data(), False,
-                                   command.data(), nullptr, messages.file());
-  if (outcome.exit_code == 0) {
-    for (facetT* facet = qh->facet_list; facet != nullptr && facet->next != nullptr; facet = facet->next) {
-      const std::vector<Index> cycle = facet_cycle(qh, facet);
-      if (cycle.empty()) {
-        outcome.exit_code = qh_ERRqhull;
-        outcome.message = "a Qhull facet has no consistent vertex cycle";
-        break;
-      }
-      outcome.faces.add(cycle);
-    }
-  }
-  if (outcome.message.empty()) outcome.message = messages.text();
-  return outcome;
-}
-
-// Union-find over faces.
-class Groups {
- public:
-  explicit Groups(Index n) : parent_(static_cast<std::size_t>(n)) { std::iota(parent_.begin(), parent_.end(), 0); }
-  Index find(Index f) {
-    while (parent_[static_cast<std::size_t>(f)] != f) {
-      parent_[static_cast<std::size_t>(f)] = parent_[static_cast<std::size_t>(parent_[static_cast<std::size_t>(f)])];
-      f = parent_[static_cast<std::size_t>(f)];
-    }
-    return f;
-  }
-  void unite(Index a, Index b) {
-    a = find(a), b = find(b);
-    if (a != b) parent_[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-  }
-
- private:
-  std::vector<Index> parent_;
-};
-
-// Three vertices of face f that are not collinear (exactly), or nothing.
-// Spread out (farthest-point choice in double) to keep the filter effective.
-bool face_triangle(const Cycles& faces, Index f, std::span<const Vec3> pts, std::span<const Vec3> scaled,
-                   std::array<Index, 3>& tri) {
-  const Index n = faces.size(f);
-  const Index a = faces.at(f, 0);
-  const Vec3& sa = scaled[static_cast<std::size_t>(a)];
-  Index b = faces.at(f, 1);
-  double best = -1.0;
-  for (Index i = 1; i < n; ++i) {
-    const Index v = faces.at(f, i);
-    const double d = (scaled[static_cast<std::size_t>(v)] - sa).squaredNorm();
-    if (d > best) best = d, b = v;
-  }
-  const Vec3 line = scaled[static_cast<std::size_t>(b)] - sa;
-  Index c = -1;
-  best = -1.0;
-  for (Index i = 1; i < n; ++i) {
-    const Index v = faces.at(f, i);
-    if (v == b || collinear3d(pts[static_cast<std::size_t>(a)], pts[static_cast<std::size_t>(b)],
-                              pts[static_cast<std::size_t>(v)])) {
-      continue;
-    }
-    const double d = line.cross(scaled[static_cast<std::size_t>(v)] - sa).squaredNorm();
-    if (d > best) best = d, c = v;
-  }
-  if (c < 0) return false;
-  tri = {a, b, c};
-  return true;
-}
-
-// Exact cleaning of Qhull's facets, in the coordinates of the given doubles:
-//  - neighbouring facets that are exactly coplanar (and lie on either side of
-//    their common edge, not folded) become one face: Qhull's triangles of
-//    a square, or facets Qhull left unmerged;
-//  - a vertex on exactly two faces and exactly collinear with its two
-//    neighbours along them lies inside an edge: it is not an extreme point and
-//    is dropped from both cycles (a cube's edge midpoints).
-// A vertex strictly inside a face disappears with the merge, because it is on
-// no boundary cycle any more.
-//
-// `proven_convex` tells whether the result is exactly a convex polytope's
-// boundary: a closed, consistently oriented surface whose faces are planar
-// and whose every edge is exactly convex (x strictly below the plane of the
-// face across the edge). A closed surface that is locally convex at every
-// edge bounds a convex body, so no global test is needed.
-Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts, std::span<const Vec3> scaled,
-                   bool& proven_convex) {
-  const Index face_count = raw.count();
-  const HalfEdges he(raw, point_count);
-  proven_convex = he.consistent();
-  const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
-  Groups groups(face_count);
-  {
-    // A face is planar when all its vertices lie on the plane of a spread
-    // triangle of them (exact; zero is the expected answer, so this is where
-    // the exact fallback runs, once per vertex of a non-triangular face).
-    std::vector<std::array<Index, 3>> tri(static_cast<std::size_t>(face_count));
-    std::vector<bool> planar(static_cast<std::size_t>(face_count), false);
-    for (Index f = 0; f < face_count; ++f) {
-      auto& t = tri[static_cast<std::size_t>(f)];
-      if (!face_triangle(raw, f, pts, scaled, t)) continue;
-      bool flat = true;
-      for (Index i = 0; i < raw.size(f) && flat; ++i) {
-        const Index v = raw.at(f, i);
-        flat = v == t[0] || v == t[1] || v == t[2] || side3d(at(t[0]), at(t[1]), at(t[2]), at(v)) == 0;
-      }
-      planar[static_cast<std::size_t>(f)] = flat;
-      proven_convex = proven_convex && flat;
-    }
-    // Planar neighbours f and g share the edge s -> t (in f; t -> s in g).
-    // With y a vertex of f and x one of g off the line s t, side3d(s, t, y, x)
-    // is the edge's convexity: negative convex, zero coplanar, positive
-    // reflex (Qhull's roundoff). Coplanar faces merge when, in a projection
-    // that keeps the plane's orientation, x and y lie on opposite sides of
-    // the edge.
-    for (Index h = 0; h < static_cast<Index>(raw.vertices.size()); ++h) {
-      const Index twin = he.twin(h);
-      if (twin < 0) continue;
-      const Index f = he.face(h), g = he.face(twin);
-      if (f >= g) continue;
-      if (!planar[static_cast<std::size_t>(f)] || !planar[static_cast<std::size_t>(g)]) continue;
-      const Index s = he.source(h), t = he.target(h);
-      const auto off_line = [&](Index face) {
-        for (const Index v : tri[static_cast<std::size_t>(face)]) {
-          if (v != s && v != t && !collinear3d(at(s), at(t), at(v))) return v;
-        }
-        return Index{-1};
-      };
-      const Index y = off_line(f), x = off_line(g);
-      if (x < 0 || y < 0) {
-        proven_convex = false;
-        continue;
-      }
-      const int side = side3d(at(s), at(t), at(y), at(x));
-      if (side != 0) {
-        proven_convex = proven_convex && side < 0;
-        continue;
-      }
-      int y_side = 0, x_side = 0;
-      for (int k = 0; k < 3 && y_side == 0; ++k) {
-        const int i = (k + 1) % 3, j = (k + 2) % 3;
-        y_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(y)[i], at(y)[j]);
-        x_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(x)[i], at(x)[j]);
-      }
-      if (x_side == -y_side) {
-        groups.unite(f, g);
-      } else {
-        proven_convex = false;  // folded onto itself
-      }
-    }
-  }
-
-  // Boundary cycle of each group: its half-edges whose twin lies in another
-  // group, chained head to tail. A group that does not chain into one simple
-  // cycle keeps its facets unmerged.
-  std::vector<std::vector<Index>> members(static_cast<std::size_t>(face_count));
-  for (Index f = 0; f < face_count; ++f) {
-    const Index root = groups.find(f);
-    if (root != f) members[static_cast<std::size_t>(root)].push_back(f);
-  }
-  Cycles merged;
-  const auto add_own = [&](Index f) {
-    const auto first = raw.vertices.begin() + raw.offsets[static_cast<std::size_t>(f)];
-    merged.add(std::span<const Index>(&*first, static_cast<std::size_t>(raw.size(f))));
-  };
-  std::vector<std::pair<Index, Index>> boundary;  // (source, target)
-  std::vector<Index> chain;
-  for (Index root = 0; root < face_count; ++root) {
-    if (groups.find(root) != root) continue;
-    auto& group = members[static_cast<std::size_t>(root)];
-    if (group.empty()) {
-      add_own(root);
-      continue;
-    }
-    group.push_back(root);
-    boundary.clear();
-    for (const Index f : group) {
-      for (Index i = 0; i < raw.size(f); ++i) {
-        const Index h = raw.offsets[static_cast<std::size_t>(f)] + i;
-        const Index twin = he.twin(h);
-        if (twin < 0 || groups.find(he.face(twin)) != root) boundary.emplace_back(he.source(h), he.target(h));
-      }
-    }
-    std::sort(boundary.begin(), boundary.end());
-    bool simple = boundary.size() >= 3;
-    for (std::size_t k = 1; k < boundary.size() && simple; ++k) simple = boundary[k].first != boundary[k - 1].first;
-    chain.clear();
-    if (simple) {
-      const auto next_of = [&](Index v) {
-        const auto it = std::lower_bound(boundary.begin(), boundary.end(), std::pair<Index, Index>(v, INT32_MIN));
-        return it != boundary.end() && it->first == v ? it->second : -1;
-      };
-      Index v = boundary.front().first;
-      do {
-        chain.push_back(v);
-        v = next_of(v);
-      } while (v >= 0 && v != boundary.front().first && chain.size() <= boundary.size());
-      simple = v == boundary.front().first && chain.size() == boundary.size();
-    }
-    if (simple) {
-      merged.add(chain);
-    } else {
-      proven_convex = false;
-      for (const Index f : group) add_own(f);
-    }
-  }
-
-  // Drop vertices inside edges. The cycles become doubly linked lists over
-  // nodes (one node per slot of merged.vertices); a vertex on exactly two
-  // faces remembers its two nodes.
-  const auto node_count = merged.vertices.size();
-  std::vector<Index> next(node_count), prev(node_count), node_face(node_count);
-  std::vector<Index> face_size(static_cast<std::size_t>(merged.count()));
-  for (Index f = 0; f < merged.count(); ++f) {
-    const Index b = merged.offsets[static_cast<std::size_t>(f)], n = merged.size(f);
-    face_size[static_cast<std::size_t>(f)] = n;
-    for (Index i = 0; i < n; ++i) {
-      next[static_cast<std::size_t>(b + i)] = b + (i + 1) % n;
-      prev[static_cast<std::size_t>(b + i)] = b + (i + n - 1) % n;
-      node_face[static_cast<std::size_t>(b + i)] = f;
-    }
-  }
-  std::vector<Index> occurrence_count(static_cast<std::size_t>(point_count), 0);
-  std::vector<std::array<Index, 2>> occurrence(static_cast<std::size_t>(point_count), {-1, -1});
-  for (std::size_t node = 0; node < node_count; ++node) {
-    const auto v = static_cast<std::size_t>(merged.vertices[node]);
-    if (occurrence_count[v] < 2) occurrence[v][static_cast<std::size_t>(occurrence_count[v])] = static_cast<Index>(node);
-    ++occurrence_count[v];
-  }
-  std::vector<bool> alive(node_count, true);
-  std::vector<Index> work;
-  for (Index v = 0; v < point_count; ++v) {
-    if (occurrence_count[static_cast<std::size_t>(v)] == 2) work.push_back(v);
-  }
-  const auto vertex_of = [&](Index node) { return merged.vertices[static_cast<std::size_t>(node)]; };
-  while (!work.empty()) {
-    const Index v = work.back();
-    work.pop_back();
-    if (occurrence_count[static_cast<std::size_t>(v)] != 2) continue;
-    const auto [n0, n1] = occurrence[static_cast<std::size_t>(v)];
-    const Index u = vertex_of(prev[static_cast<std::size_t>(n0)]);
-    const Index w = vertex_of(next[static_cast<std::size_t>(n0)]);
-    // The other face must run w -> v -> u: v sits on one edge of both.
-    if (vertex_of(prev[static_cast<std::size_t>(n1)]) != w || vertex_of(next[static_cast<std::size_t>(n1)]) != u) continue;
-    if (face_size[static_cast<std::size_t>(node_face[static_cast<std::size_t>(n0)])] <= 3 ||
-        face_size[static_cast<std::size_t>(node_face[static_cast<std::size_t>(n1)])] <= 3) {
-      continue;
-    }
-    if (!collinear3d(at(u), at(v), at(w))) continue;
-    for (const Index node : {n0, n1}) {
-      const Index before = prev[static_cast<std::size_t>(node)], after = next[static_cast<std::size_t>(node)];
-      next[static_cast<std::size_t>(before)] = after;
-      prev[static_cast<std::size_t>(after)] = before;
-      alive[static_cast<std::size_t>(node)] = false;
-      --face_size[static_cast<std::size_t>(node_face[static_cast<std::size_t>(node)])];
-    }
-    occurrence_count[static_cast<std::size_t>(v)] = 0;
-    work.push_back(u);  // their neighbours changed: check them again
-    work.push_back(w);
-  }
-
-  Cycles out;
-  out.vertices.reserve(node_count);
-  for (Index f = 0; f < merged.count(); ++f) {
-    Index start = merged.offsets[static_cast<std::size_t>(f)];
-    while (!alive[static_cast<std::size_t>(start)]) ++start;  // some node survives: faces keep >= 3
-    Index node = start;
-    do {
-      out.vertices.push_back(vertex_of(node));
-      node = next[static_cast<std::size_t>(node)];
-    } while (node != start);
-    out.offsets.push_back(static_cast<Index>(out.vertices.size()));
-  }
-  return out;
-}
-
-// Work limit (point-face tests) of contains_all: beyond it the check is
-// skipped, so that it never dominates the build of a large input (each test
-// is one filtered side3d).
-constexpr double kContainmentBudget = 4e6;
-
-// Whether every input point that is not a vertex of `faces` (a surface that
-// clean_faces proved convex, so every face is exactly planar) is on or below
-// every face's plane, exactly. Qhull decides "inside" within its roundoff
-// estimate, even without merging, so on rounded nearly flat data a true
-// extreme point can be left out of a convex triangulation (found by
-// polytope_test's NearlyFlatCloudsFarFromTheOriginAreExact). Inputs whose non-vertex count
-// times face count exceeds kContainmentBudget are trusted to Qhull (a known
-// gap: large clouds with many interior points and many faces).
-bool contains_all(const Cycles& faces, std::span<const Vec3> pts, std::span<const Vec3> scaled) {
-  std::vector<bool> on_hull(pts.size(), false);
-  for (const Index v : faces.vertices) on_hull[static_cast<std::size_t>(v)] = true;
-  const auto inner = static_cast<double>(std::count(on_hull.begin(), on_hull.end(), false));
-  if (inner == 0.0 || inner * static_cast<double>(faces.count()) > kContainmentBudget) return true;
-  std::vector<std::array<Index, 3>> tri(static_cast<std::size_t>(faces.count()));
-  for (Index f = 0; f < faces.count(); ++f) {
-    if (!face_triangle(faces, f, pts, scaled, tri[static_cast<std::size_t>(f)])) return false;
-  }
-  const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
-  for (Index i = 0; i < static_cast<Index>(pts.size()); ++i) {
-    if (on_hull[static_cast<std::size_t>(i)]) continue;
-    for (const auto& t : tri) {
-      if (side3d(at(t[0]), at(t[1]), at(t[2]), at(i)) > 0) return false;
-    }
-  }
-  return true;
-}
-
-// Exact incremental hull, the fallback when Qhull's unmerged triangulation is
-// not exactly convex (rounded data: nearly flat sets, rotated grids, clouds
-// far from the origin whose body is small against their coordinates). Qhull's
-// merging is then no answer: it treats points within its roundoff estimate
-// of a facet as "coplanar" and drops them, and on inputs it calls flat the
-// projected polygon drops the third dimension; both lose true extreme points
-// (measured: 0.03 of support on a body of size 2 at distance 420, 1e11 of
-// support on a cloud of size 5e11 at 4.7e13).
-//
-// The classic beneath-beyond construction (Kallay; Preparata and Shamos
-// 3.4.3) with every decision an exact side3d: start from a tetrahedron of
-// four exactly non-coplanar input points; add the other points farthest
-// first; a point p is outside the current hull iff some face sees it
-// strictly (side3d > 0: a closed convex polytope contains exactly the points
-// on or below all of its face planes). The strictly visible faces form a
-// connected cap whose boundary (the horizon: edges between a visible and a
-// non-visible face) is a simple cycle; the cap is replaced by the cone of
-// triangles from the horizon edges to p. No cone triangle is degenerate: if
-// p were on the line of a horizon edge it would lie in the plane of the
-// visible face across that edge, which then would not see it strictly. Points
-// that are on the hull's boundary without being beyond any face (on a face
-// or an edge) are not added; coplanar triangles are left for clean_faces to
-// merge. The result is exactly the convex hull, as triangles.
-//
-// Cost: every point is tested against every current face, O(n h) for h hull
-// vertices. Farthest-first order makes h small early. It runs only when the
-// fast Qhull path could not be proven exact. Rounded nearly coplanar points
-// (a rotated cylinder's caps) send most tests to the exact path: measured
-// 0.6 s for a rotated 2 x 500 point cylinder at distance 500 (Qhull's
-// merged hull: 0.1 s), about 1.2 us a test. So the construction gives up
-// (returns false) after kIncrementalBudget tests, about 0.6 s, and the caller
-// falls back to Qhull's merged hull (a known gap, see there). Inputs of a
-// few hundred points always fit.
-constexpr double kIncrementalBudget = 5e5;
-
-bool exact_incremental_hull(std::span<const Vec3> pts, std::span<const Vec3> scaled, const Frame& frame,
-                            Cycles& out) {
-  const auto n = static_cast<Index>(pts.size());
-  const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
-  const auto sc = [&](Index v) -> const Vec3& { return scaled[static_cast<std::size_t>(v)]; };
-  const Index a = frame.base[0], b = frame.base[1], c = frame.base[2];
-  // Fourth point: the farthest from the base plane (in double, for a
-  // well-shaped start) among the points exactly off it.
-  const Vec3 normal = (sc(b) - sc(a)).cross(sc(c) - sc(a));
-  Index d = -1;
-  double best = -1.0;
-  for (Index i = 0; i < n; ++i) {
-    const double h = std::abs(normal.dot(sc(i) - sc(a)));
-    if (h > best && side3d(at(a), at(b), at(c), at(i)) != 0) best = h, d = i;
-  }
-  if (d < 0) return false;  // coplanar: not a solid (the frame says otherwise)
-
-  std::vector<std::array<Index, 3>> tris;
-  std::vector<char> alive;
-  std::unordered_map<std::uint64_t, Index> edge_face;  // directed edge u -> v to its triangle
-  const auto key = [](Index u, Index v) {
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u)) << 32) | static_cast<std::uint32_t>(v);
-  };
-  const auto add = [&](Index u, Index v, Index w) {
-    const auto t = static_cast<Index>(tris.size());
-    tris.push_back({u, v, w});
-    alive.push_back(1);
-    edge_face[key(u, v)] = t;
-    edge_face[key(v, w)] = t;
-    edge_face[key(w, u)] = t;
-  };
-  // Outward tetrahedron: with d below triangle (p, q, r), its faces are
-  // (p, q, r), (p, d, q), (q, d, r), (r, d, p).
-  Index p = a, q = b, r = c;
-  if (side3d(at(p), at(q), at(r), at(d)) > 0) std::swap(q, r);
-  add(p, q, r);
-  add(p, d, q);
-  add(q, d, r);
-  add(r, d, p);
-
-  Vec3 centre = Vec3::Zero();
-  for (const Index v : {a, b, c, d}) centre += 0.25 * sc(v);
-  std::vector<Index> order;
-  order.reserve(pts.size());
-  for (Index i = 0; i < n; ++i) {
-    if (i != a && i != b && i != c && i != d) order.push_back(i);
-  }
-  std::vector<double> distance(pts.size(), 0.0);
-  for (const Index i : order) distance[static_cast<std::size_t>(i)] = (sc(i) - centre).squaredNorm();
-  std::stable_sort(order.begin(), order.end(), [&](Index l, Index rr) {
-    return distance[static_cast<std::size_t>(l)] > distance[static_cast<std::size_t>(rr)];
-  });
-
-  std::vector<Index> live = {0, 1, 2, 3};
-  std::vector<Index> visible;
-  std::vector<std::pair<Index, Index>> horizon;
-  double tests = 0.0;
-  for (const Index x : order) {
-    tests += static_cast<double>(live.size());
-    if (tests > kIncrementalBudget) return false;
-    visible.clear();
-    for (const Index t : live) {
-      const auto& tri = tris[static_cast<std::size_t>(t)];
-      if (side3d(at(tri[0]), at(tri[1]), at(tri[2]), at(x)) > 0) visible.push_back(t);
-    }
-    if (visible.empty()) continue;  // inside or on the boundary
-    for (const Index t : visible) alive[static_cast<std::size_t>(t)] = 2;  // 2: visible from x
-    horizon.clear();
-    for (const Index t : visible) {
-      const auto tri = tris[static_cast<std::size_t>(t)];
-      for (int k = 0; k < 3; ++k) {
-        const Index u = tri[static_cast<std::size_t>(k)], v = tri[static_cast<std::size_t>((k + 1) % 3)];
-        const auto it = edge_face.find(key(v, u));
-        if (it == edge_face.end()) return false;  // not closed: cannot happen
-        if (alive[static_cast<std::size_t>(it->second)] != 2) horizon.emplace_back(u, v);
-      }
-    }
-    for (const Index t : visible) {
-      const auto tri = tris[static_cast<std::size_t>(t)];
-      for (int k = 0; k < 3; ++k) {
-        edge_face.erase(key(tri[static_cast<std::size_t>(k)], tri[static_cast<std::size_t>((k + 1) % 3)]));
-      }
-      alive[static_cast<std::size_t>(t)] = 0;
-    }
-    for (const auto& [u, v] : horizon) add(u, v, x);
-    std::erase_if(live, [&](Index t) { return alive[static_cast<std::size_t>(t)] == 0; });
-    for (auto t = static_cast<Index>(tris.size() - horizon.size()); t < static_cast<Index>(tris.size()); ++t) {
-      live.push_back(t);
-    }
-  }
-  out = Cycles();
-  for (const Index t : live) out.add(tris[static_cast<std::size_t>(t)]);
-  return true;
-}
-
-// ---------------------------------------------------------------------------
-// The build
-// ---------------------------------------------------------------------------
 
 // A built boundary before renumbering: hull vertices as unique-point ids and
 // face cycles over them.
@@ -1144,89 +78,30 @@ Boundary polygon_boundary(std::vector<Index> ccw) {
   return b;
 }
 
-Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled, const Frame& frame) {
-  // Qhull sees the points centred and scaled by a power of two, so that its
-  // own roundoff estimates and squared distances stay far from overflow and
-  // underflow at any input magnitude. Only its combinatorics are used; every
-  // later decision is exact on the original doubles.
-  Vec3 lo = scaled[0], hi = scaled[0];
-  for (const Vec3& s : scaled) lo = lo.cwiseMin(s), hi = hi.cwiseMax(s);
-  const Vec3 centre = 0.5 * lo + 0.5 * hi;
-  const double extent = (hi - lo).maxCoeff();
-  const int extent_exponent = magnitude_exponent(extent);
-  std::vector<double> coordinates;
-  coordinates.reserve(3 * scaled.size());
-  for (const Vec3& s : scaled) {
-    for (int k = 0; k < 3; ++k) coordinates.push_back(std::ldexp(s[k] - centre[k], -extent_exponent));
-  }
+// The exact hull's triangles, cleaned into faces. The construction is exact,
+// so a result the cleaning cannot prove convex is a defect of this file,
+// never an inexact answer handed on.
+Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled,
+                        const Frame& frame) {
   const auto point_count = static_cast<Index>(pts.size());
-  // First "Q0": no merging, triangles only. It is fast even when thousands
-  // of points share a face (Qhull's default merging is quadratic there: a
-  // cylinder of 2 x 2000 points takes 1.5 s with it, 60 ms without), and the
-  // exact cleaning turns its triangles into the true faces. Accepted only if
-  // that cleaning proves the result convex and every other input point is
-  // exactly inside it (contains_all). Otherwise (rounded, nearly degenerate
-  // data, or Qhull calling the input flat) the exact incremental hull. Only
-  // past its work budget, the old fallbacks: Qhull's default options, which
-  // merge facets coplanar within its roundoff estimate (C-0); on a precision
-  // or flatness error, every axis scaled to [-1, 1] (QbB); then the projected
-  // polygon. Those are not exact (see below).
-  const auto boundary_of = [&](Cycles faces) {
-    Boundary b;
-    b.dimension = 3;
-    std::vector<bool> used(pts.size(), false);
-    for (const Index v : faces.vertices) used[static_cast<std::size_t>(v)] = true;
-    for (Index v = 0; v < point_count; ++v) {
-      if (used[static_cast<std::size_t>(v)]) b.vertices.push_back(v);
-    }
-    b.faces = std::move(faces);
-    return b;
-  };
-  {
-    QhullOutcome outcome = run_qhull(coordinates, "Q0");
-    if (outcome.exit_code == 0) {
-      bool proven_convex = false;
-      Cycles faces = clean_faces(outcome.faces, point_count, pts, scaled, proven_convex);
-      if (proven_convex && contains_all(faces, pts, scaled)) return boundary_of(std::move(faces));
-    }
+  Cycles triangles;
+  bool proven_convex = false;
+  Boundary b;
+  b.dimension = 3;
+  if (exact_incremental_hull(pts, scaled, frame, triangles)) {
+    b.faces = clean_faces(triangles, point_count, pts, scaled, proven_convex);
   }
-  // Not provably exact (or Qhull called the input flat): the exact
-  // incremental hull, which keeps every extreme point whatever the rounding.
-  {
-    Cycles triangles;
-    if (exact_incremental_hull(pts, scaled, frame, triangles)) {
-      bool proven_convex = false;
-      Cycles faces = clean_faces(triangles, point_count, pts, scaled, proven_convex);
-      if (proven_convex) return boundary_of(std::move(faces));
-    }
+  if (!proven_convex) {
+    throw std::logic_error("ConvexPolytope: internal error: the exact hull of " +
+                           std::to_string(pts.size()) +
+                           " distinct points is not a proven convex surface");
   }
-  // Only for large inputs, past the incremental hull's work budget: Qhull's
-  // merged hull. It is NOT exact: merging drops points within Qhull's
-  // roundoff estimate of a facet, true extreme points among them, and the
-  // projected polygon below drops the third dimension of a set Qhull calls
-  // flat. A known gap for large rounded, nearly degenerate inputs.
-  std::string last_message;
-  bool flat = false;
-  for (const char* options : {"", "QbB"}) {
-    QhullOutcome outcome = run_qhull(coordinates, options);
-    if (outcome.exit_code == 0) {
-      bool proven_convex = false;
-      return boundary_of(clean_faces(outcome.faces, point_count, pts, scaled, proven_convex));
-    }
-    last_message = outcome.message;
-    flat = outcome.exit_code == qh_ERRsingular || outcome.exit_code == qh_ERRprec ||
-           outcome.exit_code == qh_ERRwide || outcome.exit_code == qh_ERRtopology;
-    if (!flat) break;
+  std::vector<bool> used(pts.size(), false);
+  for (const Index v : b.faces.vertices) used[static_cast<std::size_t>(v)] = true;
+  for (Index v = 0; v < point_count; ++v) {
+    if (used[static_cast<std::size_t>(v)]) b.vertices.push_back(v);
   }
-  if (flat) {
-    // Flat to Qhull even after scaling: the points lie within roundoff of the
-    // plane of the frame. Their hull is, to that precision, the polygon of
-    // their projection.
-    return polygon_boundary(polygon_hull(pts, projection_axis(pts, scaled, frame)));
-  }
-  const auto first_line = last_message.substr(0, last_message.find('\n'));
-  throw InvalidInput("ConvexPolytope: Qhull failed on " + std::to_string(pts.size()) + " distinct points: " +
-                     (first_line.empty() ? std::string("unknown error") : first_line));
+  return b;
 }
 
 const char* axis_name(int k) { return k == 0 ? "x" : k == 1 ? "y" : "z"; }
@@ -1240,12 +115,12 @@ void validate(std::span<const Vec3> points) {
     for (int k = 0; k < 3; ++k) {
       const double c = points[i][k];
       if (std::isnan(c)) {
-        throw InvalidInput("ConvexPolytope: input point " + std::to_string(i) + " has a NaN " + axis_name(k) +
-                           " coordinate");
+        throw InvalidInput("ConvexPolytope: input point " + std::to_string(i) + " has a NaN " +
+                           axis_name(k) + " coordinate");
       }
       if (std::isinf(c)) {
-        throw InvalidInput("ConvexPolytope: input point " + std::to_string(i) + " has an infinite " + axis_name(k) +
-                           " coordinate");
+        throw InvalidInput("ConvexPolytope: input point " + std::to_string(i) +
+                           " has an infinite " + axis_name(k) + " coordinate");
       }
     }
   }
@@ -1263,7 +138,9 @@ std::vector<Index> distinct_points(std::span<const Vec3> points) {
     const auto kl = key(l), kr = key(r);
     return kl != kr ? kl < kr : l < r;
   });
-  order.erase(std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }), order.end());
+  order.erase(
+      std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }),
+      order.end());
   std::sort(order.begin(), order.end());
   return order;
 }
@@ -1285,10 +162,18 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   Boundary boundary;
   boundary.dimension = frame.dimension;
   switch (frame.dimension) {
-    case 0: boundary.vertices = {0}; break;
-    case 1: boundary.vertices = segment_ends(pts, frame); break;
-    case 2: boundary = polygon_boundary(polygon_hull(pts, projection_axis(pts, scaled, frame))); break;
-    default: boundary = solid_boundary(pts, scaled, frame); break;
+    case 0:
+      boundary.vertices = {0};
+      break;
+    case 1:
+      boundary.vertices = segment_ends(pts, frame);
+      break;
+    case 2:
+      boundary = polygon_boundary(polygon_hull(pts, projection_axis(pts, scaled, frame)));
+      break;
+    default:
+      boundary = solid_boundary(pts, scaled, frame);
+      break;
   }
 
   // Renumber: unique-point ids -> hull vertex ids.
@@ -1306,7 +191,8 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   Cycles faces;
   faces.offsets = std::move(boundary.faces.offsets);
   faces.vertices.reserve(boundary.faces.vertices.size());
-  for (const Index u : boundary.faces.vertices) faces.vertices.push_back(local[static_cast<std::size_t>(u)]);
+  for (const Index u : boundary.faces.vertices)
+    faces.vertices.push_back(local[static_cast<std::size_t>(u)]);
 
   if (dimension_ == 1) {
     adjacency_offsets_ = {0, 1, 2};
@@ -1318,7 +204,7 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
     Adjacency adjacency;
     if (!build_adjacency(faces, vertex_count, adjacency)) {
       throw InvalidInput("ConvexPolytope: the hull of " + std::to_string(points.size()) +
-                         " points is not a closed surface after cleaning (inconsistent Qhull output)");
+                         " points is not a closed surface after cleaning (internal error)");
     }
     adjacency_offsets_ = std::move(adjacency.offsets);
     adjacency_ = std::move(adjacency.neighbors);
@@ -1326,7 +212,8 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
     face_offsets_ = std::move(faces.offsets);
     face_vertices_ = std::move(faces.vertices);
   }
-  for (auto* v : {&input_index_, &adjacency_offsets_, &adjacency_, &adjacency_faces_, &face_offsets_, &face_vertices_}) {
+  for (auto* v : {&input_index_, &adjacency_offsets_, &adjacency_, &adjacency_faces_,
+                  &face_offsets_, &face_vertices_}) {
     v->shrink_to_fit();
   }
   vertices_.shrink_to_fit();
@@ -1338,7 +225,8 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   for (const Vec3& v : vertices_) sum += times_pow2(v, -exponent);
   const Vec3 mean = sum / static_cast<double>(vertices_.size());
   double radius = 0.0;
-  for (const Vec3& v : vertices_) radius = std::max(radius, (times_pow2(v, -exponent) - mean).norm());
+  for (const Vec3& v : vertices_)
+    radius = std::max(radius, (times_pow2(v, -exponent) - mean).norm());
   // Scale back per value: 2^exponent itself overflows for coordinates
   // beyond 2^1023 (found by the reader fuzzer: a vertex at -1e308).
   centroid_ = times_pow2(mean, exponent);
@@ -1360,6 +248,12 @@ namespace {
 // (a convex polygon's fan from one vertex gives a ratio near n / pi), so only
 // slivers pay for the exact path.
 constexpr double kSliverRatio = 16.0;
+// Largest distance, in units of u times the face's largest coordinate
+// magnitude, that a face's own vertex may have from the plane built from
+// Newell's normal before face_plane takes the exact normal instead: well
+// inside the accuracy standard's 64 u R, and above the few u that evaluating
+// the distance itself costs.
+constexpr double kPlaneResidual = 8.0;
 }  // namespace
 
 Plane ConvexPolytope::face_plane(int f) const {
@@ -1367,52 +261,61 @@ Plane ConvexPolytope::face_plane(int f) const {
   double max_abs = 0.0;
   for (const Index v : cycle) max_abs = std::max(max_abs, vertex(v).cwiseAbs().maxCoeff());
   const int exponent = magnitude_exponent(max_abs);
-  const Vec3 origin = times_pow2(vertex(cycle[0]), -exponent);
+  const auto local = [&](std::size_t i) { return times_pow2(vertex(cycle[i]), -exponent); };
+  const Vec3 origin = local(0);
   Vec3 normal = Vec3::Zero();
   Vec3 sum = Vec3::Zero();
+  double magnitude_sum = 0.0;
   for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const Vec3 p = times_pow2(vertex(cycle[i]), -exponent) - origin;
-    const Vec3 q = times_pow2(vertex(cycle[(i + 1) % cycle.size()]), -exponent) - origin;
+    const Vec3 p = local(i) - origin;
+    const Vec3 q = local((i + 1) % cycle.size()) - origin;
     normal += p.cross(q);
     sum += p;
+    magnitude_sum += p.norm() * q.norm();
   }
+  const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
   // Conditioning: the rounded Newell sum is off by about u sum |p_i||p_i+1|
   // (each cross product's error). When that bound exceeds kSliverRatio per
   // vertex times the normal (a sliver: nearly collinear vertices, which the
-  // exact hull of rounded data keeps as faces), take the normal exactly from a
-  // spread triangle of the face; faces are exactly planar (the cleaning
-  // proves it), so any non-collinear triangle of them has the face's normal.
-  double magnitude_sum = 0.0;
-  for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const Vec3 p = times_pow2(vertex(cycle[i]), -exponent) - origin;
-    const Vec3 q = times_pow2(vertex(cycle[(i + 1) % cycle.size()]), -exponent) - origin;
-    magnitude_sum += p.norm() * q.norm();
+  // exact hull of rounded data keeps as faces), or when a vertex of the face
+  // is farther than kPlaneResidual u from the resulting plane (coordinates
+  // here are below 1), the normal is taken exactly instead.
+  bool exact = !(magnitude_sum <= kSliverRatio * static_cast<double>(cycle.size()) * normal.norm());
+  if (!exact) {
+    const Vec3 unit = normal.normalized();
+    for (std::size_t i = 0; i < cycle.size() && !exact; ++i) {
+      exact = !(std::abs(unit.dot(local(i) - mean)) <= kPlaneResidual * kEpsilon);
+    }
   }
-  if (magnitude_sum > kSliverRatio * static_cast<double>(cycle.size()) * normal.norm()) {
-    // b farthest from the first vertex a, c farthest from the line a b, taken
-    // in cycle order so that (a, b, c) turns like the face.
+  if (exact) {
+    // From a spread triangle of the face (b farthest from the first vertex
+    // a, c farthest from the line a b, in double), taken in cycle order so
+    // that (a, b, c) turns like the face. Faces are exactly planar and
+    // strictly convex (the cleaning proves it), so any three of their
+    // vertices are exactly non-collinear and span the face's plane: the
+    // exact cross product, rounded, is the face's normal with its
+    // orientation, to a relative error of a few u, however thin the face.
     std::size_t ib = 1;
     double best = -1.0;
     for (std::size_t i = 1; i < cycle.size(); ++i) {
-      const double d = (times_pow2(vertex(cycle[i]), -exponent) - origin).squaredNorm();
+      const double d = (local(i) - origin).squaredNorm();
       if (d > best) best = d, ib = i;
     }
-    const Vec3 line = times_pow2(vertex(cycle[ib]), -exponent) - origin;
+    const Vec3 line = local(ib) - origin;
     std::size_t ic = ib == 1 ? 2 : 1;
     best = -1.0;
     for (std::size_t i = 1; i < cycle.size(); ++i) {
       if (i == ib) continue;
-      const double d = line.cross(times_pow2(vertex(cycle[i]), -exponent) - origin).squaredNorm();
+      const double d = line.cross(local(i) - origin).squaredNorm();
       if (d > best) best = d, ic = i;
     }
-    const Vec3 exact = exact_triangle_normal(vertex(cycle[0]), vertex(cycle[std::min(ib, ic)]),
-                                             vertex(cycle[std::max(ib, ic)]));
-    if (exact.dot(normal) > 0.0 || !(normal.norm() > 0.0)) normal = exact;  // else collinear: keep Newell's
+    normal = exact_triangle_normal(vertex(cycle[0]), vertex(cycle[std::min(ib, ic)]),
+                                   vertex(cycle[std::max(ib, ic)]));
   }
   const double length = normal.norm();
-  if (!(length > 0.0)) return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
+  if (!(length > 0.0))
+    return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
   normal /= length;
-  const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
   return {normal, std::ldexp(normal.dot(mean), exponent)};
 }
 
@@ -1448,7 +351,9 @@ std::vector<std::array<std::int32_t, 2>> ConvexPolytope::edges() const {
 }
 
 std::size_t ConvexPolytope::memory_bytes() const {
-  const auto index_bytes = [](const std::vector<std::int32_t>& v) { return v.capacity() * sizeof(std::int32_t); };
+  const auto index_bytes = [](const std::vector<std::int32_t>& v) {
+    return v.capacity() * sizeof(std::int32_t);
+  };
   return sizeof(*this) + vertices_.capacity() * sizeof(Vec3) + index_bytes(input_index_) +
          index_bytes(adjacency_offsets_) + index_bytes(adjacency_) + index_bytes(adjacency_faces_) +
          index_bytes(face_offsets_) + index_bytes(face_vertices_);

@@ -3,21 +3,23 @@
 //
 // Layer 3: a convex polytope built once from a point list.
 //
-// The hull is computed by Qhull (qhull_r) for full-dimensional inputs. Inputs
-// of lower dimension are valid polytopes and never go through Qhull's
-// joggling: a single point (or only duplicates), collinear points (a segment),
-// coplanar points (a convex polygon with both sides as faces).
+// The hull is exact for every input: every decision is an exact predicate on
+// the given doubles, so every input point is inside or on the hull, every
+// hull vertex is an input point and an extreme one, and faces are exactly
+// planar and convex. Inputs of lower dimension are valid polytopes: a single
+// point (or only duplicates), collinear points (a segment), coplanar points
+// (a convex polygon with both sides as faces).
 //
 // Thread safety: a ConvexPolytope is immutable after construction and may be
 // shared between threads without synchronization.
 #pragma once
 
-#include "proxima/types.h"
-
 #include <cstddef>
 #include <cstdint>
 #include <span>
 #include <vector>
+
+#include "proxima/types.h"
 
 namespace proxima {
 
