@@ -42,7 +42,7 @@ struct Pair {
   std::unique_ptr<ConvexPolytope> b;
 };
 
-// Bodies are built once per N (Qhull on 4096 points is not what is timed).
+// Bodies are built once per N (the hull of 4096 points is not what is timed).
 const Pair& bodies(int n) {
   static std::map<int, Pair> cache;
   auto it = cache.find(n);

@@ -1,6 +1,6 @@
 # Installs proxima from a build tree into a fresh prefix, configures and
 # builds tests/consumer against it with find_package(proxima CONFIG), and
-# runs the consumer: once on proxima::proxima alone with Qhull, TBB and the
+# runs the consumer: once on proxima::proxima alone with TBB and the
 # readers' parser hidden (Eigen is all it may need), once with proxima::io. Run as a CTest test:
 #   cmake -DPROXIMA_BINARY_DIR=<build> -DCONSUMER_SOURCE_DIR=<tests/consumer>
 #         -DWORK_DIR=<scratch> -DGENERATOR=<gen> -DCXX_COMPILER=<c++>
@@ -36,12 +36,12 @@ foreach(header IN LISTS headers)
   endif()
 endforeach()
 
-# 1. proxima::proxima alone, with Qhull, TBB and the readers' parser hidden
+# 1. proxima::proxima alone, with TBB and the readers' parser hidden
 #    from find_package: the package must need Eigen only.
 # 2. proxima::proxima and proxima::io.
 set(common_args "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
     "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}"
-    "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}" -DCMAKE_DISABLE_FIND_PACKAGE_Qhull=ON
+    "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}"
     -DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON)
 foreach(variant core io)
   set(build "${WORK_DIR}/build-${variant}")
