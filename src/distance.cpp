@@ -20,10 +20,6 @@
 namespace proxima {
 namespace {
 
-// The contact band of the accuracy standard: a distance at or below
-// 64 u R is indistinguishable from contact for doubles of magnitude R.
-constexpr double kContactUlps = 64.0;
-
 // Slack of an answer's certificate (distance - lower_bound) in units of
 // u R_bound: the lower bound's own rounding is a few u R, so a larger gap
 // means the answer was not certified at machine precision.
@@ -37,10 +33,10 @@ constexpr double kCertificateUlps = 32.0;
 // are NaN. Such input is refused by name instead of answered with NaN.
 constexpr double kMaxMagnitude = 0x1p1018;
 
-// Upper bound on the largest coordinate magnitude of a body placed at `pose`:
-// |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale. O(1).
+// Upper bound on the largest coordinate magnitude of a body placed at
+// `pose` (types.h). O(1).
 double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
-  return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * p.scale();
+  return magnitude_bound(pose, p.scale());
 }
 
 // The largest coordinate magnitude of vertex y placed at `pose`.
@@ -117,7 +113,7 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const
     throw InvalidInput(what);
   }
   const Pose b_in_a = pose_a.inverse() * pose_b;
-  const double band_bound = kContactUlps * kUnitRoundoff * r_bound + options.absolute_tolerance;
+  const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
   DistanceCache cold;
   DistanceCache& c = cache != nullptr ? *cache : cold;
@@ -156,7 +152,7 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const
     const std::array ids_b = {c.vertices_b[0], c.vertices_b[1], c.vertices_b[2], c.hint_b};
     const double r_floor =
         std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
-    return kContactUlps * kUnitRoundoff * r_floor + options.absolute_tolerance;
+    return contact_band(r_floor, options.absolute_tolerance);
   };
   // A touching answer above the band of the exact R is re-solved with that
   // band, cross-check included, so that whichever stage answers decides
@@ -166,7 +162,7 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const
   if (result.status == Status::touching && result.distance > 0.0 &&
       result.distance > band_floor()) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
-    const double exact_band = kContactUlps * kUnitRoundoff * r_exact + options.absolute_tolerance;
+    const double exact_band = contact_band(r_exact, options.absolute_tolerance);
     if (exact_band < band_bound && result.distance > exact_band) {
       band = exact_band;
       result = solve(band);

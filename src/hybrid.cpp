@@ -29,6 +29,7 @@
 #include <cmath>
 #include <optional>
 
+#include "power_of_two.h"
 #include "proxima/closest_point.h"
 #include "proxima/support.h"
 
@@ -474,16 +475,13 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                                const DistanceOptions& options, double contact_tolerance,
                                DistanceCache& cache) {
-  // R in A's frame: B's coordinates are bounded by |t| + |y| <= |t|_inf + sqrt(3) scale_B per axis.
-  const double r_local =
-      std::max(a.scale(), b_in_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
+  // R in A's frame, B's coordinates bounded without mapping its vertices.
+  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
   if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
       !std::isfinite(r_local)) [[likely]] {
     return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
   }
-  int exponent = 0;
-  std::frexp(r_local, &exponent);
-  const double scale = std::ldexp(1.0, -exponent);
+  const double scale = detail::power_of_two_unit(r_local).inverse;
   return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale,
                           scale);
 }

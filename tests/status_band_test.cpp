@@ -130,5 +130,96 @@ TEST(ForeignCache, WitnessFacesAreThoseOfTheQueriedHulls) {
   EXPECT_GT(face_witnesses, 50);  // the trials exercised face witnesses
 }
 
+// Story: bodies whose coordinates are all subnormal (below 2.2e-308; issue 9
+// found it below about 2.8e-309) got NaN from the hybrid and inf from GJK:
+// both work in units of a power of two near the bodies' magnitude, and
+// 2^-e for such a magnitude (e below -1023) overflows to inf. Every
+// algorithm must give a finite answer within the accuracy standard, whose
+// 64 u R (R ~ 2e-309: about four subnormal steps) is still representable.
+TEST(SubnormalInput, AnswersAreFiniteAndWithinTheStandard) {
+  test::Rng rng(7);
+  test::ExactOracle oracle;
+  int checked = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const double s = 2e-309;
+    const Points a = test::scaled(test::points_in_cube(rng, 8), s);
+    const Points b0 = test::scaled(test::points_in_cube(rng, 8), s);
+    const double gap = (trial % 3 - 1) * 0.3 * s;  // overlapping, touching, apart
+    const Points b = test::place_along(a, b0, test::random_unit_vector(rng), gap);
+    const auto exact = oracle.distance(a, b);
+    ASSERT_TRUE(exact) << oracle.last_error();
+    const double r = std::max(test::max_abs_coordinate(a), test::max_abs_coordinate(b));
+    const double bound = 64.0 * kUnitRoundoff * r;
+    const ConvexPolytope pa(a);
+    const ConvexPolytope pb(b);
+    for (const Algorithm alg : kAlgorithms) {
+      DistanceOptions options;
+      options.algorithm = alg;
+      const DistanceResult res = distance(pa, Pose{}, pb, Pose{}, options);
+      const std::string what = std::string(to_string(alg)) + " trial " + std::to_string(trial);
+      ASSERT_TRUE(std::isfinite(res.distance) && res.point_a.allFinite() &&
+                  res.point_b.allFinite() && res.normal.allFinite() &&
+                  std::isfinite(res.lower_bound))
+          << what << " distance " << res.distance;
+      EXPECT_TRUE(test::within_bound(res.distance, exact->distance_squared, 1e-12, bound))
+          << what << " distance " << res.distance << " exact " << exact->distance() << " bound "
+          << bound;
+      EXPECT_NE(res.status, Status::iteration_cap) << what;
+      if (!test::sqrt_at_most(exact->distance_squared, bound)) {
+        EXPECT_EQ(res.status, Status::separated) << what;
+      } else {
+        EXPECT_NE(res.status, Status::separated) << what;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 90);
+}
+
+// Story: a warm cache turned a touching pair (exact overlap depth below
+// 1e-26 against a band of 8e-24) into intersecting (issue 9). The hybrid
+// keeps the contact classification's last tetrahedron of A - B around the
+// origin in DistanceCache::contact_a/contact_b and re-certifies it in O(1)
+// (gjk.cpp, origin_depth): each face is oriented outwards by the
+// tetrahedron's centroid. A nearly flat tetrahedron a few bands off the
+// origin has its centroid within rounding of its faces, so an orientation
+// can flip, and then every face "has" the origin below it by more than the
+// band: a false certificate. Here A is a pyramid with its apex exactly at
+// the origin (B is that point: touching, depth 0) and a base that is such a
+// tetrahedron (one corner lifted by a few ulps), in random orientations.
+TEST(ForeignCache, FlatContactTetrahedronDoesNotCertifyIntersection) {
+  test::Rng rng(5);
+  int wrong = 0;
+  int queries = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double size = test::log_uniform(rng, 1e-9, 1e3);
+    const double band = 64.0 * kUnitRoundoff * size;
+    const double h = test::uniform(rng, 2.0, 20.0) * band;
+    const double lift = test::uniform_int(rng, 0, 8) * kUnitRoundoff * size;
+    const Mat3 rot = test::random_rotation(rng);
+    const Points base = {rot * Vec3(size, size, h), rot * Vec3(-size, size, h),
+                         rot * Vec3(-size, -size, h), rot * Vec3(size, -size, h + lift)};
+    Points a = base;
+    a.push_back(Vec3::Zero());
+    const ConvexPolytope pa(a);
+    const ConvexPolytope pb(Points{Vec3::Zero()});
+    DistanceCache cache;
+    for (std::size_t k = 0; k < 4; ++k) {
+      for (int v = 0; v < pa.vertex_count(); ++v) {
+        if (pa.vertex(v) == base[k]) cache.contact_a[k] = v;
+      }
+      cache.contact_b[k] = 0;
+    }
+    if (cache.contact_a[3] < 0 || cache.contact_a[0] < 0 || cache.contact_a[1] < 0 ||
+        cache.contact_a[2] < 0)
+      continue;
+    const DistanceResult res = distance(pa, Pose{}, pb, Pose{}, {}, &cache);
+    ++queries;
+    wrong += res.status == Status::intersecting;
+  }
+  EXPECT_EQ(wrong, 0) << "of " << queries;
+  EXPECT_GT(queries, 1000);
+}
+
 }  // namespace
 }  // namespace proxima
