@@ -138,6 +138,7 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const
         r = second;
       }
       r.lower_bound = std::min(lower, r.distance);
+      r.second_algorithm = true;
     }
     return r;
   };
@@ -191,6 +192,7 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& given_pose_a, const
       contact = enhanced_gjk_distance(a, b, b_in_a, options, band, contact_cache);
       c.contact_a = contact_cache.vertices_a;
       c.contact_b = contact_cache.vertices_b;
+      result.second_algorithm = true;
     }
     if (contact.status == Status::intersecting) {
       const Vec3 middle = 0.5 * (result.point_a + result.point_b);

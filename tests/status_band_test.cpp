@@ -221,5 +221,27 @@ TEST(ForeignCache, FlatContactTetrahedronDoesNotCertifyIntersection) {
   EXPECT_GT(queries, 1000);
 }
 
+// DistanceResult::second_algorithm says when the hybrid needed Enhanced GJK
+// (issue 9: every figure labelled "hybrid" must say what ran): its contact
+// classification runs for a pair in contact, not for a separated one, and
+// GJK and Enhanced GJK never report a second algorithm.
+TEST(SecondAlgorithm, ReportedWhenTheHybridNeedsEnhancedGjk) {
+  const ConvexPolytope cube(test::cube(1.0));
+  const Pose apart = Pose::from_translation(Vec3(1.5, 0.25, 0.0));
+  const Pose overlapping = Pose::from_translation(Vec3(0.5, 0.25, 0.0));
+  DistanceOptions hybrid;
+  EXPECT_FALSE(distance(cube, Pose{}, cube, apart, hybrid).second_algorithm);
+  const DistanceResult overlap = distance(cube, Pose{}, cube, overlapping, hybrid);
+  EXPECT_EQ(overlap.status, Status::intersecting);
+  EXPECT_TRUE(overlap.second_algorithm);
+  for (const Algorithm alg : {Algorithm::gjk, Algorithm::enhanced_gjk}) {
+    DistanceOptions options;
+    options.algorithm = alg;
+    EXPECT_FALSE(distance(cube, Pose{}, cube, overlapping, options).second_algorithm)
+        << to_string(alg);
+    EXPECT_FALSE(distance(cube, Pose{}, cube, apart, options).second_algorithm) << to_string(alg);
+  }
+}
+
 }  // namespace
 }  // namespace proxima

@@ -113,6 +113,13 @@ struct DistanceOptions {
   // distance at or below it is reported as touching.
   double absolute_tolerance = 0.0;
   // Hard cap on iterations; a query that reaches it says so in its status.
+  // It bounds each stage of a query, not their sum: the hybrid's loop, and
+  // then Enhanced GJK's contact classification or its cross-check of an
+  // uncertified answer (DistanceResult::second_algorithm), each get the full
+  // cap; a touching answer re-solved with the band of the exact R runs its
+  // stages once more. DistanceResult::iterations counts the hybrid's
+  // iterations plus Enhanced GJK's where its answer is the one reported (an
+  // intersection it certified, or the closer pair of the cross-check).
   int max_iterations = 64;
 };
 
@@ -156,6 +163,12 @@ struct DistanceResult {
   Feature feature_a;
   Feature feature_b;
   int iterations = 0;
+  // Whether a second algorithm ran in this query: for the hybrid, Enhanced
+  // GJK's contact classification (touching or intersecting; not when a
+  // cached contact tetrahedron re-certified intersection in O(1)) or its
+  // cross-check of an answer the hybrid could not certify. Always false for
+  // GJK and Enhanced GJK.
+  bool second_algorithm = false;
 };
 
 }  // namespace proxima
