@@ -178,9 +178,8 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
     capped = r.status == Status::iteration_cap;
     if (capped) {
       // The same band the library uses for touching: 64 u R plus Ae.
-      constexpr double kContactBandUlps = 64.0;
       const double scale = std::max(world_scale(a, pose_a), world_scale(b, pose_b));
-      contact_band = kContactBandUlps * kUnitRoundoff * scale + options.absolute_tolerance;
+      contact_band = proxima::contact_band(scale, options.absolute_tolerance);
     }
   } catch (const QueryError& e) {
     append_error_answer(out, id, line_number, e.what());

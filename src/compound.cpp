@@ -283,7 +283,7 @@ namespace {
 // Upper bound on the largest world coordinate of a body placed at `pose`:
 // |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale.
 double world_magnitude_bound(const CompoundBody& body, const Pose& pose) {
-  return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * body.scale();
+  return magnitude_bound(pose, body.scale());
 }
 
 // Whether (distance, intersecting, pair) orders `r` before the current best:

@@ -20,10 +20,6 @@
 namespace proxima {
 namespace {
 
-// The contact band of the accuracy standard: a distance at or below
-// 64 u R is indistinguishable from contact for doubles of magnitude R.
-constexpr double kContactUlps = 64.0;
-
 // Slack of an answer's certificate (distance - lower_bound) in units of
 // u R_bound: the lower bound's own rounding is a few u R, so a larger gap
 // means the answer was not certified at machine precision.
@@ -37,10 +33,10 @@ constexpr double kCertificateUlps = 32.0;
 // are NaN. Such input is refused by name instead of answered with NaN.
 constexpr double kMaxMagnitude = 0x1p1018;
 
-// Upper bound on the largest coordinate magnitude of a body placed at `pose`:
-// |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale. O(1).
+// Upper bound on the largest coordinate magnitude of a body placed at
+// `pose` (types.h). O(1).
 double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
-  return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * p.scale();
+  return magnitude_bound(pose, p.scale());
 }
 
 // The largest coordinate magnitude of vertex y placed at `pose`.
@@ -121,11 +117,37 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
     throw InvalidInput(what);
   }
   const Pose b_in_a = pose_a.inverse() * pose_b;
-  const double band_bound = kContactUlps * kUnitRoundoff * r_bound + options.absolute_tolerance;
+  const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
   DistanceCache cold;
   DistanceCache& c = cache != nullptr ? *cache : cold;
-  DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
+  // The hybrid stops when no support point improves its feature pair at
+  // machine precision. Near contact on needles and slivers the direction
+  // between two nearly touching features can be too rough for that to mean
+  // the pair is optimal: the answer is then an honest upper bound without a
+  // matching lower bound. Such an uncertified answer is checked by Enhanced
+  // GJK from its own cold start, and the closer of the two pairs of points
+  // (both lie in the hulls) is kept with the larger of the two lower bounds.
+  // Both runs use the same band.
+  const auto solve = [&](double band) {
+    DistanceResult r = run(a, b, b_in_a, options, band, c);
+    if (options.algorithm == Algorithm::hybrid && r.status == Status::separated &&
+        r.distance - r.lower_bound >
+            options.relative_tolerance * r.distance + kCertificateUlps * kUnitRoundoff * r_bound) {
+      DistanceCache second_cache;
+      DistanceResult second = enhanced_gjk_distance(a, b, b_in_a, options, band, second_cache);
+      const double lower = std::max(r.lower_bound, second.lower_bound);
+      if (second.status != Status::iteration_cap && second.distance < r.distance) {
+        second.iterations += r.iterations;
+        r = second;
+      }
+      r.lower_bound = std::min(lower, r.distance);
+      r.second_algorithm = true;
+    }
+    return r;
+  };
+  double band = band_bound;
+  DistanceResult result = solve(band);
   // Most contacts (overlapping bodies) end with a distance of a few
   // roundings: inside the band of a lower bound on R taken from the cached
   // features and support hints, where the exact R could not change the
@@ -135,13 +157,21 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
     const std::array ids_b = {c.vertices_b[0], c.vertices_b[1], c.vertices_b[2], c.hint_b};
     const double r_floor =
         std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
-    return kContactUlps * kUnitRoundoff * r_floor + options.absolute_tolerance;
+    return contact_band(r_floor, options.absolute_tolerance);
   };
+  // A touching answer above the band of the exact R is re-solved with that
+  // band, cross-check included, so that whichever stage answers decides
+  // with it (StatusBand.VertexJustAboveAFaceIsSeparatedOutsideTheExactBand:
+  // the cross-check used the cheap band and turned the refined separated
+  // answer back into touching).
   if (result.status == Status::touching && result.distance > 0.0 &&
       result.distance > band_floor()) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
-    const double band = kContactUlps * kUnitRoundoff * r_exact + options.absolute_tolerance;
-    if (band < band_bound && result.distance > band) result = run(a, b, b_in_a, options, band, c);
+    const double exact_band = contact_band(r_exact, options.absolute_tolerance);
+    if (exact_band < band_bound && result.distance > exact_band) {
+      band = exact_band;
+      result = solve(band);
+    }
   }
   // The hybrid reports contact without telling touching from overlapping.
   // Enhanced GJK's contact search decides it (a direction whose support gap
@@ -154,7 +184,7 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   // with). Otherwise the search starts from the search's last simplex.
   if (options.algorithm == Algorithm::hybrid && result.status == Status::touching) {
     DistanceResult contact;
-    if (encloses_origin_deeply(a, b, b_in_a, band_bound, c.contact_a, c.contact_b)) {
+    if (encloses_origin_deeply(a, b, b_in_a, band, c.contact_a, c.contact_b)) {
       contact.status = Status::intersecting;
       contact.iterations = 0;
     } else {
@@ -163,9 +193,10 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
       contact_cache.hint_b = c.hint_b;
       contact_cache.vertices_a = c.contact_a;
       contact_cache.vertices_b = c.contact_b;
-      contact = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, contact_cache);
+      contact = enhanced_gjk_distance(a, b, b_in_a, options, band, contact_cache);
       c.contact_a = contact_cache.vertices_a;
       c.contact_b = contact_cache.vertices_b;
+      result.second_algorithm = true;
     }
     if (contact.status == Status::intersecting) {
       const Vec3 middle = 0.5 * (result.point_a + result.point_b);
@@ -174,25 +205,6 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
       result.point_a = result.point_b = middle;
       result.iterations += contact.iterations;
     }
-  }
-  // The hybrid stops when no support point improves its feature pair at
-  // machine precision. Near contact on needles and slivers the direction
-  // between two nearly touching features can be too rough for that to mean
-  // the pair is optimal: the answer is then an honest upper bound without a
-  // matching lower bound. Such an uncertified answer is checked by Enhanced
-  // GJK from its own cold start, and the closer of the two pairs of points
-  // (both lie in the hulls) is kept with the larger of the two lower bounds.
-  if (options.algorithm == Algorithm::hybrid && result.status == Status::separated &&
-      result.distance - result.lower_bound > options.relative_tolerance * result.distance +
-                                                 kCertificateUlps * kUnitRoundoff * r_bound) {
-    DistanceCache second_cache;
-    DistanceResult second = enhanced_gjk_distance(a, b, b_in_a, options, band_bound, second_cache);
-    const double lower = std::max(result.lower_bound, second.lower_bound);
-    if (second.status != Status::iteration_cap && second.distance < result.distance) {
-      second.iterations += result.iterations;
-      result = second;
-    }
-    result.lower_bound = std::min(lower, result.distance);
   }
   // Back to the world frame, in place.
   result.point_a = pose_a.apply(result.point_a);

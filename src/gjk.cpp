@@ -39,14 +39,15 @@
 // scale.
 #include "proxima/gjk.h"
 
-#include "proxima/support.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+
+#include "power_of_two.h"
+#include "proxima/support.h"
 
 namespace proxima {
 namespace {
@@ -75,7 +76,7 @@ constexpr std::size_t idx(int i) { return static_cast<std::size_t>(i); }
 
 // A point of the Minkowski difference with the hull vertices it comes from.
 struct SupportPoint {
-  Vec3 w;              // (a_ia - b_ib) / unit, A's frame
+  Vec3 w;  // (a_ia - b_ib) / unit, A's frame
   std::int32_t ia = -1;
   std::int32_t ib = -1;
 };
@@ -84,8 +85,8 @@ struct Simplex {
   std::array<SupportPoint, 4> p;
   std::array<double, 4> lambda{};
   int size = 0;
-  Vec3 v = Vec3::Zero();  // closest point of conv(p) to the origin
-  double vv = 0.0;        // |v|^2
+  Vec3 v = Vec3::Zero();         // closest point of conv(p) to the origin
+  double vv = 0.0;               // |v|^2
   bool encloses_origin = false;  // a tetrahedron with the origin strictly inside
 
   bool contains(std::int32_t ia, std::int32_t ib) const {
@@ -318,7 +319,8 @@ Reduction solve_triangle(const Points& p, int i, int j, int k) {
 // inside exactly when every lambda_m is positive; otherwise the closest
 // point is on a face opposite a vertex whose lambda is not positive (every
 // face of a flat tetrahedron).
-constexpr std::array<std::array<int, 3>, 4> kOppositeFace = {{{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
+constexpr std::array<std::array<int, 3>, 4> kOppositeFace = {
+    {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}}};
 
 Reduction solve_tetrahedron(const Points& p) {
   std::array<double, 4> origin_height{};
@@ -389,10 +391,18 @@ void apply(Simplex& s, const Reduction& r) {
 // Replaces the simplex by the sub-simplex realizing its closest point.
 void solve(Simplex& s) {
   switch (s.size) {
-    case 1: apply(s, single(s.p, 0)); break;
-    case 2: apply(s, solve_segment(s.p, 0, 1)); break;
-    case 3: apply(s, solve_triangle(s.p, 0, 1, 2)); break;
-    default: apply(s, solve_tetrahedron(s.p)); break;
+    case 1:
+      apply(s, single(s.p, 0));
+      break;
+    case 2:
+      apply(s, solve_segment(s.p, 0, 1));
+      break;
+    case 3:
+      apply(s, solve_triangle(s.p, 0, 1, 2));
+      break;
+    default:
+      apply(s, solve_tetrahedron(s.p));
+      break;
   }
 }
 
@@ -406,17 +416,13 @@ struct Frame {
   double unit = 1.0;      // a power of two near the bodies' magnitude
   double inv_unit = 1.0;  // exact reciprocal
 
-  Frame(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& pose) : a(pa), b(pb), b_in_a(pose) {
-    // |R y + t|_inf <= |t|_inf + sqrt(3) |y|_inf bounds B's coordinates in
-    // A's frame without mapping its vertices.
-    const double magnitude =
-        std::max(a.scale(), pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
-    if (magnitude > 0.0 && std::isfinite(magnitude)) {
-      int e = 0;
-      std::frexp(magnitude, &e);
-      unit = std::ldexp(1.0, e);
-      inv_unit = std::ldexp(1.0, -e);
-    }
+  Frame(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& pose)
+      : a(pa), b(pb), b_in_a(pose) {
+    // B's coordinates in A's frame are bounded without mapping its vertices.
+    const detail::PowerOfTwoUnit u =
+        detail::power_of_two_unit(std::max(a.scale(), magnitude_bound(pose, b.scale())));
+    unit = u.unit;
+    inv_unit = u.inverse;
   }
 
   Vec3 b_point(std::int32_t ib) const { return b_in_a.apply(b.vertex(ib)); }
@@ -451,10 +457,20 @@ struct HillClimbSupport {
 // The origin's depth inside the tetrahedron (p0, p1, p2, p3): its smallest
 // distance to the four face planes, each oriented outwards by the centroid
 // and computed as classify_contact computes a face (below). Negative when the
-// origin is outside; the lowest double when the tetrahedron is flat (no face
-// can be oriented). Depth above the contact band certifies intersection:
-// the tetrahedron's points are points of C.
-double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
+// origin is outside. Depth above the contact band tol certifies
+// intersection: the tetrahedron's points are points of C.
+//
+// The orientation must be right for the certificate to hold, and it is
+// decided by the centroid's side of each face: on a nearly flat tetrahedron
+// that side is rounding noise, and a flipped face puts the origin "below"
+// every face (ForeignCache.FlatContactTetrahedronDoesNotCertifyIntersection:
+// a flat base a few bands above a touching apex certified intersection from
+// a warm cache). A tetrahedron holding a ball of radius r has each face's
+// height h_f = 3V/A_f > 6V/A = 2r (a face is smaller than half the surface
+// A), so its centroid is more than h_f/4 > r/2 from every face: one whose
+// centroid is within tol/2 of a face cannot hold the origin deeper than tol,
+// and is refused (the lowest double), as a flat one is.
+double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3, double tol) {
   const std::array<const Vec3*, 4> p = {&p0, &p1, &p2, &p3};
   const Vec3 inner = 0.25 * (p0 + p1 + p2 + p3);
   double depth = std::numeric_limits<double>::max();
@@ -467,7 +483,8 @@ double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& 
       side = -side;
     }
     const double len = nrm.norm();
-    if (!(side > 0.0) || !(len > 0.0)) return std::numeric_limits<double>::lowest();
+    if (!(side > 0.0) || !(len > 0.0) || !(side > 0.5 * tol * len))
+      return std::numeric_limits<double>::lowest();
     depth = std::min(depth, (nrm / len).dot(pi));
   }
   return depth;
@@ -508,8 +525,8 @@ struct ContactFace {
 // query re-checks it in O(1) (encloses_origin_deeply). deep[0].ia stays -1
 // when there is none.
 template <class Support>
-Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations, int max_iterations,
-                        Points& deep) {
+Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations,
+                        int max_iterations, Points& deep) {
   tol = std::max(tol, 0.0);
   std::array<SupportPoint, kMaxContactVertices> sp;
   std::array<Vec3, kMaxContactVertices> p;
@@ -586,7 +603,8 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
         for (int f = 0; f < nf; ++f) {
           const auto& v = faces[idx(f)].v;
           if (v[0] == r || v[1] == r || v[2] == r) continue;
-          const double depth = origin_depth(p[idx(r)], p[idx(v[0])], p[idx(v[1])], p[idx(v[2])]);
+          const double depth =
+              origin_depth(p[idx(r)], p[idx(v[0])], p[idx(v[1])], p[idx(v[2])], tol);
           if (depth > deepest) {
             deepest = depth;
             deep = {sp[idx(r)], sp[idx(v[0])], sp[idx(v[1])], sp[idx(v[2])]};
@@ -631,7 +649,8 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
     }
     nf = kept;
     for (int e = 0; e < ne; ++e) {
-      if (edges[idx(e)][2] == 1 && !add_face(edges[idx(e)][0], edges[idx(e)][1], n)) return Status::touching;
+      if (edges[idx(e)][2] == 1 && !add_face(edges[idx(e)][0], edges[idx(e)][1], n))
+        return Status::touching;
     }
     ++n;
   }
@@ -716,7 +735,8 @@ Feature witness_feature(const ConvexPolytope& poly, const std::array<std::int32_
   }
   const std::int32_t heaviest_id = ids[idx(heaviest)];
   for (int j = 1; j < m; ++j) {  // ascending ids (at most three: insertion)
-    for (int i = j; i > 0 && ids[idx(i - 1)] > ids[idx(i)]; --i) std::swap(ids[idx(i - 1)], ids[idx(i)]);
+    for (int i = j; i > 0 && ids[idx(i - 1)] > ids[idx(i)]; --i)
+      std::swap(ids[idx(i - 1)], ids[idx(i)]);
   }
 
   Feature f;
@@ -753,11 +773,13 @@ Feature witness_feature(const ConvexPolytope& poly, const std::array<std::int32_
 // when it certifies intersection (classify_contact).
 template <class Support>
 DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, double contact_tolerance,
-                       Simplex& simplex, int iterations, Vec3 direction, Support& support, Points& deep) {
+                       Simplex& simplex, int iterations, Vec3 direction, Support& support,
+                       Points& deep) {
   const double tol = contact_tolerance * frame.inv_unit;
   double lower = 0.0;  // certified lower bound, scaled units
   double w_max2 = 0.0;
-  for (int k = 0; k < simplex.size; ++k) w_max2 = std::max(w_max2, simplex.p[idx(k)].w.squaredNorm());
+  for (int k = 0; k < simplex.size; ++k)
+    w_max2 = std::max(w_max2, simplex.p[idx(k)].w.squaredNorm());
   direction = direction.squaredNorm() > 0.0 ? Vec3(direction.normalized()) : Vec3(Vec3::UnitX());
 
   bool contact = false;
@@ -777,7 +799,8 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
     ++iterations;
     w_max2 = std::max(w_max2, w.w.squaredNorm());
     lower = std::max(lower, simplex.v.dot(w.w) / v_norm);
-    if (v_norm - lower <= options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
+    if (v_norm - lower <=
+        options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
       break;
     }
     if (simplex.contains(w.ia, w.ib)) break;  // nothing new: v is exact for this simplex
@@ -796,7 +819,8 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
     // the classification would have certified depth), so that face's
     // closest points are the witnesses. Its barycentric weights of the
     // origin would only give rounding noise from a sliver tetrahedron.
-    if (status == Status::touching && simplex.encloses_origin) apply(simplex, nearest_face(simplex.p));
+    if (status == Status::touching && simplex.encloses_origin)
+      apply(simplex, nearest_face(simplex.p));
   }
 
   // Closest points from the original coordinates (the weights are
@@ -831,7 +855,8 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
     result.point_b = point_b;
     result.distance = ((point_b - point_a) * frame.inv_unit).norm() * frame.unit;
     result.lower_bound = std::clamp(lower * frame.unit, 0.0, result.distance);
-    if (!contact) status = result.distance > contact_tolerance ? Status::separated : Status::touching;
+    if (!contact)
+      status = result.distance > contact_tolerance ? Status::separated : Status::touching;
     if (capped) status = Status::iteration_cap;
     // Within the band the points' difference is rounding noise: keep the
     // last search direction there.
@@ -841,7 +866,8 @@ DistanceResult run_gjk(const Frame& frame, const DistanceOptions& options, doubl
   }
   result.status = status;
   result.feature_a = witness_feature(frame.a, ids_a, simplex.lambda, simplex.size, result.normal);
-  result.feature_b = witness_feature(frame.b, ids_b, simplex.lambda, simplex.size, frame.dir_in_b(-result.normal));
+  result.feature_b =
+      witness_feature(frame.b, ids_b, simplex.lambda, simplex.size, frame.dir_in_b(-result.normal));
   return result;
 }
 
@@ -877,9 +903,9 @@ DistanceResult gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
   return run_gjk(frame, options, contact_tolerance, simplex, 1, direction, support, deep);
 }
 
-DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                                     const DistanceOptions& options, double contact_tolerance,
-                                     DistanceCache& cache) {
+DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b,
+                                     const Pose& b_in_a, const DistanceOptions& options,
+                                     double contact_tolerance, DistanceCache& cache) {
   const Frame frame(a, b, b_in_a);
   const auto valid = [](std::int32_t id, int count) { return id >= 0 && id < count; };
   HillClimbSupport support{frame, valid(cache.hint_a, a.vertex_count()) ? cache.hint_a : 0,
@@ -903,7 +929,8 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   } else {
     solve(simplex);
     direction = -simplex.v;
-    if (!(direction.squaredNorm() > 0.0)) direction = (frame.b_in_a.apply(b.centroid()) - a.centroid()) * frame.inv_unit;
+    if (!(direction.squaredNorm() > 0.0))
+      direction = (frame.b_in_a.apply(b.centroid()) - a.centroid()) * frame.inv_unit;
   }
 
   Points deep;
@@ -932,14 +959,16 @@ bool encloses_origin_deeply(const ConvexPolytope& a, const ConvexPolytope& b, co
                             double contact_tolerance, const std::array<std::int32_t, 4>& ids_a,
                             const std::array<std::int32_t, 4>& ids_b) {
   for (std::size_t k = 0; k < 4; ++k) {
-    if (ids_a[k] < 0 || ids_a[k] >= a.vertex_count() || ids_b[k] < 0 || ids_b[k] >= b.vertex_count()) return false;
+    if (ids_a[k] < 0 || ids_a[k] >= a.vertex_count() || ids_b[k] < 0 ||
+        ids_b[k] >= b.vertex_count())
+      return false;
   }
   // In the units of the GJK simplex, like the contact classification: the
   // same points, the same faces, the same certificate.
   const Frame frame(a, b, b_in_a);
   const double tol = std::max(contact_tolerance, 0.0) * frame.inv_unit;
   const auto w = [&](std::size_t k) { return frame.point(ids_a[k], ids_b[k]).w; };
-  return origin_depth(w(0), w(1), w(2), w(3)) > tol;
+  return origin_depth(w(0), w(1), w(2), w(3), tol) > tol;
 }
 
 }  // namespace proxima

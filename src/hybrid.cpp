@@ -25,12 +25,13 @@
 // direction is rotated into B's frame for B's support search.
 #include "proxima/hybrid.h"
 
-#include "proxima/closest_point.h"
-#include "proxima/support.h"
-
 #include <algorithm>
 #include <cmath>
 #include <optional>
+
+#include "power_of_two.h"
+#include "proxima/closest_point.h"
+#include "proxima/support.h"
 
 namespace proxima {
 namespace {
@@ -101,14 +102,15 @@ Local from_kernel(const ClosestPoints<double>& c) {
 // Barycentric coordinates of x in the tetrahedron t when x lies inside it
 // (signed volumes of the sub-tetrahedra over the whole), nothing otherwise or
 // when the tetrahedron is flat.
-std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Vec3, 4>& t, const Vec3& x) {
+std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Vec3, 4>& t,
+                                                             const Vec3& x) {
   const auto volume = [](const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
     return (p1 - p0).cross(p2 - p0).dot(p3 - p0);
   };
   const double whole = volume(t[0], t[1], t[2], t[3]);
   if (whole == 0.0) return std::nullopt;
-  std::array<double, 4> c = {volume(x, t[1], t[2], t[3]), volume(t[0], x, t[2], t[3]), volume(t[0], t[1], x, t[3]),
-                             volume(t[0], t[1], t[2], x)};
+  std::array<double, 4> c = {volume(x, t[1], t[2], t[3]), volume(t[0], x, t[2], t[3]),
+                             volume(t[0], t[1], x, t[3]), volume(t[0], t[1], t[2], x)};
   for (double& ci : c) {
     if (ci * whole < 0.0) return std::nullopt;
     ci /= whole;
@@ -122,7 +124,8 @@ std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Ve
 // point to the other feature lies on one of the three triangles through the
 // new vertex (the old triangle was the previous answer, which the new vertex
 // improves on), so the minimum over those three is the answer.
-Local local_distance(const FeatureSet& fa, const FeatureSet& fb, const KernelTolerance<double>& tol) {
+Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
+                     const KernelTolerance<double>& tol) {
   if (fa.n <= 3 && fb.n <= 3) {
     return from_kernel(closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol));
   }
@@ -137,17 +140,20 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb, const KernelTol
     Local hit{0.0, other.p[0], other.p[0], 0, 0};
     std::uint8_t tet_bits = 0;
     for (int i = 0; i < 4; ++i) {
-      if ((*inside)[static_cast<std::size_t>(i)] != 0.0) tet_bits = static_cast<std::uint8_t>(tet_bits | (1u << i));
+      if ((*inside)[static_cast<std::size_t>(i)] != 0.0)
+        tet_bits = static_cast<std::uint8_t>(tet_bits | (1u << i));
     }
     hit.active_a = on_a ? tet_bits : std::uint8_t{1};
     hit.active_b = on_a ? std::uint8_t{1} : tet_bits;
     return hit;
   }
-  static constexpr std::array<std::array<int, 3>, 3> kTriangles = {{{0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
+  static constexpr std::array<std::array<int, 3>, 3> kTriangles = {
+      {{0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
   Local best{};
   bool have = false;
   for (const auto& tri : kTriangles) {
-    const std::array<Vec3, 3> pts = {four.p[static_cast<std::size_t>(tri[0])], four.p[static_cast<std::size_t>(tri[1])],
+    const std::array<Vec3, 3> pts = {four.p[static_cast<std::size_t>(tri[0])],
+                                     four.p[static_cast<std::size_t>(tri[1])],
                                      four.p[static_cast<std::size_t>(tri[2])]};
     const ClosestPoints<double> c =
         on_a ? closest_points<double>(pts.data(), 3, other.p.data(), other.n, tol)
@@ -156,7 +162,8 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb, const KernelTol
     const std::uint8_t tri_bits = on_a ? c.active_a : c.active_b;
     std::uint8_t mapped = 0;
     for (int i = 0; i < 3; ++i) {
-      if (tri_bits & (1u << i)) mapped = static_cast<std::uint8_t>(mapped | (1u << tri[static_cast<std::size_t>(i)]));
+      if (tri_bits & (1u << i))
+        mapped = static_cast<std::uint8_t>(mapped | (1u << tri[static_cast<std::size_t>(i)]));
     }
     best = from_kernel(c);
     if (on_a) {
@@ -238,7 +245,8 @@ Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb, const Vec3& w,
 // Loads a cached feature (ids range-checked, duplicates dropped). Returns
 // false when nothing usable is cached.
 template <class MapPoint>
-bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f, MapPoint map_point) {
+bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f,
+                  MapPoint map_point) {
   f.n = 0;
   for (int i = 0; i < 3; ++i) {
     const std::int32_t v = cached[static_cast<std::size_t>(i)];
@@ -256,7 +264,8 @@ bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureS
 Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& toward,
                 const std::array<std::int32_t, 4>& cached, std::int32_t cached_face) {
   Feature out;
-  for (int i = 0; i < f.n && i < 3; ++i) out.vertices[static_cast<std::size_t>(i)] = f.id[static_cast<std::size_t>(i)];
+  for (int i = 0; i < f.n && i < 3; ++i)
+    out.vertices[static_cast<std::size_t>(i)] = f.id[static_cast<std::size_t>(i)];
   if (f.n <= 1) {
     out.type = FeatureType::vertex;
     return out;
@@ -268,13 +277,27 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
     return out;
   }
   out.type = FeatureType::face;
-  if (cached_face >= 0 && poly.dimension() == 3 && cached[0] == out.vertices[0] && cached[1] == out.vertices[1] &&
+  // The cache may come from another pair (DistanceCache's contract): its
+  // face is used only when it is a face of this hull holding every vertex
+  // of the feature (ForeignCache.WitnessFacesAreThoseOfTheQueriedHulls: a
+  // foreign face id, up to 15 on a 4-face tetrahedron, was returned).
+  if (cached_face >= 0 && cached_face < poly.face_count() && poly.dimension() == 3 &&
+      cached[0] == out.vertices[0] && cached[1] == out.vertices[1] &&
       cached[2] == out.vertices[2]) {
-    out.face = cached_face;
-    return out;
+    const auto verts = poly.face(cached_face);
+    bool holds_all = true;
+    for (int i = 0; i < f.n && holds_all; ++i) {
+      holds_all =
+          std::find(verts.begin(), verts.end(), f.id[static_cast<std::size_t>(i)]) != verts.end();
+    }
+    if (holds_all) {
+      out.face = cached_face;
+      return out;
+    }
   }
   const auto faces = poly.adjacency_faces();
-  const auto begin = static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v0)]);
+  const auto begin =
+      static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v0)]);
   double best_alignment = -2.0;
   for (std::size_t k = begin; k < begin + nbrs.size(); ++k) {
     const std::int32_t face = faces[k];
@@ -282,7 +305,8 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
     const auto verts = poly.face(face);
     bool holds_all = true;
     for (int i = 1; i < f.n; ++i) {
-      holds_all = holds_all && std::find(verts.begin(), verts.end(), f.id[static_cast<std::size_t>(i)]) != verts.end();
+      holds_all = holds_all && std::find(verts.begin(), verts.end(),
+                                         f.id[static_cast<std::size_t>(i)]) != verts.end();
     }
     if (!holds_all) continue;
     // In a solid, two faces share at most one edge, so the face holding a
@@ -306,8 +330,8 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
 // The unscaled instance is the hot path and multiplies by nothing.
 template <bool kScaled>
 DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                          const DistanceOptions& options, double contact_tolerance, DistanceCache& cache,
-                          double r_local, double scale) {
+                          const DistanceOptions& options, double contact_tolerance,
+                          DistanceCache& cache, double r_local, double scale) {
   const Mat3& rot = b_in_a.rotation;
   const Vec3& tr = b_in_a.translation;
   const auto b_point = [&](std::int32_t v) -> Vec3 {
@@ -395,7 +419,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
         nb.push(hint_b, pb);
       }
       const Local next = local_distance(na, nb, tol);
-      if (!(next.distance_squared < loc.distance_squared)) continue;  // unstable: no progress at this precision
+      if (!(next.distance_squared < loc.distance_squared))
+        continue;  // unstable: no progress at this precision
       na.reduce(next.active_a);
       nb.reduce(next.active_b);
       fa = na;
@@ -422,14 +447,17 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     result.status = Status::separated;
   }
   result.feature_a = witness(a, fa, result.normal, cache.vertices_a, cache.face_a);
-  result.feature_b = witness(b, fb, Vec3(-(rot.transpose() * result.normal)), cache.vertices_b, cache.face_b);
+  result.feature_b =
+      witness(b, fb, Vec3(-(rot.transpose() * result.normal)), cache.vertices_b, cache.face_b);
   cache.face_a = result.feature_a.face;
   cache.face_b = result.feature_b.face;
 
   cache.vertices_a = {-1, -1, -1, -1};
   cache.vertices_b = {-1, -1, -1, -1};
-  for (int i = 0; i < fa.n && i < 3; ++i) cache.vertices_a[static_cast<std::size_t>(i)] = fa.id[static_cast<std::size_t>(i)];
-  for (int i = 0; i < fb.n && i < 3; ++i) cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
+  for (int i = 0; i < fa.n && i < 3; ++i)
+    cache.vertices_a[static_cast<std::size_t>(i)] = fa.id[static_cast<std::size_t>(i)];
+  for (int i = 0; i < fb.n && i < 3; ++i)
+    cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
   cache.hint_a = hint_a;
   cache.hint_b = hint_b;
   if constexpr (kScaled) {
@@ -445,17 +473,17 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
 }  // namespace
 
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                               const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
-  // R in A's frame: B's coordinates are bounded by |t| + |y| <= |t|_inf + sqrt(3) scale_B per axis.
-  const double r_local = std::max(a.scale(), b_in_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
-  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) || !std::isfinite(r_local))
-      [[likely]] {
+                               const DistanceOptions& options, double contact_tolerance,
+                               DistanceCache& cache) {
+  // R in A's frame, B's coordinates bounded without mapping its vertices.
+  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
+  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
+      !std::isfinite(r_local)) [[likely]] {
     return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
   }
-  int exponent = 0;
-  std::frexp(r_local, &exponent);
-  const double scale = std::ldexp(1.0, -exponent);
-  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale, scale);
+  const double scale = detail::power_of_two_unit(r_local).inverse;
+  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale,
+                          scale);
 }
 
 }  // namespace proxima

@@ -45,11 +45,6 @@ std::size_t slot(BodyId id) { return static_cast<std::size_t>(id); }
 
 std::string name(BodyId id) { return "body " + std::to_string(id); }
 
-// The magnitude bound of a body at `pose` whose coordinates in its own
-// frame are at most `scale`: |R y + t|_inf <= |t|_inf + |y|_2.
-double magnitude_bound(const Pose& pose, double scale) {
-  return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * scale;
-}
 
 Aabb inflated(const Aabb& box, double by) {
   return {(box.lo.array() - by).matrix(), (box.hi.array() + by).matrix()};

@@ -5,10 +5,7 @@
 // (pose.h), feature ids, statuses and results.
 #pragma once
 
-#include "proxima/pose.h"
-
 #include <Eigen/Geometry>
-
 #include <array>
 #include <bit>
 #include <cmath>
@@ -16,7 +13,28 @@
 #include <stdexcept>
 #include <string>
 
+#include "proxima/pose.h"
+
 namespace proxima {
+
+// The shared rules of the accuracy standard (DESIGN.md), defined once.
+//
+// The contact band: a distance at or below 64 u R (plus the caller's
+// absolute tolerance Ae) is indistinguishable from contact for doubles of
+// magnitude R, R being the largest coordinate magnitude of the two bodies in
+// the frame of the query.
+inline constexpr double kContactBandUlps = 64.0;
+inline double contact_band(double magnitude, double absolute_tolerance = 0.0) {
+  return kContactBandUlps * kUnitRoundoff * magnitude + absolute_tolerance;
+}
+
+// The magnitude bound: an upper bound on the largest coordinate magnitude of
+// a body whose coordinates in its own frame are at most `scale` (|y|_inf),
+// placed at `pose`: |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3)
+// scale. O(1).
+inline double magnitude_bound(const Pose& pose, double scale) {
+  return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * scale;
+}
 
 // Which kind of boundary piece of a hull realizes a closest point.
 enum class FeatureType : std::uint8_t { vertex, edge, face };
@@ -29,7 +47,9 @@ struct Feature {
   std::array<std::int32_t, 3> vertices = {-1, -1, -1};
   std::int32_t face = -1;
 
-  int vertex_count() const { return vertices[2] >= 0 ? 3 : vertices[1] >= 0 ? 2 : vertices[0] >= 0 ? 1 : 0; }
+  int vertex_count() const {
+    return vertices[2] >= 0 ? 3 : vertices[1] >= 0 ? 2 : vertices[0] >= 0 ? 1 : 0;
+  }
 };
 
 enum class Status : std::uint8_t {
@@ -41,19 +61,26 @@ enum class Status : std::uint8_t {
 
 inline const char* to_string(Status s) {
   switch (s) {
-    case Status::separated: return "separated";
-    case Status::touching: return "touching";
-    case Status::intersecting: return "intersecting";
-    case Status::iteration_cap: return "iteration_cap";
+    case Status::separated:
+      return "separated";
+    case Status::touching:
+      return "touching";
+    case Status::intersecting:
+      return "intersecting";
+    case Status::iteration_cap:
+      return "iteration_cap";
   }
   return "unknown";
 }
 
 inline const char* to_string(FeatureType t) {
   switch (t) {
-    case FeatureType::vertex: return "vertex";
-    case FeatureType::edge: return "edge";
-    case FeatureType::face: return "face";
+    case FeatureType::vertex:
+      return "vertex";
+    case FeatureType::edge:
+      return "edge";
+    case FeatureType::face:
+      return "face";
   }
   return "unknown";
 }
@@ -68,9 +95,12 @@ enum class Algorithm : std::uint8_t {
 
 inline const char* to_string(Algorithm a) {
   switch (a) {
-    case Algorithm::hybrid: return "hybrid";
-    case Algorithm::gjk: return "gjk";
-    case Algorithm::enhanced_gjk: return "enhanced_gjk";
+    case Algorithm::hybrid:
+      return "hybrid";
+    case Algorithm::gjk:
+      return "gjk";
+    case Algorithm::enhanced_gjk:
+      return "enhanced_gjk";
   }
   return "unknown";
 }
@@ -83,6 +113,13 @@ struct DistanceOptions {
   // distance at or below it is reported as touching.
   double absolute_tolerance = 0.0;
   // Hard cap on iterations; a query that reaches it says so in its status.
+  // It bounds each stage of a query, not their sum: the hybrid's loop, and
+  // then Enhanced GJK's contact classification or its cross-check of an
+  // uncertified answer (DistanceResult::second_algorithm), each get the full
+  // cap; a touching answer re-solved with the band of the exact R runs its
+  // stages once more. DistanceResult::iterations counts the hybrid's
+  // iterations plus Enhanced GJK's where its answer is the one reported (an
+  // intersection it certified, or the closer pair of the cross-check).
   int max_iterations = 64;
 };
 
@@ -118,14 +155,20 @@ struct DistanceCache {
 
 struct DistanceResult {
   Status status = Status::separated;
-  double distance = 0.0;     // upper bound: |point_a - point_b|
-  double lower_bound = 0.0;  // certified: lower_bound <= exact distance (up to rounding)
+  double distance = 0.0;        // upper bound: |point_a - point_b|
+  double lower_bound = 0.0;     // certified: lower_bound <= exact distance (up to rounding)
   Vec3 point_a = Vec3::Zero();  // closest point on A, world frame
   Vec3 point_b = Vec3::Zero();  // closest point on B, world frame
   Vec3 normal = Vec3::UnitX();  // unit, from A towards B
   Feature feature_a;
   Feature feature_b;
   int iterations = 0;
+  // Whether a second algorithm ran in this query: for the hybrid, Enhanced
+  // GJK's contact classification (touching or intersecting; not when a
+  // cached contact tetrahedron re-certified intersection in O(1)) or its
+  // cross-check of an answer the hybrid could not certify. Always false for
+  // GJK and Enhanced GJK.
+  bool second_algorithm = false;
 };
 
 }  // namespace proxima
