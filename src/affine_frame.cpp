@@ -4,7 +4,7 @@
 // Layer 3 internals: see affine_frame.h.
 #include "affine_frame.h"
 
-#include "pow2_scaling.h"
+#include "power_of_two.h"
 #include "proxima/detail/exact_predicates.h"
 
 namespace proxima::detail {

@@ -26,6 +26,8 @@
 // the minimum over the tested pairs, each within the accuracy standard.
 #include "proxima/compound.h"
 
+#include "power_of_two.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -76,17 +78,8 @@ constexpr double kPruneRelativeUlps = 64.0;
 // produce (a few to a few dozen pairs) while bounding the cache's size.
 constexpr std::size_t kNearCapacity = 64;
 
-// The exponent e with max|x| < 2^e (0 for zero), and p * 2^e per component
-// through ldexp: exact scaling that never overflows through 2^e itself.
-int magnitude_exponent(double max_abs) {
-  if (max_abs == 0.0) return 0;
-  int e = 0;
-  std::frexp(max_abs, &e);
-  return e;
-}
-Vec3 times_pow2(const Vec3& p, int e) {
-  return {std::ldexp(p.x(), e), std::ldexp(p.y(), e), std::ldexp(p.z(), e)};
-}
+using detail::magnitude_exponent;
+using detail::times_pow2;
 
 // |p - q| with no intermediate overflow or underflow of the squares: the
 // difference of the halves is formed (no overflow even for opposite

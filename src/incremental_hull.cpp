@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "pow2_scaling.h"
+#include "power_of_two.h"
 #include "proxima/detail/exact_predicates.h"
 
 namespace proxima::detail {

@@ -10,7 +10,7 @@
 #include <numeric>
 #include <utility>
 
-#include "pow2_scaling.h"
+#include "power_of_two.h"
 #include "proxima/detail/exact_predicates.h"
 
 namespace proxima::detail {

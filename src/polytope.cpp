@@ -35,7 +35,7 @@
 #include "half_edges.h"
 #include "incremental_hull.h"
 #include "polygon_hull.h"
-#include "pow2_scaling.h"
+#include "power_of_two.h"
 #include "proxima/detail/exact_predicates.h"
 
 namespace proxima {

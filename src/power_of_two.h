@@ -1,15 +1,42 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Power-of-two scaling, one definition for the algorithms that work in units
-// near the bodies' magnitude (GJK, the hybrid): multiplying by a power of
-// two is exact, so the scaled problem has the same answer.
+// Power-of-two scaling, one definition for every part that works in units
+// near the bodies' magnitude: the hull build (its heuristics, farthest
+// points and Newell sums, run on scaled copies so that no square
+// overflows; exact decisions use the original doubles), the compound
+// hierarchy's spheres, GJK and the hybrid. Multiplying by a power of two is
+// exact, so the scaled problem has the same answer.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <span>
+
+#include "proxima/types.h"
 
 namespace proxima::detail {
+
+// The exponent e with max|x| < 2^e (0 for an all-zero input).
+inline int magnitude_exponent(double max_abs) {
+  if (max_abs == 0.0) return 0;
+  int e = 0;
+  std::frexp(max_abs, &e);
+  return e;
+}
+
+// p * 2^e per component, through ldexp: exact unless a component underflows,
+// and never through the factor 2^e itself, which overflows when |e| > 1023
+// (inputs near the largest doubles, or subnormal ones).
+inline Vec3 times_pow2(const Vec3& p, int e) {
+  return {std::ldexp(p.x(), e), std::ldexp(p.y(), e), std::ldexp(p.z(), e)};
+}
+
+inline double max_abs_coordinate(std::span<const Vec3> pts) {
+  double m = 0.0;
+  for (const Vec3& p : pts) m = std::max(m, p.cwiseAbs().maxCoeff());
+  return m;
+}
 
 // The largest exponent e of an inverse unit 2^e. A magnitude in the
 // subnormal range (below 2^-1022) would need up to 2^1074, which overflows

@@ -108,10 +108,13 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
       if (system.rfind("proxima", 0) == 0) {
         const int within = std::stoi(row.at("within_standard"));
         // The full run's figures at HEAD of issue 9: the hybrid 100% on
-        // both; Enhanced GJK and GJK 100% on experiment 2 and 1,098 of
-        // 1,100 on experiment 1 (the two cases above).
+        // both; Enhanced GJK and GJK 100% on experiment 2 and 1,094 of
+        // 1,100 on experiment 1 (since the exact incremental hulls: 6 cases
+        // of distance 2e-22 between edges of 1e-23, relative errors
+        // 1.2e-12 to 9.5e-11 against the standard's 1e-12; 2 cases on the
+        // Qhull-built hulls before). The baselines' gap, not the hybrid's.
         const int known_gjk_misses =
-            system != "proxima hybrid" && row.at("experiment") == "experiment 1" ? 2 : 0;
+            system != "proxima hybrid" && row.at("experiment") == "experiment 1" ? 6 : 0;
         EXPECT_GE(within, cases - known_gjk_misses) << row.at("experiment") << " " << system;
         EXPECT_EQ(std::stoi(row.at("crash")) + std::stoi(row.at("hang")) + std::stoi(row.at("nan")),
                   0);
