@@ -354,6 +354,9 @@ PYBIND11_MODULE(proxima, m) {
       .def_readonly("feature_a", &DistanceResult::feature_a, "Witness feature on A (hull ids).")
       .def_readonly("feature_b", &DistanceResult::feature_b, "Witness feature on B (hull ids).")
       .def_readonly("iterations", &DistanceResult::iterations, "Iterations the algorithm ran.")
+      .def_readonly("second_algorithm", &DistanceResult::second_algorithm,
+                    "True when the hybrid needed Enhanced GJK (contact classification or a "
+                    "cross-check of an uncertified answer).")
       .def("__repr__", [](const DistanceResult& r) {
         return std::string("proxima.DistanceResult(status='") + to_string(r.status) +
                "', distance=" + py::repr(py::float_(r.distance)).cast<std::string>() + ")";
