@@ -26,8 +26,6 @@
 // the minimum over the tested pairs, each within the accuracy standard.
 #include "proxima/compound.h"
 
-#include "power_of_two.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,6 +34,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "power_of_two.h"
 #include "proxima/distance.h"
 
 namespace proxima {
@@ -436,8 +435,11 @@ class Search {
     if (it != old_near_.end() && it->piece_a == pa && it->piece_b == pb) t.entry.cache = it->cache;
     const CompoundPiece& piece_a = a_.piece(pa);
     const CompoundPiece& piece_b = b_.piece(pb);
-    const DistanceResult r = distance(*piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope,
-                                      pose_b_ * piece_b.pose, options_, &t.entry.cache);
+    // Both factors are under the pose contract (checked where the body and
+    // this query took them), and so is their product: not checked again.
+    const DistanceResult r = detail::distance_of_rigid_poses(
+        *piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope, pose_b_ * piece_b.pose,
+        options_, &t.entry.cache);
     t.distance = r.distance;
     if (!have_best_ || better(r, pa, pb, best_)) {
       take(best_, r, pa, pb);

@@ -84,12 +84,21 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
                         const Pose& pose_b, const DistanceOptions& options, DistanceCache* cache) {
   // The poses as the contract takes them (proxima/pose.h): the caller's own
-  // when rigid to machine precision, else once more with re-orthonormalized
-  // copies (which are), or the contract's refusal.
+  // when rigid to machine precision, else re-orthonormalized copies, or the
+  // contract's refusal.
   if (!detail::is_rigid(pose_a) || !detail::is_rigid(pose_b)) [[unlikely]] {
-    return distance(a, checked_pose(pose_a, "distance: pose_a"), b,
-                    checked_pose(pose_b, "distance: pose_b"), options, cache);
+    return detail::distance_of_rigid_poses(a, checked_pose(pose_a, "distance: pose_a"), b,
+                                           checked_pose(pose_b, "distance: pose_b"), options,
+                                           cache);
   }
+  return detail::distance_of_rigid_poses(a, pose_a, b, pose_b, options, cache);
+}
+
+namespace detail {
+
+DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
+                                       const ConvexPolytope& b, const Pose& pose_b,
+                                       const DistanceOptions& options, DistanceCache* cache) {
   if (!(options.relative_tolerance >= 0.0) || !(options.absolute_tolerance >= 0.0) ||
       !std::isfinite(options.relative_tolerance) || !std::isfinite(options.absolute_tolerance)) {
     throw InvalidInput(
@@ -213,4 +222,5 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   return result;
 }
 
+}  // namespace detail
 }  // namespace proxima

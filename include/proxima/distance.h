@@ -25,4 +25,14 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
                         const Pose& pose_b, const DistanceOptions& options = {},
                         DistanceCache* cache = nullptr);
 
+namespace detail {
+// distance() for poses already under the contract of proxima/pose.h (checked
+// and, where needed, re-orthonormalized by the caller: a Scene's stored
+// poses, a compound's placed pieces), so that the check is not paid again
+// on every query of a traversal or a step.
+DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
+                                       const ConvexPolytope& b, const Pose& pose_b,
+                                       const DistanceOptions& options, DistanceCache* cache);
+}  // namespace detail
+
 }  // namespace proxima
