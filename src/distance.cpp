@@ -3,8 +3,9 @@
 //
 // The query API: checks the poses, moves the problem into A's frame (only
 // B's relative pose is formed, never transformed vertex arrays), picks the
-// contact band from the accuracy standard, runs the chosen algorithm and maps
-// its answer back to the world frame.
+// contact band from the accuracy standard, runs the chosen algorithm (whole:
+// the hybrid's cross-check and contact classification are its own,
+// proxima/contact.h) and maps its answer back to the world frame.
 #include "proxima/distance.h"
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include "proxima/gjk.h"
@@ -19,11 +21,6 @@
 
 namespace proxima {
 namespace {
-
-// Slack of an answer's certificate (distance - lower_bound) in units of
-// u R_bound: the lower bound's own rounding is a few u R, so a larger gap
-// means the answer was not certified at machine precision.
-constexpr double kCertificateUlps = 32.0;
 
 // Largest coordinate magnitude (bounded as below) accepted. The algorithms
 // take differences of coordinates and map B into A's frame (|R y + t| up
@@ -79,33 +76,25 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   return hybrid_distance(a, b, b_in_a, options, contact_tolerance, cache);
 }
 
-}  // namespace
-
-DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                        const Pose& pose_b, const DistanceOptions& options, DistanceCache* cache) {
-  // The poses as the contract takes them (proxima/pose.h): the caller's own
-  // when rigid to machine precision, else re-orthonormalized copies, or the
-  // contract's refusal.
-  if (!detail::is_rigid(pose_a) || !detail::is_rigid(pose_b)) [[unlikely]] {
-    return detail::distance_of_rigid_poses(a, checked_pose(pose_a, "distance: pose_a"), b,
-                                           checked_pose(pose_b, "distance: pose_b"), options,
-                                           cache);
-  }
-  return detail::distance_of_rigid_poses(a, pose_a, b, pose_b, options, cache);
+// B's pose in A's frame, pose_a^-1 pose_b, formed directly (the transpose
+// is the inverse of a rotation under the pose contract).
+Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
+  return {Mat3(pose_a.rotation.transpose() * pose_b.rotation),
+          Vec3(pose_a.rotation.transpose() * (pose_b.translation - pose_a.translation))};
 }
 
-namespace detail {
-
-DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
-                                       const ConvexPolytope& b, const Pose& pose_b,
-                                       const DistanceOptions& options, DistanceCache* cache) {
+// The query for poses under the contract; inlined into both entry points.
+inline DistanceResult distance_in_frame(const ConvexPolytope& a, const Pose& pose_a,
+                                        const ConvexPolytope& b, const Pose& pose_b,
+                                        const DistanceOptions& options, DistanceCache* cache) {
   if (!(options.relative_tolerance >= 0.0) || !(options.absolute_tolerance >= 0.0) ||
-      !std::isfinite(options.relative_tolerance) || !std::isfinite(options.absolute_tolerance)) {
+      !std::isfinite(options.relative_tolerance) || !std::isfinite(options.absolute_tolerance))
+      [[unlikely]] {
     throw InvalidInput(
         "distance: options.relative_tolerance and options.absolute_tolerance must be finite and >= "
         "0");
   }
-  if (options.max_iterations < 1) {
+  if (options.max_iterations < 1) [[unlikely]] {
     throw InvalidInput("distance: options.max_iterations must be at least 1");
   }
 
@@ -125,38 +114,12 @@ DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose
         kMaxMagnitude);
     throw InvalidInput(what);
   }
-  const Pose b_in_a = pose_a.inverse() * pose_b;
+  const Pose b_in_a = relative_pose(pose_a, pose_b);
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
-  DistanceCache cold;
-  DistanceCache& c = cache != nullptr ? *cache : cold;
-  // The hybrid stops when no support point improves its feature pair at
-  // machine precision. Near contact on needles and slivers the direction
-  // between two nearly touching features can be too rough for that to mean
-  // the pair is optimal: the answer is then an honest upper bound without a
-  // matching lower bound. Such an uncertified answer is checked by Enhanced
-  // GJK from its own cold start, and the closer of the two pairs of points
-  // (both lie in the hulls) is kept with the larger of the two lower bounds.
-  // Both runs use the same band.
-  const auto solve = [&](double band) {
-    DistanceResult r = run(a, b, b_in_a, options, band, c);
-    if (options.algorithm == Algorithm::hybrid && r.status == Status::separated &&
-        r.distance - r.lower_bound >
-            options.relative_tolerance * r.distance + kCertificateUlps * kUnitRoundoff * r_bound) {
-      DistanceCache second_cache;
-      DistanceResult second = enhanced_gjk_distance(a, b, b_in_a, options, band, second_cache);
-      const double lower = std::max(r.lower_bound, second.lower_bound);
-      if (second.status != Status::iteration_cap && second.distance < r.distance) {
-        second.iterations += r.iterations;
-        r = second;
-      }
-      r.lower_bound = std::min(lower, r.distance);
-      r.second_algorithm = true;
-    }
-    return r;
-  };
-  double band = band_bound;
-  DistanceResult result = solve(band);
+  std::optional<DistanceCache> cold;
+  DistanceCache& c = cache != nullptr ? *cache : cold.emplace();
+  DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
   // Most contacts (overlapping bodies) end with a distance of a few
   // roundings: inside the band of a lower bound on R taken from the cached
   // features and support hints, where the exact R could not change the
@@ -169,50 +132,17 @@ DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose
     return contact_band(r_floor, options.absolute_tolerance);
   };
   // A touching answer above the band of the exact R is re-solved with that
-  // band, cross-check included, so that whichever stage answers decides
-  // with it (StatusBand.VertexJustAboveAFaceIsSeparatedOutsideTheExactBand:
-  // the cross-check used the cheap band and turned the refined separated
-  // answer back into touching).
+  // band, the algorithm's cross-check and contact classification included,
+  // so that whichever stage answers decides with it
+  // (StatusBand.VertexJustAboveAFaceIsSeparatedOutsideTheExactBand: the
+  // cross-check used the cheap band and turned the refined separated answer
+  // back into touching).
   if (result.status == Status::touching && result.distance > 0.0 &&
       result.distance > band_floor()) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
     const double exact_band = contact_band(r_exact, options.absolute_tolerance);
     if (exact_band < band_bound && result.distance > exact_band) {
-      band = exact_band;
-      result = solve(band);
-    }
-  }
-  // The hybrid reports contact without telling touching from overlapping.
-  // Enhanced GJK's contact search decides it (a direction whose support gap
-  // is within the band: touching; a polytope inside A - B holding a ball of
-  // the band's radius around the origin: intersecting); undecided within the
-  // iteration cap counts as touching, the distance being in the band anyway.
-  // Tracking: the search's last tetrahedron around the origin is kept in the
-  // cache; if it still holds the origin deeper than the band, intersection
-  // is certified without a search (the same certificate the search ends
-  // with). Otherwise the search starts from the search's last simplex.
-  if (options.algorithm == Algorithm::hybrid && result.status == Status::touching) {
-    DistanceResult contact;
-    if (encloses_origin_deeply(a, b, b_in_a, band, c.contact_a, c.contact_b)) {
-      contact.status = Status::intersecting;
-      contact.iterations = 0;
-    } else {
-      DistanceCache contact_cache;
-      contact_cache.hint_a = c.hint_a;
-      contact_cache.hint_b = c.hint_b;
-      contact_cache.vertices_a = c.contact_a;
-      contact_cache.vertices_b = c.contact_b;
-      contact = enhanced_gjk_distance(a, b, b_in_a, options, band, contact_cache);
-      c.contact_a = contact_cache.vertices_a;
-      c.contact_b = contact_cache.vertices_b;
-      result.second_algorithm = true;
-    }
-    if (contact.status == Status::intersecting) {
-      const Vec3 middle = 0.5 * (result.point_a + result.point_b);
-      result.status = Status::intersecting;
-      result.distance = 0.0;
-      result.point_a = result.point_b = middle;
-      result.iterations += contact.iterations;
+      result = run(a, b, b_in_a, options, exact_band, c);
     }
   }
   // Back to the world frame, in place.
@@ -220,6 +150,28 @@ DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose
   result.point_b = pose_a.apply(result.point_b);
   result.normal = pose_a.rotation * result.normal;
   return result;
+}
+
+}  // namespace
+
+DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                        const Pose& pose_b, const DistanceOptions& options, DistanceCache* cache) {
+  // The poses as the contract takes them (proxima/pose.h): the caller's own
+  // when rigid to machine precision, else re-orthonormalized copies, or the
+  // contract's refusal.
+  if (!detail::is_rigid(pose_a) || !detail::is_rigid(pose_b)) [[unlikely]] {
+    return distance_in_frame(a, checked_pose(pose_a, "distance: pose_a"), b,
+                             checked_pose(pose_b, "distance: pose_b"), options, cache);
+  }
+  return distance_in_frame(a, pose_a, b, pose_b, options, cache);
+}
+
+namespace detail {
+
+DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
+                                       const ConvexPolytope& b, const Pose& pose_b,
+                                       const DistanceOptions& options, DistanceCache* cache) {
+  return distance_in_frame(a, pose_a, b, pose_b, options, cache);
 }
 
 }  // namespace detail

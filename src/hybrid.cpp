@@ -31,6 +31,7 @@
 
 #include "power_of_two.h"
 #include "proxima/closest_point.h"
+#include "proxima/contact.h"
 #include "proxima/support.h"
 
 namespace proxima {
@@ -470,6 +471,16 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   return result;
 }
 
+// The hybrid on coordinates times the power of two that brings R in A's
+// frame near 1 (outside 2^-64..2^64 squares would overflow or underflow).
+DistanceResult run_scaled(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                          const DistanceOptions& options, double contact_tolerance,
+                          DistanceCache& cache, double r_local) {
+  const double scale = detail::power_of_two_unit(r_local).inverse;
+  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale,
+                          scale);
+}
+
 }  // namespace
 
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
@@ -477,13 +488,19 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
                                DistanceCache& cache) {
   // R in A's frame, B's coordinates bounded without mapping its vertices.
   const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
-  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
-      !std::isfinite(r_local)) [[likely]] {
-    return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
-  }
-  const double scale = detail::power_of_two_unit(r_local).inverse;
-  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale,
-                          scale);
+  DistanceResult result =
+      (r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
+              !std::isfinite(r_local)
+          ? run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0)
+          : run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
+  // What the first answer may still need (proxima/contact.h): the hybrid
+  // reports contact without telling touching from overlapping, and an
+  // answer it could not certify is cross-checked.
+  if (needs_cross_check(result, options, r_local)) [[unlikely]]
+    cross_check_separation(a, b, b_in_a, options, contact_tolerance, result);
+  if (result.status == Status::touching)
+    classify_contact(a, b, b_in_a, options, contact_tolerance, cache, result);
+  return result;
 }
 
 }  // namespace proxima

@@ -1,7 +1,7 @@
 // Tracked queries of pairs in contact: the contact classification (touching
 // or intersecting) keeps a tetrahedron of the Minkowski difference around
 // the origin in the DistanceCache and re-certifies it in O(1) while the
-// bodies overlap (distance.cpp, gjk.cpp's encloses_origin_deeply).
+// bodies overlap (contact.cpp, gjk.cpp's encloses_origin_deeply).
 //
 // What must hold: a tracked query says what a cold one says, status for
 // status, with distances within the accuracy standard, along sequences that

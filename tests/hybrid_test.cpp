@@ -6,8 +6,7 @@
 // The exact-oracle accuracy suite for all three algorithms is
 // distance_accuracy_test.cpp; here the reference is a brute force in double
 // over all feature pairs, enough for well-conditioned random cases.
-#include "proxima/closest_point.h"
-#include "proxima/distance.h"
+#include "proxima/hybrid.h"
 
 #include <gtest/gtest.h>
 
@@ -15,13 +14,17 @@
 #include <random>
 #include <vector>
 
+#include "proxima/closest_point.h"
+#include "proxima/distance.h"
+
 namespace proxima {
 namespace {
 
 std::vector<Vec3> box(const Vec3& half) {
   std::vector<Vec3> pts;
   for (int i = 0; i < 8; ++i) {
-    pts.emplace_back((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(), (i & 4 ? 1 : -1) * half.z());
+    pts.emplace_back((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(),
+                     (i & 4 ? 1 : -1) * half.z());
   }
   return pts;
 }
@@ -39,14 +42,18 @@ std::vector<Vec3> sphere_points(int n, std::uint32_t seed, double radius = 1.0) 
 
 // Brute force over all vertex/edge/triangle pairs of the two hulls, in
 // double: the slow obvious twin for well-conditioned cases.
-double brute_force_distance(const ConvexPolytope& a, const Pose& pa, const ConvexPolytope& b, const Pose& pb) {
+double brute_force_distance(const ConvexPolytope& a, const Pose& pa, const ConvexPolytope& b,
+                            const Pose& pb) {
   std::vector<std::vector<Vec3>> fa;
   std::vector<std::vector<Vec3>> fb;
-  const auto collect = [](const ConvexPolytope& p, const Pose& pose, std::vector<std::vector<Vec3>>& out) {
+  const auto collect = [](const ConvexPolytope& p, const Pose& pose,
+                          std::vector<std::vector<Vec3>>& out) {
     for (int v = 0; v < p.vertex_count(); ++v) out.push_back({pose.apply(p.vertex(v))});
-    for (const auto& e : p.edges()) out.push_back({pose.apply(p.vertex(e[0])), pose.apply(p.vertex(e[1]))});
+    for (const auto& e : p.edges())
+      out.push_back({pose.apply(p.vertex(e[0])), pose.apply(p.vertex(e[1]))});
     for (const auto& t : p.triangles()) {
-      out.push_back({pose.apply(p.vertex(t[0])), pose.apply(p.vertex(t[1])), pose.apply(p.vertex(t[2]))});
+      out.push_back(
+          {pose.apply(p.vertex(t[0])), pose.apply(p.vertex(t[1])), pose.apply(p.vertex(t[2]))});
     }
   };
   collect(a, pa, fa);
@@ -54,7 +61,8 @@ double brute_force_distance(const ConvexPolytope& a, const Pose& pa, const Conve
   double best = INFINITY;
   for (const auto& x : fa) {
     for (const auto& y : fb) {
-      const auto c = closest_points<double>(x.data(), static_cast<int>(x.size()), y.data(), static_cast<int>(y.size()));
+      const auto c = closest_points<double>(x.data(), static_cast<int>(x.size()), y.data(),
+                                            static_cast<int>(y.size()));
       best = std::min(best, c.distance_squared);
     }
   }
@@ -106,7 +114,8 @@ TEST(Hybrid, EdgeToEdgeWitnesses) {
   // Two boxes whose closest features are crossing edges.
   const ConvexPolytope a(box(Vec3(1, 1, 1)));
   const ConvexPolytope b(box(Vec3(1, 1, 1)));
-  const Pose pb(Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())), Vec3(0, 0, 2 * std::sqrt(2.0) + 0.25));
+  const Pose pb(Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())),
+                Vec3(0, 0, 2 * std::sqrt(2.0) + 0.25));
   const Pose pa(Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())), Vec3::Zero());
   const auto r = distance(a, pa, b, pb);
   EXPECT_EQ(r.status, Status::separated);
@@ -119,18 +128,21 @@ TEST(Hybrid, EdgeToEdgeWitnesses) {
 TEST(Hybrid, TouchingAndIntersecting) {
   const ConvexPolytope cube(box(Vec3(0.5, 0.5, 0.5)));
   // Stacked cubes sharing a face exactly: touching.
-  const auto stacked = distance(cube, Pose::identity(), cube, Pose::from_translation(Vec3(0.3, -0.2, 1.0)));
+  const auto stacked =
+      distance(cube, Pose::identity(), cube, Pose::from_translation(Vec3(0.3, -0.2, 1.0)));
   EXPECT_EQ(stacked.status, Status::touching);
   EXPECT_LE(stacked.distance, 64 * kUnitRoundoff * 2);
   // Edge on edge, crossing at right angles: touching.
   const Pose ridge_a(Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitX())), Vec3::Zero());
-  const Pose ridge_b(Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())), Vec3(0, 0, 2 * std::sqrt(0.5)));
+  const Pose ridge_b(Quat(Eigen::AngleAxisd(M_PI / 4, Vec3::UnitY())),
+                     Vec3(0, 0, 2 * std::sqrt(0.5)));
   const auto edge_edge = distance(cube, ridge_a, cube, ridge_b);
   EXPECT_EQ(edge_edge.status, Status::touching);
   EXPECT_EQ(edge_edge.feature_a.type, FeatureType::edge);
   EXPECT_EQ(edge_edge.feature_b.type, FeatureType::edge);
   // Deep overlap: intersecting, distance 0.
-  const auto deep = distance(cube, Pose::identity(), cube, Pose::from_translation(Vec3(0.2, 0.1, 0.3)));
+  const auto deep =
+      distance(cube, Pose::identity(), cube, Pose::from_translation(Vec3(0.2, 0.1, 0.3)));
   EXPECT_EQ(deep.status, Status::intersecting);
   EXPECT_EQ(deep.distance, 0.0);
   EXPECT_EQ(deep.lower_bound, 0.0);
@@ -139,11 +151,43 @@ TEST(Hybrid, TouchingAndIntersecting) {
   EXPECT_EQ(same.status, Status::intersecting);
 }
 
+// Regression (issue 9): the contact classification and the cross-check of
+// uncertified answers lived in the query layer (distance.cpp), so
+// hybrid_distance answered an overlapping pair `touching` with no second
+// algorithm while distance(..., hybrid) answered `intersecting`: figures
+// labelled "hybrid" did not measure what ran. Now hybrid_distance is the
+// whole algorithm: given the same band, the same answer in A's frame.
+TEST(Hybrid, HybridDistanceIsTheWholeAlgorithm) {
+  const ConvexPolytope cube(box(Vec3(0.5, 0.5, 0.5)));
+  const ConvexPolytope ball(sphere_points(40, 3, 0.6));
+  std::mt19937 rng(11);
+  int overlapping = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const Pose pa = random_pose(rng, 0.4);
+    Pose pb = random_pose(rng, 0.4);
+    pb.translation *= 2.5;
+    const DistanceResult whole = distance(cube, pa, ball, pb);
+    const Pose b_in_a = pa.inverse() * pb;
+    const double band = contact_band(
+        std::max(magnitude_bound(pa, cube.scale()), magnitude_bound(pb, ball.scale())));
+    DistanceCache cache;
+    const DistanceResult algorithm = hybrid_distance(cube, ball, b_in_a, {}, band, cache);
+    ASSERT_EQ(algorithm.status, whole.status) << trial;
+    EXPECT_EQ(algorithm.second_algorithm, whole.second_algorithm) << trial;
+    EXPECT_NEAR(algorithm.distance, whole.distance, 1e-14) << trial;
+    EXPECT_LE((pa.apply(algorithm.point_a) - whole.point_a).norm(), 1e-13) << trial;
+    overlapping += whole.status == Status::intersecting;
+  }
+  EXPECT_GE(overlapping, 5);   // premise: the set holds overlapping pairs
+  EXPECT_LE(overlapping, 35);  // and separated ones
+}
+
 TEST(Hybrid, RandomPairsMatchBruteForce) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 60; ++trial) {
     const ConvexPolytope a(sphere_points(4 + trial % 40, 100 + static_cast<std::uint32_t>(trial)));
-    const ConvexPolytope b(sphere_points(4 + (trial * 7) % 50, 900 + static_cast<std::uint32_t>(trial), 0.7));
+    const ConvexPolytope b(
+        sphere_points(4 + (trial * 7) % 50, 900 + static_cast<std::uint32_t>(trial), 0.7));
     // Bounding spheres of radius 1 and 0.7 whose centres are at least
     // 2.55 - 2 * 0.1 * sqrt(3) * 3 apart in the worst 3-sigma case: separated.
     const Pose pa = random_pose(rng, 0.1);
@@ -187,7 +231,8 @@ TEST(Hybrid, TrackingAlongMotionEqualsCold) {
                   Vec3(2.0 + 0.3 * std::sin(t), 0.8 * std::cos(0.7 * t), 0.4 * std::sin(1.3 * t)));
     const auto warm = distance(a, Pose::identity(), b, pb, {}, &cache);
     const auto cold = distance(a, Pose::identity(), b, pb);
-    ASSERT_NEAR(warm.distance, cold.distance, 1e-12 * cold.distance + 64 * kUnitRoundoff * 3) << step;
+    ASSERT_NEAR(warm.distance, cold.distance, 1e-12 * cold.distance + 64 * kUnitRoundoff * 3)
+        << step;
     total_warm_iterations += warm.iterations;
     total_cold_iterations += cold.iterations;
   }
@@ -218,7 +263,8 @@ TEST(Hybrid, IterationCapIsReportedNotHidden) {
   const ConvexPolytope b(sphere_points(4000, 9));
   DistanceOptions options;
   options.max_iterations = 1;
-  const auto r = distance(a, Pose::identity(), b, Pose::from_translation(Vec3(2.5, 0.1, 0)), options);
+  const auto r =
+      distance(a, Pose::identity(), b, Pose::from_translation(Vec3(2.5, 0.1, 0)), options);
   EXPECT_LE(r.iterations, 1);
   if (r.status == Status::iteration_cap) {
     EXPECT_LE(r.lower_bound, r.distance);

@@ -12,7 +12,11 @@
 namespace proxima {
 
 // Result points, normal and features are in A's frame. The status is decided
-// by the caller's contact band `contact_tolerance` (64 u R plus Ae).
+// by the caller's contact band `contact_tolerance` (64 u R plus Ae): the
+// hybrid's own answer, cross-checked by Enhanced GJK where it could not
+// certify it, and classified as touching or intersecting within the band
+// (proxima/contact.h; DistanceResult::second_algorithm says when either
+// ran). The same answer as distance(..., Algorithm::hybrid) given the band.
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
                                const Pose& b_in_a, const DistanceOptions& options,
                                double contact_tolerance, DistanceCache& cache);
