@@ -4,8 +4,9 @@
 // A fixed amount of tracked-query work for instruction counts, which are
 // repeatable where timings on a shared machine are not:
 //
-//   valgrind --tool=callgrind --toggle-collect='proxima::distance(*' \
+//   valgrind --tool=callgrind --toggle-collect='proxima::distance(*'
 //     build/release/bench/tracked_instructions translation 64
+// (one command line)
 //
 // then instructions per query = the collected total / the printed queries.
 // Modes: translation (B circles A, distance about 1), rotation (B spins at

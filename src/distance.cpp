@@ -13,7 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <optional>
+#include <limits>
 #include <string>
 
 #include "proxima/gjk.h"
@@ -83,13 +83,15 @@ Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
           Vec3(pose_a.rotation.transpose() * (pose_b.translation - pose_a.translation))};
 }
 
-// The query for poses under the contract; inlined into both entry points.
-inline DistanceResult distance_in_frame(const ConvexPolytope& a, const Pose& pose_a,
-                                        const ConvexPolytope& b, const Pose& pose_b,
-                                        const DistanceOptions& options, DistanceCache* cache) {
-  if (!(options.relative_tolerance >= 0.0) || !(options.absolute_tolerance >= 0.0) ||
-      !std::isfinite(options.relative_tolerance) || !std::isfinite(options.absolute_tolerance))
-      [[unlikely]] {
+// The query for poses under the contract, with the caller's cache or a cold
+// one.
+DistanceResult distance_in_frame(const ConvexPolytope& a, const Pose& pose_a,
+                                 const ConvexPolytope& b, const Pose& pose_b,
+                                 const DistanceOptions& options, DistanceCache& c) {
+  // Finite and >= 0 (NaN fails both comparisons).
+  constexpr double kLargest = std::numeric_limits<double>::max();
+  if (!(options.relative_tolerance >= 0.0 && options.relative_tolerance <= kLargest) ||
+      !(options.absolute_tolerance >= 0.0 && options.absolute_tolerance <= kLargest)) [[unlikely]] {
     throw InvalidInput(
         "distance: options.relative_tolerance and options.absolute_tolerance must be finite and >= "
         "0");
@@ -117,8 +119,6 @@ inline DistanceResult distance_in_frame(const ConvexPolytope& a, const Pose& pos
   const Pose b_in_a = relative_pose(pose_a, pose_b);
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
-  std::optional<DistanceCache> cold;
-  DistanceCache& c = cache != nullptr ? *cache : cold.emplace();
   DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
   // Most contacts (overlapping bodies) end with a distance of a few
   // roundings: inside the band of a lower bound on R taken from the cached
@@ -159,11 +159,15 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   // The poses as the contract takes them (proxima/pose.h): the caller's own
   // when rigid to machine precision, else re-orthonormalized copies, or the
   // contract's refusal.
-  if (!detail::is_rigid(pose_a) || !detail::is_rigid(pose_b)) [[unlikely]] {
-    return distance_in_frame(a, checked_pose(pose_a, "distance: pose_a"), b,
-                             checked_pose(pose_b, "distance: pose_b"), options, cache);
+  if (cache == nullptr) {
+    DistanceCache cold;
+    return distance(a, pose_a, b, pose_b, options, &cold);
   }
-  return distance_in_frame(a, pose_a, b, pose_b, options, cache);
+  if (!detail::are_rigid(pose_a, pose_b)) [[unlikely]] {
+    return distance_in_frame(a, checked_pose(pose_a, "distance: pose_a"), b,
+                             checked_pose(pose_b, "distance: pose_b"), options, *cache);
+  }
+  return distance_in_frame(a, pose_a, b, pose_b, options, *cache);
 }
 
 namespace detail {
@@ -171,7 +175,8 @@ namespace detail {
 DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
                                        const ConvexPolytope& b, const Pose& pose_b,
                                        const DistanceOptions& options, DistanceCache* cache) {
-  return distance_in_frame(a, pose_a, b, pose_b, options, cache);
+  DistanceCache cold;
+  return distance_in_frame(a, pose_a, b, pose_b, options, cache != nullptr ? *cache : cold);
 }
 
 }  // namespace detail

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -169,6 +170,68 @@ TEST(Pose, EveryEntryPointUsesTheContract) {
   const DistanceResult as_snapped = distance(*cube, Pose{}, *cube, snapped);
   EXPECT_EQ(given.distance, as_snapped.distance);
   EXPECT_EQ(given.point_b, as_snapped.point_b);
+}
+
+}  // namespace
+}  // namespace proxima
+
+namespace proxima {
+namespace {
+
+// are_rigid (both poses in the two SIMD lanes, the check every query pays)
+// decides exactly as is_rigid on each pose: rotations from quaternions and
+// products of them, ones perturbed around the 32 u threshold, float32
+// rotations, reflections, scaled and huge entries, NaN and infinity in any
+// entry of either pose.
+TEST(Pose, PairedCheckDecidesAsTheSingleCheck) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  std::uniform_int_distribution<int> entry(0, 11);
+  std::uniform_int_distribution<int> kind(0, 7);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto random_pose = [&] {
+    Pose p(Quat(g(rng), g(rng), g(rng), g(rng)), Vec3(g(rng), g(rng), g(rng)) * 10.0);
+    const int k = kind(rng);
+    const int e = entry(rng);
+    double& x = e < 9 ? p.rotation.data()[e] : p.translation[e - 9];
+    switch (k) {
+      case 0:  // around the threshold: a few tens of u on one entry
+        x += std::ldexp(static_cast<double>(entry(rng) - 6) * 8.0, -53);
+        break;
+      case 1:
+        p.rotation = p.rotation.cast<float>().cast<double>();
+        break;
+      case 2:
+        p.rotation.col(0) *= -1.0;  // a reflection
+        break;
+      case 3:
+        x = (entry(rng) % 2 == 0) ? nan : -inf;
+        break;
+      case 4:
+        x *= 1e300;
+        break;
+      case 5:
+        p.rotation = p.rotation * Mat3(Quat(g(rng), g(rng), g(rng), g(rng)).normalized());
+        break;
+      default:
+        break;  // as built
+    }
+    return p;
+  };
+  int rigid = 0;
+  int refused = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Pose a = random_pose();
+    const Pose b = random_pose();
+    const bool single = detail::is_rigid(a) && detail::is_rigid(b);
+    ASSERT_EQ(detail::are_rigid(a, b), single) << trial;
+    ASSERT_EQ(detail::are_rigid(b, a), single) << trial;
+    ASSERT_EQ(detail::are_rigid(a, a), detail::is_rigid(a)) << trial;
+    (single ? rigid : refused) += 1;
+  }
+  EXPECT_GT(rigid, 2000);  // premise: both decisions are well represented
+  EXPECT_GT(refused, 2000);
 }
 
 }  // namespace

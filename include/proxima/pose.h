@@ -20,6 +20,9 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -150,6 +153,66 @@ inline bool is_rigid(const Pose& pose) {
   const double det = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
                      m[2] * (m[3] * m[7] - m[4] * m[6]);
   return skew <= kOrthonormalUlps * kUnitRoundoff && det > 0.0;
+}
+
+// is_rigid(a) && is_rigid(b), the same decision bit for bit, with the two
+// poses in the two lanes of SSE2 registers where the target has them (every
+// x86-64): one pass of the arithmetic for both poses instead of two, half
+// the instructions of the check that every query pays.
+inline bool are_rigid(const Pose& pose_a, const Pose& pose_b) {
+#if defined(__SSE2__)
+  const double* ma = pose_a.rotation.data();
+  const double* mb = pose_b.rotation.data();
+  const auto pair = [](const double& x, const double& y) {
+    return _mm_loadh_pd(_mm_load_sd(&x), &y);
+  };
+  __m128d r[9];
+  for (int k = 0; k < 9; ++k) r[k] = pair(ma[k], mb[k]);
+  // The bounds of is_rigid on the bits, lane-wise 64-bit integers.
+  const __m128i magnitude = _mm_set1_epi64x(0x7fffffffffffffffLL);
+  const __m128i below_four =
+      _mm_set1_epi64x(static_cast<long long>(0x8000000000000000ULL - 0x4010000000000000ULL));
+  const __m128i finite =
+      _mm_set1_epi64x(static_cast<long long>(0x8000000000000000ULL - 0x7ff0000000000000ULL));
+  __m128i out_of_range = _mm_setzero_si128();
+  for (int k = 0; k < 9; ++k) {
+    out_of_range = _mm_or_si128(
+        out_of_range, _mm_add_epi64(_mm_and_si128(_mm_castpd_si128(r[k]), magnitude), below_four));
+  }
+  for (int k = 0; k < 3; ++k) {
+    const __m128d t = pair(pose_a.translation[k], pose_b.translation[k]);
+    out_of_range = _mm_or_si128(
+        out_of_range, _mm_add_epi64(_mm_and_si128(_mm_castpd_si128(t), magnitude), finite));
+  }
+  if (_mm_movemask_pd(_mm_castsi128_pd(out_of_range)) != 0) [[unlikely]]
+    return false;
+  // The arithmetic of is_rigid, operation for operation in each lane.
+  const auto dot = [&r](int i, int j) {
+    return _mm_add_pd(
+        _mm_add_pd(_mm_mul_pd(r[3 * i], r[3 * j]), _mm_mul_pd(r[3 * i + 1], r[3 * j + 1])),
+        _mm_mul_pd(r[3 * i + 2], r[3 * j + 2]));
+  };
+  const __m128d one = _mm_set1_pd(1.0);
+  const __m128d sign = _mm_set1_pd(-0.0);
+  const auto abs = [sign](__m128d x) { return _mm_andnot_pd(sign, x); };
+  const __m128d d00 = abs(_mm_sub_pd(dot(0, 0), one)), d11 = abs(_mm_sub_pd(dot(1, 1), one)),
+                d22 = abs(_mm_sub_pd(dot(2, 2), one));
+  const __m128d d01 = abs(dot(0, 1)), d02 = abs(dot(0, 2)), d12 = abs(dot(1, 2));
+  const __m128d skew =
+      _mm_max_pd(_mm_max_pd(_mm_max_pd(d00, d11), _mm_max_pd(d22, d01)), _mm_max_pd(d02, d12));
+  const auto minor = [&r](int i, int j, int k, int l) {
+    return _mm_sub_pd(_mm_mul_pd(r[i], r[j]), _mm_mul_pd(r[k], r[l]));
+  };
+  const __m128d det = _mm_add_pd(
+      _mm_sub_pd(_mm_mul_pd(r[0], minor(4, 8, 5, 7)), _mm_mul_pd(r[1], minor(3, 8, 5, 6))),
+      _mm_mul_pd(r[2], minor(3, 7, 4, 6)));
+  // Both comparisons are ordered: the values are finite here.
+  const __m128d ok = _mm_and_pd(_mm_cmple_pd(skew, _mm_set1_pd(kOrthonormalUlps * kUnitRoundoff)),
+                                _mm_cmpgt_pd(det, _mm_setzero_pd()));
+  return _mm_movemask_pd(ok) == 3;
+#else
+  return is_rigid(pose_a) && is_rigid(pose_b);
+#endif
 }
 }  // namespace detail
 
