@@ -326,13 +326,15 @@ Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& tow
 }
 
 // The algorithm on coordinates multiplied by `scale`, a power of two, when
-// kScaled (see hybrid_distance); `r_local` and `contact_tolerance` are in
-// those units already, and the result is returned in the caller's units.
-// The unscaled instance is the hot path and multiplies by nothing.
+// kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
+// in the caller's units, like the result returned. The unscaled instance is
+// the hot path and multiplies by nothing.
 template <bool kScaled>
 DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                          const DistanceOptions& options, double contact_tolerance,
-                          DistanceCache& cache, double r_local, double scale) {
+                          const DistanceOptions& options, double band, DistanceCache& cache,
+                          double magnitude, double scale) {
+  const double contact_tolerance = kScaled ? band * scale : band;
+  const double r_local = kScaled ? magnitude * scale : magnitude;
   const Mat3& rot = b_in_a.rotation;
   const Vec3& tr = b_in_a.translation;
   const auto b_point = [&](std::int32_t v) -> Vec3 {
@@ -441,7 +443,7 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   result.normal = d > 0.0 ? Vec3((loc.xb - loc.xa) / d) : last_direction;
   if (contact) {
     // In contact at machine precision. Whether the bodies only touch or
-    // overlap is decided by the query layer (distance.cpp).
+    // overlap is decided by the contact unit (hybrid_distance, contact.h).
     result.status = Status::touching;
     result.lower_bound = 0.0;
   } else if (result.status != Status::iteration_cap) {
@@ -468,6 +470,13 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     result.distance *= unit;
     result.lower_bound *= unit;
   }
+  // What the first answer may still need (proxima/contact.h): the hybrid
+  // reports contact without telling touching from overlapping, and an
+  // answer it could not certify is cross-checked. In the caller's units.
+  if (needs_cross_check(result, options, magnitude)) [[unlikely]]
+    cross_check_separation(a, b, b_in_a, options, band, result);
+  if (result.status == Status::touching)
+    classify_contact(a, b, b_in_a, options, band, cache, result);
   return result;
 }
 
@@ -477,8 +486,7 @@ DistanceResult run_scaled(const ConvexPolytope& a, const ConvexPolytope& b, cons
                           const DistanceOptions& options, double contact_tolerance,
                           DistanceCache& cache, double r_local) {
   const double scale = detail::power_of_two_unit(r_local).inverse;
-  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance * scale, cache, r_local * scale,
-                          scale);
+  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance, cache, r_local, scale);
 }
 
 }  // namespace
@@ -488,19 +496,11 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
                                DistanceCache& cache) {
   // R in A's frame, B's coordinates bounded without mapping its vertices.
   const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
-  DistanceResult result =
-      (r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
-              !std::isfinite(r_local)
-          ? run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0)
-          : run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
-  // What the first answer may still need (proxima/contact.h): the hybrid
-  // reports contact without telling touching from overlapping, and an
-  // answer it could not certify is cross-checked.
-  if (needs_cross_check(result, options, r_local)) [[unlikely]]
-    cross_check_separation(a, b, b_in_a, options, contact_tolerance, result);
-  if (result.status == Status::touching)
-    classify_contact(a, b, b_in_a, options, contact_tolerance, cache, result);
-  return result;
+  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
+      !std::isfinite(r_local)) [[likely]] {
+    return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
+  }
+  return run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
 }
 
 }  // namespace proxima
