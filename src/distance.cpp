@@ -85,9 +85,9 @@ Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
 
 // The query for poses under the contract, with the caller's cache or a cold
 // one.
-DistanceResult distance_in_frame(const ConvexPolytope& a, const Pose& pose_a,
-                                 const ConvexPolytope& b, const Pose& pose_b,
-                                 const DistanceOptions& options, DistanceCache& c) {
+[[gnu::always_inline]] inline DistanceResult distance_in_frame(
+    const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
+    const DistanceOptions& options, DistanceCache& c) {
   // Finite and >= 0 (NaN fails both comparisons).
   constexpr double kLargest = std::numeric_limits<double>::max();
   if (!(options.relative_tolerance >= 0.0 && options.relative_tolerance <= kLargest) ||
@@ -164,8 +164,9 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
     return distance(a, pose_a, b, pose_b, options, &cold);
   }
   if (!detail::are_rigid(pose_a, pose_b)) [[unlikely]] {
-    return distance_in_frame(a, checked_pose(pose_a, "distance: pose_a"), b,
-                             checked_pose(pose_b, "distance: pose_b"), options, *cache);
+    return detail::distance_of_rigid_poses(a, checked_pose(pose_a, "distance: pose_a"), b,
+                                           checked_pose(pose_b, "distance: pose_b"), options,
+                                           cache);
   }
   return distance_in_frame(a, pose_a, b, pose_b, options, *cache);
 }
