@@ -8,10 +8,6 @@
 // so two runs print the same text.
 #include "demo.h"
 
-#include "proxima/closest_point.h"
-#include "proxima/distance.h"
-#include "proxima/polytope.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -22,6 +18,10 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "proxima/closest_point.h"
+#include "proxima/distance.h"
+#include "proxima/polytope.h"
 
 namespace proxima::cli {
 namespace {

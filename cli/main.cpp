@@ -20,8 +20,8 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -48,14 +48,14 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
   return proxima::Algorithm::hybrid;
 }
 
-int run_query_command(const std::string& file, const proxima::DistanceOptions& options,
-                      int threads) {
+int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads,
+                      proxima::QuaternionOrder order) {
   // Answers go through std::cout only; untying it from C stdio lets it
   // buffer a whole answer line before the explicit flush.
   std::ios::sync_with_stdio(false);
   proxima::cli::QueryRunSummary summary;
   if (file == "-") {
-    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads);
+    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads, order);
   } else {
     // An ifstream opens a directory without complaint and then reads
     // nothing; that would look like an empty, successful run.
@@ -69,7 +69,7 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
       std::cerr << "proxima query: cannot open '" << file << "': " << std::strerror(errno) << "\n";
       return kExitFailure;
     }
-    summary = proxima::cli::run_queries(in, std::cout, options, threads);
+    summary = proxima::cli::run_queries(in, std::cout, options, threads, order);
   }
   if (summary.read_failed) {
     std::cerr << "proxima query: reading the input failed after " << summary.answered
@@ -111,6 +111,14 @@ int main(int argc, char** argv) {
   std::string algorithm = "hybrid";
   proxima::DistanceOptions options;
   int threads = 1;
+  // Four numbers in the wrong order are another rotation: the order is a
+  // named choice, the same flag on every command that reads quaternions.
+  const std::vector<std::string> orders = {"wxyz", "xyzw"};
+  const auto parse_order = [](const std::string& name) {
+    return name == "xyzw" ? proxima::QuaternionOrder::xyzw : proxima::QuaternionOrder::wxyz;
+  };
+  std::string query_order = "wxyz";
+  std::string distance_order = "wxyz";
   query->footer(
       "Example:\n"
       "  echo '{\"id\":1,\"a\":{\"vertices\":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]]},"
@@ -123,6 +131,12 @@ int main(int argc, char** argv) {
       ->add_option("--max-iterations", options.max_iterations,
                    "Iteration cap per query; a capped answer says \"iteration_cap\": true")
       ->check(CLI::Range(1, kMaxIterationsLimit))
+      ->capture_default_str();
+  query
+      ->add_option("--quaternion-order", query_order,
+                   "Order of a body's \"rotation\" numbers: wxyz (scalar first, the default) or "
+                   "xyzw (scalar last, as ROS and scipy write them)")
+      ->check(CLI::IsMember(orders))
       ->capture_default_str();
   query
       ->add_option("--threads", threads,
@@ -140,14 +154,22 @@ int main(int argc, char** argv) {
   distance->add_option("B", distance_command.file_b, "Second body's mesh file")->required();
   distance
       ->add_option("--pose-a", distance_command.pose_a,
-                   "Pose of A: translation x y z, then rotation quaternion qw qx qy qz")
+                   "Pose of A: translation x y z, then rotation quaternion qw qx qy qz (or qx "
+                   "qy qz qw with --quaternion-order xyzw)")
       ->expected(7)
       ->type_name("x y z qw qx qy qz");
   distance
       ->add_option("--pose-b", distance_command.pose_b,
-                   "Pose of B: translation x y z, then rotation quaternion qw qx qy qz")
+                   "Pose of B: translation x y z, then rotation quaternion qw qx qy qz (or qx "
+                   "qy qz qw with --quaternion-order xyzw)")
       ->expected(7)
       ->type_name("x y z qw qx qy qz");
+  distance
+      ->add_option("--quaternion-order", distance_order,
+                   "Order of the quaternion in --pose-a/--pose-b: wxyz (qw qx qy qz, the "
+                   "default) or xyzw (qx qy qz qw, as ROS and scipy write them)")
+      ->check(CLI::IsMember(orders))
+      ->capture_default_str();
   distance->add_option("--algorithm", distance_algorithm, "Algorithm answering the query")
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
       ->capture_default_str();
@@ -192,10 +214,11 @@ int main(int argc, char** argv) {
     if (*demo) return proxima::cli::run_demo();
     if (*query) {
       options.algorithm = parse_algorithm(algorithm);
-      return run_query_command(file, options, threads);
+      return run_query_command(file, options, threads, parse_order(query_order));
     }
     if (*distance) {
       distance_command.options.algorithm = parse_algorithm(distance_algorithm);
+      distance_command.quaternion_order = parse_order(distance_order);
       return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
     }
     if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);

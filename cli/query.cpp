@@ -60,9 +60,10 @@ void read_numbers(const Json& v, const std::string& path, std::size_t n, const c
   }
 }
 
-// Reads body `name` ("a" or "b") of `query` into vertices and pose.
-void read_body(const Json& query, const std::string& name, std::vector<Vec3>& vertices,
-               Pose& pose) {
+// Reads body `name` ("a" or "b") of `query` into vertices and pose, its
+// rotation's four numbers in `order`.
+void read_body(const Json& query, const std::string& name, QuaternionOrder order,
+               std::vector<Vec3>& vertices, Pose& pose) {
   const auto body = query.find(name);
   if (body == query.end()) fail("missing \"" + name + "\"");
   if (!body->is_object()) fail(name + " is not an object (it is " + kind(*body) + ")");
@@ -97,12 +98,16 @@ void read_body(const Json& query, const std::string& name, std::vector<Vec3>& ve
   Quat rotation = Quat::Identity();
   const auto q = body->find("rotation");
   if (q != body->end() && !q->is_null()) {
-    double wxyz[4];
-    read_numbers(*q, name + ".rotation", 4, "4 numbers [w, x, y, z]", wxyz);
+    double numbers[4];
+    read_numbers(*q, name + ".rotation", 4,
+                 order == QuaternionOrder::wxyz
+                     ? "4 numbers [w, x, y, z]"
+                     : "4 numbers [x, y, z, w] (--quaternion-order xyzw)",
+                 numbers);
     // Normalized at any magnitude, a zero quaternion refused: the pose
     // contract's own function (proxima/pose.h), as in Python.
     try {
-      rotation = unit_quaternion(Quat(wxyz[0], wxyz[1], wxyz[2], wxyz[3]), name + ".rotation");
+      rotation = unit_quaternion(quaternion_in_order(numbers, order), name + ".rotation");
     } catch (const InvalidInput& e) {
       fail(e.what());
     }
@@ -142,7 +147,7 @@ ConvexPolytope build_hull(const std::vector<Vec3>& vertices, const std::string& 
 // Appends the answer to one query line to `out`; returns false for an error
 // answer.
 bool answer_line(const std::string& line, long line_number, const DistanceOptions& options,
-                 Workspace& work, std::string& out) {
+                 QuaternionOrder order, Workspace& work, std::string& out) {
   if (const std::size_t column = nesting_overflow_column(line); column != 0) {
     append_error_answer(out, nullptr, line_number,
                         "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
@@ -170,8 +175,8 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   try {
     Pose pose_a;
     Pose pose_b;
-    read_body(query, "a", work.vertices_a, pose_a);
-    read_body(query, "b", work.vertices_b, pose_b);
+    read_body(query, "a", order, work.vertices_a, pose_a);
+    read_body(query, "b", order, work.vertices_b, pose_b);
     const ConvexPolytope a = build_hull(work.vertices_a, "a");
     const ConvexPolytope b = build_hull(work.vertices_b, "b");
     r = distance(a, pose_a, b, pose_b, options, nullptr);
@@ -229,7 +234,7 @@ bool is_blank(std::string_view line) {
 }  // namespace
 
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads) {
+                            int threads, QuaternionOrder order) {
   QueryRunSummary summary;
   std::string line;
   long line_number = 0;
@@ -240,7 +245,7 @@ QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceO
       ++line_number;
       if (is_blank(line)) continue;
       answer.clear();
-      if (!answer_line(line, line_number, options, work, answer)) ++summary.errors;
+      if (!answer_line(line, line_number, options, order, work, answer)) ++summary.errors;
       ++summary.answered;
       answer += '\n';
       out.write(answer.data(), static_cast<std::streamsize>(answer.size()));
@@ -294,7 +299,7 @@ QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceO
         for (std::size_t i = next++; i < count; i = next++) {
           Pending& p = block[i];
           p.answer.clear();
-          p.ok = answer_line(p.line, p.line_number, options, ws, p.answer);
+          p.ok = answer_line(p.line, p.line_number, options, order, ws, p.answer);
           p.answer += '\n';
         }
       } catch (...) {

@@ -7,10 +7,10 @@
 // parsing (main.cpp) and the stream loop (query.cpp).
 #pragma once
 
-#include "proxima/types.h"
-
 #include <istream>
 #include <ostream>
+
+#include "proxima/types.h"
 
 namespace proxima::cli {
 
@@ -30,8 +30,11 @@ struct QueryRunSummary {
 // not arrived, so a pipe fed one query at a time still gets each answer),
 // answered by `threads` threads, written in input order and flushed once per
 // block. The output is byte for byte the one of threads == 1.
+//
+// A body's "rotation" is four numbers in `order`: (w, x, y, z) by default,
+// (x, y, z, w) for ROS and scipy users (--quaternion-order xyzw).
 inline constexpr int kQueryBlockLines = 256;
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads = 1);
+                            int threads = 1, QuaternionOrder order = QuaternionOrder::wxyz);
 
 }  // namespace proxima::cli

@@ -90,8 +90,12 @@ LoadedFile load_file(const std::string& path, std::uint64_t max_file_bytes) {
   }
 }
 
-double parse_number(const std::string& token, const std::string& option, int position) {
-  static constexpr std::array<const char*, 7> kNames = {"x", "y", "z", "qw", "qx", "qy", "qz"};
+double parse_number(const std::string& token, const std::string& option, int position,
+                    QuaternionOrder order) {
+  static constexpr std::array<const char*, 7> kScalarFirst = {"x",  "y",  "z", "qw",
+                                                              "qx", "qy", "qz"};
+  static constexpr std::array<const char*, 7> kScalarLast = {"x", "y", "z", "qx", "qy", "qz", "qw"};
+  const auto& kNames = order == QuaternionOrder::wxyz ? kScalarFirst : kScalarLast;
   double value = 0.0;
   const char* first = token.data();
   const char* last = token.data() + token.size();
@@ -106,18 +110,21 @@ double parse_number(const std::string& token, const std::string& option, int pos
   return value;
 }
 
-// x y z qw qx qy qz; the quaternion is normalized by Pose, so it only has to
-// be non-zero (a zero quaternion has no rotation to normalize to).
-Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option) {
+// x y z, then the quaternion in `order` (qw qx qy qz or qx qy qz qw); the
+// quaternion is normalized, so it only has to be non-zero (a zero
+// quaternion has no rotation to normalize to).
+Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option,
+                QuaternionOrder order) {
   if (tokens.empty()) return Pose::identity();
   std::array<double, 7> v{};
   for (std::size_t i = 0; i < v.size(); ++i)
-    v[i] = parse_number(tokens[i], option, static_cast<int>(i));
+    v[i] = parse_number(tokens[i], option, static_cast<int>(i), order);
   // The pose contract's quaternion (proxima/pose.h): normalized at any
   // magnitude, a zero one refused in the same words as everywhere.
   try {
+    const char* words = order == QuaternionOrder::wxyz ? " (qw qx qy qz)" : " (qx qy qz qw)";
     return Pose(
-        unit_quaternion(Quat(v[3], v[4], v[5], v[6]), option + " (qw qx qy qz)").toRotationMatrix(),
+        unit_quaternion(quaternion_in_order(&v[3], order), option + words).toRotationMatrix(),
         Vec3(v[0], v[1], v[2]));
   } catch (const InvalidInput& e) {
     throw BadArgument(e.what());
@@ -286,8 +293,8 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
   Pose pose_a;
   Pose pose_b;
   try {
-    pose_a = parse_pose(command.pose_a, "--pose-a");
-    pose_b = parse_pose(command.pose_b, "--pose-b");
+    pose_a = parse_pose(command.pose_a, "--pose-a", command.quaternion_order);
+    pose_b = parse_pose(command.pose_b, "--pose-b", command.quaternion_order);
   } catch (const BadArgument& e) {
     err << "proxima distance: " << e.what() << "\n";
     return kExitFailure;

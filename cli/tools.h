@@ -20,10 +20,12 @@ namespace proxima::cli {
 struct DistanceCommand {
   std::string file_a;
   std::string file_b;
-  // Seven tokens each, x y z qw qx qy qz, as typed (parsed by the command so
-  // that a bad number is bad input, exit 1, not a usage error).
+  // Seven tokens each, x y z and the quaternion in `quaternion_order`
+  // (qw qx qy qz by default), as typed (parsed by the command so that a bad
+  // number is bad input, exit 1, not a usage error).
   std::vector<std::string> pose_a;
   std::vector<std::string> pose_b;
+  QuaternionOrder quaternion_order = QuaternionOrder::wxyz;
   DistanceOptions options;
   bool json = false;
   std::uint64_t max_file_bytes = kDefaultMaxFileBytes;  // per input file (ReadOptions)

@@ -96,6 +96,24 @@ py::array_t<double> matrix_array(const Eigen::Matrix<double, kRows, kCols>& m) {
   return out;
 }
 
+// The 12 entries of a 3x4 [R | t] matrix, row-major, under the pose
+// contract.
+inline Pose pose_from_rows(const double* rows, const std::string& name) {
+  for (int k = 0; k < 12; ++k) {
+    if (!is_finite_bits(rows[k])) {
+      throw InvalidInput(name + " is not finite (NaN or infinite entry at row " +
+                         std::to_string(k / 4) + ", column " + std::to_string(k % 4) + ")");
+    }
+  }
+  Mat3 r;
+  Vec3 t;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = rows[4 * i + j];
+    t[i] = rows[4 * i + 3];
+  }
+  return checked_pose(Pose(r, t), name);
+}
+
 // A 4x4 matrix under the rigid-pose contract (proxima/pose.h): every entry
 // finite (the bottom row too), the bottom row (0, 0, 0, 1) within the
 // contract's tolerance, the rest checked (and re-orthonormalized when
@@ -111,41 +129,84 @@ inline Pose pose_from_matrix(const double* m, const std::string& name) {
       std::max({std::abs(m[12]), std::abs(m[13]), std::abs(m[14]), std::abs(m[15] - 1.0)});
   if (off_bottom > kRotationTolerance)
     value_error(name + ": the bottom row of a pose matrix must be (0, 0, 0, 1)");
-  Mat3 r;
-  Vec3 t;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) r(i, j) = m[4 * i + j];
-    t[i] = m[4 * i + 3];
-  }
-  return checked_pose(Pose(r, t), name);
+  return pose_from_rows(m, name);  // its top three rows, [R | t]
 }
 
-inline Pose pose_from_quaternion(py::handle q_obj, py::handle t_obj, const std::string& name) {
+inline const char* order_words(QuaternionOrder order) {
+  return order == QuaternionOrder::wxyz ? "(w, x, y, z)" : "(x, y, z, w)";
+}
+
+// The rotation of 4 numbers read in `order`: normalized at any magnitude; a
+// zero or non-finite quaternion is refused (InvalidInput naming `name`), as
+// in the CLI: the same function.
+inline Mat3 quaternion_rotation(py::handle q_obj, QuaternionOrder order, const std::string& name) {
   const DoubleArray q = as_double_array(q_obj, name + " quaternion");
   if (q.ndim() != 1 || q.shape(0) != 4) {
-    value_error(name + ": the quaternion must be 4 numbers (w, x, y, z), got shape " + shape_of(q));
+    value_error(name + ": the quaternion must be 4 numbers " + order_words(order) + ", got shape " +
+                shape_of(q));
   }
-  // Normalized at any magnitude; a zero or non-finite quaternion is refused
-  // (InvalidInput naming `name`), as in the CLI: the same function.
-  const Quat unit = unit_quaternion(Quat(q.at(0), q.at(1), q.at(2), q.at(3)), name);
-  return {unit.toRotationMatrix(), to_vec3(t_obj, name + " translation")};
+  const double numbers[4] = {q.at(0), q.at(1), q.at(2), q.at(3)};
+  return unit_quaternion(quaternion_in_order(numbers, order), name).toRotationMatrix();
 }
 
-// A pose argument: None (identity), a proxima.Pose, a 4x4 matrix or a
-// (quaternion wxyz, translation) pair.
+inline Vec3 translation_or_zero(py::handle t_obj, const std::string& name) {
+  return t_obj.is_none() ? Vec3::Zero() : to_vec3(t_obj, name + " translation");
+}
+
+inline Pose pose_from_quaternion(py::handle q_obj, py::handle t_obj, const std::string& name,
+                                 QuaternionOrder order = QuaternionOrder::wxyz) {
+  return {quaternion_rotation(q_obj, order, name), translation_or_zero(t_obj, name)};
+}
+
+// A scipy.spatial.transform.Rotation, recognized by its type without
+// importing scipy: its own matrix is used, so no quaternion order can be
+// misread.
+inline bool is_scipy_rotation(py::handle obj) {
+  const py::handle type = reinterpret_cast<PyObject*>(Py_TYPE(obj.ptr()));
+  if (!py::hasattr(type, "__module__")) return false;
+  const std::string module = py::str(type.attr("__module__"));
+  return module.rfind("scipy.spatial.transform", 0) == 0 &&
+         std::string(py::str(type.attr("__name__"))) == "Rotation";
+}
+
+// A rotation argument: a scipy Rotation (one, not a stack) or a 3x3 matrix,
+// under the pose contract.
+inline Mat3 to_rotation(py::handle obj, const std::string& name) {
+  if (is_scipy_rotation(obj)) {
+    if (!py::bool_(obj.attr("single"))) {
+      value_error(name + ": a stack of " + std::to_string(py::len(obj)) +
+                  " scipy rotations where one rotation is expected");
+    }
+    return checked_pose(Pose(to_mat3(obj.attr("as_matrix")(), name), Vec3::Zero()), name).rotation;
+  }
+  return checked_pose(Pose(to_mat3(obj, name), Vec3::Zero()), name).rotation;
+}
+
+// A pose argument: None (identity), a proxima.Pose, a 4x4 or 3x4 matrix, a
+// scipy Rotation, or a (rotation, translation) pair whose rotation is a
+// quaternion (w, x, y, z), a 3x3 matrix or a scipy Rotation.
 inline Pose to_pose(py::handle obj, const std::string& name) {
   if (obj.is_none()) return Pose{};
   if (py::isinstance<Pose>(obj)) return obj.cast<Pose>();
+  if (is_scipy_rotation(obj)) return {to_rotation(obj, name), Vec3::Zero()};
   if ((py::isinstance<py::tuple>(obj) || py::isinstance<py::list>(obj)) && py::len(obj) == 2) {
-    return pose_from_quaternion(obj[py::int_(0)], obj[py::int_(1)], name);
+    const py::object first = obj[py::int_(0)];
+    const py::object second = obj[py::int_(1)];
+    // Routed by shape before any conversion, so that a bad quaternion is
+    // refused as a quaternion.
+    const py::array shaped = py::array::ensure(first);
+    if (is_scipy_rotation(first) || (shaped && shaped.ndim() == 2))
+      return {to_rotation(first, name + " rotation"), to_vec3(second, name + " translation")};
+    return pose_from_quaternion(first, second, name);
   }
   const DoubleArray m = as_double_array(obj, name);
+  if (m.ndim() == 2 && m.shape(0) == 3 && m.shape(1) == 4) return pose_from_rows(m.data(), name);
   if (m.ndim() != 2 || m.shape(0) != 4 || m.shape(1) != 4) {
-    value_error(
-        name +
-        ": expected None, a 4x4 matrix, a (quaternion wxyz, translation) pair or a proxima.Pose; "
-        "got an array of shape " +
-        shape_of(m));
+    value_error(name +
+                ": expected None, a 4x4 or 3x4 matrix, a scipy Rotation, a (rotation, "
+                "translation) pair (rotation: a quaternion w, x, y, z, a 3x3 matrix or a scipy "
+                "Rotation) or a proxima.Pose; got an array of shape " +
+                shape_of(m));
   }
   return pose_from_matrix(m.data(), name);
 }
@@ -153,21 +214,20 @@ inline Pose to_pose(py::handle obj, const std::string& name) {
 // K poses for a batch: None (K identities), one pose for all, or a (K, 4, 4)
 // array. `k` is the batch size, or -1 when this argument decides it.
 inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::string& name) {
-  if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj)) {
+  const auto one_for_all = [&] {
     if (k < 0)
       value_error(name +
                   ": give K poses as a (K, 4, 4) array (the other poses may be one pose or None)");
     return std::vector<Pose>(static_cast<std::size_t>(k), to_pose(obj, name));
-  }
+  };
+  if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj) ||
+      is_scipy_rotation(obj))
+    return one_for_all();
   const DoubleArray m = as_double_array(obj, name);
-  if (m.ndim() == 2 && m.shape(0) == 4 && m.shape(1) == 4) {
-    if (k < 0)
-      value_error(name +
-                  ": give K poses as a (K, 4, 4) array (the other poses may be one pose or None)");
-    return std::vector<Pose>(static_cast<std::size_t>(k), pose_from_matrix(m.data(), name));
-  }
-  if (m.ndim() != 3 || m.shape(1) != 4 || m.shape(2) != 4) {
-    value_error(name + ": expected a (K, 4, 4) array of poses, got shape " + shape_of(m));
+  if (m.ndim() == 2) return one_for_all();  // a 4x4 or 3x4 matrix, checked by to_pose
+  if (m.ndim() != 3 || (m.shape(1) != 4 && m.shape(1) != 3) || m.shape(2) != 4) {
+    value_error(name + ": expected a (K, 4, 4) or (K, 3, 4) array of poses, got shape " +
+                shape_of(m));
   }
   if (k >= 0 && m.shape(0) != k) {
     value_error(name + ": " + std::to_string(m.shape(0)) + " poses, but the other side has " +
@@ -176,14 +236,18 @@ inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::stri
   std::vector<Pose> poses;
   poses.reserve(static_cast<std::size_t>(m.shape(0)));
   for (py::ssize_t i = 0; i < m.shape(0); ++i) {
-    poses.push_back(pose_from_matrix(m.data(i, 0, 0), name + "[" + std::to_string(i) + "]"));
+    const std::string where = name + "[" + std::to_string(i) + "]";
+    poses.push_back(m.shape(1) == 4 ? pose_from_matrix(m.data(i, 0, 0), where)
+                                    : pose_from_rows(m.data(i, 0, 0), where));
   }
   return poses;
 }
 
 // The K of a batch from whichever pose argument is a (K, 4, 4) array.
 inline py::ssize_t batch_size(py::handle obj) {
-  if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj)) return -1;
+  if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj) ||
+      is_scipy_rotation(obj))
+    return -1;
   // No conversion here: the pose arguments are checked (dtype, shape) by to_poses.
   const py::array m = py::array::ensure(obj);
   return m && m.ndim() == 3 ? m.shape(0) : -1;

@@ -16,6 +16,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstddef>
@@ -50,8 +51,11 @@ const char* const kModuleDoc =
     r = proxima.distance(a, None, b, ((1, 0, 0, 0), (5, 0, 0)), cache=cache)
     r.status, r.distance, r.point_a, r.point_b
 
-Poses are None (identity), 4x4 rigid matrices, (quaternion wxyz, translation)
-pairs or proxima.Pose objects. Bad input raises proxima.InvalidInput (a
+Poses are None (identity), 4x4 or 3x4 rigid matrices, scipy Rotation objects,
+(rotation, translation) pairs or proxima.Pose objects. A quaternion in a pair
+is read (w, x, y, z), scalar first; ROS, scipy's as_quat() and PyBullet give
+(x, y, z, w): name the order with Pose.from_xyzw(q, t) / Pose.from_wxyz(q, t),
+or pass the scipy Rotation itself. Bad input raises proxima.InvalidInput (a
 ValueError) with the C++ message; a missing file raises FileNotFoundError.
 )doc";
 
@@ -88,13 +92,39 @@ PYBIND11_MODULE(proxima, m) {
            py::arg("rotation"), py::arg("translation"),
            "From a 3x3 rotation matrix and a translation.")
       .def_static(
+          "from_wxyz",
+          [](py::object q, py::object t) {
+            return pose_from_quaternion(q, t, "pose", QuaternionOrder::wxyz);
+          },
+          py::arg("quaternion"), py::arg("translation") = py::none(),
+          "From a quaternion in the order (w, x, y, z) (scalar first: Eigen, this library's "
+          "(quaternion, translation) pairs and the CLI's default), normalized here, and a "
+          "translation (default zero).")
+      .def_static(
+          "from_xyzw",
+          [](py::object q, py::object t) {
+            return pose_from_quaternion(q, t, "pose", QuaternionOrder::xyzw);
+          },
+          py::arg("quaternion"), py::arg("translation") = py::none(),
+          "From a quaternion in the order (x, y, z, w) (scalar last: ROS, scipy's as_quat(), "
+          "PyBullet), normalized here, and a translation (default zero).")
+      .def_static(
           "from_quaternion",
           [](py::object q, py::object t) { return pose_from_quaternion(q, t, "pose"); },
           py::arg("quaternion"), py::arg("translation"),
-          "From a quaternion (w, x, y, z), normalized here, and a translation.")
+          "Pose.from_wxyz under its older name: the quaternion is (w, x, y, z).")
       .def_static(
-          "from_matrix", [](py::object m4) { return to_pose(m4, "matrix"); }, py::arg("matrix"),
-          "From a 4x4 rigid transformation matrix.")
+          "from_rotation",
+          [](py::object r, py::object t) {
+            return Pose(to_rotation(r, "rotation"), translation_or_zero(t, "pose"));
+          },
+          py::arg("rotation"), py::arg("translation") = py::none(),
+          "From a scipy.spatial.transform.Rotation (one) or a 3x3 rotation matrix, and a "
+          "translation (default zero).")
+      .def_static(
+          "from_matrix", [](py::object matrix) { return to_pose(matrix, "matrix"); },
+          py::arg("matrix"),
+          "From a 4x4 rigid transformation matrix or its top three rows (3x4, [R | t]).")
       .def_static("identity", &Pose::identity, "The identity.")
       .def_static(
           "from_translation",
@@ -121,6 +151,20 @@ PYBIND11_MODULE(proxima, m) {
             return matrix_array(out);
           },
           "The 4x4 homogeneous matrix.")
+      .def(
+          "as_wxyz",
+          [](const Pose& p) {
+            const Quat q(p.rotation);
+            return py::array_t<double>(4, std::array<double, 4>{q.w(), q.x(), q.y(), q.z()}.data());
+          },
+          "The rotation as a unit quaternion (w, x, y, z).")
+      .def(
+          "as_xyzw",
+          [](const Pose& p) {
+            const Quat q(p.rotation);
+            return py::array_t<double>(4, std::array<double, 4>{q.x(), q.y(), q.z(), q.w()}.data());
+          },
+          "The rotation as a unit quaternion (x, y, z, w), as ROS and scipy order it.")
       .def(
           "__mul__", [](const Pose& a, const Pose& b) { return a * b; }, py::arg("other"),
           "Composition: (self * other).apply(p) == self.apply(other.apply(p)).")
@@ -386,7 +430,9 @@ PYBIND11_MODULE(proxima, m) {
       py::arg("max_iterations") = defaults.max_iterations,
       R"doc(Minimum distance, closest points and features of hulls a and b placed at pose_a and pose_b.
 
-Poses: None (identity), a 4x4 rigid matrix, a (quaternion wxyz, translation) pair or a Pose.
+Poses: None (identity), a 4x4 or 3x4 rigid matrix, a scipy Rotation, a (rotation, translation)
+pair (rotation: a quaternion (w, x, y, z), a 3x3 matrix or a scipy Rotation) or a Pose. For a
+ROS/scipy quaternion (x, y, z, w) use Pose.from_xyzw(q, t).
 cache: a DistanceCache updated in place (tracking) or None (cold).
 algorithm: 'hybrid' (the paper), 'gjk' or 'enhanced_gjk'. The tolerances and the iteration cap are
 DistanceOptions' fields. Returns a DistanceResult.)doc");
@@ -463,7 +509,7 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
       py::arg("max_iterations") = defaults.max_iterations,
       R"doc(K distance queries of one pair of polytopes, run on the thread pool without the GIL.
 
-poses_a, poses_b: (K, 4, 4) arrays of rigid matrices; one of them may be a single pose (4x4, a
+poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices; one of them may be a single pose (4x4, a
 (quaternion, translation) pair, a Pose) or None, used for all K.
 caches: None (all cold) or a list of K DistanceCache, updated in place (tracking across calls).
 threads: 0 for all cores, 1 for the calling thread only, n for n threads.

@@ -791,3 +791,40 @@ TEST(CliDemo, RunsAndShowsEveryAlgorithm) {
 }
 
 }  // namespace
+
+// Issue 11, rotations that cannot be misread: ROS's identity quaternion
+// (0, 0, 0, 1) written scalar last was read scalar first, a half turn about
+// z. With --quaternion-order xyzw the same line is the identity; the default
+// stays (w, x, y, z); a wrong count names the order expected.
+TEST(CliQuery, QuaternionOrderIsANamedChoice) {
+  REQUIRE_CLI();
+  const std::vector<Vec3> unit = box(Vec3(0, 0, 0), Vec3(1, 1, 1));
+  const Json query = {
+      {"id", 1},
+      {"a", {{"vertices", points_json(unit)}}},
+      {"b",
+       {{"vertices", points_json(unit)}, {"translation", {3, 0, 0}}, {"rotation", {0, 0, 0, 1}}}}};
+  const TempFile file(lines_of({query}));
+  // Scalar last: the identity, B spans x in [3, 4]: 2 apart.
+  const CliRun ros = run_cli("query --quaternion-order xyzw " + shell_quote(file.path()));
+  ASSERT_EQ(ros.exit_code, 0);
+  const std::vector<Json> ros_answers = parse_answers(ros.out);
+  ASSERT_EQ(ros_answers.size(), 1U) << ros.out;
+  EXPECT_NEAR(check_answer_fields(ros_answers[0]), 2.0, accuracy_bound(2.0, 4.0));
+  // Scalar first (the default): a half turn about z, B spans x in [2, 3].
+  const CliRun eigen = run_cli("query " + shell_quote(file.path()));
+  ASSERT_EQ(eigen.exit_code, 0);
+  const std::vector<Json> eigen_answers = parse_answers(eigen.out);
+  ASSERT_EQ(eigen_answers.size(), 1U) << eigen.out;
+  EXPECT_NEAR(check_answer_fields(eigen_answers[0]), 1.0, accuracy_bound(1.0, 4.0));
+
+  Json short_rotation = query;
+  short_rotation["b"]["rotation"] = {0, 0, 1};
+  const TempFile bad(lines_of({short_rotation}));
+  const CliRun refused = run_cli("query --quaternion-order xyzw " + shell_quote(bad.path()));
+  EXPECT_NE(refused.out.find("b.rotation is not an array of 4 numbers [x, y, z, w]"),
+            std::string::npos)
+      << refused.out;
+  const CliRun unknown = run_cli("query --quaternion-order zyx " + shell_quote(file.path()), true);
+  EXPECT_EQ(unknown.exit_code, 2);
+}

@@ -616,3 +616,33 @@ TEST(CliQueryThreads, SameBytesAsOneThread) {
 }
 
 }  // namespace
+
+// Issue 11: --pose-b read scalar last with --quaternion-order xyzw (ROS's
+// order) gives the library's answer for that rotation; the default reads
+// the same seven numbers scalar first.
+TEST(CliDistance, QuaternionOrderFlag) {
+  REQUIRE_CLI();
+  std::vector<Vec3> cube;
+  for (int i = 0; i < 8; ++i) cube.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const TempPath file(".obj");
+  write_obj(file.path(), cube);
+  const ConvexPolytope hull(cube);
+  const std::string pose_b = " --pose-b 3 0 0 0 0 0.3826834323650898 0.9238795325112867";
+  for (const bool scalar_last : {false, true}) {
+    const proxima::Quat q = scalar_last
+                                ? proxima::Quat(0.9238795325112867, 0, 0, 0.3826834323650898)
+                                : proxima::Quat(0, 0, 0.3826834323650898, 0.9238795325112867);
+    const proxima::DistanceResult r =
+        proxima::distance(hull, proxima::Pose{}, hull, proxima::Pose(q, Vec3(3, 0, 0)));
+    const CliRun run = run_cli("distance " + file.quoted() + " " + file.quoted() + pose_b +
+                               (scalar_last ? " --quaternion-order xyzw" : "") + " --json");
+    ASSERT_EQ(run.exit_code, 0) << run.out;
+    const Json j = parse_json(run);
+    EXPECT_EQ(j.at("distance").get<double>(), r.distance) << scalar_last;
+    EXPECT_EQ(vec(j.at("point_b")), r.point_b) << scalar_last;
+  }
+  const CliRun bad = run_cli("distance " + file.quoted() + " " + file.quoted() +
+                                 " --quaternion-order xyzw --pose-b 0 0 0 0 0 0 x",
+                             true);
+  EXPECT_NE(bad.out.find("--pose-b qw: 'x' is not a number"), std::string::npos) << bad.out;
+}

@@ -74,6 +74,26 @@ inline bool is_finite_bits(double x) {
 // neither is a rotation, and neither is silently taken as the identity.
 Quat unit_quaternion(const Quat& q, std::string_view what = "quaternion");
 
+// The two orders in which quaternions are written: (w, x, y, z), scalar
+// first (Eigen, this library's Pose(Quat, ...) and its defaults), and
+// (x, y, z, w), scalar last (ROS, scipy's as_quat(), PyBullet). Four numbers
+// read in the wrong order are another rotation (ROS's identity (0, 0, 0, 1)
+// read scalar first is a half turn about z), so every reader of four
+// numbers names its order.
+enum class QuaternionOrder { wxyz, xyzw };
+
+// "wxyz" or "xyzw", as the CLI's flag and Python spell them.
+inline const char* to_string(QuaternionOrder order) {
+  return order == QuaternionOrder::wxyz ? "wxyz" : "xyzw";
+}
+
+// The quaternion of four numbers q[0..3] written in `order` (not
+// normalized: unit_quaternion does that).
+inline Quat quaternion_in_order(const double* q, QuaternionOrder order) {
+  return order == QuaternionOrder::wxyz ? Quat(q[0], q[1], q[2], q[3])
+                                        : Quat(q[3], q[0], q[1], q[2]);
+}
+
 // A rigid motion x -> rotation x + translation.
 struct Pose {
   Mat3 rotation = Mat3::Identity();

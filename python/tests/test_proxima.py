@@ -459,7 +459,9 @@ def test_batch_errors(bodies):
     pb[:, 0, 3] = 5
     with pytest.raises(ValueError, match="9 poses, but the other side has 10"):
         proxima.distance_batch(a, pa, b, pb[:9])
-    with pytest.raises(ValueError, match=r"\(K, 4, 4\)"):
+    with pytest.raises(ValueError, match=r"\(K, 4, 4\) or \(K, 3, 4\)"):
+        proxima.distance_batch(a, np.zeros((10, 3, 3)), b, pb)
+    with pytest.raises(ValueError, match=r"poses_a\[0\]: rotation is not orthonormal"):
         proxima.distance_batch(a, np.zeros((10, 3, 4)), b, pb)
     with pytest.raises(ValueError, match="give K poses"):
         proxima.distance_batch(a, None, b, None)
@@ -626,3 +628,69 @@ def test_every_binding_has_a_docstring():
                 if not (getattr(obj, member).__doc__ or "").strip():
                     missing.append(f"{name}.{member}")
     assert not missing, missing
+
+
+# Issue 11, rotations that cannot be misread: a ROS/scipy quaternion
+# (x, y, z, w) passed as a plain 4-tuple was read as (w, x, y, z): ROS's
+# identity (0, 0, 0, 1) became a half turn about z. The orders now have
+# names, and scipy Rotation objects and 3x4 matrices are taken as they are.
+def test_quaternion_orders_are_named():
+    ros_identity = (0.0, 0.0, 0.0, 1.0)
+    np.testing.assert_array_equal(proxima.Pose.from_xyzw(ros_identity).rotation, np.eye(3))
+    # The same four numbers read scalar first: the half turn about z.
+    np.testing.assert_array_equal(
+        proxima.Pose.from_wxyz(ros_identity).rotation, np.diag([-1.0, -1.0, 1.0]))
+    rng = np.random.default_rng(11)
+    q_wxyz, rot = random_rotation(rng)
+    q_xyzw = np.roll(q_wxyz, -1)
+    t = np.array([0.5, -2.0, 3.0])
+    from_xyzw = proxima.Pose.from_xyzw(q_xyzw, t)
+    from_wxyz = proxima.Pose.from_wxyz(q_wxyz, t)
+    np.testing.assert_array_equal(from_xyzw.rotation, from_wxyz.rotation)
+    np.testing.assert_allclose(from_xyzw.rotation, rot, atol=1e-15)
+    np.testing.assert_array_equal(from_xyzw.translation, t)
+    # Round trips, up to the quaternion's sign.
+    sign = np.sign(from_wxyz.as_wxyz()[0]) * np.sign(q_wxyz[0])
+    np.testing.assert_allclose(from_wxyz.as_wxyz() * sign, q_wxyz, atol=1e-15)
+    np.testing.assert_allclose(from_xyzw.as_xyzw() * sign, q_xyzw, atol=1e-15)
+    # The older name keeps its meaning.
+    np.testing.assert_array_equal(proxima.Pose.from_quaternion(q_wxyz, t).rotation, from_wxyz.rotation)
+    # The error names the order it expected.
+    with pytest.raises(ValueError, match=r"4 numbers \(x, y, z, w\)"):
+        proxima.Pose.from_xyzw((0.0, 0.0, 1.0))
+
+
+def test_scipy_rotations_and_3x4_matrices_are_poses():
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(12)
+    a = proxima.ConvexPolytope(rng.normal(size=(25, 3)))
+    b = proxima.ConvexPolytope(rng.normal(size=(25, 3)))
+    r = Rotation.from_euler("xyz", [0.3, -1.1, 2.0])
+    t = np.array([4.0, 0.5, -0.3])
+    reference = proxima.distance(a, None, b, proxima.Pose(r.as_matrix(), t))
+    as_pair = proxima.distance(a, None, b, (r, t))
+    as_matrix_pair = proxima.distance(a, None, b, (r.as_matrix(), t))
+    as_rows = proxima.distance(a, None, b, np.hstack([r.as_matrix(), t[:, None]]))
+    from_rotation = proxima.distance(a, None, b, proxima.Pose.from_rotation(r, t))
+    from_scipy_quat = proxima.distance(a, None, b, proxima.Pose.from_xyzw(r.as_quat(), t))
+    for result in (as_pair, as_matrix_pair, as_rows, from_rotation):
+        assert result.distance == reference.distance
+    assert from_scipy_quat.distance == pytest.approx(reference.distance, rel=1e-13)
+    # A rotation alone is a pose without translation.
+    alone = proxima.distance(a, r, b, proxima.Pose.from_translation(t))
+    assert alone.distance == proxima.distance(a, proxima.Pose(r.as_matrix(), [0, 0, 0]), b,
+                                              proxima.Pose.from_translation(t)).distance
+    # Batches take (K, 3, 4) poses too.
+    rows = np.stack([np.hstack([Rotation.from_rotvec([0, 0, 0.1 * k]).as_matrix(), t[:, None]])
+                     for k in range(4)])
+    batch = proxima.distance_batch(a, None, b, rows)
+    for k in range(4):
+        single = proxima.distance(a, None, b, rows[k])
+        assert batch["distance"][k] == single.distance
+    # A stack of rotations where one is expected is refused by name.
+    with pytest.raises(ValueError, match="a stack of 3 scipy rotations"):
+        proxima.Pose.from_rotation(Rotation.from_rotvec(np.zeros((3, 3))))
+    # A non-rigid 3x4 matrix is refused by the pose contract.
+    with pytest.raises(ValueError, match="not orthonormal"):
+        proxima.distance(a, None, b, np.hstack([1.01 * np.eye(3), t[:, None]]))
