@@ -293,7 +293,9 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("close_pairs", &SceneStats::close_pairs, "Pairs at distance <= margin.")
       .def_readonly("convex_queries", &SceneStats::convex_queries, "Convex queries run.")
       .def_readonly("warm_pairs", &SceneStats::warm_pairs,
-                    "Candidate pairs that started from the previous step's cache.");
+                    "Candidate pairs that started from the previous step's cache.")
+      .def_readonly("filtered_pairs", &SceneStats::filtered_pairs,
+                    "Pairs whose boxes overlapped but that the pair filters dropped.");
 
   // Every method holds the scene's in-use flag (step() and
   // close_pairs_all_pairs() run without the GIL; anything else at the same
@@ -374,6 +376,54 @@ void bind_compound_and_scene(py::module_& m) {
           py::arg("ids"), py::arg("poses"),
           "Moves many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing: an unknown "
           "id or a bad pose raises before any body moves.")
+      .def(
+          "set_filter",
+          [](PyScene& s, BodyId id, std::uint32_t group, std::uint32_t mask) {
+            const InUse in_use(s, "Scene");
+            s.set_filter(id, CollisionFilter{group, mask});
+          },
+          py::arg("id"), py::arg("group") = CollisionFilter{}.group,
+          py::arg("mask") = CollisionFilter{}.mask,
+          "Pair filter of body id: bodies a and b are tested only when (a.group & b.mask) and "
+          "(b.group & a.mask) are both non-zero (bit sets; default group 1, mask all ones).")
+      .def(
+          "filter",
+          [](const PyScene& s, BodyId id) {
+            const InUse in_use(s, "Scene");
+            const CollisionFilter f = s.filter(id);
+            return py::make_tuple(f.group, f.mask);
+          },
+          py::arg("id"), "(group, mask) of body id.")
+      .def(
+          "exclude_pair",
+          [](PyScene& s, BodyId a, BodyId b) {
+            const InUse in_use(s, "Scene");
+            s.exclude_pair(a, b);
+          },
+          py::arg("a"), py::arg("b"),
+          "Never test the pair (a, b) (e.g. a robot's adjacent links); undone by include_pair or "
+          "by removing either body.")
+      .def(
+          "include_pair",
+          [](PyScene& s, BodyId a, BodyId b) {
+            const InUse in_use(s, "Scene");
+            s.include_pair(a, b);
+          },
+          py::arg("a"), py::arg("b"), "Undoes exclude_pair(a, b).")
+      .def(
+          "is_excluded",
+          [](const PyScene& s, BodyId a, BodyId b) {
+            const InUse in_use(s, "Scene");
+            return s.is_excluded(a, b);
+          },
+          py::arg("a"), py::arg("b"))
+      .def(
+          "tests_pair",
+          [](const PyScene& s, BodyId a, BodyId b) {
+            const InUse in_use(s, "Scene");
+            return s.tests_pair(a, b);
+          },
+          py::arg("a"), py::arg("b"), "Whether step() tests the pair (filters and exclusions).")
       .def(
           "remove",
           [](PyScene& s, BodyId id) {

@@ -64,6 +64,7 @@ struct Scene::Impl {
     std::shared_ptr<const CompoundBody> compound;
     Pose pose;
     std::array<std::int32_t, 6> hints = {-1, -1, -1, -1, -1, -1};  // support_box
+    CollisionFilter filter;
     bool live = false;
   };
 
@@ -83,8 +84,9 @@ struct Scene::Impl {
   std::unique_ptr<detail::PairFinder> finder;
   std::vector<Aabb> boxes;
   std::vector<std::uint64_t> candidates;
-  std::vector<PairState> pairs;       // sorted by key: this step's candidates
-  std::vector<PairState> next_pairs;  // scratch of the merge
+  std::vector<PairState> pairs;         // sorted by key: this step's candidates
+  std::vector<PairState> next_pairs;    // scratch of the merge
+  std::vector<std::uint64_t> excluded;  // pair keys, increasing
   std::vector<BodyId> removed_since_step;
   std::vector<std::uint8_t> removed_flag;  // by id, scratch
   std::vector<CompoundResult> results;     // parallel to pairs
@@ -162,6 +164,32 @@ struct Scene::Impl {
       return r;
     }
     return distance(*a.compound, a.pose, *b.compound, b.pose, options.distance, &state.compound);
+  }
+
+  bool groups_meet(const Body& a, const Body& b) const {
+    return (a.filter.group & b.filter.mask) != 0 && (b.filter.group & a.filter.mask) != 0;
+  }
+
+  bool excluded_key(std::uint64_t key) const {
+    return std::binary_search(excluded.begin(), excluded.end(), key);
+  }
+
+  // Drops the candidates the filters reject: one merge with the sorted
+  // exclusions (both lists increase). Returns how many were dropped.
+  int filter_candidates() {
+    const bool any_groups = std::any_of(bodies.begin(), bodies.end(), [](const Body& b) {
+      return b.live && (b.filter.group != 1 || b.filter.mask != 0xffffffffu);
+    });
+    if (!any_groups && excluded.empty()) return 0;
+    std::size_t e = 0;
+    const std::size_t before = candidates.size();
+    std::erase_if(candidates, [&](std::uint64_t key) {
+      while (e < excluded.size() && excluded[e] < key) ++e;
+      if (e < excluded.size() && excluded[e] == key) return true;
+      return !groups_meet(bodies[slot(detail::pair_first(key))],
+                          bodies[slot(detail::pair_second(key))]);
+    });
+    return static_cast<int>(before - candidates.size());
   }
 
   // Carries the cache of every pair that stays a candidate over to this
@@ -264,10 +292,64 @@ void Scene::remove(BodyId id) {
   Impl::Body& b = impl_->bodies[slot(id)];
   if (!b.convex) --impl_->compound_count;
   b = Impl::Body{};
+  // Its exclusions go with it: the id may be reused by a new body.
+  std::erase_if(impl_->excluded, [id](std::uint64_t key) {
+    return detail::pair_first(key) == id || detail::pair_second(key) == id;
+  });
   impl_->finder->remove(id);
   impl_->free_ids.push_back(id);
   impl_->removed_since_step.push_back(id);
   --impl_->live_count;
+}
+
+void Scene::set_filter(BodyId id, const CollisionFilter& filter) {
+  impl_->live_body(id, "set_filter");
+  impl_->bodies[slot(id)].filter = filter;
+}
+
+const CollisionFilter& Scene::filter(BodyId id) const {
+  return impl_->live_body(id, "filter").filter;
+}
+
+namespace {
+// The key of the pair {a, b} of two distinct live bodies, checked.
+std::uint64_t checked_pair(const Scene& scene, BodyId a, BodyId b, const char* what) {
+  for (const BodyId id : {a, b}) {
+    if (!scene.contains(id)) {
+      throw InvalidInput(std::string("Scene::") + what + ": " + name(id) +
+                         " is not in the scene (never added, or removed)");
+    }
+  }
+  if (a == b) {
+    throw InvalidInput(std::string("Scene::") + what + ": a pair needs two bodies, got " + name(a) +
+                       " twice");
+  }
+  return detail::pair_key(std::min(a, b), std::max(a, b));
+}
+}  // namespace
+
+void Scene::exclude_pair(BodyId a, BodyId b) {
+  const std::uint64_t key = checked_pair(*this, a, b, "exclude_pair");
+  auto& excluded = impl_->excluded;
+  const auto at = std::lower_bound(excluded.begin(), excluded.end(), key);
+  if (at == excluded.end() || *at != key) excluded.insert(at, key);
+}
+
+void Scene::include_pair(BodyId a, BodyId b) {
+  const std::uint64_t key = checked_pair(*this, a, b, "include_pair");
+  auto& excluded = impl_->excluded;
+  const auto at = std::lower_bound(excluded.begin(), excluded.end(), key);
+  if (at != excluded.end() && *at == key) excluded.erase(at);
+}
+
+bool Scene::is_excluded(BodyId a, BodyId b) const {
+  return impl_->excluded_key(checked_pair(*this, a, b, "is_excluded"));
+}
+
+bool Scene::tests_pair(BodyId a, BodyId b) const {
+  const std::uint64_t key = checked_pair(*this, a, b, "tests_pair");
+  return !impl_->excluded_key(key) &&
+         impl_->groups_meet(impl_->bodies[slot(a)], impl_->bodies[slot(b)]);
 }
 
 bool Scene::contains(BodyId id) const {
@@ -296,6 +378,7 @@ std::span<const ClosePair> Scene::step() {
     if (s.bodies[k].live) s.boxes[k] = s.world_box(s.bodies[k]);
   }
   s.finder->find_pairs(s.boxes, s.candidates);
+  const int filtered = s.filter_candidates();
   const int warm = s.carry_caches();
 
   const std::size_t n = s.pairs.size();
@@ -322,6 +405,7 @@ std::span<const ClosePair> Scene::step() {
   s.stats.close_pairs = static_cast<int>(s.close.size());
   s.stats.convex_queries = convex_queries;
   s.stats.warm_pairs = warm;
+  s.stats.filtered_pairs = filtered;
   return s.close;
 }
 
@@ -334,6 +418,7 @@ std::vector<ClosePair> Scene::close_pairs_all_pairs() const {
   for (std::size_t i = 0; i < ids.size(); ++i) {
     const Impl::Body& a = s.bodies[slot(ids[i])];
     for (std::size_t j = i + 1; j < ids.size(); ++j) {
+      if (!tests_pair(ids[i], ids[j])) continue;
       const Impl::Body& b = s.bodies[slot(ids[j])];
       CompoundResult r;
       if (a.convex && b.convex) {

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -523,6 +524,117 @@ TEST(Scene, EmptyAndMovedScenes) {
   EXPECT_EQ(other.body_count(), 2);
   ASSERT_EQ(other.step().size(), 1u);
   EXPECT_EQ(other.step()[0].result.status, Status::intersecting);
+}
+
+}  // namespace
+}  // namespace proxima
+
+namespace proxima {
+namespace {
+
+// Issue 11, pair filters: groups and masks (Box2D's category and mask bits)
+// and excluded pairs are applied in the broad phase. step() must report
+// exactly the unfiltered twin's close pairs that the filters let through,
+// run no distance query on a dropped pair, and forget a removed body's
+// exclusions (its id is reused by a new body).
+TEST(SceneFilters, StepIsTheUnfilteredTwinMinusTheFilteredPairs) {
+  Rng rng(4242);
+  for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
+    SceneOptions o;
+    o.margin = 0.3;
+    o.broad_phase = bp;
+    Scene filtered(o);
+    Scene plain(o);
+    std::vector<BodyId> ids;
+    for (int i = 0; i < 50; ++i) {
+      const auto body = random_convex(rng);
+      const Pose p = random_pose(rng, 6.0, Vec3::Zero());
+      ids.push_back(filtered.add(body, p));
+      EXPECT_EQ(plain.add(body, p), ids.back());
+    }
+    // Three groups: robot links (bit 1) skip each other, the world (bit 2)
+    // meets everything, and a ghost (bit 3) meets nothing.
+    for (const BodyId id : ids) {
+      const int kind = id % 5;
+      if (kind < 2) filtered.set_filter(id, {0b010, 0b100});  // robot: meets the world only
+      if (kind == 4) filtered.set_filter(id, {0b1000, 0});    // ghost
+    }
+    std::set<std::pair<BodyId, BodyId>> excluded;
+    for (int k = 0; k < 40; ++k) {
+      const BodyId a = ids[static_cast<std::size_t>(test::uniform_int(rng, 0, 49))];
+      const BodyId b = ids[static_cast<std::size_t>(test::uniform_int(rng, 0, 49))];
+      if (a == b) continue;
+      filtered.exclude_pair(a, b);
+      excluded.insert({std::min(a, b), std::max(a, b)});
+    }
+    int dropped_close = 0;
+    for (int step = 0; step < 3; ++step) {
+      const std::vector<ClosePair> out(filtered.step().begin(), filtered.step().end());
+      const SceneStats stats = filtered.stats();
+      const std::vector<ClosePair> all(plain.step().begin(), plain.step().end());
+      std::vector<ClosePair> expected;
+      for (const ClosePair& p : all) {
+        const bool groups = (filtered.filter(p.a).group & filtered.filter(p.b).mask) != 0 &&
+                            (filtered.filter(p.b).group & filtered.filter(p.a).mask) != 0;
+        const bool kept = groups && excluded.count({p.a, p.b}) == 0;
+        EXPECT_EQ(filtered.tests_pair(p.a, p.b), kept);
+        if (kept) {
+          expected.push_back(p);
+        } else {
+          ++dropped_close;
+        }
+      }
+      ASSERT_EQ(out.size(), expected.size()) << to_string(bp) << " step " << step;
+      for (std::size_t k = 0; k < out.size(); ++k) {
+        EXPECT_EQ(out[k].a, expected[k].a);
+        EXPECT_EQ(out[k].b, expected[k].b);
+        EXPECT_TRUE(same_bits(out[k].result.distance, expected[k].result.distance));
+      }
+      // The twin of step() applies the same filters.
+      const std::vector<ClosePair> twin = filtered.close_pairs_all_pairs();
+      ASSERT_EQ(twin.size(), out.size());
+      for (std::size_t k = 0; k < out.size(); ++k) {
+        EXPECT_EQ(twin[k].a, out[k].a);
+        EXPECT_EQ(twin[k].b, out[k].b);
+      }
+      // Dropped pairs never reached the narrow phase.
+      EXPECT_GT(stats.filtered_pairs, 0);
+      EXPECT_EQ(stats.candidate_pairs + stats.filtered_pairs, plain.stats().candidate_pairs);
+      EXPECT_EQ(stats.convex_queries, stats.candidate_pairs);
+      for (const BodyId id : ids) {
+        const Pose next = moved(rng, filtered.pose(id));
+        filtered.set_pose(id, next);
+        plain.set_pose(id, next);
+      }
+    }
+    EXPECT_GT(dropped_close, 10);  // premise: the filters dropped close pairs
+
+    // A removed body's exclusions go with it: the new body on its id is
+    // tested against everyone.
+    const auto [a, b] = *excluded.begin();
+    filtered.remove(b);
+    const BodyId reused = filtered.add(random_convex(rng), filtered.pose(a));
+    ASSERT_EQ(reused, b);
+    EXPECT_FALSE(filtered.is_excluded(a, reused));
+    filtered.include_pair(a, a == ids[0] ? ids[1] : ids[0]);  // not excluded: no effect
+  }
+}
+
+TEST(SceneFilters, BadPairsAreRefusedByName) {
+  Scene scene;
+  const BodyId a = scene.add(unit_cube(), Pose{});
+  EXPECT_THROW(scene.exclude_pair(a, a), InvalidInput);
+  try {
+    scene.exclude_pair(a, 7);
+    ADD_FAILURE() << "no throw";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("Scene::exclude_pair: body 7 is not in the scene"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(scene.set_filter(3, {}), InvalidInput);
+  EXPECT_EQ(scene.filter(a).group, 1u);
+  EXPECT_EQ(scene.filter(a).mask, 0xffffffffu);
 }
 
 }  // namespace

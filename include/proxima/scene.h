@@ -41,13 +41,16 @@ using BodyId = std::int32_t;
 
 enum class BroadPhase : std::uint8_t {
   sweep_and_prune,    // sorted interval lists, kept sorted by insertion sort between steps
-  dynamic_aabb_tree,  // fattened boxes in a balanced tree, re-inserted when they leave their fat box
+  dynamic_aabb_tree,  // fattened boxes in a balanced tree, re-inserted when they leave their fat
+                      // box
 };
 
 inline const char* to_string(BroadPhase b) {
   switch (b) {
-    case BroadPhase::sweep_and_prune: return "sweep_and_prune";
-    case BroadPhase::dynamic_aabb_tree: return "dynamic_aabb_tree";
+    case BroadPhase::sweep_and_prune:
+      return "sweep_and_prune";
+    case BroadPhase::dynamic_aabb_tree:
+      return "dynamic_aabb_tree";
   }
   return "unknown";
 }
@@ -65,6 +68,16 @@ struct SceneOptions {
   int threads = 1;
 };
 
+// Which pairs a scene tests, per body (Box2D's category and mask bits, Bullet's
+// collision groups): bodies a and b are a candidate pair only when
+//   (a.group & b.mask) != 0  and  (b.group & a.mask) != 0
+// and the pair is not excluded (Scene::exclude_pair). The default puts every
+// body in group 1 and tests it against every group: all pairs are tested.
+struct CollisionFilter {
+  std::uint32_t group = 1;           // the groups this body belongs to, as bits
+  std::uint32_t mask = 0xffffffffu;  // the groups it is tested against, as bits
+};
+
 // One close pair: a < b, and the answer of the distance query between them
 // (for two convex bodies piece_a == piece_b == 0 and pairs_tested == 1).
 struct ClosePair {
@@ -80,6 +93,7 @@ struct SceneStats {
   int close_pairs = 0;      // of those, at distance <= margin
   int convex_queries = 0;   // convex distance queries run (compounds run several per pair)
   int warm_pairs = 0;       // candidate pairs that started from the previous step's cache
+  int filtered_pairs = 0;   // pairs whose boxes overlap but that the filters dropped
 };
 
 class Scene {
@@ -100,6 +114,20 @@ class Scene {
   void set_pose(BodyId id, const Pose& pose);
   void remove(BodyId id);
 
+  // Pair filters, applied in the broad phase before any narrow-phase work
+  // (a dropped pair costs no distance query and keeps no cache). Throw
+  // InvalidInput naming the id for an unknown id.
+  void set_filter(BodyId id, const CollisionFilter& filter);
+  const CollisionFilter& filter(BodyId id) const;
+  // Never test the pair (a, b), e.g. a robot's adjacent links, which overlap
+  // by construction. Both bodies must be in the scene and differ. Undone by
+  // include_pair, or by the removal of either body.
+  void exclude_pair(BodyId a, BodyId b);
+  void include_pair(BodyId a, BodyId b);
+  bool is_excluded(BodyId a, BodyId b) const;
+  // Whether step() tests the pair: the filters and exclusions above.
+  bool tests_pair(BodyId a, BodyId b) const;
+
   bool contains(BodyId id) const;
   const Pose& pose(BodyId id) const;
   // Every live body id, increasing.
@@ -113,7 +141,8 @@ class Scene {
   const SceneStats& stats() const;
 
   // The slow, obvious twin of step(): the cold distance query on every pair
-  // of bodies, no broad phase, no caches; same output order. For tests.
+  // of bodies that tests_pair, no broad phase, no caches; same output order.
+  // For tests.
   std::vector<ClosePair> close_pairs_all_pairs() const;
 
  private:

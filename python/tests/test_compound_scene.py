@@ -257,3 +257,31 @@ def test_set_poses_is_all_or_nothing():
     scene.set_poses([a, c], moved[:2])
     np.testing.assert_array_equal(scene.pose(a).translation, [1, 1, 1])
     np.testing.assert_array_equal(scene.pose(c).translation, [2, 2, 2])
+
+
+# Issue 11, pair filters: a robot's adjacent links overlap by construction
+# and were computed and reported every step. Groups/masks and excluded pairs
+# drop pairs in the broad phase.
+def test_scene_pair_filters():
+    rng = np.random.default_rng(21)
+    scene, ids, _ = random_scene(rng, 60, margin=0.3)
+    plain = {(p.a, p.b) for p in scene.step()}
+    assert len(plain) > 10
+    excluded = sorted(plain)[:5]
+    for a, b in excluded:
+        scene.exclude_pair(int(a), int(b))
+        assert scene.is_excluded(int(b), int(a))
+    ghost = int(ids[1])
+    scene.set_filter(ghost, group=0b10, mask=0)  # tested against nothing
+    assert scene.filter(ghost) == (0b10, 0)
+    kept = {(p.a, p.b) for p in scene.step()}
+    expected = {pair for pair in plain if pair not in set(excluded) and ghost not in pair}
+    assert kept == expected
+    assert {(p.a, p.b) for p in scene.close_pairs_all_pairs()} == expected
+    assert scene.stats.filtered_pairs >= len(plain) - len(expected)
+    scene.include_pair(*map(int, excluded[0]))
+    assert not scene.is_excluded(*map(int, excluded[0]))
+    with pytest.raises(ValueError, match="a pair needs two bodies"):
+        scene.exclude_pair(int(ids[0]), int(ids[0]))
+    with pytest.raises(ValueError, match="body 999 is not in the scene"):
+        scene.set_filter(999, 1, 1)
