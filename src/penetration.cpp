@@ -263,9 +263,31 @@ Candidate evaluate(const Query& q, const MinkowskiFaceId& id, const Vec3& n, int
   return c;
 }
 
-// The candidate of a Minkowski face id; nullopt-like (value inf) when the
-// id does not fit the polytopes (a foreign cache) or has no normal.
-Candidate evaluate_id(const Query& q, const MinkowskiFaceId& id) {
+Candidate evaluate_one(const Query& q, const MinkowskiFaceId& id);
+bool edge_side_unclear(const Query& q, const MinkowskiFaceId& id);
+
+// The candidates of a Minkowski face id: one, or two (n and -n) when the
+// side of an edge pair's normal is unclear; none (count 0) when the id has
+// no normal (parallel edges). Ids are the polytopes' own (from the
+// enumeration).
+int evaluate_id(const Query& q, const MinkowskiFaceId& id, std::array<Candidate, 2>& out) {
+  out[0] = evaluate_one(q, id);
+  if (id.kind != MinkowskiFace::edge_edge || !std::isfinite(out[0].value))
+    return std::isfinite(out[0].value) ? 1 : 0;
+  if (!edge_side_unclear(q, id)) return 1;
+  out[1] = evaluate(q, id, -out[0].normal, id.a0, id.b0);
+  return 2;
+}
+
+// An edge pair whose normal's side neither arc tells (see kClearMiddle).
+bool edge_side_unclear(const Query& q, const MinkowskiFaceId& id) {
+  return arc_middle(q, true, id.a0, id.a1).squaredNorm() == 0 &&
+         arc_middle(q, false, id.b0, id.b1).squaredNorm() == 0;
+}
+
+// The candidate of a Minkowski face id (for an unclear edge pair, along the
+// plus side); value inf when the id has no normal.
+Candidate evaluate_one(const Query& q, const MinkowskiFaceId& id) {
   Candidate none;
   none.id = id;
   switch (id.kind) {
@@ -292,19 +314,13 @@ Candidate evaluate_id(const Query& q, const MinkowskiFaceId& id) {
       // An arc shorter than a half circle holds n or -n, the one on the
       // side of its middle p + q (a polygon's two quarter arcs: the side
       // of their common end o). A segment's arcs make a whole circle:
-      // then -B's arc decides, and for two segments (or an arc so near a
-      // half circle that the side is unclear, kClearMiddle) both signs
-      // are evaluated (each is an upper bound).
+      // then -B's arc decides, and for two segments (or arcs so near a
+      // half circle that the side is unclear, kClearMiddle) evaluate_id
+      // adds -n too (each is an upper bound).
       const Vec3 middle_a = arc_middle(q, true, id.a0, id.a1);
       const Vec3 middle =
           middle_a.squaredNorm() > 0 ? middle_a : arc_middle(q, false, id.b0, id.b1);
-      const double side = n.dot(middle);
-      if (middle.squaredNorm() == 0) {
-        const Candidate plus = evaluate(q, id, n, id.a0, id.b0);
-        const Candidate minus = evaluate(q, id, -n, id.a0, id.b0);
-        return plus.value <= minus.value ? plus : minus;
-      }
-      if (side < 0) n = -n;
+      if (n.dot(middle) < 0) n = -n;
       return evaluate(q, id, n, id.a0, id.b0);
     }
   }
@@ -316,7 +332,7 @@ void add_face_candidates(const Query& q, std::vector<Candidate>& out) {
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
-    Candidate c = evaluate_id(q, id);
+    Candidate c = evaluate_one(q, id);
     c.id.b0 = c.support_b;
     hint_b = c.support_b;
     out.push_back(c);
@@ -324,7 +340,7 @@ void add_face_candidates(const Query& q, std::vector<Candidate>& out) {
   int hint_a = 0;
   for (int g = 0; g < q.b.face_count(); ++g) {
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
-    Candidate c = evaluate_id(q, id);
+    Candidate c = evaluate_one(q, id);
     c.id.a0 = c.support_a;
     hint_a = c.support_a;
     out.push_back(c);
@@ -333,8 +349,9 @@ void add_face_candidates(const Query& q, std::vector<Candidate>& out) {
 
 void add_edge_candidate(const Query& q, int a0, int a1, int b0, int b1,
                         std::vector<Candidate>& out) {
-  const Candidate c = evaluate_id(q, {MinkowskiFace::edge_edge, a0, a1, b0, b1});
-  if (std::isfinite(c.value)) out.push_back(c);
+  std::array<Candidate, 2> c;
+  const int count = evaluate_id(q, {MinkowskiFace::edge_edge, a0, a1, b0, b1}, c);
+  for (int i = 0; i < count; ++i) out.push_back(c[static_cast<std::size_t>(i)]);
 }
 
 // Brute force over all edge pairs.
@@ -526,7 +543,7 @@ PenetrationResult finish(const Query& q, const Candidate& best, double lower_sca
   r.status = depth > band ? PenetrationStatus::penetrating : PenetrationStatus::touching;
   r.depth = std::max(depth, 0.0);
   r.upper_bound = r.depth;
-  r.lower_bound = std::max(0.0, lower_scaled * q.unit - contact_band(q.magnitude));
+  r.lower_bound = std::max(0.0, std::min(lower_scaled, value) * q.unit - contact_band(q.magnitude));
   return r;
 }
 
@@ -568,6 +585,21 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
           static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
 }
 
+// Sorts the kSorted nearest cached faces to the front.
+void sort_prefix(PenetrationCache& cache) {
+  const auto by_offset = [](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
+    return x.offset < y.offset;
+  };
+  const std::size_t k = std::min<std::size_t>(PenetrationCache::kSorted, cache.facets.size());
+  std::nth_element(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k),
+                   cache.facets.end(), by_offset);
+  std::sort(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k), by_offset);
+  cache.sorted = static_cast<int>(k);
+  cache.rest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = k; i < cache.facets.size(); ++i)
+    cache.rest = std::min(cache.rest, cache.facets[i].offset);
+}
+
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a) {
   q.compute_all_normals();
   std::vector<Candidate> candidates;
@@ -580,29 +612,61 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     add_edge_candidates_brute_force(q, candidates);
   if (candidates.empty()) return finish_without_candidates(q);
   const int count = static_cast<int>(candidates.size());
-  const std::size_t keep = std::min<std::size_t>(PenetrationCache::kNearest + 1, candidates.size());
-  std::partial_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(keep),
-                    candidates.end(),
-                    [](const Candidate& x, const Candidate& y) { return x.value < y.value; });
-  const Candidate& best = candidates.front();
-  PenetrationResult r = finish(q, best, best.value, count, false);
+  const auto best =
+      std::min_element(candidates.begin(), candidates.end(),
+                       [](const Candidate& x, const Candidate& y) { return x.value < y.value; });
+  PenetrationResult r = finish(q, *best, best->value, count, false);
   if (cache != nullptr) {
     cache->a = &q.a;
     cache->b = &q.b;
     cache->fingerprint = fingerprint(q.a, q.b);
     cache->rotation = b_in_a.rotation;
     cache->translation = b_in_a.translation;
-    cache->nearest_count =
-        static_cast<int>(std::min<std::size_t>(PenetrationCache::kNearest, candidates.size()));
-    for (int i = 0; i < cache->nearest_count; ++i)
-      cache->nearest[static_cast<std::size_t>(i)] = candidates[static_cast<std::size_t>(i)].id;
-    cache->margin = candidates.size() > PenetrationCache::kNearest
-                        ? candidates[PenetrationCache::kNearest].value * q.unit
-                        : std::numeric_limits<double>::infinity();
-    cache->hint_a = best.support_a;
-    cache->hint_b = best.support_b;
+    cache->facets.resize(candidates.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      cache->facets[i] = {candidates[i].id, candidates[i].normal, candidates[i].value * q.unit,
+                          candidates[i].support_a, candidates[i].support_b};
+    cache->anchors = 0;
+    sort_prefix(*cache);
   }
   return r;
+}
+
+// Re-anchors the cache at translation t: every offset moves by -n.(t - t_ref)
+// (the facets of A - B translate with B), and the nearest are sorted again.
+void re_anchor(PenetrationCache& cache, const Vec3& t) {
+  const Vec3 delta = t - cache.translation;
+  for (PenetrationCache::Facet& f : cache.facets) f.offset -= f.normal.dot(delta);
+  cache.translation = t;
+  ++cache.anchors;
+  sort_prefix(cache);
+}
+
+// A translation-only tracked query: the cached facets at their offsets
+// moved by -n.delta, nearest first, until the next one cannot beat the best
+// found (its offset at the reference minus |delta| is a lower bound on its
+// offset now: |n.delta| <= |delta|). Returns the best cached facet, or -1
+// when the sorted prefix was used up without certifying (re-anchor then).
+int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double& best,
+         double& cutoff, int& scanned) {
+  best = std::numeric_limits<double>::infinity();
+  int arg = -1;
+  scanned = 0;
+  for (int i = 0; i < cache.sorted; ++i) {
+    const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
+    if (f.offset - moved >= best) {
+      cutoff = f.offset - moved;
+      return arg;
+    }
+    ++scanned;
+    const double value = f.offset - f.normal.dot(delta);
+    if (value < best) {
+      best = value;
+      arg = i;
+    }
+  }
+  cutoff = cache.rest - moved;
+  return best <= cutoff ? arg : -1;
 }
 
 }  // namespace
@@ -616,25 +680,30 @@ PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const C
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, PenetrationCache& cache) {
   Query q(a, b, b_in_a);
-  const bool same_pair = cache.a == &a && cache.b == &b && cache.nearest_count > 0 &&
+  const bool same_pair = cache.a == &a && cache.b == &b && !cache.facets.empty() &&
+                         cache.anchors < PenetrationCache::kMaxAnchors &&
                          cache.fingerprint == fingerprint(a, b) &&
                          cache.rotation == b_in_a.rotation;
   if (same_pair) {
-    // M is the reference's M translated by -(t - t_ref): every facet's
-    // offset moved by at most |t - t_ref|. The cached nearest are evaluated
-    // again; every other facet is at least margin - |t - t_ref| away.
-    const double moved = ((b_in_a.translation - cache.translation) * q.inverse).norm() * q.unit;
-    Candidate best;
-    for (int i = 0; i < cache.nearest_count; ++i) {
-      const Candidate c = evaluate_id(q, cache.nearest[static_cast<std::size_t>(i)]);
-      if (c.value < best.value) best = c;
-    }
+    // M is the reference's M translated by -(t - t_ref): the cached facets
+    // are all of its facets, each offset moved by -n.(t - t_ref).
     const double slack = kValueSlackUlps * kUnitRoundoff * q.magnitude;
-    const double others = cache.margin - moved - slack;
-    if (std::isfinite(best.value) && best.value * q.unit <= others) {
-      cache.hint_a = best.support_a;
-      cache.hint_b = best.support_b;
-      return finish(q, best, best.value, cache.nearest_count, true);
+    double best = 0.0, cutoff = 0.0;
+    int scanned = 0;
+    const Vec3 delta = b_in_a.translation - cache.translation;
+    int arg = scan(cache, delta, (delta * q.inverse).norm() * q.unit, best, cutoff, scanned);
+    int work = scanned;
+    if (arg < 0) {
+      re_anchor(cache, b_in_a.translation);
+      arg = scan(cache, Vec3::Zero(), 0.0, best, cutoff, scanned);
+      work += static_cast<int>(cache.facets.size()) + scanned;
+    }
+    if (arg >= 0) {
+      // The winner evaluated with true supports (they do not move under a
+      // translation: the cached ones are checked by one hill-climbing step).
+      const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(arg)];
+      Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
+      return finish(q, c, (std::min(best, cutoff) - slack) * q.inverse, work, true);
     }
   }
   return solve_cold(q, true, &cache, b_in_a);

@@ -497,10 +497,12 @@ TEST(PenetrationTracking, RotationAndForeignCachesAreNeverWrong) {
     const PenetrationResult c1 = penetration_depth_brute_force(pa1, pb1, p2);
     EXPECT_FALSE(r1.tracked);
     EXPECT_NEAR(r1.depth, c1.depth, 1e-12 * c1.depth + 1e-14);
-    // A cache whose ids were scribbled on (out of range and wrong kinds).
-    PenetrationCache scribbled = cache;
-    for (auto& id : scribbled.nearest) id = {MinkowskiFace::edge_edge, 100000, -5, 7, 7};
-    const PenetrationResult r3 = penetration_depth(pa1, pb1, p2, scribbled);
+    // The cache moved to copies of the same polytopes (other objects):
+    // not trusted, right.
+    const ConvexPolytope copy_a = pa1, copy_b = pb1;
+    PenetrationCache moved = cache;
+    const PenetrationResult r3 = penetration_depth(copy_a, copy_b, p2, moved);
+    EXPECT_FALSE(r3.tracked);
     EXPECT_NEAR(r3.depth, c1.depth, 1e-12 * c1.depth + 1e-14);
   }
 }

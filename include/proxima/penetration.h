@@ -122,42 +122,54 @@ struct PenetrationResult {
   MinkowskiFaceId face;         // the Minkowski face realizing the depth
   Feature feature_a;
   Feature feature_b;
-  // Candidates (Minkowski faces) evaluated by this query: F_A + F_B + the
-  // crossing edge pairs for a cold query, the cached few for a tracked one.
+  // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
+  // crossing edge pairs) for a cold query; scanned, plus every cached one
+  // when it re-anchored, for a tracked one.
   int candidates = 0;
   // True when the cache certified the answer (no enumeration of M).
   bool tracked = false;
 };
 
 // Coherence between queries of one pair, owned by the caller;
-// default-constructed means cold. A query reuses it when it comes from the
-// same two polytope objects (address, sizes and a few coordinates are
-// checked: a cache of another pair is ignored, at worst making a query
-// cold) and B's rotation is unchanged bit for bit (translations are free):
-// then the facets of A - B are those of the last enumeration translated, the
-// cached nearest ones are evaluated again and the cached margin (the
-// smallest offset of all the others at the reference translation, minus
-// the distance moved since) certifies that none of the others is nearer. A
-// rotated B, or a translation that used up the margin, re-enumerates.
+// default-constructed means cold. It holds every Minkowski face of A - B
+// found by the last enumeration (O(F_A + F_B + crossing edge pairs)
+// entries: not small for large hulls), with their offsets at a reference
+// translation of B. A query reuses it when it comes from the same two
+// polytope objects (addresses, sizes and a few coordinates are checked: a
+// cache of another pair is ignored, at worst making a query cold) and B's
+// rotation is unchanged bit for bit: then the faces of A - B are the cached
+// ones translated, each offset moved by -n.(t - t_ref). The nearest
+// kSorted are kept sorted; a query scans them until the next cannot beat
+// the best (offset at the reference minus |t - t_ref|), and when the
+// sorted prefix does not settle it, re-anchors: every offset is moved to
+// the new translation (O(entries) multiply-adds, no support or Gauss-map
+// work) and the prefix sorted again. A rotated B enumerates again, and so
+// does every kMaxAnchors-th re-anchor (the moved offsets gather rounding).
 struct PenetrationCache {
-  static constexpr int kNearest = 16;
+  static constexpr int kSorted = 64;
+  static constexpr int kMaxAnchors = 256;
+
+  struct Facet {
+    MinkowskiFaceId id;
+    Vec3 normal = Vec3::UnitX();  // outward unit normal of the face of A - B
+    double offset = 0.0;          // h_A(n) + h_B(-n) at the reference, A's units
+    std::int32_t support_a = -1;  // supports along n and -n (they do not
+    std::int32_t support_b = -1;  // change under a translation)
+  };
 
   // Identity of the pair the cache was filled for.
   const ConvexPolytope* a = nullptr;
   const ConvexPolytope* b = nullptr;
   std::array<double, 4> fingerprint = {0, 0, 0, 0};
-  // B's pose of the last enumeration (the reference).
+  // B's pose at the reference.
   Mat3 rotation = Mat3::Zero();
   Vec3 translation = Vec3::Zero();
-  // The nearest Minkowski faces at the reference, nearest first.
-  std::array<MinkowskiFaceId, kNearest> nearest{};
-  int nearest_count = 0;
-  // Lower bound on the offset of every other facet of A - B at the
-  // reference (+infinity when there is none), in A's units.
-  double margin = 0.0;
-  // Support hints.
-  std::int32_t hint_a = -1;
-  std::int32_t hint_b = -1;
+  // All faces of A - B; [0, sorted) ascending by offset, every later one
+  // at least `rest`.
+  std::vector<Facet> facets;
+  int sorted = 0;
+  double rest = 0.0;
+  int anchors = 0;  // re-anchors since the last enumeration
 
   bool is_cold() const { return a == nullptr; }
   void reset() { *this = PenetrationCache{}; }
@@ -168,7 +180,7 @@ struct PenetrationCache {
 // walks the overlay of the two Gauss maps (for each edge of A, the cells of
 // B its arc crosses, found by hill climbing and stepping across B's edges),
 // O(F_A + F_B + E_A + E_B + crossings); a tracked query (same pair, same
-// rotation, see PenetrationCache) costs O(kNearest) hill-climbing checks.
+// rotation, see PenetrationCache) scans the nearest cached faces.
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, PenetrationCache& cache);
 
