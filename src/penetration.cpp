@@ -590,7 +590,9 @@ void sort_prefix(PenetrationCache& cache) {
   const auto by_offset = [](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
     return x.offset < y.offset;
   };
-  const std::size_t k = std::min<std::size_t>(PenetrationCache::kSorted, cache.facets.size());
+  const std::size_t k =
+      std::min(std::max<std::size_t>(PenetrationCache::kSorted, cache.facets.size() / 16),
+               cache.facets.size());
   std::nth_element(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k),
                    cache.facets.end(), by_offset);
   std::sort(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k), by_offset);
@@ -624,9 +626,14 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     cache->translation = b_in_a.translation;
     cache->facets.resize(candidates.size());
     for (std::size_t i = 0; i < candidates.size(); ++i)
-      cache->facets[i] = {candidates[i].id, candidates[i].normal, candidates[i].value * q.unit,
-                          candidates[i].support_a, candidates[i].support_b};
-    cache->anchors = 0;
+      cache->facets[i] = {candidates[i].id,
+                          candidates[i].normal,
+                          candidates[i].value * q.unit,
+                          candidates[i].value * q.unit,
+                          candidates[i].support_a,
+                          candidates[i].support_b};
+    cache->enumerated_translation = b_in_a.translation;
+    cache->scan_work = 0;
     sort_prefix(*cache);
   }
   return r;
@@ -635,10 +642,13 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
 // Re-anchors the cache at translation t: every offset moves by -n.(t - t_ref)
 // (the facets of A - B translate with B), and the nearest are sorted again.
 void re_anchor(PenetrationCache& cache, const Vec3& t) {
-  const Vec3 delta = t - cache.translation;
-  for (PenetrationCache::Facet& f : cache.facets) f.offset -= f.normal.dot(delta);
+  // From the enumeration's offsets, not the last reference's: one rounding
+  // per offset however many re-anchors.
+  const Vec3 delta = t - cache.enumerated_translation;
+  for (PenetrationCache::Facet& f : cache.facets)
+    f.offset = f.enumerated_offset - f.normal.dot(delta);
   cache.translation = t;
-  ++cache.anchors;
+  cache.scan_work = 0;
   sort_prefix(cache);
 }
 
@@ -681,7 +691,6 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
                                     const Pose& b_in_a, PenetrationCache& cache) {
   Query q(a, b, b_in_a);
   const bool same_pair = cache.a == &a && cache.b == &b && !cache.facets.empty() &&
-                         cache.anchors < PenetrationCache::kMaxAnchors &&
                          cache.fingerprint == fingerprint(a, b) &&
                          cache.rotation == b_in_a.rotation;
   if (same_pair) {
@@ -699,9 +708,17 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
       work += static_cast<int>(cache.facets.size()) + scanned;
     }
     if (arg >= 0) {
+      const PenetrationCache::Facet f = cache.facets[static_cast<std::size_t>(arg)];
+      cache.scan_work += scanned;
+      if (cache.scan_work > static_cast<std::int64_t>(cache.facets.size())) {
+        // Certified, but the scans since the reference cost as much as a
+        // re-anchor: re-anchor for the next queries (amortized, at most
+        // doubling the work).
+        re_anchor(cache, b_in_a.translation);
+        work += static_cast<int>(cache.facets.size());
+      }
       // The winner evaluated with true supports (they do not move under a
       // translation: the cached ones are checked by one hill-climbing step).
-      const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(arg)];
       Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
       return finish(q, c, (std::min(best, cutoff) - slack) * q.inverse, work, true);
     }

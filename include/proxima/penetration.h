@@ -139,37 +139,41 @@ struct PenetrationResult {
 // cache of another pair is ignored, at worst making a query cold) and B's
 // rotation is unchanged bit for bit: then the faces of A - B are the cached
 // ones translated, each offset moved by -n.(t - t_ref). The nearest
-// kSorted are kept sorted; a query scans them until the next cannot beat
+// max(kSorted, entries / 16) are kept sorted; a query scans them until the next cannot beat
 // the best (offset at the reference minus |t - t_ref|), and when the
 // sorted prefix does not settle it, re-anchors: every offset is moved to
 // the new translation (O(entries) multiply-adds, no support or Gauss-map
-// work) and the prefix sorted again. A rotated B enumerates again, and so
-// does every kMaxAnchors-th re-anchor (the moved offsets gather rounding).
+// work) and the prefix sorted again; so does a query after scans that
+// together cost as much as a re-anchor (amortized: at most twice the work).
+// Offsets are always moved from the enumeration's (one rounding each, however
+// many re-anchors). A rotated B enumerates again.
 struct PenetrationCache {
+  // The sorted prefix: at least kSorted faces, and a sixteenth of them.
   static constexpr int kSorted = 64;
-  static constexpr int kMaxAnchors = 256;
 
   struct Facet {
     MinkowskiFaceId id;
-    Vec3 normal = Vec3::UnitX();  // outward unit normal of the face of A - B
-    double offset = 0.0;          // h_A(n) + h_B(-n) at the reference, A's units
-    std::int32_t support_a = -1;  // supports along n and -n (they do not
-    std::int32_t support_b = -1;  // change under a translation)
+    Vec3 normal = Vec3::UnitX();     // outward unit normal of the face of A - B
+    double offset = 0.0;             // h_A(n) + h_B(-n) at the reference, A's units
+    double enumerated_offset = 0.0;  // the same at the enumeration
+    std::int32_t support_a = -1;     // supports along n and -n (they do not
+    std::int32_t support_b = -1;     // change under a translation)
   };
 
   // Identity of the pair the cache was filled for.
   const ConvexPolytope* a = nullptr;
   const ConvexPolytope* b = nullptr;
   std::array<double, 4> fingerprint = {0, 0, 0, 0};
-  // B's pose at the reference.
+  // B's pose at the reference, and its translation at the enumeration.
   Mat3 rotation = Mat3::Zero();
   Vec3 translation = Vec3::Zero();
+  Vec3 enumerated_translation = Vec3::Zero();
   // All faces of A - B; [0, sorted) ascending by offset, every later one
   // at least `rest`.
   std::vector<Facet> facets;
   int sorted = 0;
   double rest = 0.0;
-  int anchors = 0;  // re-anchors since the last enumeration
+  std::int64_t scan_work = 0;  // faces scanned since the last re-anchor
 
   bool is_cold() const { return a == nullptr; }
   void reset() { *this = PenetrationCache{}; }
