@@ -145,13 +145,6 @@ int left_face(const ConvexPolytope& poly, int v, int w) {
   return -1;
 }
 
-bool is_edge(const ConvexPolytope& poly, int v, int w) {
-  if (v < 0 || w < 0 || v >= poly.vertex_count() || w >= poly.vertex_count()) return false;
-  for (const std::int32_t x : poly.neighbors(v))
-    if (x == w) return true;
-  return false;
-}
-
 // The Gauss-map arcs of edge v -> w (1 for a solid, 2 for a polygon, 4 for
 // a segment), axis `k` (the edge vector in A's frame), endpoints from the
 // face normals `nl`, `nr` (in A's frame; already negated for -B, in which
@@ -226,14 +219,12 @@ bool edges_may_cross(const std::array<Arc, 4>& xs, int nx, const std::array<Arc,
 // (a needle of width 1e-17 on a plate) and PenetrationDegenerate.PolygonCuttingThroughSolid.
 constexpr double kClearMiddle = 0.5;
 
-// The middle of the Gauss-map arc of edge (v, w), as a direction whose side
-// tells which of n, -n lies on the arc: for a solid p + q (A) or -(p + q)
-// (-B), for a polygon the outward in-plane normal (negated for -B); zero
-// when unclear (see kClearMiddle), for a segment (its arcs make a whole
-// circle) or for an edge that is not one.
-Vec3 arc_middle(const Query& q, bool on_a, int v, int w) {
-  std::array<Arc, 4> arcs;
-  const int count = on_a ? arcs_of_a(q, v, w, arcs) : arcs_of_b(q, v, w, arcs);
+// The middle of an edge's Gauss-map arcs (from arcs_of_a / arcs_of_b), as
+// a direction whose side tells which of n, -n lies on them: for a solid
+// p + q, for a polygon the outward in-plane normal (both negated for -B,
+// as the arcs are); zero when unclear (see kClearMiddle) or for a segment
+// (its arcs make a whole circle).
+Vec3 arc_middle(const std::array<Arc, 4>& arcs, int count) {
   if (count == 1) {
     const Vec3 middle = arcs[0].p + arcs[0].q;
     return middle.norm() >= kClearMiddle ? middle : Vec3::Zero();
@@ -263,68 +254,40 @@ Candidate evaluate(const Query& q, const MinkowskiFaceId& id, const Vec3& n, int
   return c;
 }
 
-Candidate evaluate_one(const Query& q, const MinkowskiFaceId& id);
-bool edge_side_unclear(const Query& q, const MinkowskiFaceId& id);
-
-// The candidates of a Minkowski face id: one, or two (n and -n) when the
-// side of an edge pair's normal is unclear; none (count 0) when the id has
-// no normal (parallel edges). Ids are the polytopes' own (from the
-// enumeration).
-int evaluate_id(const Query& q, const MinkowskiFaceId& id, std::array<Candidate, 2>& out) {
-  out[0] = evaluate_one(q, id);
-  if (id.kind != MinkowskiFace::edge_edge || !std::isfinite(out[0].value))
-    return std::isfinite(out[0].value) ? 1 : 0;
-  if (!edge_side_unclear(q, id)) return 1;
-  out[1] = evaluate(q, id, -out[0].normal, id.a0, id.b0);
-  return 2;
+// The candidate of a face of A (face_vertex) or of B (vertex_face), hints
+// from the id.
+Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
+  if (id.kind == MinkowskiFace::face_vertex)
+    return evaluate(q, id, q.normal_a(id.a0), q.a.face(id.a0)[0], id.b0);
+  return evaluate(q, id, q.normal_b(id.b0), id.a0, q.b.face(id.b0)[0]);
 }
 
-// An edge pair whose normal's side neither arc tells (see kClearMiddle).
-bool edge_side_unclear(const Query& q, const MinkowskiFaceId& id) {
-  return arc_middle(q, true, id.a0, id.a1).squaredNorm() == 0 &&
-         arc_middle(q, false, id.b0, id.b1).squaredNorm() == 0;
-}
-
-// The candidate of a Minkowski face id (for an unclear edge pair, along the
-// plus side); value inf when the id has no normal.
-Candidate evaluate_one(const Query& q, const MinkowskiFaceId& id) {
-  Candidate none;
-  none.id = id;
-  switch (id.kind) {
-    case MinkowskiFace::face_vertex: {
-      if (id.a0 < 0 || id.a0 >= q.a.face_count()) return none;
-      const int hint_b = id.b0 >= 0 && id.b0 < q.b.vertex_count() ? id.b0 : -1;
-      return evaluate(q, id, q.normal_a(id.a0), q.a.face(id.a0)[0], hint_b);
-    }
-    case MinkowskiFace::vertex_face: {
-      if (id.b0 < 0 || id.b0 >= q.b.face_count()) return none;
-      const int hint_a = id.a0 >= 0 && id.a0 < q.a.vertex_count() ? id.a0 : -1;
-      return evaluate(q, id, q.normal_b(id.b0), hint_a, q.b.face(id.b0)[0]);
-    }
-    case MinkowskiFace::edge_edge: {
-      if (!is_edge(q.a, id.a0, id.a1) || !is_edge(q.b, id.b0, id.b1)) return none;
-      const Vec3 ea = q.point_a(id.a1) - q.point_a(id.a0);
-      const Vec3 eb = q.point_b(id.b1) - q.point_b(id.b0);
-      Vec3 n = ea.cross(eb);
-      const double length = n.norm();
-      // Parallel edges span no facet (their faces' candidates cover it).
-      if (!(length > 0x1p-200 * ea.norm() * eb.norm()) || !(length > 0.0)) return none;
-      n /= length;
-      // The facet's normal is on A's arc (outward at A's edge) and on -B's.
-      // An arc shorter than a half circle holds n or -n, the one on the
-      // side of its middle p + q (a polygon's two quarter arcs: the side
-      // of their common end o). A segment's arcs make a whole circle:
-      // then -B's arc decides, and for two segments (or arcs so near a
-      // half circle that the side is unclear, kClearMiddle) evaluate_id
-      // adds -n too (each is an upper bound).
-      const Vec3 middle_a = arc_middle(q, true, id.a0, id.a1);
-      const Vec3 middle =
-          middle_a.squaredNorm() > 0 ? middle_a : arc_middle(q, false, id.b0, id.b1);
-      if (n.dot(middle) < 0) n = -n;
-      return evaluate(q, id, n, id.a0, id.b0);
-    }
+// The candidates of an edge pair whose arcs may cross (xa: A's arcs, yb:
+// -B's), appended to out: none for parallel edges (they span no face of
+// A - B; their faces' candidates cover it). The face's normal is on A's
+// arc (outward at A's edge) and on -B's. An arc shorter than a half circle
+// holds n or -n, the one on the side of its middle; a segment's arcs make
+// a whole circle, then -B's arc decides; for two segments (or arcs so near
+// a half circle that the side is unclear, kClearMiddle) both n and -n are
+// added (each an upper bound).
+void add_edge_candidate(const Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na,
+                        int b0, int b1, const std::array<Arc, 4>& yb, int nb,
+                        std::vector<Candidate>& out) {
+  const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
+  const Vec3& ea = xa[0].k;
+  const Vec3& eb = yb[0].k;
+  Vec3 n = ea.cross(eb);
+  const double length = n.norm();
+  if (!(length > 0x1p-200 * ea.norm() * eb.norm()) || !(length > 0.0)) return;
+  n /= length;
+  Vec3 middle = arc_middle(xa, na);
+  if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);
+  if (middle.squaredNorm() == 0) {
+    out.push_back(evaluate(q, id, n, a0, b0));
+    out.push_back(evaluate(q, id, -n, a0, b0));
+    return;
   }
-  return none;
+  out.push_back(evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0));
 }
 
 // Appends every face candidate (faces of A, faces of B).
@@ -332,7 +295,7 @@ void add_face_candidates(const Query& q, std::vector<Candidate>& out) {
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
-    Candidate c = evaluate_one(q, id);
+    Candidate c = evaluate_face(q, id);
     c.id.b0 = c.support_b;
     hint_b = c.support_b;
     out.push_back(c);
@@ -340,18 +303,11 @@ void add_face_candidates(const Query& q, std::vector<Candidate>& out) {
   int hint_a = 0;
   for (int g = 0; g < q.b.face_count(); ++g) {
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
-    Candidate c = evaluate_one(q, id);
+    Candidate c = evaluate_face(q, id);
     c.id.a0 = c.support_a;
     hint_a = c.support_a;
     out.push_back(c);
   }
-}
-
-void add_edge_candidate(const Query& q, int a0, int a1, int b0, int b1,
-                        std::vector<Candidate>& out) {
-  std::array<Candidate, 2> c;
-  const int count = evaluate_id(q, {MinkowskiFace::edge_edge, a0, a1, b0, b1}, c);
-  for (int i = 0; i < count; ++i) out.push_back(c[static_cast<std::size_t>(i)]);
 }
 
 // Brute force over all edge pairs.
@@ -376,7 +332,7 @@ void add_edge_candidates_brute_force(const Query& q, std::vector<Candidate>& out
   for (const EdgeArcs& x : ea)
     for (const EdgeArcs& y : eb)
       if (edges_may_cross(x.arcs, x.count, y.arcs, y.count))
-        add_edge_candidate(q, x.v, x.w, y.v, y.w, out);
+        add_edge_candidate(q, x.v, x.w, x.arcs, x.count, y.v, y.w, y.arcs, y.count, out);
 }
 
 // The overlay walk: for each arc of A, the chain of B cells it crosses.
@@ -385,6 +341,13 @@ void add_edge_candidates_walk(const Query& q, std::vector<Candidate>& out) {
   std::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0);
   int hint = 0;
   std::array<Arc, 4> xs, ys;
+  // A solid B's arcs, one per edge, computed once on first use (each is
+  // met from several arcs of A), by adjacency slot of either direction
+  // (an arc read backwards is the same arc for the crossing test).
+  const bool memo = q.b.dimension() == 3;
+  const auto offsets = q.b.adjacency_offsets();
+  std::vector<Arc> slot_arc(memo ? q.b.adjacency().size() : 0);
+  std::vector<char> slot_ready(slot_arc.size(), 0);
   for (const auto& e : q.a.edges()) {
     const int nx = arcs_of_a(q, e[0], e[1], xs);
     for (int i = 0; i < nx; ++i) {
@@ -397,8 +360,22 @@ void add_edge_candidates_walk(const Query& q, std::vector<Candidate>& out) {
       visited[static_cast<std::size_t>(start)] = 1;
       for (std::size_t head = 0; head < chain.size(); ++head) {
         const int j = chain[head];
-        for (const std::int32_t k : q.b.neighbors(j)) {
-          const int ny = arcs_of_b(q, j, k, ys);
+        const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
+        const auto nbrs = q.b.neighbors(j);
+        for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
+          const std::int32_t k = nbrs[slot - slot0];
+          int ny = 0;
+          if (memo) {
+            if (!slot_ready[slot]) {
+              const int count = arcs_of_b(q, j, k, ys);
+              slot_ready[slot] = count == 1 ? 1 : 2;
+              slot_arc[slot] = ys[0];
+            }
+            ny = slot_ready[slot] == 1 ? 1 : 0;
+            ys[0] = slot_arc[slot];
+          } else {
+            ny = arcs_of_b(q, j, k, ys);
+          }
           bool crosses = false;
           for (int m = 0; m < ny && !crosses; ++m)
             crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
@@ -407,14 +384,14 @@ void add_edge_candidates_walk(const Query& q, std::vector<Candidate>& out) {
           if (!visited[static_cast<std::size_t>(k)]) {
             visited[static_cast<std::size_t>(k)] = 1;
             chain.push_back(k);
-            add_edge_candidate(q, e[0], e[1], std::min(j, static_cast<int>(k)),
-                               std::max(j, static_cast<int>(k)), out);
+            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                               std::max(j, static_cast<int>(k)), ys, ny, out);
           } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
                                k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
             // k was reached from another cell of this chain, not expanded
             // yet: the edge j-k is another crossing of the arc.
-            add_edge_candidate(q, e[0], e[1], std::min(j, static_cast<int>(k)),
-                               std::max(j, static_cast<int>(k)), out);
+            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                               std::max(j, static_cast<int>(k)), ys, ny, out);
           }
         }
       }
