@@ -440,6 +440,63 @@ TEST(PenetrationTwins, WalkMatchesBruteForce) {
   }
 }
 
+TEST(PenetrationTwins, GridsWithCoplanarFacesAndRotationSweep) {
+  // Grid points: many coplanar faces, parallel edges and exact ties, the
+  // plateaus where the arc test and the supports meet rounding.
+  Rng rng(19);
+  for (int trial = 0; trial < 30; ++trial) {
+    const Points a = grid_points(rng, 40, uniform_int(rng, 1, 3));
+    const Points b_local = grid_points(rng, 30, uniform_int(rng, 1, 3));
+    const Pose pose =
+        trial % 2 == 0
+            ? Pose::from_translation(
+                  Vec3(uniform_int(rng, -2, 2), uniform_int(rng, -2, 2), uniform_int(rng, -2, 2)) /
+                  4.0)
+            : Pose(random_quaternion(rng), 0.5 * random_unit_vector(rng));
+    const ConvexPolytope pa(a), pb(b_local);
+    PenetrationCache cache;
+    const PenetrationResult rf = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult rs = penetration_depth_brute_force(pa, pb, pose);
+    EXPECT_EQ(rf.status, rs.status) << trial;
+    EXPECT_NEAR(rf.depth, rs.depth, kRel * rs.depth + 1e-14) << trial;
+  }
+  // B spinning in place inside A: every query enumerates (a rotation), the
+  // value is continuous.
+  const Points a = points_on_sphere(rng, 80), b = points_in_cube(rng, 30, 0.4);
+  const ConvexPolytope pa(a), pb(b);
+  PenetrationCache cache;
+  double previous = -1;
+  for (int i = 0; i < 100; ++i) {
+    const Pose pose(Quat(Eigen::AngleAxisd(0.01 * i, Vec3(1, 2, 3).normalized())),
+                    Vec3(0.1, 0.2, -0.1));
+    const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult s = penetration_depth_brute_force(pa, pb, pose);
+    EXPECT_NEAR(r.depth, s.depth, kRel * s.depth + 1e-14) << i;
+    // Lipschitz in the rotation: B's points move by at most 0.01 |y| <= 0.01 sqrt(3) 0.4.
+    if (previous >= 0) {
+      EXPECT_LE(std::abs(r.depth - previous), 0.01 * std::sqrt(3.0) * 0.4 + 1e-14) << i;
+    }
+    previous = r.depth;
+  }
+}
+
+TEST(PenetrationDegenerate, LongThinTriangleThroughABox) {
+  // Jolt's long thin triangle: a triangle 100 long and 1e-3 wide cutting
+  // through a box; the depth is set by the box, not by the triangle's
+  // sliver shape.
+  Rng rng(20);
+  ExactOracle oracle;
+  for (int trial = 0; trial < 10; ++trial) {
+    const Points tri =
+        transformed({Vec3(-50, 0, 0), Vec3(50, 0, 0), Vec3(uniform(rng, -50, 50), 1e-3, 0)},
+                    random_small_rotation(rng, 0.3), Vec3(0, 0, uniform(rng, -0.4, 0.4)));
+    const Points box_points = box(Vec3(1, 1, 0.5));
+    EXPECT_TRUE(meets_standard(box_points, tri, fast(box_points, tri), oracle)) << trial;
+    EXPECT_TRUE(meets_standard(tri, box_points, fast(tri, box_points), oracle)) << trial;
+    EXPECT_TRUE(meets_standard(box_points, tri, slow(box_points, tri), oracle)) << trial;
+  }
+}
+
 // ---------------------------------------------------------------------------
 // Tracking.
 
