@@ -102,6 +102,17 @@ struct Query {
   double magnitude = 0.0;       // R, unscaled
   std::vector<Vec3> normals_a;  // outward unit face normals of A
   std::vector<Vec3> normals_b;  // of -B in A's frame: -(rotation n)
+  // Pruning (cold fast path only): the centroids (scaled, A's frame) and
+  // the radii of balls about them inside the hulls (0 for flat hulls), so
+  // that h_X(n) >= n.centroid_X + inradius_X for every unit n.
+  Vec3 centroid_a = Vec3::Zero();
+  Vec3 centroid_b = Vec3::Zero();
+  double inradius_a = 0.0;
+  double inradius_b = 0.0;
+  bool prune = false;
+  double bound = std::numeric_limits<double>::infinity();   // upper bound on the depth (scaled)
+  double pruned = std::numeric_limits<double>::infinity();  // least lower bound of a pruned face
+  double prune_margin = 0.0;  // faces within this of the bound are kept (scaled)
 
   Query(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& b_in_a)
       : a(pa), b(pb), rotation(b_in_a.rotation), rotation_t(b_in_a.rotation.transpose()) {
@@ -115,15 +126,40 @@ struct Query {
   Vec3 point_a(int i) const { return a.vertex(i) * inverse; }
   Vec3 point_b(int j) const { return rotation * (b.vertex(j) * inverse) + translation; }
 
-  // Normals are computed on demand for a tracked query (only the cached
-  // faces), all at once for a cold one.
-  void compute_all_normals() {
-    normals_a.resize(static_cast<std::size_t>(a.face_count()));
-    for (int f = 0; f < a.face_count(); ++f)
-      normals_a[static_cast<std::size_t>(f)] = a.face_plane(f).normal;
-    normals_b.resize(static_cast<std::size_t>(b.face_count()));
-    for (int g = 0; g < b.face_count(); ++g)
-      normals_b[static_cast<std::size_t>(g)] = -(rotation * b.face_plane(g).normal);
+  // All face normals (each hull in its own frame, from `shapes` when it
+  // holds them for this pair), B's rotated into A's frame, and the
+  // inradii.
+  void compute_all_normals(PenetrationCache::Shapes& shapes) {
+    if (shapes.normals_a.size() != static_cast<std::size_t>(a.face_count()) ||
+        shapes.normals_b.size() != static_cast<std::size_t>(b.face_count())) {
+      shapes.normals_a.resize(static_cast<std::size_t>(a.face_count()));
+      shapes.normals_b.resize(static_cast<std::size_t>(b.face_count()));
+      shapes.inradius_a = inradius(a, shapes.normals_a);
+      shapes.inradius_b = inradius(b, shapes.normals_b);
+    }
+    normals_a = shapes.normals_a;
+    normals_b.resize(shapes.normals_b.size());
+    for (std::size_t g = 0; g < normals_b.size(); ++g)
+      normals_b[g] = -(rotation * shapes.normals_b[g]);
+    centroid_a = a.centroid() * inverse;
+    centroid_b = rotation * (b.centroid() * inverse) + translation;
+    inradius_a = shapes.inradius_a * inverse;
+    inradius_b = shapes.inradius_b * inverse;
+  }
+
+  // Fills `normals` with the hull's face normals and returns the radius of
+  // a ball about its centroid inside it: the least distance from the
+  // centroid to a face plane, less the rounding of that distance; 0 for a
+  // flat hull (its two faces' planes hold the centroid).
+  static double inradius(const ConvexPolytope& poly, std::vector<Vec3>& normals) {
+    double r = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < poly.face_count(); ++f) {
+      const Plane plane = poly.face_plane(f);
+      normals[static_cast<std::size_t>(f)] = plane.normal;
+      r = std::min(r, plane.offset - plane.normal.dot(poly.centroid()));
+    }
+    if (poly.dimension() < 3 || !(r > 0.0)) return 0.0;
+    return std::max(0.0, r - kValueSlackUlps * kUnitRoundoff * poly.scale());
   }
   Vec3 normal_a(int f) const {
     return normals_a.empty() ? a.face_plane(f).normal : normals_a[static_cast<std::size_t>(f)];
@@ -262,6 +298,29 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
   return evaluate(q, id, q.normal_b(id.b0), id.a0, q.b.face(id.b0)[0]);
 }
 
+// Pruning (fast cold query): a face of A - B whose lower bound exceeds the
+// best value found so far (an upper bound on the depth, q.bound) by more
+// than rounding cannot realize the depth and is not evaluated; q.pruned
+// keeps the least such lower bound (the tracking cache needs it). Lower
+// bounds from the balls inside the hulls (Query::inradius):
+//   face f of A, normal n:   n.a_f + h_B(-n) >= n.(a_f - c_B) + r_B,
+//   face g of B, normal n:   h_A(n) - n.b_g >= n.(c_A - b_g) + r_A,
+//   edge e of A, n on its arc: n.a_e + h_B(-n) >= min over the arc of
+//                            n.(a_e - c_B), plus r_B (arc_minimum).
+// The face that realizes the depth has a lower bound at most the depth, so
+// it is never pruned.
+bool pruned_by(Query& q, double lower) {
+  if (!q.prune || !(lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff))
+    return false;
+  q.pruned = std::min(q.pruned, lower);
+  return true;
+}
+
+void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
+  out.push_back(c);
+  q.bound = std::min(q.bound, c.value);
+}
+
 // The candidates of an edge pair whose arcs may cross (xa: A's arcs, yb:
 // -B's), appended to out: none for parallel edges (they span no face of
 // A - B; their faces' candidates cover it). The face's normal is on A's
@@ -270,9 +329,8 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
 // a whole circle, then -B's arc decides; for two segments (or arcs so near
 // a half circle that the side is unclear, kClearMiddle) both n and -n are
 // added (each an upper bound).
-void add_edge_candidate(const Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na,
-                        int b0, int b1, const std::array<Arc, 4>& yb, int nb,
-                        std::vector<Candidate>& out) {
+void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
+                        int b1, const std::array<Arc, 4>& yb, int nb, std::vector<Candidate>& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
   const Vec3& ea = xa[0].k;
   const Vec3& eb = yb[0].k;
@@ -283,35 +341,51 @@ void add_edge_candidate(const Query& q, int a0, int a1, const std::array<Arc, 4>
   Vec3 middle = arc_middle(xa, na);
   if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);
   if (middle.squaredNorm() == 0) {
-    out.push_back(evaluate(q, id, n, a0, b0));
-    out.push_back(evaluate(q, id, -n, a0, b0));
+    keep(q, evaluate(q, id, n, a0, b0), out);
+    keep(q, evaluate(q, id, -n, a0, b0), out);
     return;
   }
-  out.push_back(evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0));
+  keep(q, evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0), out);
 }
 
 // Appends every face candidate (faces of A, faces of B).
-void add_face_candidates(const Query& q, std::vector<Candidate>& out) {
+void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
+    const Vec3& n = q.normals_a[static_cast<std::size_t>(f)];
+    if (pruned_by(q, n.dot(q.point_a(q.a.face(f)[0]) - q.centroid_b) + q.inradius_b)) continue;
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
     Candidate c = evaluate_face(q, id);
     c.id.b0 = c.support_b;
     hint_b = c.support_b;
-    out.push_back(c);
+    keep(q, c, out);
   }
   int hint_a = 0;
   for (int g = 0; g < q.b.face_count(); ++g) {
+    const Vec3& n = q.normals_b[static_cast<std::size_t>(g)];
+    if (pruned_by(q, n.dot(q.centroid_a - q.point_b(q.b.face(g)[0])) + q.inradius_a)) continue;
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
     Candidate c = evaluate_face(q, id);
     c.id.a0 = c.support_a;
     hint_a = c.support_a;
-    out.push_back(c);
+    keep(q, c, out);
   }
 }
 
+// The least n.w over the arc from p to q (unit, angle alpha < pi), or a
+// lower bound on it: with n = c1 p + c2 q, c1, c2 >= 0 and
+// 1 <= c1 + c2 <= 1 / cos(alpha / 2), n.w >= m = min(p.w, q.w) when
+// m >= 0 and n.w >= m / cos(alpha / 2) otherwise (cos(alpha / 2) =
+// |p + q| / 2). -infinity for an arc too near a half circle.
+double arc_minimum(const Arc& arc, const Vec3& w) {
+  const double m = std::min(arc.p.dot(w), arc.q.dot(w));
+  if (m >= 0.0) return m;
+  const double half_cos = 0.5 * (arc.p + arc.q).norm();
+  return half_cos > 1e-3 ? m / half_cos : -std::numeric_limits<double>::infinity();
+}
+
 // Brute force over all edge pairs.
-void add_edge_candidates_brute_force(const Query& q, std::vector<Candidate>& out) {
+void add_edge_candidates_brute_force(Query& q, std::vector<Candidate>& out) {
   struct EdgeArcs {
     int v, w, count;
     std::array<Arc, 4> arcs;
@@ -336,7 +410,7 @@ void add_edge_candidates_brute_force(const Query& q, std::vector<Candidate>& out
 }
 
 // The overlay walk: for each arc of A, the chain of B cells it crosses.
-void add_edge_candidates_walk(const Query& q, std::vector<Candidate>& out) {
+void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   std::vector<std::int32_t> chain;  // visited B vertices of the current arc (the queue too)
   std::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0);
   int hint = 0;
@@ -350,6 +424,13 @@ void add_edge_candidates_walk(const Query& q, std::vector<Candidate>& out) {
   std::vector<char> slot_ready(slot_arc.size(), 0);
   for (const auto& e : q.a.edges()) {
     const int nx = arcs_of_a(q, e[0], e[1], xs);
+    if (q.prune && nx > 0) {
+      const Vec3 w = q.point_a(e[0]) - q.centroid_b;
+      double lower = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < nx; ++i)
+        lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
+      if (pruned_by(q, lower + q.inradius_b)) continue;
+    }
     for (int i = 0; i < nx; ++i) {
       const Arc& x = xs[static_cast<std::size_t>(i)];
       // The B cell of direction p: B's support along -p.
@@ -579,8 +660,23 @@ void sort_prefix(PenetrationCache& cache) {
     cache.rest = std::min(cache.rest, cache.facets[i].offset);
 }
 
-PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a) {
-  q.compute_all_normals();
+PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
+                             const PenetrationCache::Facet* start) {
+  PenetrationCache::Shapes local;
+  q.compute_all_normals(cache != nullptr ? cache->shapes : local);
+  Candidate first;
+  if (walk) {
+    // The first upper bound: the last answer's direction (a rotated B), or
+    // the direction from A's centroid to B's.
+    q.prune = true;
+    if (cache != nullptr) q.prune_margin = cache->prune_margin * q.inverse;
+    Vec3 d = start != nullptr ? start->normal : Vec3(q.centroid_b - q.centroid_a);
+    if (!(d.squaredNorm() > 0x1p-400)) d = Vec3::UnitZ();
+    d.normalize();
+    first = evaluate(q, {}, d, start != nullptr ? start->support_a : -1,
+                     start != nullptr ? start->support_b : -1);
+    q.bound = first.value;
+  }
   std::vector<Candidate> candidates;
   candidates.reserve(static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
                                               2 * (q.a.vertex_count() + q.b.vertex_count())));
@@ -589,7 +685,16 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     add_edge_candidates_walk(q, candidates);
   else
     add_edge_candidates_brute_force(q, candidates);
-  if (candidates.empty()) return finish_without_candidates(q);
+  // The first direction is an upper bound too (and, when every face was
+  // pruned below it, a separating direction: the bodies are apart). Last,
+  // so that a face of A - B wins a tie. Its id has no hull ids (-1).
+  if (candidates.empty()) {
+    // No face of A - B: flat (points, segments), or all pruned below a
+    // separating first direction.
+    if (walk && first.value < 0.0) return finish(q, first, first.value, 0, false);
+    return finish_without_candidates(q);
+  }
+  if (walk) candidates.push_back(first);
   const int count = static_cast<int>(candidates.size());
   const auto best =
       std::min_element(candidates.begin(), candidates.end(),
@@ -610,6 +715,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
                           candidates[i].support_a,
                           candidates[i].support_b};
     cache->enumerated_translation = b_in_a.translation;
+    cache->pruned = q.pruned * q.unit;
     cache->scan_work = 0;
     sort_prefix(*cache);
   }
@@ -632,18 +738,20 @@ void re_anchor(PenetrationCache& cache, const Vec3& t) {
 // A translation-only tracked query: the cached facets at their offsets
 // moved by -n.delta, nearest first, until the next one cannot beat the best
 // found (its offset at the reference minus |delta| is a lower bound on its
-// offset now: |n.delta| <= |delta|). Returns the best cached facet, or -1
-// when the sorted prefix was used up without certifying (re-anchor then).
-int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double& best,
-         double& cutoff, int& scanned) {
+// offset now: |n.delta| <= |delta|), and the faces the enumeration pruned
+// at least `pruned_cut` (their least lower bound less the distance moved
+// since the enumeration). Returns the best cached facet, or -1 when that
+// does not certify it (re-anchor, or enumerate, then).
+int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double pruned_cut,
+         double& best, double& cutoff, int& scanned) {
   best = std::numeric_limits<double>::infinity();
   int arg = -1;
   scanned = 0;
   for (int i = 0; i < cache.sorted; ++i) {
     const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
     if (f.offset - moved >= best) {
-      cutoff = f.offset - moved;
-      return arg;
+      cutoff = std::min(f.offset - moved, pruned_cut);
+      return best <= cutoff ? arg : -1;
     }
     ++scanned;
     const double value = f.offset - f.normal.dot(delta);
@@ -652,7 +760,7 @@ int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double&
       arg = i;
     }
   }
-  cutoff = cache.rest - moved;
+  cutoff = std::min(cache.rest - moved, pruned_cut);
   return best <= cutoff ? arg : -1;
 }
 
@@ -661,28 +769,41 @@ int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double&
 PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const ConvexPolytope& b,
                                                 const Pose& b_in_a) {
   Query q(a, b, b_in_a);
-  return solve_cold(q, false, nullptr, b_in_a);
+  return solve_cold(q, false, nullptr, b_in_a, nullptr);
 }
 
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, PenetrationCache& cache) {
   Query q(a, b, b_in_a);
-  const bool same_pair = cache.a == &a && cache.b == &b && !cache.facets.empty() &&
-                         cache.fingerprint == fingerprint(a, b) &&
-                         cache.rotation == b_in_a.rotation;
-  if (same_pair) {
+  const bool same_polytopes =
+      cache.a == &a && cache.b == &b && cache.fingerprint == fingerprint(a, b);
+  if (!same_polytopes) {
+    cache.reset();
+  } else if (!cache.facets.empty() && cache.rotation == b_in_a.rotation) {
     // M is the reference's M translated by -(t - t_ref): the cached facets
-    // are all of its facets, each offset moved by -n.(t - t_ref).
+    // are all of its facets but the pruned ones, each offset moved by
+    // -n.(t - t_ref).
     const double slack = kValueSlackUlps * kUnitRoundoff * q.magnitude;
+    const auto distance = [&](const Vec3& from) {
+      return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
+    };
+    const double pruned_cut = cache.pruned - distance(cache.enumerated_translation);
     double best = 0.0, cutoff = 0.0;
     int scanned = 0;
     const Vec3 delta = b_in_a.translation - cache.translation;
-    int arg = scan(cache, delta, (delta * q.inverse).norm() * q.unit, best, cutoff, scanned);
+    int arg = scan(cache, delta, distance(cache.translation), pruned_cut, best, cutoff, scanned);
     int work = scanned;
-    if (arg < 0) {
+    if (arg < 0 && best <= pruned_cut) {
       re_anchor(cache, b_in_a.translation);
-      arg = scan(cache, Vec3::Zero(), 0.0, best, cutoff, scanned);
+      arg = scan(cache, Vec3::Zero(), 0.0, pruned_cut, best, cutoff, scanned);
       work += static_cast<int>(cache.facets.size()) + scanned;
+    }
+    if (arg < 0 && best > pruned_cut) {
+      // The pruned faces may be nearer now: enumerate again, keeping more
+      // of them for the translations to come (twice the distance moved
+      // since the enumeration, and at least twice the last margin).
+      cache.prune_margin =
+          std::max(2.0 * cache.prune_margin, 2.0 * distance(cache.enumerated_translation));
     }
     if (arg >= 0) {
       const PenetrationCache::Facet f = cache.facets[static_cast<std::size_t>(arg)];
@@ -700,7 +821,14 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
       return finish(q, c, (std::min(best, cutoff) - slack) * q.inverse, work, true);
     }
   }
-  return solve_cold(q, true, &cache, b_in_a);
+  // Enumerate, pruned by the last answer's direction when there is one. A
+  // rotated B halves the margin (rotating bodies enumerate every query:
+  // the fewer faces kept, the faster).
+  const bool has_start = same_polytopes && !cache.facets.empty();
+  if (has_start && cache.rotation != b_in_a.rotation) cache.prune_margin *= 0.5;
+  const PenetrationCache::Facet start =
+      has_start ? cache.facets.front() : PenetrationCache::Facet{};
+  return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr);
 }
 
 }  // namespace proxima

@@ -104,7 +104,10 @@ inline const char* to_string(MinkowskiFace k) {
 
 // One Minkowski face: the kind and its hull ids. face_vertex: a = face of A,
 // b0 = vertex of B; vertex_face: a0 = vertex of A, b = face of B;
-// edge_edge: (a0, a1) an edge of A, (b0, b1) an edge of B. Unused ids -1.
+// edge_edge: (a0, a1) an edge of A, (b0, b1) an edge of B. Unused ids -1;
+// all -1 when the reported direction is not a face of A - B (the fast
+// query's first trial direction, which can be the answer only for
+// separated bodies or in a tie).
 struct MinkowskiFaceId {
   MinkowskiFace kind = MinkowskiFace::face_vertex;
   std::int32_t a0 = -1, a1 = -1;
@@ -173,6 +176,20 @@ struct PenetrationCache {
   std::vector<Facet> facets;
   int sorted = 0;
   double rest = 0.0;
+  // Least lower bound of the faces the enumeration pruned (not in facets),
+  // at the enumeration's translation; +infinity when none.
+  double pruned = 0.0;
+  // Faces within this of the first upper bound are kept by the enumeration
+  // even where a lower bound would prune them: it grows while B translates
+  // past it (so that tracking finds them cached) and halves when B turns.
+  double prune_margin = 0.0;
+  // What the query needs of the two hulls whatever the pose: face normals
+  // (each in its own frame) and the radii of balls about the centroids
+  // inside them.
+  struct Shapes {
+    std::vector<Vec3> normals_a, normals_b;
+    double inradius_a = 0.0, inradius_b = 0.0;
+  } shapes;
   std::int64_t scan_work = 0;  // faces scanned since the last re-anchor
 
   bool is_cold() const { return a == nullptr; }
