@@ -197,11 +197,16 @@ struct PenetrationCache {
 };
 
 // Penetration depth of hulls a and b, B placed by b_in_a (checked by the
-// caller against the pose contract; rigid). The fast algorithm: a cold query
-// walks the overlay of the two Gauss maps (for each edge of A, the cells of
-// B its arc crosses, found by hill climbing and stepping across B's edges),
-// O(F_A + F_B + E_A + E_B + crossings); a tracked query (same pair, same
-// rotation, see PenetrationCache) scans the nearest cached faces.
+// caller against the pose contract; rigid). The fast algorithm: an
+// enumeration walks the overlay of the two Gauss maps (for each edge of A,
+// the cells of B its arc crosses, found by hill climbing and stepping
+// across B's edges), O(F_A + F_B + E_A + E_B + crossings), and skips every
+// face of A - B (and every edge of A with all its edge pairs) whose lower
+// bound exceeds the best value found so far, so that only the faces near
+// the answer are evaluated; a tracked query (same pair, same rotation, see
+// PenetrationCache) scans the nearest cached faces. A rotated B enumerates
+// again (with the cached face normals and the last answer as the first
+// bound). Not thread-safe on one cache; the polytopes may be shared.
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, PenetrationCache& cache);
 
