@@ -802,8 +802,10 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
       // The pruned faces may be nearer now: enumerate again, keeping more
       // of them for the translations to come (twice the distance moved
       // since the enumeration, and at least twice the last margin).
+      // Capped at half the bodies' radii: a B that jumps keeps pruning.
       cache.prune_margin =
-          std::max(2.0 * cache.prune_margin, 2.0 * distance(cache.enumerated_translation));
+          std::min(std::max(2.0 * cache.prune_margin, 2.0 * distance(cache.enumerated_translation)),
+                   0.5 * (a.bounding_radius() + b.bounding_radius()));
     }
     if (arg >= 0) {
       const PenetrationCache::Facet f = cache.facets[static_cast<std::size_t>(arg)];
