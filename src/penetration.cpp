@@ -23,6 +23,11 @@
 // overlay: for each arc of A, the cells of -B (vertices of B) that it passes
 // through form a chain linked by the B edges whose arcs it crosses, found
 // from the support at the arc's start by stepping across crossing edges.
+// It also prunes (pruned_by): faces whose lower bound exceeds the best value
+// so far are not evaluated, which leaves the faces near the answer.
+// Tracking (penetration_depth): under a translation of B the faces of M
+// only translate, so the cache keeps them with their offsets and a query
+// scans the nearest (scan); see PenetrationCache.
 //
 // Arcs. For a directed edge v -> w of a solid with the face L on its left
 // and R on its right (outward normals nL, nR), nL x nR points along +(w - v)
