@@ -1,0 +1,219 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 5: penetration depth of two overlapping convex polytopes (the
+// negative side of the signed distance, DESIGN.md "Signed distance").
+//
+// Definitions. Work in A's frame; B's vertices are b_in_a applied to B's.
+// M = A - B = {x - y : x in A, y in B} is a convex polytope, and the hulls
+// overlap exactly when the origin is in M. Translating B by t turns M into
+// M - t, so the shortest translation after which a plane separates A and B
+// (they then touch) has the length
+//   depth = distance from the origin to the boundary of M
+//         = min over the facets of M of the facet plane's offset,
+// the offset of a facet with outward unit normal n being
+//   h_M(n) = h_A(n) + h_B(-n),  h_X(n) = max over x in X of n.x.
+// Every facet of M is one of three Minkowski faces:
+//   face_vertex: a face of A (n its normal) plus a vertex of B,
+//   vertex_face: a vertex of A plus a face of B (n minus its normal),
+//   edge_edge:   an edge of A and an edge of B whose Gauss-map arcs cross
+//                (n along the cross product of the edges).
+// For any unit n, h_M(n) >= depth, so every candidate's value, evaluated
+// with true supports, is an upper bound, and the minimum over a candidate
+// set that contains every facet of M is the depth.
+//
+// The result:
+//   normal  unit, from A towards B: translating B by depth * normal makes
+//           the hulls touch (a plane with this normal then separates them);
+//   point_a a deepest point of A, on A's supporting plane along normal;
+//   point_b a deepest point of B, on B's supporting plane along -normal;
+//           point_b + depth * normal == point_a (up to rounding): B moved by
+//           depth * normal carries point_b onto point_a;
+//   feature_a, feature_b the two faces of the Minkowski face (a face and a
+//           vertex, or two edges); for a face, the vertex ids of the fan
+//           triangle of the face that holds the witness point;
+//   lower_bound <= depth* <= upper_bound (up to 64 u R), upper_bound the
+//           overlap h_A(n) + h_B(-n) along the reported normal.
+//
+// Degenerate bodies. Lower-dimensional hulls are valid. When M is flat (two
+// coplanar polygons, a segment crossing a polygon in its plane, crossing
+// segments, points on a body's boundary plane ...) it has no interior and
+// the depth is 0: the bodies touch, and any translation out of the plane
+// separates them (status touching, normal the plane's normal). A polygon
+// cutting through a solid has a positive depth. Coplanar face-face contact:
+// the witnesses are not unique; any pair of the overlap is returned.
+//
+// Input contract: meant for overlapping pairs (Status::intersecting from
+// distance()). A separated pair gets PenetrationStatus::separated with depth
+// 0 and a touching pair (depth within the contact band 64 u R) touching with
+// its depth (>= 0); ask distance() for their distance. Never NaN, never a
+// hang: every loop is bounded by the hull sizes.
+//
+// Robustness. Which candidates enter the minimum is decided by the Gauss-map
+// arc test evaluated in double with a tolerance that errs towards inclusion:
+// a pair included by mistake only adds an honest upper bound (its value is
+// evaluated with hill-climbing supports, never assumed from its edges), so
+// the minimum is never below the depth by more than rounding, and a facet of
+// M is left out only if a face normal of a hull is wrong by more than the
+// tolerance (kArcTolerance in penetration.cpp). All work is done in units of
+// a power of two near R (src/power_of_two.h): the same answer from 1e-300
+// to 1e300.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
+namespace proxima {
+
+enum class PenetrationStatus : std::uint8_t {
+  penetrating,  // depth > 64 u R: the interiors overlap
+  touching,     // depth <= 64 u R (flat M included): in contact at machine precision
+  separated,    // the hulls do not meet (depth reported as 0): use distance()
+};
+
+inline const char* to_string(PenetrationStatus s) {
+  switch (s) {
+    case PenetrationStatus::penetrating:
+      return "penetrating";
+    case PenetrationStatus::touching:
+      return "touching";
+    case PenetrationStatus::separated:
+      return "separated";
+  }
+  return "unknown";
+}
+
+// The kind of Minkowski face of A - B that realizes the depth.
+enum class MinkowskiFace : std::uint8_t { face_vertex, vertex_face, edge_edge };
+
+inline const char* to_string(MinkowskiFace k) {
+  switch (k) {
+    case MinkowskiFace::face_vertex:
+      return "face_vertex";
+    case MinkowskiFace::vertex_face:
+      return "vertex_face";
+    case MinkowskiFace::edge_edge:
+      return "edge_edge";
+  }
+  return "unknown";
+}
+
+// One Minkowski face: the kind and its hull ids. face_vertex: a = face of A,
+// b0 = vertex of B; vertex_face: a0 = vertex of A, b = face of B;
+// edge_edge: (a0, a1) an edge of A, (b0, b1) an edge of B. Unused ids -1;
+// all -1 when the reported direction is not a face of A - B (the fast
+// query's first trial direction, which can be the answer only for
+// separated bodies or in a tie).
+struct MinkowskiFaceId {
+  MinkowskiFace kind = MinkowskiFace::face_vertex;
+  std::int32_t a0 = -1, a1 = -1;
+  std::int32_t b0 = -1, b1 = -1;
+};
+
+struct PenetrationResult {
+  PenetrationStatus status = PenetrationStatus::separated;
+  double depth = 0.0;           // >= 0; the exact depth within the accuracy standard
+  double lower_bound = 0.0;     // lower_bound <= exact depth (up to 64 u R)
+  double upper_bound = 0.0;     // exact depth <= upper_bound: the overlap along normal
+  Vec3 normal = Vec3::UnitX();  // unit, from A towards B, A's frame
+  Vec3 point_a = Vec3::Zero();  // deepest point of A, A's frame
+  Vec3 point_b = Vec3::Zero();  // deepest point of B, A's frame
+  MinkowskiFaceId face;         // the Minkowski face realizing the depth
+  Feature feature_a;
+  Feature feature_b;
+  // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
+  // crossing edge pairs) for a cold query; scanned, plus every cached one
+  // when it re-anchored, for a tracked one.
+  int candidates = 0;
+  // True when the cache certified the answer (no enumeration of M).
+  bool tracked = false;
+};
+
+// Coherence between queries of one pair, owned by the caller;
+// default-constructed means cold. It holds every Minkowski face of A - B
+// found by the last enumeration (O(F_A + F_B + crossing edge pairs)
+// entries: not small for large hulls), with their offsets at a reference
+// translation of B. A query reuses it when it comes from the same two
+// polytope objects (addresses, sizes and a few coordinates are checked: a
+// cache of another pair is ignored, at worst making a query cold) and B's
+// rotation is unchanged bit for bit: then the faces of A - B are the cached
+// ones translated, each offset moved by -n.(t - t_ref). The nearest
+// max(kSorted, entries / 16) are kept sorted; a query scans them until the next cannot beat
+// the best (offset at the reference minus |t - t_ref|), and when the
+// sorted prefix does not settle it, re-anchors: every offset is moved to
+// the new translation (O(entries) multiply-adds, no support or Gauss-map
+// work) and the prefix sorted again; so does a query after scans that
+// together cost as much as a re-anchor (amortized: at most twice the work).
+// Offsets are always moved from the enumeration's (one rounding each, however
+// many re-anchors). A rotated B enumerates again.
+struct PenetrationCache {
+  // The sorted prefix: at least kSorted faces, and a sixteenth of them.
+  static constexpr int kSorted = 64;
+
+  struct Facet {
+    MinkowskiFaceId id;
+    Vec3 normal = Vec3::UnitX();     // outward unit normal of the face of A - B
+    double offset = 0.0;             // h_A(n) + h_B(-n) at the reference, A's units
+    double enumerated_offset = 0.0;  // the same at the enumeration
+    std::int32_t support_a = -1;     // supports along n and -n (they do not
+    std::int32_t support_b = -1;     // change under a translation)
+  };
+
+  // Identity of the pair the cache was filled for.
+  const ConvexPolytope* a = nullptr;
+  const ConvexPolytope* b = nullptr;
+  std::array<double, 4> fingerprint = {0, 0, 0, 0};
+  // B's pose at the reference, and its translation at the enumeration.
+  Mat3 rotation = Mat3::Zero();
+  Vec3 translation = Vec3::Zero();
+  Vec3 enumerated_translation = Vec3::Zero();
+  // All faces of A - B; [0, sorted) ascending by offset, every later one
+  // at least `rest`.
+  std::vector<Facet> facets;
+  int sorted = 0;
+  double rest = 0.0;
+  // Least lower bound of the faces the enumeration pruned (not in facets),
+  // at the enumeration's translation; +infinity when none.
+  double pruned = 0.0;
+  // Faces within this of the first upper bound are kept by the enumeration
+  // even where a lower bound would prune them: it grows while B translates
+  // past it (so that tracking finds them cached) and halves when B turns.
+  double prune_margin = 0.0;
+  // What the query needs of the two hulls whatever the pose: face normals
+  // (each in its own frame) and the radii of balls about the centroids
+  // inside them.
+  struct Shapes {
+    std::vector<Vec3> normals_a, normals_b;
+    double inradius_a = 0.0, inradius_b = 0.0;
+  } shapes;
+  std::int64_t scan_work = 0;  // faces scanned since the last re-anchor
+
+  bool is_cold() const { return a == nullptr; }
+  void reset() { *this = PenetrationCache{}; }
+};
+
+// Penetration depth of hulls a and b, B placed by b_in_a (checked by the
+// caller against the pose contract; rigid). The fast algorithm: an
+// enumeration walks the overlay of the two Gauss maps (for each edge of A,
+// the cells of B its arc crosses, found by hill climbing and stepping
+// across B's edges), O(F_A + F_B + E_A + E_B + crossings), and skips every
+// face of A - B (and every edge of A with all its edge pairs) whose lower
+// bound exceeds the best value found so far, so that only the faces near
+// the answer are evaluated; a tracked query (same pair, same rotation, see
+// PenetrationCache) scans the nearest cached faces. A rotated B enumerates
+// again (with the cached face normals and the last answer as the first
+// bound). Not thread-safe on one cache; the polytopes may be shared.
+PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
+                                    const Pose& b_in_a, PenetrationCache& cache);
+
+// The slow, obvious twin: every face of A, every face of B, and every pair
+// (edge of A, edge of B) through the Gauss-map arc test,
+// O(F_A + F_B + E_A * E_B). Same result conventions; no cache.
+PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const ConvexPolytope& b,
+                                                const Pose& b_in_a);
+
+}  // namespace proxima

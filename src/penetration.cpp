@@ -1,0 +1,841 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 5: penetration depth (see proxima/penetration.h for the definitions).
+//
+// Derivation. For M = A - B containing the origin, depth = min over the
+// facets of M of h_M(n) (n the facet's outward unit normal), and
+// h_M(n) >= depth for every unit n (the support function of a convex set
+// containing a ball of radius depth about the origin is at least depth).
+// The facets of M are the crossings of the Gauss maps of A and of -B: a
+// vertex of A's Gauss map (a face of A, normal n) lying in a cell of -B's
+// (a vertex of B), the reverse, or an arc of A (an edge, between the normals
+// of its two faces) crossing an arc of -B. So
+//   1. candidates: all faces of A, all faces of B, and the edge pairs whose
+//      arcs cross (tested with a tolerance that errs towards inclusion);
+//   2. every candidate's value is h_A(n) + h_B(-n) evaluated with
+//      hill-climbing supports started at the candidate's own vertices (one
+//      look at their neighbours when the candidate is a true facet), so a
+//      wrong inclusion only adds an upper bound;
+//   3. depth = the smallest value; its normal, supports and the Minkowski
+//      face are the answer.
+// The slow twin tests every pair of edges; the fast cold query walks the
+// overlay: for each arc of A, the cells of -B (vertices of B) that it passes
+// through form a chain linked by the B edges whose arcs it crosses, found
+// from the support at the arc's start by stepping across crossing edges.
+// It also prunes (pruned_by): faces whose lower bound exceeds the best value
+// so far are not evaluated, which leaves the faces near the answer.
+// Tracking (penetration_depth): under a translation of B the faces of M
+// only translate, so the cache keeps them with their offsets and a query
+// scans the nearest (scan); see PenetrationCache.
+//
+// Arcs. For a directed edge v -> w of a solid with the face L on its left
+// and R on its right (outward normals nL, nR), nL x nR points along +(w - v)
+// (a cube's top edge checks it); the arc runs from nL to nR around the axis
+// k = w - v. A polygon's edge has the two sides as faces (nR = -nL): its arc
+// is the half circle through the outward in-plane normal o = (w - v) x nL,
+// cut into the quarter arcs nL -> o -> -nL (still around k = w - v). A
+// segment's arc is the whole circle orthogonal to it: four quarter arcs.
+// For -B the endpoints are negated and the axis is unchanged
+// ((-nL) x (-nR) = nL x nR).
+//
+// Crossing of two arcs X = (p1, q1, k1) and Y = (p2, q2, k2) (after
+// Gregorius, "The Separating Axis Test between convex polyhedra", GDC 2013):
+// with s1 = p1.k2, t1 = q1.k2, s2 = p2.k1, t2 = q2.k1, they cross when
+// s1 t1 < 0 (X's ends on both sides of Y's plane), s2 t2 < 0, and
+// s2 t1 > 0 (the crossing is the one on the arcs, not its antipode).
+#include "proxima/penetration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+
+#include "power_of_two.h"
+#include "proxima/closest_point.h"
+#include "proxima/support.h"
+
+namespace proxima {
+namespace {
+
+// A sign value s = p.k (p unit) with |s| <= kArcTolerance |k| counts as
+// zero, and zeros never reject a pair. face_plane's normals are within
+// about 16 u per face vertex of the exact ones (polytope.cpp, kSliverRatio)
+// and the scaled edge vectors within a few u: a true crossing whose signs
+// are decided wrongly by rounding is always kept. Pairs kept by it that do
+// not cross cost one evaluation each and cannot lower the minimum (step 2
+// above). Pinned by PenetrationDegenerate.* (parallel and coplanar edges).
+constexpr double kArcTolerance = 1e-12;
+
+// Slack on a value computed in double, in units of u times the scaled
+// magnitude (about 1 after scaling): the dot product of a unit normal with
+// a difference of two rounded points. Used for the lower bound and the
+// tracked certificate (the contact band of types.h, 64 u R).
+constexpr double kValueSlackUlps = kContactBandUlps;
+
+// A vertex belongs to the supporting feature of a direction when its value
+// is within this many u (scaled units) of the support value: ties of a
+// coplanar face-face contact or a parallel edge, seen through rounding.
+constexpr double kTieUlps = 64.0;
+
+struct Arc {
+  Vec3 p, q;               // unit endpoints
+  Vec3 k;                  // axis: p x q along +k
+  double tolerance = 0.0;  // kArcTolerance |k|
+};
+
+bool arcs_may_cross(const Arc& x, const Arc& y) {
+  const double s1 = x.p.dot(y.k), t1 = x.q.dot(y.k);
+  const double s2 = y.p.dot(x.k), t2 = y.q.dot(x.k);
+  const double ty = y.tolerance, tx = x.tolerance;
+  if ((s1 > ty && t1 > ty) || (s1 < -ty && t1 < -ty)) return false;
+  if ((s2 > tx && t2 > tx) || (s2 < -tx && t2 < -tx)) return false;
+  if ((s2 > tx && t1 < -ty) || (s2 < -tx && t1 > ty)) return false;
+  return true;
+}
+
+// The query in scaled units: A's vertices times s, B's mapped by b_in_a and
+// times s (s a power of two near 1 / R, exact), normals unchanged.
+struct Query {
+  const ConvexPolytope& a;
+  const ConvexPolytope& b;
+  Mat3 rotation;
+  Mat3 rotation_t;
+  Vec3 translation;  // scaled
+  double inverse = 1.0;
+  double unit = 1.0;
+  double magnitude = 0.0;       // R, unscaled
+  std::vector<Vec3> normals_a;  // outward unit face normals of A
+  std::vector<Vec3> normals_b;  // of -B in A's frame: -(rotation n)
+  // Pruning (cold fast path only): the centroids (scaled, A's frame) and
+  // the radii of balls about them inside the hulls (0 for flat hulls), so
+  // that h_X(n) >= n.centroid_X + inradius_X for every unit n.
+  Vec3 centroid_a = Vec3::Zero();
+  Vec3 centroid_b = Vec3::Zero();
+  double inradius_a = 0.0;
+  double inradius_b = 0.0;
+  bool prune = false;
+  double bound = std::numeric_limits<double>::infinity();   // upper bound on the depth (scaled)
+  double pruned = std::numeric_limits<double>::infinity();  // least lower bound of a pruned face
+  double prune_margin = 0.0;  // faces within this of the bound are kept (scaled)
+
+  Query(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& b_in_a)
+      : a(pa), b(pb), rotation(b_in_a.rotation), rotation_t(b_in_a.rotation.transpose()) {
+    magnitude = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
+    const detail::PowerOfTwoUnit u = detail::power_of_two_unit(magnitude);
+    unit = u.unit;
+    inverse = u.inverse;
+    translation = b_in_a.translation * inverse;
+  }
+
+  Vec3 point_a(int i) const { return a.vertex(i) * inverse; }
+  Vec3 point_b(int j) const { return rotation * (b.vertex(j) * inverse) + translation; }
+
+  // All face normals (each hull in its own frame, from `shapes` when it
+  // holds them for this pair), B's rotated into A's frame, and the
+  // inradii.
+  void compute_all_normals(PenetrationCache::Shapes& shapes) {
+    if (shapes.normals_a.size() != static_cast<std::size_t>(a.face_count()) ||
+        shapes.normals_b.size() != static_cast<std::size_t>(b.face_count())) {
+      shapes.normals_a.resize(static_cast<std::size_t>(a.face_count()));
+      shapes.normals_b.resize(static_cast<std::size_t>(b.face_count()));
+      shapes.inradius_a = inradius(a, shapes.normals_a);
+      shapes.inradius_b = inradius(b, shapes.normals_b);
+    }
+    normals_a = shapes.normals_a;
+    normals_b.resize(shapes.normals_b.size());
+    for (std::size_t g = 0; g < normals_b.size(); ++g)
+      normals_b[g] = -(rotation * shapes.normals_b[g]);
+    centroid_a = a.centroid() * inverse;
+    centroid_b = rotation * (b.centroid() * inverse) + translation;
+    inradius_a = shapes.inradius_a * inverse;
+    inradius_b = shapes.inradius_b * inverse;
+  }
+
+  // Fills `normals` with the hull's face normals and returns the radius of
+  // a ball about its centroid inside it: the least distance from the
+  // centroid to a face plane, less the rounding of that distance; 0 for a
+  // flat hull (its two faces' planes hold the centroid).
+  static double inradius(const ConvexPolytope& poly, std::vector<Vec3>& normals) {
+    double r = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < poly.face_count(); ++f) {
+      const Plane plane = poly.face_plane(f);
+      normals[static_cast<std::size_t>(f)] = plane.normal;
+      r = std::min(r, plane.offset - plane.normal.dot(poly.centroid()));
+    }
+    if (poly.dimension() < 3 || !(r > 0.0)) return 0.0;
+    return std::max(0.0, r - kValueSlackUlps * kUnitRoundoff * poly.scale());
+  }
+  Vec3 normal_a(int f) const {
+    return normals_a.empty() ? a.face_plane(f).normal : normals_a[static_cast<std::size_t>(f)];
+  }
+  Vec3 normal_b(int g) const {
+    return normals_b.empty() ? Vec3(-(rotation * b.face_plane(g).normal))
+                             : normals_b[static_cast<std::size_t>(g)];
+  }
+};
+
+// The face to the left of the directed edge v -> w, or -1.
+int left_face(const ConvexPolytope& poly, int v, int w) {
+  const auto offsets = poly.adjacency_offsets();
+  const auto adjacency = poly.adjacency();
+  const auto faces = poly.adjacency_faces();
+  for (std::int32_t k = offsets[static_cast<std::size_t>(v)];
+       k < offsets[static_cast<std::size_t>(v) + 1]; ++k)
+    if (adjacency[static_cast<std::size_t>(k)] == w) return faces[static_cast<std::size_t>(k)];
+  return -1;
+}
+
+// The Gauss-map arcs of edge v -> w (1 for a solid, 2 for a polygon, 4 for
+// a segment), axis `k` (the edge vector in A's frame), endpoints from the
+// face normals `nl`, `nr` (in A's frame; already negated for -B, in which
+// case `negate` flips the in-plane normals the same way). Returns the count.
+int edge_arcs(int dimension, const Vec3& k, const Vec3& nl, const Vec3& nr, bool negate,
+              std::array<Arc, 4>& out) {
+  const double tolerance = kArcTolerance * k.norm();
+  const double sign = negate ? -1.0 : 1.0;
+  if (dimension == 3) {
+    out[0] = {nl, nr, k, tolerance};
+    return 1;
+  }
+  const Vec3 axis = k.normalized();
+  if (dimension == 2) {
+    // nl is the left side's normal (for -B: minus it); o the outward normal.
+    const Vec3 left = sign * nl;  // the un-negated left normal
+    const Vec3 o = axis.cross(left).normalized();
+    out[0] = {sign * left, sign * o, k, tolerance};
+    out[1] = {sign * o, -sign * left, k, tolerance};
+    return 2;
+  }
+  // Segment: u, v orthonormal with u x v = axis.
+  const Vec3 helper = std::abs(axis.x()) < 0.6 ? Vec3::UnitX() : Vec3::UnitY();
+  const Vec3 u = axis.cross(helper).normalized();
+  const Vec3 v = axis.cross(u);
+  out[0] = {u, v, k, tolerance};
+  out[1] = {v, -u, k, tolerance};
+  out[2] = {-u, -v, k, tolerance};
+  out[3] = {-v, u, k, tolerance};
+  return 4;
+}
+
+int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+  const int dim = q.a.dimension();
+  const Vec3 k = q.point_a(w) - q.point_a(v);
+  if (dim == 3 || dim == 2) {
+    const int l = left_face(q.a, v, w);
+    const int r = left_face(q.a, w, v);
+    if (l < 0 || r < 0) return 0;
+    return edge_arcs(dim, k, q.normal_a(l), q.normal_a(r), false, out);
+  }
+  return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), false, out);
+}
+
+int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+  const int dim = q.b.dimension();
+  const Vec3 k = q.point_b(w) - q.point_b(v);
+  if (dim == 3 || dim == 2) {
+    const int l = left_face(q.b, v, w);
+    const int r = left_face(q.b, w, v);
+    if (l < 0 || r < 0) return 0;
+    return edge_arcs(dim, k, q.normal_b(l), q.normal_b(r), true, out);
+  }
+  return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), true, out);
+}
+
+bool edges_may_cross(const std::array<Arc, 4>& xs, int nx, const std::array<Arc, 4>& ys, int ny) {
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j)
+      if (arcs_may_cross(xs[static_cast<std::size_t>(i)], ys[static_cast<std::size_t>(j)]))
+        return true;
+  return false;
+}
+
+// The side of an arc that a normal n lies on is read from the arc's middle
+// only when the arc is clearly shorter than a half circle: |p + q| >= this
+// (an arc of at most about 150 degrees; |p + q| = 2 cos(angle / 2)).
+// Longer arcs (a plate's rim, whose two faces are nearly opposite; a
+// needle's edges) have a middle made of rounding; then the other body's
+// arc decides, and when both are long both n and -n are evaluated (each an
+// upper bound). Pinned by PenetrationOracle.RandomOverlapsFromGrazingToContainment
+// (a needle of width 1e-17 on a plate) and PenetrationDegenerate.PolygonCuttingThroughSolid.
+constexpr double kClearMiddle = 0.5;
+
+// The middle of an edge's Gauss-map arcs (from arcs_of_a / arcs_of_b), as
+// a direction whose side tells which of n, -n lies on them: for a solid
+// p + q, for a polygon the outward in-plane normal (both negated for -B,
+// as the arcs are); zero when unclear (see kClearMiddle) or for a segment
+// (its arcs make a whole circle).
+Vec3 arc_middle(const std::array<Arc, 4>& arcs, int count) {
+  if (count == 1) {
+    const Vec3 middle = arcs[0].p + arcs[0].q;
+    return middle.norm() >= kClearMiddle ? middle : Vec3::Zero();
+  }
+  if (count == 2) return arcs[0].q;  // o (for -B: -o)
+  return Vec3::Zero();
+}
+
+// An evaluated candidate: its value h_A(n) + h_B(-n) (scaled units), the
+// normal and the supports found.
+struct Candidate {
+  MinkowskiFaceId id;
+  Vec3 normal = Vec3::UnitX();
+  double value = std::numeric_limits<double>::infinity();
+  int support_a = 0;
+  int support_b = 0;
+};
+
+Candidate evaluate(const Query& q, const MinkowskiFaceId& id, const Vec3& n, int hint_a,
+                   int hint_b) {
+  Candidate c;
+  c.id = id;
+  c.normal = n;
+  c.support_a = support_hill_climb(q.a, n, hint_a);
+  c.support_b = support_hill_climb(q.b, q.rotation_t * (-n), hint_b);
+  c.value = n.dot(q.point_a(c.support_a) - q.point_b(c.support_b));
+  return c;
+}
+
+// The candidate of a face of A (face_vertex) or of B (vertex_face), hints
+// from the id.
+Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
+  if (id.kind == MinkowskiFace::face_vertex)
+    return evaluate(q, id, q.normal_a(id.a0), q.a.face(id.a0)[0], id.b0);
+  return evaluate(q, id, q.normal_b(id.b0), id.a0, q.b.face(id.b0)[0]);
+}
+
+// Pruning (fast cold query): a face of A - B whose lower bound exceeds the
+// best value found so far (an upper bound on the depth, q.bound) by more
+// than rounding cannot realize the depth and is not evaluated; q.pruned
+// keeps the least such lower bound (the tracking cache needs it). Lower
+// bounds from the balls inside the hulls (Query::inradius):
+//   face f of A, normal n:   n.a_f + h_B(-n) >= n.(a_f - c_B) + r_B,
+//   face g of B, normal n:   h_A(n) - n.b_g >= n.(c_A - b_g) + r_A,
+//   edge e of A, n on its arc: n.a_e + h_B(-n) >= min over the arc of
+//                            n.(a_e - c_B), plus r_B (arc_minimum).
+// The face that realizes the depth has a lower bound at most the depth, so
+// it is never pruned.
+bool pruned_by(Query& q, double lower) {
+  if (!q.prune || !(lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff))
+    return false;
+  q.pruned = std::min(q.pruned, lower);
+  return true;
+}
+
+void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
+  out.push_back(c);
+  q.bound = std::min(q.bound, c.value);
+}
+
+// The candidates of an edge pair whose arcs may cross (xa: A's arcs, yb:
+// -B's), appended to out: none for parallel edges (they span no face of
+// A - B; their faces' candidates cover it). The face's normal is on A's
+// arc (outward at A's edge) and on -B's. An arc shorter than a half circle
+// holds n or -n, the one on the side of its middle; a segment's arcs make
+// a whole circle, then -B's arc decides; for two segments (or arcs so near
+// a half circle that the side is unclear, kClearMiddle) both n and -n are
+// added (each an upper bound).
+void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
+                        int b1, const std::array<Arc, 4>& yb, int nb, std::vector<Candidate>& out) {
+  const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
+  const Vec3& ea = xa[0].k;
+  const Vec3& eb = yb[0].k;
+  Vec3 n = ea.cross(eb);
+  const double length = n.norm();
+  if (!(length > 0x1p-200 * ea.norm() * eb.norm()) || !(length > 0.0)) return;
+  n /= length;
+  Vec3 middle = arc_middle(xa, na);
+  if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);
+  if (middle.squaredNorm() == 0) {
+    keep(q, evaluate(q, id, n, a0, b0), out);
+    keep(q, evaluate(q, id, -n, a0, b0), out);
+    return;
+  }
+  keep(q, evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0), out);
+}
+
+// Appends every face candidate (faces of A, faces of B).
+void add_face_candidates(Query& q, std::vector<Candidate>& out) {
+  int hint_b = 0;
+  for (int f = 0; f < q.a.face_count(); ++f) {
+    const Vec3& n = q.normals_a[static_cast<std::size_t>(f)];
+    if (pruned_by(q, n.dot(q.point_a(q.a.face(f)[0]) - q.centroid_b) + q.inradius_b)) continue;
+    MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
+    Candidate c = evaluate_face(q, id);
+    c.id.b0 = c.support_b;
+    hint_b = c.support_b;
+    keep(q, c, out);
+  }
+  int hint_a = 0;
+  for (int g = 0; g < q.b.face_count(); ++g) {
+    const Vec3& n = q.normals_b[static_cast<std::size_t>(g)];
+    if (pruned_by(q, n.dot(q.centroid_a - q.point_b(q.b.face(g)[0])) + q.inradius_a)) continue;
+    MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
+    Candidate c = evaluate_face(q, id);
+    c.id.a0 = c.support_a;
+    hint_a = c.support_a;
+    keep(q, c, out);
+  }
+}
+
+// The least n.w over the arc from p to q (unit, angle alpha < pi), or a
+// lower bound on it: with n = c1 p + c2 q, c1, c2 >= 0 and
+// 1 <= c1 + c2 <= 1 / cos(alpha / 2), n.w >= m = min(p.w, q.w) when
+// m >= 0 and n.w >= m / cos(alpha / 2) otherwise (cos(alpha / 2) =
+// |p + q| / 2). -infinity for an arc too near a half circle.
+double arc_minimum(const Arc& arc, const Vec3& w) {
+  const double m = std::min(arc.p.dot(w), arc.q.dot(w));
+  if (m >= 0.0) return m;
+  const double half_cos = 0.5 * (arc.p + arc.q).norm();
+  return half_cos > 1e-3 ? m / half_cos : -std::numeric_limits<double>::infinity();
+}
+
+// Brute force over all edge pairs.
+void add_edge_candidates_brute_force(Query& q, std::vector<Candidate>& out) {
+  struct EdgeArcs {
+    int v, w, count;
+    std::array<Arc, 4> arcs;
+  };
+  auto all = [](const ConvexPolytope& poly, auto&& arcs_of) {
+    std::vector<EdgeArcs> edges;
+    for (const auto& e : poly.edges()) {
+      EdgeArcs x{e[0], e[1], 0, {}};
+      x.count = arcs_of(e[0], e[1], x.arcs);
+      if (x.count > 0) edges.push_back(x);
+    }
+    return edges;
+  };
+  const std::vector<EdgeArcs> ea =
+      all(q.a, [&](int v, int w, std::array<Arc, 4>& o) { return arcs_of_a(q, v, w, o); });
+  const std::vector<EdgeArcs> eb =
+      all(q.b, [&](int v, int w, std::array<Arc, 4>& o) { return arcs_of_b(q, v, w, o); });
+  for (const EdgeArcs& x : ea)
+    for (const EdgeArcs& y : eb)
+      if (edges_may_cross(x.arcs, x.count, y.arcs, y.count))
+        add_edge_candidate(q, x.v, x.w, x.arcs, x.count, y.v, y.w, y.arcs, y.count, out);
+}
+
+// The overlay walk: for each arc of A, the chain of B cells it crosses.
+void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
+  std::vector<std::int32_t> chain;  // visited B vertices of the current arc (the queue too)
+  std::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0);
+  int hint = 0;
+  std::array<Arc, 4> xs, ys;
+  // A solid B's arcs, one per edge, computed once on first use (each is
+  // met from several arcs of A), by adjacency slot of either direction
+  // (an arc read backwards is the same arc for the crossing test).
+  const bool memo = q.b.dimension() == 3;
+  const auto offsets = q.b.adjacency_offsets();
+  std::vector<Arc> slot_arc(memo ? q.b.adjacency().size() : 0);
+  std::vector<char> slot_ready(slot_arc.size(), 0);
+  for (const auto& e : q.a.edges()) {
+    const int nx = arcs_of_a(q, e[0], e[1], xs);
+    if (q.prune && nx > 0) {
+      const Vec3 w = q.point_a(e[0]) - q.centroid_b;
+      double lower = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < nx; ++i)
+        lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
+      if (pruned_by(q, lower + q.inradius_b)) continue;
+    }
+    for (int i = 0; i < nx; ++i) {
+      const Arc& x = xs[static_cast<std::size_t>(i)];
+      // The B cell of direction p: B's support along -p.
+      const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), hint);
+      hint = start;
+      chain.clear();
+      chain.push_back(start);
+      visited[static_cast<std::size_t>(start)] = 1;
+      for (std::size_t head = 0; head < chain.size(); ++head) {
+        const int j = chain[head];
+        const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
+        const auto nbrs = q.b.neighbors(j);
+        for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
+          const std::int32_t k = nbrs[slot - slot0];
+          int ny = 0;
+          if (memo) {
+            if (!slot_ready[slot]) {
+              const int count = arcs_of_b(q, j, k, ys);
+              slot_ready[slot] = count == 1 ? 1 : 2;
+              slot_arc[slot] = ys[0];
+            }
+            ny = slot_ready[slot] == 1 ? 1 : 0;
+            ys[0] = slot_arc[slot];
+          } else {
+            ny = arcs_of_b(q, j, k, ys);
+          }
+          bool crosses = false;
+          for (int m = 0; m < ny && !crosses; ++m)
+            crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
+          if (!crosses) continue;
+          // Each crossing edge once: from its first-visited end.
+          if (!visited[static_cast<std::size_t>(k)]) {
+            visited[static_cast<std::size_t>(k)] = 1;
+            chain.push_back(k);
+            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                               std::max(j, static_cast<int>(k)), ys, ny, out);
+          } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
+                               k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
+            // k was reached from another cell of this chain, not expanded
+            // yet: the edge j-k is another crossing of the arc.
+            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                               std::max(j, static_cast<int>(k)), ys, ny, out);
+          }
+        }
+      }
+      for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
+    }
+  }
+}
+
+// The supporting region of `poly` (mapped by `point`) in direction d, from
+// its support vertex v: the vertices whose value is within `tie` of v's,
+// found by a walk over the adjacency (the region is connected: it is a face
+// of the hull thickened by rounding), as simplices to search for witness
+// points: every face all of whose vertices are in the region (fan
+// triangles), else every edge in it, else v. Nearly coplanar faces (a
+// polygon whose doubles are not exactly planar, a coplanar face-face
+// contact) are all in, so the witness is found wherever it is.
+struct Simplex {
+  std::array<int, 3> v = {-1, -1, -1};
+  FeatureType type = FeatureType::vertex;
+  int face = -1;
+};
+
+template <class PointOf>
+std::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d,
+                                    int v, double tie) {
+  const double top = d.dot(point(v));
+  const auto in = [&](int w) { return d.dot(point(w)) >= top - tie; };
+  std::vector<int> region{v};
+  // Bounded by the vertex count: each vertex enters once.
+  for (std::size_t head = 0; head < region.size(); ++head)
+    for (const std::int32_t w : poly.neighbors(region[head]))
+      if (std::find(region.begin(), region.end(), w) == region.end() && in(w)) region.push_back(w);
+  std::vector<Simplex> out;
+  std::vector<int> faces_seen;
+  const auto faces = poly.adjacency_faces();
+  for (const int x : region) {
+    const auto offset =
+        static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(x)]);
+    const auto nbrs = poly.neighbors(x);
+    for (std::size_t k = 0; k < nbrs.size(); ++k) {
+      const int f = faces[offset + k];
+      if (f < 0 || std::find(faces_seen.begin(), faces_seen.end(), f) != faces_seen.end()) continue;
+      faces_seen.push_back(f);
+      const auto cycle = poly.face(f);
+      bool all = true;
+      for (const std::int32_t w : cycle) all = all && in(w);
+      if (!all) continue;
+      for (std::size_t i = 1; i + 1 < cycle.size(); ++i)
+        out.push_back({{cycle[0], cycle[i], cycle[i + 1]}, FeatureType::face, f});
+    }
+  }
+  if (!out.empty()) return out;
+  for (const int x : region)
+    for (const std::int32_t w : poly.neighbors(x))
+      if (x < w && std::find(region.begin(), region.end(), w) != region.end())
+        out.push_back({{x, w, -1}, FeatureType::edge, -1});
+  if (!out.empty()) return out;
+  out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
+  return out;
+}
+
+Feature to_feature(const Simplex& s) {
+  Feature f;
+  f.type = s.type;
+  f.face = s.face;
+  f.vertices = {s.v[0], s.v[1], s.v[2]};
+  return f;
+}
+
+// Builds the result from the winning candidate.
+PenetrationResult finish(const Query& q, const Candidate& best, double lower_scaled, int candidates,
+                         bool tracked) {
+  PenetrationResult r;
+  r.candidates = candidates;
+  r.tracked = tracked;
+  r.face = best.id;
+  const double band = contact_band(q.magnitude);
+  const Vec3& n = best.normal;
+  const double value = best.value;  // scaled
+  r.normal = n;
+  // Witnesses: the supporting features along n (A) and -n (B), and a pair
+  // of their points that differ by value * n: the closest points of
+  // feature A and feature B moved by value * n.
+  const double tie = kTieUlps * kUnitRoundoff;
+  const auto ta = support_region(
+      q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie);
+  const auto tb = support_region(
+      q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie);
+  const Vec3 shift = std::max(value, 0.0) * n;
+  ClosestPoints<double> closest;
+  closest.point_a = closest.point_b = Vec3::Zero();
+  closest.distance_squared = std::numeric_limits<double>::infinity();
+  Simplex best_ta, best_tb;
+  for (const Simplex& s : ta) {
+    Vec3 pa[3];
+    int na = 0;
+    for (; na < 3 && s.v[static_cast<std::size_t>(na)] >= 0; ++na)
+      pa[na] = q.point_a(s.v[static_cast<std::size_t>(na)]);
+    for (const Simplex& t : tb) {
+      Vec3 pb[3];
+      int nb = 0;
+      for (; nb < 3 && t.v[static_cast<std::size_t>(nb)] >= 0; ++nb)
+        pb[nb] = q.point_b(t.v[static_cast<std::size_t>(nb)]) + shift;
+      const ClosestPoints<double> c = closest_points<double>(pa, na, pb, nb);
+      if (c.distance_squared < closest.distance_squared) {
+        closest = c;
+        best_ta = s;
+        best_tb = t;
+      }
+    }
+  }
+  const double residual = std::sqrt(closest.distance_squared) * q.unit;
+  r.point_a = closest.point_a * q.unit;
+  r.point_b = (closest.point_b - shift) * q.unit;
+  r.feature_a = to_feature(best_ta);
+  r.feature_b = to_feature(best_tb);
+  const double depth = value * q.unit;
+  if (depth < -band || residual > band) {
+    // Separated: a plane separates them (depth < 0), or the supporting
+    // features along the nearest plane do not meet (a flat M whose plane
+    // holds the origin outside M).
+    r.status = PenetrationStatus::separated;
+    r.depth = r.lower_bound = r.upper_bound = 0.0;
+    return r;
+  }
+  r.status = depth > band ? PenetrationStatus::penetrating : PenetrationStatus::touching;
+  r.depth = std::max(depth, 0.0);
+  r.upper_bound = r.depth;
+  r.lower_bound = std::max(0.0, std::min(lower_scaled, value) * q.unit - contact_band(q.magnitude));
+  return r;
+}
+
+// Both hulls of dimension <= 1 with no crossing edges (points, parallel or
+// collinear segments): M is a point or a segment, flat, depth 0. Touching
+// when it holds the origin (the two hulls meet), else separated.
+PenetrationResult finish_without_candidates(const Query& q) {
+  Vec3 pa[2], pb[2];
+  const int na = std::min(q.a.vertex_count(), 2), nb = std::min(q.b.vertex_count(), 2);
+  for (int i = 0; i < na; ++i) pa[i] = q.point_a(i);
+  for (int j = 0; j < nb; ++j) pb[j] = q.point_b(j);
+  const ClosestPoints<double> c = closest_points<double>(pa, na, pb, nb);
+  PenetrationResult r;
+  r.point_a = c.point_a * q.unit;
+  r.point_b = c.point_b * q.unit;
+  r.feature_a.vertices = {0, na > 1 ? 1 : -1, -1};
+  r.feature_a.type = na > 1 ? FeatureType::edge : FeatureType::vertex;
+  r.feature_b.vertices = {0, nb > 1 ? 1 : -1, -1};
+  r.feature_b.type = nb > 1 ? FeatureType::edge : FeatureType::vertex;
+  // A normal orthogonal to M's direction (any, if M is a point).
+  Vec3 along = na > 1 ? Vec3(pa[1] - pa[0]) : nb > 1 ? Vec3(pb[1] - pb[0]) : Vec3::UnitZ();
+  along.normalize();
+  r.normal = along.cross(std::abs(along.x()) < 0.6 ? Vec3::UnitX() : Vec3::UnitY()).normalized();
+  const double distance = std::sqrt(c.distance_squared) * q.unit;
+  r.status = distance > contact_band(q.magnitude) ? PenetrationStatus::separated
+                                                  : PenetrationStatus::touching;
+  return r;
+}
+
+// The fingerprint of a pair: sizes and a few coordinates, so that a cache
+// of another pair of polytopes built at the same addresses is not trusted.
+std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope& b) {
+  const auto sum = [](const ConvexPolytope& p) {
+    const Vec3& first = p.vertex(0);
+    const Vec3& last = p.vertex(p.vertex_count() - 1);
+    return first.x() + 2 * first.y() + 3 * first.z() + 5 * last.x() + 7 * last.y() + 11 * last.z();
+  };
+  return {static_cast<double>(a.vertex_count()) + 1e6 * a.face_count(),
+          static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
+}
+
+// Sorts the kSorted nearest cached faces to the front.
+void sort_prefix(PenetrationCache& cache) {
+  const auto by_offset = [](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
+    return x.offset < y.offset;
+  };
+  const std::size_t k =
+      std::min(std::max<std::size_t>(PenetrationCache::kSorted, cache.facets.size() / 16),
+               cache.facets.size());
+  std::nth_element(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k),
+                   cache.facets.end(), by_offset);
+  std::sort(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k), by_offset);
+  cache.sorted = static_cast<int>(k);
+  cache.rest = std::numeric_limits<double>::infinity();
+  for (std::size_t i = k; i < cache.facets.size(); ++i)
+    cache.rest = std::min(cache.rest, cache.facets[i].offset);
+}
+
+PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
+                             const PenetrationCache::Facet* start) {
+  PenetrationCache::Shapes local;
+  q.compute_all_normals(cache != nullptr ? cache->shapes : local);
+  Candidate first;
+  if (walk) {
+    // The first upper bound: the last answer's direction (a rotated B), or
+    // the direction from A's centroid to B's.
+    q.prune = true;
+    if (cache != nullptr) q.prune_margin = cache->prune_margin * q.inverse;
+    Vec3 d = start != nullptr ? start->normal : Vec3(q.centroid_b - q.centroid_a);
+    if (!(d.squaredNorm() > 0x1p-400)) d = Vec3::UnitZ();
+    d.normalize();
+    first = evaluate(q, {}, d, start != nullptr ? start->support_a : -1,
+                     start != nullptr ? start->support_b : -1);
+    q.bound = first.value;
+  }
+  std::vector<Candidate> candidates;
+  candidates.reserve(static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
+                                              2 * (q.a.vertex_count() + q.b.vertex_count())));
+  add_face_candidates(q, candidates);
+  if (walk)
+    add_edge_candidates_walk(q, candidates);
+  else
+    add_edge_candidates_brute_force(q, candidates);
+  // The first direction is an upper bound too (and, when every face was
+  // pruned below it, a separating direction: the bodies are apart). Last,
+  // so that a face of A - B wins a tie. Its id has no hull ids (-1).
+  if (candidates.empty()) {
+    // No face of A - B: flat (points, segments), or all pruned below a
+    // separating first direction.
+    if (walk && first.value < 0.0) return finish(q, first, first.value, 0, false);
+    return finish_without_candidates(q);
+  }
+  if (walk) candidates.push_back(first);
+  const int count = static_cast<int>(candidates.size());
+  const auto best =
+      std::min_element(candidates.begin(), candidates.end(),
+                       [](const Candidate& x, const Candidate& y) { return x.value < y.value; });
+  PenetrationResult r = finish(q, *best, best->value, count, false);
+  if (cache != nullptr) {
+    cache->a = &q.a;
+    cache->b = &q.b;
+    cache->fingerprint = fingerprint(q.a, q.b);
+    cache->rotation = b_in_a.rotation;
+    cache->translation = b_in_a.translation;
+    cache->facets.resize(candidates.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      cache->facets[i] = {candidates[i].id,
+                          candidates[i].normal,
+                          candidates[i].value * q.unit,
+                          candidates[i].value * q.unit,
+                          candidates[i].support_a,
+                          candidates[i].support_b};
+    cache->enumerated_translation = b_in_a.translation;
+    cache->pruned = q.pruned * q.unit;
+    cache->scan_work = 0;
+    sort_prefix(*cache);
+  }
+  return r;
+}
+
+// Re-anchors the cache at translation t: every offset moves by -n.(t - t_ref)
+// (the facets of A - B translate with B), and the nearest are sorted again.
+void re_anchor(PenetrationCache& cache, const Vec3& t) {
+  // From the enumeration's offsets, not the last reference's: one rounding
+  // per offset however many re-anchors.
+  const Vec3 delta = t - cache.enumerated_translation;
+  for (PenetrationCache::Facet& f : cache.facets)
+    f.offset = f.enumerated_offset - f.normal.dot(delta);
+  cache.translation = t;
+  cache.scan_work = 0;
+  sort_prefix(cache);
+}
+
+// A translation-only tracked query: the cached facets at their offsets
+// moved by -n.delta, nearest first, until the next one cannot beat the best
+// found (its offset at the reference minus |delta| is a lower bound on its
+// offset now: |n.delta| <= |delta|), and the faces the enumeration pruned
+// at least `pruned_cut` (their least lower bound less the distance moved
+// since the enumeration). Returns the best cached facet, or -1 when that
+// does not certify it (re-anchor, or enumerate, then).
+int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double pruned_cut,
+         double& best, double& cutoff, int& scanned) {
+  best = std::numeric_limits<double>::infinity();
+  int arg = -1;
+  scanned = 0;
+  for (int i = 0; i < cache.sorted; ++i) {
+    const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
+    if (f.offset - moved >= best) {
+      cutoff = std::min(f.offset - moved, pruned_cut);
+      return best <= cutoff ? arg : -1;
+    }
+    ++scanned;
+    const double value = f.offset - f.normal.dot(delta);
+    if (value < best) {
+      best = value;
+      arg = i;
+    }
+  }
+  cutoff = std::min(cache.rest - moved, pruned_cut);
+  return best <= cutoff ? arg : -1;
+}
+
+}  // namespace
+
+PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const ConvexPolytope& b,
+                                                const Pose& b_in_a) {
+  Query q(a, b, b_in_a);
+  return solve_cold(q, false, nullptr, b_in_a, nullptr);
+}
+
+PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
+                                    const Pose& b_in_a, PenetrationCache& cache) {
+  Query q(a, b, b_in_a);
+  const bool same_polytopes =
+      cache.a == &a && cache.b == &b && cache.fingerprint == fingerprint(a, b);
+  if (!same_polytopes) {
+    cache.reset();
+  } else if (!cache.facets.empty() && cache.rotation == b_in_a.rotation) {
+    // M is the reference's M translated by -(t - t_ref): the cached facets
+    // are all of its facets but the pruned ones, each offset moved by
+    // -n.(t - t_ref).
+    const double slack = kValueSlackUlps * kUnitRoundoff * q.magnitude;
+    const auto distance = [&](const Vec3& from) {
+      return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
+    };
+    const double pruned_cut = cache.pruned - distance(cache.enumerated_translation);
+    double best = 0.0, cutoff = 0.0;
+    int scanned = 0;
+    const Vec3 delta = b_in_a.translation - cache.translation;
+    int arg = scan(cache, delta, distance(cache.translation), pruned_cut, best, cutoff, scanned);
+    int work = scanned;
+    if (arg < 0 && best <= pruned_cut) {
+      re_anchor(cache, b_in_a.translation);
+      arg = scan(cache, Vec3::Zero(), 0.0, pruned_cut, best, cutoff, scanned);
+      work += static_cast<int>(cache.facets.size()) + scanned;
+    }
+    if (arg < 0 && best > pruned_cut) {
+      // The pruned faces may be nearer now: enumerate again, keeping more
+      // of them for the translations to come (twice the distance moved
+      // since the enumeration, and at least twice the last margin).
+      // Capped at half the bodies' radii: a B that jumps keeps pruning.
+      cache.prune_margin =
+          std::min(std::max(2.0 * cache.prune_margin, 2.0 * distance(cache.enumerated_translation)),
+                   0.5 * (a.bounding_radius() + b.bounding_radius()));
+    }
+    if (arg >= 0) {
+      const PenetrationCache::Facet f = cache.facets[static_cast<std::size_t>(arg)];
+      cache.scan_work += scanned;
+      if (cache.scan_work > static_cast<std::int64_t>(cache.facets.size())) {
+        // Certified, but the scans since the reference cost as much as a
+        // re-anchor: re-anchor for the next queries (amortized, at most
+        // doubling the work).
+        re_anchor(cache, b_in_a.translation);
+        work += static_cast<int>(cache.facets.size());
+      }
+      // The winner evaluated with true supports (they do not move under a
+      // translation: the cached ones are checked by one hill-climbing step).
+      Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
+      return finish(q, c, (std::min(best, cutoff) - slack) * q.inverse, work, true);
+    }
+  }
+  // Enumerate, pruned by the last answer's direction when there is one. A
+  // rotated B halves the margin (rotating bodies enumerate every query:
+  // the fewer faces kept, the faster).
+  const bool has_start = same_polytopes && !cache.facets.empty();
+  if (has_start && cache.rotation != b_in_a.rotation) cache.prune_margin *= 0.5;
+  const PenetrationCache::Facet start =
+      has_start ? cache.facets.front() : PenetrationCache::Facet{};
+  return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr);
+}
+
+}  // namespace proxima
