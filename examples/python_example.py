@@ -29,6 +29,9 @@ print("tracked, after 11 steps:", r.distance, "in", r.iterations, "iterations")
 poses_b = np.tile(np.eye(4), (1000, 1, 1))
 poses_b[:, 0, 3] = np.linspace(6.0, 0.0, 1000)
 out = proxima.distance_batch(a, None, b, poses_b)
+
+pairs = proxima.PairBatch([a, a, b], [b, b, b])   # K different pairs, caches kept inside
+out = pairs.distance(None, poses_b[:3])          # one call; out["distance"] has K rows
 first_contact = np.argmax(out["status"] != "separated")
 print("first contact at x =", poses_b[first_contact, 0, 3])
 

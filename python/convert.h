@@ -97,11 +97,13 @@ py::array_t<double> matrix_array(const Eigen::Matrix<double, kRows, kCols>& m) {
 }
 
 // The 12 entries of a 3x4 [R | t] matrix, row-major, under the pose
-// contract.
-inline Pose pose_from_rows(const double* rows, const std::string& name) {
+// contract. `name()` gives the name for a refusal: built only then, since
+// batches convert thousands of poses per call.
+template <class Name>
+requires std::invocable<Name> Pose pose_from_rows(const double* rows, Name&& name) {
   for (int k = 0; k < 12; ++k) {
-    if (!is_finite_bits(rows[k])) {
-      throw InvalidInput(name + " is not finite (NaN or infinite entry at row " +
+    if (!is_finite_bits(rows[k])) [[unlikely]] {
+      throw InvalidInput(std::string(name()) + " is not finite (NaN or infinite entry at row " +
                          std::to_string(k / 4) + ", column " + std::to_string(k % 4) + ")");
     }
   }
@@ -113,23 +115,30 @@ inline Pose pose_from_rows(const double* rows, const std::string& name) {
   }
   return checked_pose(Pose(r, t), name);
 }
+inline Pose pose_from_rows(const double* rows, const std::string& name) {
+  return pose_from_rows(rows, [&name] { return name; });
+}
 
 // A 4x4 matrix under the rigid-pose contract (proxima/pose.h): every entry
 // finite (the bottom row too), the bottom row (0, 0, 0, 1) within the
 // contract's tolerance, the rest checked (and re-orthonormalized when
-// needed) by checked_pose, whose refusal (InvalidInput) names `name`.
-inline Pose pose_from_matrix(const double* m, const std::string& name) {
-  for (int k = 0; k < 16; ++k) {
-    if (!is_finite_bits(m[k])) {
-      throw InvalidInput(name + " is not finite (NaN or infinite entry at row " +
+// needed) by checked_pose, whose refusal (InvalidInput) names `name()`.
+template <class Name>
+requires std::invocable<Name> Pose pose_from_matrix(const double* m, Name&& name) {
+  for (int k = 12; k < 16; ++k) {
+    if (!is_finite_bits(m[k])) [[unlikely]] {
+      throw InvalidInput(std::string(name()) + " is not finite (NaN or infinite entry at row " +
                          std::to_string(k / 4) + ", column " + std::to_string(k % 4) + ")");
     }
   }
   const double off_bottom =
       std::max({std::abs(m[12]), std::abs(m[13]), std::abs(m[14]), std::abs(m[15] - 1.0)});
-  if (off_bottom > kRotationTolerance)
-    value_error(name + ": the bottom row of a pose matrix must be (0, 0, 0, 1)");
+  if (off_bottom > kRotationTolerance) [[unlikely]]
+    value_error(std::string(name()) + ": the bottom row of a pose matrix must be (0, 0, 0, 1)");
   return pose_from_rows(m, name);  // its top three rows, [R | t]
+}
+inline Pose pose_from_matrix(const double* m, const std::string& name) {
+  return pose_from_matrix(m, [&name] { return name; });
 }
 
 inline const char* order_words(QuaternionOrder order) {
@@ -233,12 +242,38 @@ inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::stri
     value_error(name + ": " + std::to_string(m.shape(0)) + " poses, but the other side has " +
                 std::to_string(k));
   }
+  // Batches convert thousands of poses per call: the rows are copied as
+  // they are, then checked two at a time by the pose contract's paired test
+  // (detail::are_rigid, one pass for both); a pose that fails it goes
+  // through the full conversion, which names it (name[i]), says what is
+  // wrong, or re-orthonormalizes it.
+  const py::ssize_t count = m.shape(0);
+  const bool square = m.shape(1) == 4;
+  const auto full = [&](py::ssize_t i) {
+    const auto where = [&name, i] { return name + "[" + std::to_string(i) + "]"; };
+    return square ? pose_from_matrix(m.data(i, 0, 0), where)
+                  : pose_from_rows(m.data(i, 0, 0), where);
+  };
+  const double* data = m.data();
+  const py::ssize_t stride = square ? 16 : 12;  // c_style: the matrices back to back
   std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(m.shape(0)));
-  for (py::ssize_t i = 0; i < m.shape(0); ++i) {
-    const std::string where = name + "[" + std::to_string(i) + "]";
-    poses.push_back(m.shape(1) == 4 ? pose_from_matrix(m.data(i, 0, 0), where)
-                                    : pose_from_rows(m.data(i, 0, 0), where));
+  poses.reserve(static_cast<std::size_t>(count));
+  for (py::ssize_t i = 0; i < count; ++i) {
+    const double* rows = data + i * stride;
+    poses.emplace_back(
+        Mat3{
+            {rows[0], rows[1], rows[2]}, {rows[4], rows[5], rows[6]}, {rows[8], rows[9], rows[10]}},
+        Vec3(rows[3], rows[7], rows[11]));
+    if (square && !(rows[12] == 0.0 && rows[13] == 0.0 && rows[14] == 0.0 && rows[15] == 1.0))
+      poses.back() = full(i);  // the bottom row exactly (0, 0, 0, 1) or the full check
+  }
+  for (py::ssize_t i = 0; i < count; i += 2) {
+    const py::ssize_t j = std::min(i + 1, count - 1);
+    if (detail::are_rigid(poses[static_cast<std::size_t>(i)], poses[static_cast<std::size_t>(j)]))
+        [[likely]]
+      continue;
+    poses[static_cast<std::size_t>(i)] = full(i);
+    poses[static_cast<std::size_t>(j)] = full(j);
   }
   return poses;
 }
@@ -381,16 +416,22 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   }
   // Strings by table lookup in numpy (one fancy-indexing call instead of K
   // Python strings).
-  const py::module_ np = py::module_::import("numpy");
-  py::list status_names, type_names;
-  for (Status s :
-       {Status::separated, Status::touching, Status::intersecting, Status::iteration_cap}) {
-    status_names.append(to_string(s));
-  }
-  for (FeatureType t : {FeatureType::vertex, FeatureType::edge, FeatureType::face})
-    type_names.append(to_string(t));
-  const py::object status_table = np.attr("array")(status_names);
-  const py::object type_table = np.attr("array")(type_names);
+  // The two tables, made once per process (deliberately never freed: a
+  // static py::object would be destroyed after the interpreter).
+  static const py::object& status_table = *new py::object([] {
+    py::list names;
+    for (Status s :
+         {Status::separated, Status::touching, Status::intersecting, Status::iteration_cap}) {
+      names.append(to_string(s));
+    }
+    return py::module_::import("numpy").attr("array")(names);
+  }());
+  static const py::object& type_table = *new py::object([] {
+    py::list names;
+    for (FeatureType t : {FeatureType::vertex, FeatureType::edge, FeatureType::face})
+      names.append(to_string(t));
+    return py::module_::import("numpy").attr("array")(names);
+  }());
 
   py::dict out;
   out["status"] = status_table[status_code];
@@ -475,7 +516,9 @@ class InUse {
 
 using PyDistanceCache = Guarded<DistanceCache>;
 
-// Registers CompoundBody, Scene and their companions (compound_scene.cpp).
+// Registers CompoundBody, Scene and their companions (compound_scene.cpp),
+// and PairBatch (pair_batch.cpp).
 void bind_compound_and_scene(py::module_& m);
+void bind_pair_batch(py::module_& m);
 
 }  // namespace proxima::python

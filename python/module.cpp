@@ -518,4 +518,5 @@ point_b (K, 3), normal (K, 3), feature_a_type (str), feature_a_vertices (K, 3; -
 feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k], b, poses_b[k]).)doc");
 
   bind_compound_and_scene(m);
+  bind_pair_batch(m);
 }

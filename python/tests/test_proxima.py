@@ -694,3 +694,38 @@ def test_scipy_rotations_and_3x4_matrices_are_poses():
     # A non-rigid 3x4 matrix is refused by the pose contract.
     with pytest.raises(ValueError, match="not orthonormal"):
         proxima.distance(a, None, b, np.hstack([1.01 * np.eye(3), t[:, None]]))
+
+
+# Issue 11, Python at C++ speed: K different pairs in one call, each pair's
+# cache kept inside the PairBatch. Row k equals the single tracked query of
+# pair k, bit for bit, call after call.
+def test_pair_batch_equals_single_tracked_queries():
+    rng = np.random.default_rng(31)
+    shapes = [proxima.ConvexPolytope(rng.normal(size=(int(rng.integers(8, 60)), 3))) for _ in range(7)]
+    k = 50
+    a = [shapes[i % 7] for i in range(k)]
+    b = [shapes[(3 * i + 1) % 7] for i in range(k)]
+    batch = proxima.PairBatch(a, b)
+    assert len(batch) == k
+    caches = [proxima.DistanceCache() for _ in range(k)]
+    poses_b = np.tile(np.eye(4), (k, 1, 1))
+    poses_b[:, :3, 3] = rng.uniform(-4, 4, size=(k, 3))
+    statuses = set()
+    for step in range(4):
+        poses_b[:, :3, 3] += rng.normal(size=(k, 3)) * 0.05
+        out = batch.distance(None, poses_b, threads=2)
+        assert batch.last_call_seconds > 0
+        for i in range(k):
+            single = proxima.distance(a[i], None, b[i], poses_b[i], cache=caches[i])
+            assert out["distance"][i] == single.distance
+            assert out["status"][i] == single.status
+            np.testing.assert_array_equal(out["point_b"][i], single.point_b)
+            statuses.add(single.status)
+    assert {"separated", "intersecting"} <= statuses  # premise: both kinds of pair
+    batch.reset()
+    with pytest.raises(ValueError, match="PairBatch: 2 bodies a but 1 bodies b"):
+        proxima.PairBatch(a[:2], b[:1])
+    with pytest.raises(ValueError, match=r"b\[1\] is not a ConvexPolytope"):
+        proxima.PairBatch(a[:2], [b[0], "x"])
+    with pytest.raises(ValueError, match="poses_b"):
+        batch.distance(None, poses_b[:3])
