@@ -491,6 +491,34 @@ void bind_compound_and_scene(py::module_& m) {
           },
           "SceneStats of the last step.")
       .def(
+          "nearest_pair",
+          [](PyScene& s) -> py::object {
+            const InUse in_use(s, "Scene");
+            std::optional<ClosePair> nearest;
+            {
+              py::gil_scoped_release release;
+              nearest = s.nearest_pair();
+            }
+            if (!nearest) return py::none();
+            return py::cast(*nearest);
+          },
+          "The pair of smallest distance over every pair the filters let through, however far "
+          "apart (a ClosePair), or None with fewer than two bodies or no tested pair.")
+      .def(
+          "pairs_within",
+          [](PyScene& s, BodyId id, double margin) {
+            const InUse in_use(s, "Scene");
+            std::vector<ClosePair> pairs;
+            {
+              py::gil_scoped_release release;
+              pairs = s.pairs_within(id, margin);
+            }
+            return close_pair_list(pairs);
+          },
+          py::arg("id"), py::arg("margin"),
+          "Every body within margin of body id (touching and intersecting included), as "
+          "ClosePair (min id, max id), by increasing other id.")
+      .def(
           "close_pairs_all_pairs",
           [](const PyScene& s) {
             const InUse in_use(s, "Scene");

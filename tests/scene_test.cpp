@@ -639,3 +639,79 @@ TEST(SceneFilters, BadPairsAreRefusedByName) {
 
 }  // namespace
 }  // namespace proxima
+
+namespace proxima {
+namespace {
+
+// The brute-force distance of bodies a and b of `scene` (cold, the query
+// the scene's twin uses).
+CompoundResult brute(const Scene& scene, BodyId a, BodyId b,
+                     const std::vector<std::shared_ptr<const ConvexPolytope>>& convex) {
+  CompoundResult r;
+  static_cast<DistanceResult&>(r) = distance(*convex[static_cast<std::size_t>(a)], scene.pose(a),
+                                             *convex[static_cast<std::size_t>(b)], scene.pose(b));
+  return r;
+}
+
+// Issue 11, the queries a planner asks of a scene: the nearest pair however
+// far apart, and one body's pairs within a margin, against brute force over
+// every pair the filters let through, on sparse scenes (the nearest pair far
+// beyond the margin) and dense ones, with tracking (the scene's caches) in
+// between.
+TEST(SceneQueries, NearestPairAndPairsWithinMatchBruteForce) {
+  Rng rng(777);
+  for (const double side : {4.0, 12.0, 60.0}) {
+    SceneOptions o;
+    o.margin = 0.05;
+    Scene scene(o);
+    std::vector<std::shared_ptr<const ConvexPolytope>> convex;
+    for (int i = 0; i < 25; ++i) {
+      convex.push_back(random_convex(rng));
+      EXPECT_EQ(scene.add(convex.back(), random_pose(rng, side, Vec3::Zero())), i);
+    }
+    scene.exclude_pair(0, 1);
+    scene.set_filter(2, {0b10, 0b10});  // meets only its own group: nobody else
+    for (int step = 0; step < 3; ++step) {
+      scene.step();
+      double best = std::numeric_limits<double>::infinity();
+      for (BodyId a = 0; a < 25; ++a) {
+        for (BodyId b = a + 1; b < 25; ++b) {
+          if (scene.tests_pair(a, b)) best = std::min(best, brute(scene, a, b, convex).distance);
+        }
+      }
+      const std::optional<ClosePair> nearest = scene.nearest_pair();
+      ASSERT_TRUE(nearest.has_value());
+      EXPECT_TRUE(scene.tests_pair(nearest->a, nearest->b));
+      const double r = 2 * side;
+      EXPECT_NEAR(nearest->result.distance, best, 2 * (1e-12 * best + 64 * kUnitRoundoff * r))
+          << "side " << side << " step " << step;
+
+      const BodyId id = static_cast<BodyId>(step * 7 % 25);
+      const double margin = side / 4;
+      const std::vector<ClosePair> within = scene.pairs_within(id, margin);
+      std::vector<BodyId> expected;
+      for (BodyId other = 0; other < 25; ++other) {
+        if (other == id || !scene.tests_pair(id, other)) continue;
+        if (brute(scene, std::min(id, other), std::max(id, other), convex).distance <= margin)
+          expected.push_back(other);
+      }
+      std::vector<BodyId> got;
+      for (const ClosePair& p : within) got.push_back(p.a == id ? p.b : p.a);
+      EXPECT_EQ(got, expected) << "side " << side << " body " << id;
+
+      for (BodyId k = 0; k < 25; ++k) scene.set_pose(k, moved(rng, scene.pose(k)));
+    }
+  }
+  Scene lonely;
+  EXPECT_FALSE(lonely.nearest_pair().has_value());
+  const BodyId a = lonely.add(unit_cube(), Pose{});
+  const BodyId b = lonely.add(unit_cube(), Pose::from_translation(Vec3(5, 0, 0)));
+  EXPECT_NEAR(lonely.nearest_pair()->result.distance, 4.0, 1e-14);
+  lonely.exclude_pair(a, b);
+  EXPECT_FALSE(lonely.nearest_pair().has_value());  // no tested pair
+  EXPECT_THROW(lonely.pairs_within(a, -1.0), InvalidInput);
+  EXPECT_THROW(lonely.pairs_within(9, 1.0), InvalidInput);
+}
+
+}  // namespace
+}  // namespace proxima

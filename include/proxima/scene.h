@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -139,6 +140,19 @@ class Scene {
   // pairs, sorted by (a, b); valid until the next call of a non-const method.
   std::span<const ClosePair> step();
   const SceneStats& stats() const;
+
+  // Queries a planner asks besides step(), on the current poses, with the
+  // caches the scene keeps (a pair that was a candidate of the last step
+  // starts from its cache and updates it; other pairs are answered cold):
+  // - nearest_pair: the pair of smallest distance over every pair the
+  //   filters let through, however far apart (an intersecting pair first
+  //   among pairs at distance 0); nullopt with fewer than two bodies or no
+  //   tested pair.
+  // - pairs_within: every body within `margin` of body `id` (touching and
+  //   intersecting included), as pairs (min id, max id), by increasing
+  //   other id. Throws InvalidInput for an unknown id or a bad margin.
+  std::optional<ClosePair> nearest_pair();
+  std::vector<ClosePair> pairs_within(BodyId id, double margin);
 
   // The slow, obvious twin of step(): the cold distance query on every pair
   // of bodies that tests_pair, no broad phase, no caches; same output order.

@@ -285,3 +285,20 @@ def test_scene_pair_filters():
         scene.exclude_pair(int(ids[0]), int(ids[0]))
     with pytest.raises(ValueError, match="body 999 is not in the scene"):
         scene.set_filter(999, 1, 1)
+
+
+def test_scene_nearest_pair_and_pairs_within():
+    # The same seeded scene twice: one with margin 0 asked the queries, one
+    # with a huge margin whose all-pairs twin gives every pair's distance.
+    scene, ids, _ = random_scene(np.random.default_rng(22), 30, margin=0.0)
+    twin, _, _ = random_scene(np.random.default_rng(22), 30, margin=1e6)
+    all_pairs = twin.close_pairs_all_pairs()
+    assert len(all_pairs) == 30 * 29 // 2
+    nearest = scene.nearest_pair()
+    assert abs(nearest.result.distance - min(p.result.distance for p in all_pairs)) <= 1e-9
+    body = int(ids[0])
+    within = scene.pairs_within(body, 1.0)
+    expected = sorted(p.b if p.a == body else p.a for p in all_pairs
+                      if body in (p.a, p.b) and p.result.distance <= 1.0)
+    assert [p.b if p.a == body else p.a for p in within] == expected
+    assert proxima.Scene().nearest_pair() is None
