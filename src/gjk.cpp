@@ -23,8 +23,8 @@
 //
 // Each simplex point carries its vertex pair (i in A, j in B), so the closest
 // points are sum(lambda_k a_ik) and sum(lambda_k b_jk) with the barycentric
-// weights lambda of v, and the ids with non-zero weight are the witness
-// features.
+// weights lambda of v; the ids and those points give the witness features
+// (witness_features.h, the rule the hybrid uses too).
 //
 // Enhanced GJK differs in two places only: the support points come from hill
 // climbing over the vertex adjacency, starting from the previous answers
@@ -43,10 +43,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "gjk_contact.h"
 #include "gjk_frame.h"
 #include "simplex_solver.h"
+#include "witness_features.h"
 
 namespace proxima {
 namespace {
@@ -68,112 +70,6 @@ using detail::SupportPoint;
 constexpr double kGapUlps = 16.0;
 
 // ---------------------------------------------------------------------------
-// Witness features.
-// ---------------------------------------------------------------------------
-
-bool face_has(const ConvexPolytope& poly, int f, std::int32_t v) {
-  for (const std::int32_t x : poly.face(f)) {
-    if (x == v) return true;
-  }
-  return false;
-}
-
-// A face containing all of ids[0..m), found among the faces around ids[0]
-// (each face through a vertex is left of exactly one of its outgoing edges).
-// A polygon has two, one per side: take the one facing `outward`.
-int face_containing(const ConvexPolytope& poly, const std::array<std::int32_t, 4>& ids, int m,
-                    const Vec3& outward) {
-  const auto offsets = poly.adjacency_offsets();
-  const auto left = poly.adjacency_faces();
-  const auto v0 = idx(ids[0]);
-  int best = -1;
-  bool best_aligned = false;  // best_alignment computed (only when another face competes)
-  double best_alignment = 0.0;
-  for (auto k = idx(offsets[v0]); k < idx(offsets[v0 + 1]); ++k) {
-    const int f = left[k];
-    if (f < 0) continue;
-    bool all = true;
-    for (int i = 1; i < m && all; ++i) all = face_has(poly, f, ids[idx(i)]);
-    if (!all) continue;
-    if (best < 0) {
-      best = f;
-      continue;
-    }
-    if (!best_aligned) {
-      best_alignment = poly.face_plane(best).normal.dot(outward);
-      best_aligned = true;
-    }
-    const double alignment = poly.face_plane(f).normal.dot(outward);
-    if (alignment > best_alignment) {
-      best = f;
-      best_alignment = alignment;
-    }
-  }
-  return best;
-}
-
-// The feature spanned by the vertex ids that carry weight: one id is a
-// vertex, two adjacent ids an edge, two non-adjacent ids or three ids a face
-// (the hull face through them). When the ids span no hull face (only when
-// intersecting, or when rounding kept a sliver of weight on a vertex off the
-// closest face), the feature falls back to the heaviest vertex.
-Feature witness_feature(const ConvexPolytope& poly, const std::array<std::int32_t, 4>& raw_ids,
-                        const std::array<double, 4>& raw_weights, int count, const Vec3& outward) {
-  std::array<std::int32_t, 4> ids{};
-  std::array<double, 4> weights{};
-  int m = 0;
-  for (int k = 0; k < count; ++k) {
-    int j = 0;
-    while (j < m && ids[idx(j)] != raw_ids[idx(k)]) ++j;
-    if (j == m) {
-      ids[idx(m)] = raw_ids[idx(k)];
-      weights[idx(m++)] = 0.0;
-    }
-    weights[idx(j)] += raw_weights[idx(k)];
-  }
-  if (m == 4) {  // a tetrahedron around the origin: keep the three heaviest
-    int lightest = 0;
-    for (int j = 1; j < 4; ++j) {
-      if (weights[idx(j)] < weights[idx(lightest)]) lightest = j;
-    }
-    ids[idx(lightest)] = ids[3];
-    weights[idx(lightest)] = weights[3];
-    m = 3;
-  }
-  int heaviest = 0;
-  for (int j = 1; j < m; ++j) {
-    if (weights[idx(j)] > weights[idx(heaviest)]) heaviest = j;
-  }
-  const std::int32_t heaviest_id = ids[idx(heaviest)];
-  for (int j = 1; j < m; ++j) {  // ascending ids (at most three: insertion)
-    for (int i = j; i > 0 && ids[idx(i - 1)] > ids[idx(i)]; --i)
-      std::swap(ids[idx(i - 1)], ids[idx(i)]);
-  }
-
-  Feature f;
-  f.vertices = {ids[0], -1, -1};
-  if (m == 1) return f;
-  if (m == 2) {
-    for (const std::int32_t w : poly.neighbors(ids[0])) {
-      if (w == ids[1]) {
-        f.type = FeatureType::edge;
-        f.vertices = {ids[0], ids[1], -1};
-        return f;
-      }
-    }
-  }
-  const int face = face_containing(poly, ids, m, outward);
-  if (face < 0) {
-    f.vertices = {heaviest_id, -1, -1};
-    return f;
-  }
-  f.type = FeatureType::face;
-  f.face = face;
-  f.vertices = {ids[0], ids[1], m == 3 ? ids[2] : -1};
-  return f;
-}
-
-// ---------------------------------------------------------------------------
 // The loop shared by both variants.
 // ---------------------------------------------------------------------------
 
@@ -181,11 +77,13 @@ Feature witness_feature(const ConvexPolytope& poly, const std::array<std::int32_
 // support evaluations made so far; `direction` is the search direction used
 // so far (from A towards B), the normal reported when no better one exists.
 // `deep` receives the contact classification's tetrahedron around the origin
-// when it certifies intersection (classify_contact).
+// when it certifies intersection (classify_contact). `cached_face_a` and
+// `cached_face_b` are a previous answer's witness faces (-1 for none).
 template <class Support>
 DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
                        double contact_tolerance, Simplex& simplex, int iterations, Vec3 direction,
-                       Support& support, Points& deep) {
+                       Support& support, Points& deep, std::int32_t cached_face_a = -1,
+                       std::int32_t cached_face_b = -1) {
   const double tol = contact_tolerance * frame.inv_unit;
   double lower = 0.0;  // certified lower bound, scaled units
   double w_max2 = 0.0;
@@ -277,9 +175,17 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
                         : direction;
   }
   result.status = status;
-  result.feature_a = witness_feature(frame.a, ids_a, simplex.lambda, simplex.size, result.normal);
-  result.feature_b =
-      witness_feature(frame.b, ids_b, simplex.lambda, simplex.size, frame.dir_in_b(-result.normal));
+  // The witness features by the rule all algorithms share
+  // (witness_features.h), A's in A's frame, B's in B's.
+  const double witness_band = detail::witness_band(frame.magnitude);
+  const std::span ids_a_used(ids_a.data(), idx(simplex.size));
+  const std::span ids_b_used(ids_b.data(), idx(simplex.size));
+  result.feature_a = detail::witness_feature(frame.a, ids_a_used, witness_band, cached_face_a, [&] {
+    return detail::WitnessPoint{point_a, result.normal};
+  });
+  result.feature_b = detail::witness_feature(frame.b, ids_b_used, witness_band, cached_face_b, [&] {
+    return detail::WitnessPoint{local_b, frame.dir_in_b(-result.normal)};
+  });
   return result;
 }
 
@@ -346,8 +252,8 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   }
 
   Points deep;
-  const DistanceResult result =
-      run_gjk(frame, options, contact_tolerance, simplex, iterations, direction, support, deep);
+  const DistanceResult result = run_gjk(frame, options, contact_tolerance, simplex, iterations,
+                                        direction, support, deep, cache.face_a, cache.face_b);
   // run_gjk reduced `simplex` in place to the final one. An intersection
   // certified by a tetrahedron around the origin caches that tetrahedron
   // instead: while the bodies overlap by more than the band, the next query
@@ -364,6 +270,8 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   }
   cache.hint_a = support.hint_a;
   cache.hint_b = support.hint_b;
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
   return result;
 }
 

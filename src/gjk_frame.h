@@ -21,14 +21,15 @@ struct GjkFrame {
   const ConvexPolytope& a;
   const ConvexPolytope& b;
   const Pose& b_in_a;
-  double unit = 1.0;      // a power of two near the bodies' magnitude
-  double inv_unit = 1.0;  // exact reciprocal
+  double magnitude = 0.0;  // bound on the largest coordinate magnitude in A's frame
+  double unit = 1.0;       // a power of two near it
+  double inv_unit = 1.0;   // exact reciprocal
 
   GjkFrame(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& pose)
       : a(pa), b(pb), b_in_a(pose) {
     // B's coordinates in A's frame are bounded without mapping its vertices.
-    const PowerOfTwoUnit u =
-        power_of_two_unit(std::max(a.scale(), magnitude_bound(pose, b.scale())));
+    magnitude = std::max(a.scale(), magnitude_bound(pose, b.scale()));
+    const PowerOfTwoUnit u = power_of_two_unit(magnitude);
     unit = u.unit;
     inv_unit = u.inverse;
   }
