@@ -93,6 +93,11 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
 
   bool contact = false;
   bool capped = false;
+  // The gap test passed, or the support point was already in the simplex
+  // (v is then optimal up to rounding): |v| is the distance.
+  bool certified = false;
+  std::array<SupportPoint, 3> stall_plane;  // a triangle through v and the new point, if stalled
+  bool stalled = false;
   for (;;) {
     if (simplex.encloses_origin || simplex.vv <= tol * tol) {
       contact = true;
@@ -110,15 +115,58 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     lower = std::max(lower, simplex.v.dot(w.w) / v_norm);
     if (v_norm - lower <=
         options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
+      certified = true;
       break;
     }
-    if (simplex.contains(w.ia, w.ib)) break;  // nothing new: v is exact for this simplex
+    if (simplex.contains(w.ia, w.ib)) {  // nothing new: v is exact for this simplex
+      certified = true;
+      break;
+    }
     Simplex next = simplex;
     next.p[idx(next.size++)] = w;
     detail::solve(next);
-    if (!next.encloses_origin && next.vv >= simplex.vv) break;  // rounding has taken over: keep v
+    if (!next.encloses_origin && next.vv >= simplex.vv) {  // rounding has taken over: keep v
+      if (next.size == 3) {
+        stall_plane = {next.p[0], next.p[1], next.p[2]};
+        stalled = true;
+      } else if (simplex.size == 2) {
+        stall_plane = {simplex.p[0], simplex.p[1], w};
+        stalled = true;
+      } else if (simplex.size == 3) {
+        stall_plane = {simplex.p[0], simplex.p[1], simplex.p[2]};
+        stalled = true;
+      }
+      break;
+    }
     simplex = next;
   }
+
+  // Stalled: the loop left because |v| did not decrease at this precision
+  // while the support point beyond v was new, so |v| may be far above the
+  // distance, and its lower bound from v's direction may be 0. On a flat
+  // Minkowski difference (two nearly parallel needles or slivers in contact)
+  // the support point beyond v improves |v| only at second order, below
+  // rounding, and GJK stopped with |v| many bands above a distance of 0 and
+  // called the pair separated (GjkTouching.NeedlesSideBySideTouch). The
+  // plane through v's simplex and that support point is then nearly C's
+  // closest face (for a vertex just above a face, exactly it), and its
+  // normal gives one more lower bound (one support). Separated is reported
+  // only when a lower bound certifies it (above the band); otherwise the
+  // pair is in contact as far as GJK can tell, and touching is reported
+  // with GJK's distance as the upper bound it is.
+  if (!contact && !capped && !certified && stalled && iterations < options.max_iterations) {
+    Vec3 n = detail::face_normal(stall_plane[1].w - stall_plane[0].w,
+                                 stall_plane[2].w - stall_plane[0].w)
+                 .n;
+    if (n.dot(simplex.v) < 0.0) n = -n;
+    const double n_norm = n.norm();
+    if (n_norm > 0.0) {
+      const SupportPoint w = support(-n);
+      ++iterations;
+      lower = std::max(lower, n.dot(w.w) / n_norm);
+    }
+  }
+  const bool separation_certified = certified || lower > tol;
 
   Status status = Status::separated;
   if (contact) {
@@ -165,8 +213,10 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     result.point_b = point_b;
     result.distance = ((point_b - point_a) * frame.inv_unit).norm() * frame.unit;
     result.lower_bound = std::clamp(lower * frame.unit, 0.0, result.distance);
-    if (!contact)
-      status = result.distance > contact_tolerance ? Status::separated : Status::touching;
+    if (!contact) {
+      status = result.distance > contact_tolerance && separation_certified ? Status::separated
+                                                                           : Status::touching;
+    }
     if (capped) status = Status::iteration_cap;
     // Within the band the points' difference is rounding noise: keep the
     // last search direction there.

@@ -170,6 +170,16 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
     }
     if (faces[idx(best)].offset > tol) {
       if (n == 4) {
+        // P is the first tetrahedron, oriented by its own centroid: the
+        // certificate holds only when that orientation is reliable, by
+        // origin_depth's rule (centroid further than tol/2 from every
+        // face); a flatter one is undecided, which counts as touching like
+        // a flat one above. A cached flat tetrahedron a few bands above a
+        // touching apex certified intersection here once Enhanced GJK's
+        // stalled answers stopped being called separated and reached the
+        // contact classification
+        // (ForeignCache.FlatContactTetrahedronDoesNotCertifyIntersection).
+        if (!(origin_depth(p[0], p[1], p[2], p[3], tol) > tol)) return Status::touching;
         deep = {sp[0], sp[1], sp[2], sp[3]};
         return Status::intersecting;
       }
