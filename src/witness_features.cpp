@@ -256,25 +256,6 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
   const View view(poly, point);
   const double scaled_band = band * view.inverse_unit;
   const double band2 = scaled_band * scaled_band;
-  // Two distinct ids, the common case of tracked queries: rule 1 keeps the
-  // nearer end when the point is within the band of it, rule 2 names the
-  // edge when they are adjacent. Straight-line code for the hot path; the
-  // general case below gives the same answers.
-  if (id.size() == 2 && id[0] != id[1]) {
-    const double d0 = view.at(id[0]).squaredNorm();
-    const double d1 = view.at(id[1]).squaredNorm();
-    Feature f;
-    if (d0 <= band2 || d1 <= band2) {
-      f.vertices = {d0 <= d1 ? id[0] : id[1], -1, -1};
-      return f;
-    }
-    const auto nbrs = poly.neighbors(id[0]);
-    if (std::find(nbrs.begin(), nbrs.end(), id[1]) != nbrs.end()) {
-      f.type = FeatureType::edge;
-      f.vertices = {std::min(id[0], id[1]), std::max(id[0], id[1]), -1};
-      return f;
-    }
-  }
   // The distinct ids (a GJK simplex repeats a vertex of one body).
   // with their positions relative to the point.
   std::array<std::int32_t, 4> ids;

@@ -7,6 +7,7 @@
 // points do.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -68,6 +69,24 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
     return f;
   }
   const WitnessPoint p = describe();
+  // Two distinct ids at ordinary magnitudes, the tracked edge case: rules 1
+  // and 2 inline (witness_feature_of_vertices applies the same ones).
+  if (id.size() == 2 && id[0] != id[1] && poly.scale() > 0x1p-300 && poly.scale() < 0x1p300) {
+    const double band2 = band * band;
+    const double d0 = (poly.vertex(id[0]) - p.point).squaredNorm();
+    const double d1 = (poly.vertex(id[1]) - p.point).squaredNorm();
+    Feature f;
+    if (d0 <= band2 || d1 <= band2) {
+      f.vertices = {d0 <= d1 ? id[0] : id[1], -1, -1};
+      return f;
+    }
+    const auto nbrs = poly.neighbors(id[0]);
+    if (std::find(nbrs.begin(), nbrs.end(), id[1]) != nbrs.end()) {
+      f.type = FeatureType::edge;
+      f.vertices = {std::min(id[0], id[1]), std::max(id[0], id[1]), -1};
+      return f;
+    }
+  }
   return witness_feature_of_vertices(poly, id, p.point, band, p.outward, cached_face);
 }
 
