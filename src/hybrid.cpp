@@ -28,11 +28,13 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <span>
 
 #include "power_of_two.h"
 #include "proxima/closest_point.h"
 #include "proxima/contact.h"
 #include "proxima/support.h"
+#include "witness_features.h"
 
 namespace proxima {
 namespace {
@@ -257,74 +259,6 @@ bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureS
   return f.n > 0;
 }
 
-// The minimal hull feature containing the points spanned by `f`: a vertex, an
-// edge if the two vertices are adjacent, else a face holding all of them (for
-// a polygon, the side facing `toward`).
-// `cached` and `cached_face` are the previous query's feature and face: when
-// the feature is unchanged on a solid, its face is too.
-Feature witness(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& toward,
-                const std::array<std::int32_t, 4>& cached, std::int32_t cached_face) {
-  Feature out;
-  for (int i = 0; i < f.n && i < 3; ++i)
-    out.vertices[static_cast<std::size_t>(i)] = f.id[static_cast<std::size_t>(i)];
-  if (f.n <= 1) {
-    out.type = FeatureType::vertex;
-    return out;
-  }
-  const std::int32_t v0 = f.id[0];
-  const auto nbrs = poly.neighbors(v0);
-  if (f.n == 2 && std::find(nbrs.begin(), nbrs.end(), f.id[1]) != nbrs.end()) {
-    out.type = FeatureType::edge;
-    return out;
-  }
-  out.type = FeatureType::face;
-  // The cache may come from another pair (DistanceCache's contract): its
-  // face is used only when it is a face of this hull holding every vertex
-  // of the feature (ForeignCache.WitnessFacesAreThoseOfTheQueriedHulls: a
-  // foreign face id, up to 15 on a 4-face tetrahedron, was returned).
-  if (cached_face >= 0 && cached_face < poly.face_count() && poly.dimension() == 3 &&
-      cached[0] == out.vertices[0] && cached[1] == out.vertices[1] &&
-      cached[2] == out.vertices[2]) {
-    const auto verts = poly.face(cached_face);
-    bool holds_all = true;
-    for (int i = 0; i < f.n && holds_all; ++i) {
-      holds_all =
-          std::find(verts.begin(), verts.end(), f.id[static_cast<std::size_t>(i)]) != verts.end();
-    }
-    if (holds_all) {
-      out.face = cached_face;
-      return out;
-    }
-  }
-  const auto faces = poly.adjacency_faces();
-  const auto begin =
-      static_cast<std::size_t>(poly.adjacency_offsets()[static_cast<std::size_t>(v0)]);
-  double best_alignment = -2.0;
-  for (std::size_t k = begin; k < begin + nbrs.size(); ++k) {
-    const std::int32_t face = faces[k];
-    if (face < 0) continue;
-    const auto verts = poly.face(face);
-    bool holds_all = true;
-    for (int i = 1; i < f.n; ++i) {
-      holds_all = holds_all && std::find(verts.begin(), verts.end(),
-                                         f.id[static_cast<std::size_t>(i)]) != verts.end();
-    }
-    if (!holds_all) continue;
-    // In a solid, two faces share at most one edge, so the face holding a
-    // triangle or a diagonal is unique. A polygon has two, one per side.
-    if (poly.dimension() == 3) {
-      out.face = face;
-      break;
-    }
-    const double alignment = poly.face_plane(face).normal.dot(toward);
-    if (alignment > best_alignment) {
-      best_alignment = alignment;
-      out.face = face;
-    }
-  }
-  return out;
-}
-
 // The algorithm on coordinates multiplied by `scale`, a power of two, when
 // kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
 // in the caller's units, like the result returned. The unscaled instance is
@@ -449,9 +383,21 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   } else if (result.status != Status::iteration_cap) {
     result.status = Status::separated;
   }
-  result.feature_a = witness(a, fa, result.normal, cache.vertices_a, cache.face_a);
-  result.feature_b =
-      witness(b, fb, Vec3(-(rot.transpose() * result.normal)), cache.vertices_b, cache.face_b);
+  // The witness features by the rule all algorithms share
+  // (witness_features.h), in each hull's own frame and units.
+  const double unit = kScaled ? 1.0 / scale : 1.0;  // exact: a power of two
+  const double witness_band = detail::witness_band(r_local * unit);
+  result.feature_a = detail::witness_feature(
+      a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a, [&] {
+        return detail::WitnessPoint{Vec3(loc.xa * unit), result.normal};
+      });
+  result.feature_b = detail::witness_feature(
+      b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b, [&] {
+        // The outward side only matters on a polygon.
+        return detail::WitnessPoint{
+            Vec3(rot.transpose() * (loc.xb * unit - tr)),
+            b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+      });
   cache.face_a = result.feature_a.face;
   cache.face_b = result.feature_b.face;
 
@@ -464,7 +410,6 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   cache.hint_a = hint_a;
   cache.hint_b = hint_b;
   if constexpr (kScaled) {
-    const double unit = 1.0 / scale;  // exact: a power of two
     result.point_a *= unit;
     result.point_b *= unit;
     result.distance *= unit;

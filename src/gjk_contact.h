@@ -1,0 +1,33 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 5 internals: GJK's contact search. Once GJK's closest point is in
+// the contact band, classify_contact tells touching from intersecting, each
+// by a certificate (gjk_contact.cpp); origin_depth is the intersection
+// certificate of one tetrahedron, also behind encloses_origin_deeply
+// (proxima/gjk.h).
+#pragma once
+
+#include "gjk_frame.h"
+#include "proxima/types.h"
+#include "simplex_solver.h"
+
+namespace proxima::detail {
+
+// The origin's depth inside the tetrahedron (p0, p1, p2, p3), each face
+// oriented by the centroid; the lowest double when the tetrahedron is too
+// flat to orient (gjk_contact.cpp says why). Above tol it certifies
+// intersection.
+double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3, double tol);
+
+// Touching, intersecting or iteration_cap for a solved simplex whose closest
+// point is within tol of the origin (gjk_contact.cpp). Its support
+// evaluations count in `iterations`. When it certifies intersection, `deep`
+// receives a tetrahedron of C's points that holds the origin deeper than tol
+// by itself, if one exists (deep[0].ia stays -1 otherwise). Instantiated for
+// BruteForceSupport and HillClimbSupport (gjk_frame.h).
+template <class Support>
+Status classify_contact(const Simplex& s, double tol, Support& support, int& iterations,
+                        int max_iterations, Points& deep);
+
+}  // namespace proxima::detail

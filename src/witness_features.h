@@ -1,0 +1,99 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Layer 5 internals: the witness feature of a closest point, from the hull
+// vertices that span it. One rule for every algorithm (the hybrid, GJK and
+// Enhanced GJK), so that their witness features agree whenever their closest
+// points do.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
+namespace proxima::detail {
+
+// The closest point whose witness feature is wanted, in poly's frame.
+struct WitnessPoint {
+  Vec3 point = Vec3::Zero();
+  Vec3 outward = Vec3::UnitX();  // for a polygon, the side to report
+};
+
+// The witness feature on hull `poly` of `point`, a point of the hull of the
+// vertices `id` (1 to 4 of them, repeats allowed) that is a closest point
+// of a distance query, everything in poly's own frame: the feature of least
+// dimension that holds the point within `band`, and a real feature of this
+// hull. The rule:
+//   1. While the point is within `band` of the hull of all ids but one, that
+//      one is dropped (the nearest such hull first): rounding and the
+//      relative tolerance leave vertices that add nothing within the band.
+//      Four left (a tetrahedron around the origin: a contact) lose the one
+//      whose opposite face is nearest.
+//   2. What is left names the feature: one vertex; two adjacent vertices,
+//      an edge; two non-adjacent vertices or three, the hull face holding
+//      them (for a polygon, of its two sides the one facing `outward`).
+//   3. When no hull face holds them (the vertices straddle faces that are
+//      coplanar within rounding but were not merged: a closest point within
+//      the relative tolerance on a chord across them; or a contact's point
+//      inside the hull), the face is located from the point itself: a walk
+//      over the faces, from the one around the vertices whose plane is
+//      nearest, to one whose polygon holds the point within `band`; then
+//      its vertex or edge within `band` of the point if there is one, else
+//      the face with the three vertices of its fan triangle nearest the
+//      point. If the walk finds none, vertices are dropped as in rule 1
+//      until the rest is a feature.
+// The face id is a face of `poly` holding every reported vertex, always:
+// `cached_face` (a previous answer's, from any pair) is used when it is one,
+// which spares the lookup while a tracked feature does not change; otherwise
+// the faces around the first vertex are searched. The vertex ids are
+// reported in ascending order. O(1) but for that search (the faces around
+// one vertex) and rule 3's walk (rare, and capped).
+Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const std::int32_t> id,
+                                    const Vec3& point, double band, const Vec3& outward,
+                                    std::int32_t cached_face);
+
+// The same, with the point and the outward direction given by a callable
+// returning a WitnessPoint, called only for two or more ids: a single vertex
+// is its own feature (the tracked vertex-face query's common case), and
+// mapping the point into poly's frame is then not paid for.
+template <class Describe>
+Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t> id, double band,
+                        std::int32_t cached_face, const Describe& describe) {
+  if (id.size() == 1) {
+    Feature f;
+    f.vertices = {id[0], -1, -1};
+    return f;
+  }
+  const WitnessPoint p = describe();
+  // Two distinct ids at ordinary magnitudes, the tracked edge case: rules 1
+  // and 2 inline (witness_feature_of_vertices applies the same ones).
+  if (id.size() == 2 && id[0] != id[1] && poly.scale() > 0x1p-300 && poly.scale() < 0x1p300) {
+    const double band2 = band * band;
+    const double d0 = (poly.vertex(id[0]) - p.point).squaredNorm();
+    const double d1 = (poly.vertex(id[1]) - p.point).squaredNorm();
+    Feature f;
+    if (d0 <= band2 || d1 <= band2) {
+      f.vertices = {d0 <= d1 ? id[0] : id[1], -1, -1};
+      return f;
+    }
+    const auto nbrs = poly.neighbors(id[0]);
+    if (std::find(nbrs.begin(), nbrs.end(), id[1]) != nbrs.end()) {
+      f.type = FeatureType::edge;
+      f.vertices = {std::min(id[0], id[1]), std::max(id[0], id[1]), -1};
+      return f;
+    }
+  }
+  return witness_feature_of_vertices(poly, id, p.point, band, p.outward, cached_face);
+}
+
+// The band of rule 1 for coordinates bounded by r (the algorithms' bound on
+// R): a quarter of the contact band, which leaves room for that bound
+// exceeding the exact R of the accuracy standard (the reported feature must
+// hold the point within the standard's 64 u R).
+inline double witness_band(double r) { return 0.25 * contact_band(r); }
+
+}  // namespace proxima::detail
