@@ -78,9 +78,38 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 
 // B's pose in A's frame, pose_a^-1 pose_b, formed directly (the transpose
 // is the inverse of a rotation under the pose contract).
+//
+// With SSE2, two entries at a time: column j of R_a^T R_b (or R_a^T d) is
+// sum_k (R_a row k) * v_k for v = column j of R_b (or d), and the first two
+// entries of each row of R_a are a pair of lanes. Eigen's 3x3 product
+// vectorizes each length-3 dot product with horizontal adds instead: 127
+// instructions per query against about 90 here (callgrind,
+// bench/tracked_instructions).
 Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
+  const Vec3 d = pose_b.translation - pose_a.translation;
+#if defined(__SSE2__)
+  const double* ra = pose_a.rotation.data();  // column-major: R_a(k, i) = ra[3 i + k]
+  const double* rb = pose_b.rotation.data();
+  const __m128d row0 = _mm_loadh_pd(_mm_load_sd(ra + 0), ra + 3);  // (R_a(0,0), R_a(0,1))
+  const __m128d row1 = _mm_loadh_pd(_mm_load_sd(ra + 1), ra + 4);
+  const __m128d row2 = _mm_loadh_pd(_mm_load_sd(ra + 2), ra + 5);
+  // R_a^T v into out[0..2]: the first two entries paired, the third alone.
+  const auto apply_transpose = [&](const double* v, double* out) {
+    const __m128d top = _mm_add_pd(
+        _mm_add_pd(_mm_mul_pd(row0, _mm_set1_pd(v[0])), _mm_mul_pd(row1, _mm_set1_pd(v[1]))),
+        _mm_mul_pd(row2, _mm_set1_pd(v[2])));
+    _mm_storeu_pd(out, top);
+    out[2] = ra[6] * v[0] + ra[7] * v[1] + ra[8] * v[2];
+  };
+  Mat3 rotation;
+  Vec3 translation;
+  for (int j = 0; j < 3; ++j) apply_transpose(rb + 3 * j, rotation.data() + 3 * j);
+  apply_transpose(d.data(), translation.data());
+  return {rotation, translation};
+#else
   return {Mat3(pose_a.rotation.transpose() * pose_b.rotation),
-          Vec3(pose_a.rotation.transpose() * (pose_b.translation - pose_a.translation))};
+          Vec3(pose_a.rotation.transpose() * d)};
+#endif
 }
 
 // The query for poses under the contract, with the caller's cache or a cold
