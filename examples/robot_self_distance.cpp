@@ -131,6 +131,10 @@ bool same_pairs(std::span<const proxima::ClosePair> fast,
   return true;
 }
 
+const char* link_name(const std::array<proxima::BodyId, 9>& ids, proxima::BodyId id) {
+  return kLinkNames[static_cast<std::size_t>(std::find(ids.begin(), ids.end(), id) - ids.begin())];
+}
+
 int run(const std::string& mesh_dir) {
   proxima::SceneOptions options;
   options.margin = 0.05;  // report pairs of links closer than 5 cm
@@ -169,7 +173,7 @@ int run(const std::string& mesh_dir) {
                   100 * options.margin);
     } else {
       std::printf("config %3zu: closest %s-%s %-12s %.4f m (%zu pairs within %.0f cm)\n", c,
-                  kLinkNames[closest->a], kLinkNames[closest->b],
+                  link_name(ids, closest->a), link_name(ids, closest->b),
                   proxima::to_string(closest->result.status), closest->result.distance,
                   pairs.size(), 100 * options.margin);
     }

@@ -130,8 +130,9 @@ for c, q in enumerate(path):
     seconds += time.perf_counter() - start
     if pairs:
         p = min(pairs, key=lambda p: p.result.distance)
-        print(f"config {c:3}: closest {LINK_NAMES[p.a]}-{LINK_NAMES[p.b]} {p.result.status:12} "
-              f"{p.result.distance:.4f} m ({len(pairs)} pairs within 5 cm)")
+        a, b = LINK_NAMES[ids.index(p.a)], LINK_NAMES[ids.index(p.b)]
+        print(f"config {c:3}: closest {a}-{b} {p.result.status:12} {p.result.distance:.4f} m "
+              f"({len(pairs)} pairs within 5 cm)")
     else:
         print(f"config {c:3}: no pair of non-adjacent links within 5 cm")
     if c % 20 == 0:  # check against the slow twin: cold queries on every tested pair
