@@ -39,6 +39,7 @@
 #include <cstdlib>
 #include <exception>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -107,7 +108,10 @@ int run(int repeat, const std::string& mesh_dir) {
     proxima::SceneOptions options;
     options.margin = margin;
     auto scene = std::make_unique<proxima::Scene>(options);
-    for (int i = 0; i < kBodies; ++i) scene->add(hulls[i], poses[0][i]);
+    // Link i is body i: a new scene numbers its bodies 0, 1, ... (checked).
+    for (int i = 0; i < kBodies; ++i) {
+      if (scene->add(hulls[i], poses[0][i]) != i) throw std::logic_error("robot_bench: body ids");
+    }
     for (int i = 0; i + 1 < kBodies; ++i) scene->exclude_pair(i, i + 1);
     return scene;
   };
