@@ -87,6 +87,40 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
       return f;
     }
   }
+  // Three distinct ids on a solid at ordinary magnitudes that the previous
+  // answer's face holds, the tracked face case: rules 1 and 2 inline. The
+  // point is farther than `band` from every edge of the triangle (no vertex
+  // dropped), so the feature is the face; anything else takes the general
+  // path, which applies the same rules.
+  if (id.size() == 3 && poly.dimension() == 3 && cached_face >= 0 &&
+      cached_face < poly.face_count() && id[0] != id[1] && id[1] != id[2] && id[0] != id[2] &&
+      poly.scale() > 0x1p-300 && poly.scale() < 0x1p300) {
+    const Vec3 r0 = poly.vertex(id[0]) - p.point;
+    const Vec3 r1 = poly.vertex(id[1]) - p.point;
+    const Vec3 r2 = poly.vertex(id[2]) - p.point;
+    const double band2 = band * band;
+    // Squared distance from the point (the origin here) to segment [u, v].
+    const auto segment2 = [](const Vec3& u, const Vec3& v) {
+      const Vec3 e = v - u;
+      const double ee = e.squaredNorm();
+      const double t = ee > 0.0 ? std::clamp(-u.dot(e) / ee, 0.0, 1.0) : 0.0;
+      return (u + t * e).squaredNorm();
+    };
+    const auto verts = poly.face(cached_face);
+    const auto holds = [&verts](std::int32_t v) {
+      return std::find(verts.begin(), verts.end(), v) != verts.end();
+    };
+    if (segment2(r1, r2) > band2 && segment2(r2, r0) > band2 && segment2(r0, r1) > band2 &&
+        holds(id[0]) && holds(id[1]) && holds(id[2])) {
+      std::array<std::int32_t, 3> sorted = {id[0], id[1], id[2]};
+      std::sort(sorted.begin(), sorted.end());
+      Feature f;
+      f.type = FeatureType::face;
+      f.vertices = sorted;
+      f.face = cached_face;
+      return f;
+    }
+  }
   return witness_feature_of_vertices(poly, id, p.point, band, p.outward, cached_face);
 }
 
