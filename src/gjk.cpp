@@ -230,12 +230,19 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   const double witness_band = detail::witness_band(frame.magnitude);
   const std::span ids_a_used(ids_a.data(), idx(simplex.size));
   const std::span ids_b_used(ids_b.data(), idx(simplex.size));
-  result.feature_a = detail::witness_feature(frame.a, ids_a_used, witness_band, cached_face_a, [&] {
-    return detail::WitnessPoint{point_a, result.normal};
-  });
-  result.feature_b = detail::witness_feature(frame.b, ids_b_used, witness_band, cached_face_b, [&] {
-    return detail::WitnessPoint{local_b, frame.dir_in_b(-result.normal)};
-  });
+  const bool locate = status != Status::intersecting;  // witness_features.h
+  result.feature_a = detail::witness_feature(
+      frame.a, ids_a_used, witness_band, cached_face_a,
+      [&] {
+        return detail::WitnessPoint{point_a, result.normal};
+      },
+      locate);
+  result.feature_b = detail::witness_feature(
+      frame.b, ids_b_used, witness_band, cached_face_b,
+      [&] {
+        return detail::WitnessPoint{local_b, frame.dir_in_b(-result.normal)};
+      },
+      locate);
   return result;
 }
 

@@ -383,24 +383,7 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   } else if (result.status != Status::iteration_cap) {
     result.status = Status::separated;
   }
-  // The witness features by the rule all algorithms share
-  // (witness_features.h), in each hull's own frame and units.
   const double unit = kScaled ? 1.0 / scale : 1.0;  // exact: a power of two
-  const double witness_band = detail::witness_band(r_local * unit);
-  result.feature_a = detail::witness_feature(
-      a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a, [&] {
-        return detail::WitnessPoint{Vec3(loc.xa * unit), result.normal};
-      });
-  result.feature_b = detail::witness_feature(
-      b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b, [&] {
-        // The outward side only matters on a polygon.
-        return detail::WitnessPoint{
-            Vec3(rot.transpose() * (loc.xb * unit - tr)),
-            b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-      });
-  cache.face_a = result.feature_a.face;
-  cache.face_b = result.feature_b.face;
-
   cache.vertices_a = {-1, -1, -1, -1};
   cache.vertices_b = {-1, -1, -1, -1};
   for (int i = 0; i < fa.n && i < 3; ++i)
@@ -415,13 +398,38 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     result.distance *= unit;
     result.lower_bound *= unit;
   }
-  // What the first answer may still need (proxima/contact.h): the hybrid
-  // reports contact without telling touching from overlapping, and an
-  // answer it could not certify is cross-checked. In the caller's units.
-  if (needs_cross_check(result, options, magnitude)) [[unlikely]]
-    cross_check_separation(a, b, b_in_a, options, band, result);
+  // The hybrid reports contact without telling touching from overlapping:
+  // the contact unit (proxima/contact.h) decides, in the caller's units,
+  // before the witness features, which an intersecting answer reports
+  // without rule 3's walk (witness_features.h).
   if (result.status == Status::touching)
     classify_contact(a, b, b_in_a, options, band, cache, result);
+  const bool locate = result.status != Status::intersecting;
+
+  // The witness features by the rule all algorithms share
+  // (witness_features.h), in each hull's own frame and units.
+  const double witness_band = detail::witness_band(r_local * unit);
+  result.feature_a = detail::witness_feature(
+      a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+      [&] {
+        return detail::WitnessPoint{Vec3(loc.xa * unit), result.normal};
+      },
+      locate);
+  result.feature_b = detail::witness_feature(
+      b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+      [&] {
+        // The outward side only matters on a polygon.
+        return detail::WitnessPoint{
+            Vec3(rot.transpose() * (loc.xb * unit - tr)),
+            b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+      },
+      locate);
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
+
+  // An answer the hybrid could not certify is cross-checked (contact.h).
+  if (needs_cross_check(result, options, magnitude)) [[unlikely]]
+    cross_check_separation(a, b, b_in_a, options, band, result);
   return result;
 }
 

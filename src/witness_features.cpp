@@ -252,7 +252,7 @@ std::optional<Feature> feature_of_face(const View& view, int f, double band) {
 
 Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const std::int32_t> id,
                                     const Vec3& point, double band, const Vec3& outward,
-                                    std::int32_t cached_face) {
+                                    std::int32_t cached_face, bool locate) {
   const View view(poly, point);
   const double scaled_band = band * view.inverse_unit;
   const double band2 = scaled_band * scaled_band;
@@ -342,7 +342,7 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
       f.face = face;
       return f;
     }
-    if (!walked && poly.dimension() == 3) {
+    if (!walked && locate && poly.dimension() == 3) {
       walked = true;
       const int located = locate_face(view, scaled_band, nearest_plane(view, ids, m));
       if (located >= 0) {

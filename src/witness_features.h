@@ -52,9 +52,16 @@ struct WitnessPoint {
 // the faces around the first vertex are searched. The vertex ids are
 // reported in ascending order. O(1) but for that search (the faces around
 // one vertex) and rule 3's walk (rare, and capped).
+//
+// `locate` false skips rule 3's walk (vertices are dropped at once): for an
+// intersecting answer, whose point lies inside the other hull and whose
+// features only name where the search stopped, the walk (which evaluates
+// face planes around the vertices and along its path) would cost several
+// microseconds per tracked overlapping query for nothing the answer
+// promises.
 Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const std::int32_t> id,
                                     const Vec3& point, double band, const Vec3& outward,
-                                    std::int32_t cached_face);
+                                    std::int32_t cached_face, bool locate = true);
 
 // The same, with the point and the outward direction given by a callable
 // returning a WitnessPoint, called only for two or more ids: a single vertex
@@ -62,7 +69,7 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
 // mapping the point into poly's frame is then not paid for.
 template <class Describe>
 Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t> id, double band,
-                        std::int32_t cached_face, const Describe& describe) {
+                        std::int32_t cached_face, const Describe& describe, bool locate = true) {
   if (id.size() == 1) {
     Feature f;
     f.vertices = {id[0], -1, -1};
@@ -121,7 +128,7 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
       return f;
     }
   }
-  return witness_feature_of_vertices(poly, id, p.point, band, p.outward, cached_face);
+  return witness_feature_of_vertices(poly, id, p.point, band, p.outward, cached_face, locate);
 }
 
 // The band of rule 1 for coordinates bounded by r (the algorithms' bound on
