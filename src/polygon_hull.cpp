@@ -7,11 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <numeric>
 #include <utility>
 
 #include "power_of_two.h"
 #include "proxima/detail/exact_predicates.h"
+#include "sorted_distinct.h"
 
 namespace proxima::detail {
 
@@ -59,21 +59,12 @@ int projection_axis(std::span<const Vec3> pts, std::span<const Vec3> scaled, con
 // orient2d. Exact for coplanar points.
 std::vector<Index> polygon_hull(std::span<const Vec3> pts, int axis) {
   const int i = (axis + 1) % 3, j = (axis + 2) % 3;
-  std::vector<Index> order(pts.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](Index v) {
+  // Sorted by projection; of points that project to one 2D point (only when
+  // not exactly coplanar), the first.
+  std::vector<Index> order = sorted_distinct(pts.size(), [&](Index v) {
     const Vec3& p = pts[static_cast<std::size_t>(v)];
     return std::pair<double, double>(p[i], p[j]);
-  };
-  std::sort(order.begin(), order.end(), [&](Index l, Index r) {
-    const auto kl = key(l), kr = key(r);
-    return kl != kr ? kl < kr : l < r;
   });
-  // Points that project to one 2D point (only when not exactly coplanar):
-  // keep the first.
-  order.erase(
-      std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }),
-      order.end());
   const auto turns_left = [&](Index a, Index b, Index c) {
     const Vec3& pa = pts[static_cast<std::size_t>(a)];
     const Vec3& pb = pts[static_cast<std::size_t>(b)];

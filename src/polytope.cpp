@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -37,6 +36,7 @@
 #include "polygon_hull.h"
 #include "power_of_two.h"
 #include "proxima/detail/exact_predicates.h"
+#include "sorted_distinct.h"
 
 namespace proxima {
 namespace {
@@ -128,19 +128,10 @@ void validate(std::span<const Vec3> points) {
 
 // Input indices of the distinct points, the first occurrence of each.
 std::vector<Index> distinct_points(std::span<const Vec3> points) {
-  std::vector<Index> order(points.size());
-  std::iota(order.begin(), order.end(), 0);
-  const auto key = [&](Index i) {
+  std::vector<Index> order = detail::sorted_distinct(points.size(), [&](Index i) {
     const Vec3& p = points[static_cast<std::size_t>(i)];
     return std::array<double, 3>{p.x(), p.y(), p.z()};
-  };
-  std::sort(order.begin(), order.end(), [&](Index l, Index r) {
-    const auto kl = key(l), kr = key(r);
-    return kl != kr ? kl < kr : l < r;
   });
-  order.erase(
-      std::unique(order.begin(), order.end(), [&](Index l, Index r) { return key(l) == key(r); }),
-      order.end());
   std::sort(order.begin(), order.end());
   return order;
 }
