@@ -11,15 +11,17 @@
 // then instructions per query = the collected total / the printed queries.
 // Modes: translation (B circles A, distance about 1), rotation (B spins at
 // 0.01 rad per step), fast_rotation (0.1 rad per step), random (unrelated
-// poses, warm cache). The poses are those of bench/distance_bench.cpp.
-#include "proxima/distance.h"
-
+// poses, warm cache), cold_random (the same poses, cold every query: the
+// figure a warm cache must not exceed by more than 10%, issue 14). The
+// poses are those of bench/distance_bench.cpp.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <random>
 #include <vector>
+
+#include "proxima/distance.h"
 
 namespace {
 
@@ -44,7 +46,9 @@ constexpr int kSteps = 10000;
 
 int main(int argc, char** argv) {
   if (argc != 3) {
-    std::fprintf(stderr, "usage: tracked_instructions translation|rotation|fast_rotation|random N\n");
+    std::fprintf(
+        stderr,
+        "usage: tracked_instructions translation|rotation|fast_rotation|random|cold_random N\n");
     return 2;
   }
   const char* mode = argv[1];
@@ -56,11 +60,12 @@ int main(int argc, char** argv) {
   for (int i = 0; i < kSteps; ++i) {
     const double t = 2.0 * M_PI * i / kSteps;
     if (std::strcmp(mode, "translation") == 0) {
-      poses.push_back(Pose::from_translation(Vec3(3.0 * std::cos(t), 3.0 * std::sin(t), 0.5 * std::sin(3 * t))));
+      poses.push_back(Pose::from_translation(
+          Vec3(3.0 * std::cos(t), 3.0 * std::sin(t), 0.5 * std::sin(3 * t))));
     } else if (std::strcmp(mode, "rotation") == 0 || std::strcmp(mode, "fast_rotation") == 0) {
       const double speed = mode[0] == 'r' ? 0.01 : 0.1;
       poses.emplace_back(Quat(Eigen::AngleAxisd(speed * i, axis)), Vec3(3.0, 0.2, -0.1));
-    } else if (std::strcmp(mode, "random") == 0) {
+    } else if (std::strcmp(mode, "random") == 0 || std::strcmp(mode, "cold_random") == 0) {
       const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
       poses.emplace_back(Quat(g(rng), g(rng), g(rng), g(rng)), Vec3(3.0 * dir));
     } else {
@@ -72,7 +77,11 @@ int main(int argc, char** argv) {
   const proxima::ConvexPolytope b(sphere_points(n, 2));
   proxima::DistanceCache cache;
   double sum = 0.0;
-  for (const Pose& pose : poses) sum += proxima::distance(a, Pose::identity(), b, pose, {}, &cache).distance;
+  const bool cold = std::strcmp(mode, "cold_random") == 0;
+  for (const Pose& pose : poses) {
+    if (cold) cache.reset();
+    sum += proxima::distance(a, Pose::identity(), b, pose, {}, &cache).distance;
+  }
   std::printf("queries %d, mode %s, N %d, mean distance %.6f\n", kSteps, mode, n, sum / kSteps);
   return 0;
 }

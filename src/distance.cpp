@@ -85,7 +85,7 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // vectorizes each length-3 dot product with horizontal adds instead: 127
 // instructions per query against about 90 here (callgrind,
 // bench/tracked_instructions).
-Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
+[[gnu::always_inline]] inline Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
   const Vec3 d = pose_b.translation - pose_a.translation;
 #if defined(__SSE2__)
   const double* ra = pose_a.rotation.data();  // column-major: R_a(k, i) = ra[3 i + k]

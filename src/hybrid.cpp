@@ -60,6 +60,10 @@ constexpr double kGapUlps = 16.0;
 constexpr double kMinUnscaled = 0x1p-64;
 constexpr double kMaxUnscaled = 0x1p64;
 
+// A cache whose pose is further than this share of the bodies' size from
+// the query's is taken for stale (see moved_far).
+constexpr double kStaleMotion = 0.5;
+
 // A feature of one body: up to three hull vertex ids (a fourth slot for the
 // support point being added), with their positions in A's frame.
 struct FeatureSet {
@@ -80,6 +84,7 @@ struct FeatureSet {
   }
   // Keeps the vertices whose bit is set in `active`, in order.
   void reduce(std::uint8_t active) {
+    if (active == (1u << n) - 1u) return;  // all kept: the tracked case
     int k = 0;
     for (int i = 0; i < n; ++i) {
       if (active & (1u << i)) {
@@ -259,6 +264,27 @@ bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureS
   return f.n > 0;
 }
 
+// Whether B moved so far relative to A since the cache's query that its
+// feature pair says nothing any more (a planner sampling unrelated
+// configurations with one cache per pair): a bound on how far any point of
+// B moved, |t - t'| + ||R - R'||_F max|y|, beyond a share of the bodies'
+// size. Such a warm start would cost more than a cold one
+// (bench/distance_bench WarmRandom: 7.7 iterations against 1.2, 2.7 times
+// the cold query's instructions at N = 4096), so the cold start is taken.
+// A cache without a pose (rotation zero: cold, or filled by GJK) moved
+// far. About 70 instructions on every query (callgrind,
+// bench/tracked_instructions); a heuristic for speed only: any start ends
+// in the same certified answer.
+bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+               const DistanceCache& cache) {
+  const double turn2 = (b_in_a.rotation - cache.rotation).squaredNorm();
+  const double shift = (b_in_a.translation - cache.translation).norm();
+  const double size = a.bounding_radius() + b.bounding_radius();
+  const double reach = std::sqrt(3.0) * b.scale();  // >= max |y| over B
+  // A quiet comparison: a garbage cache may hold NaN (moved far, then).
+  return !std::islessequal(shift + std::sqrt(turn2) * reach, kStaleMotion * size);
+}
+
 // The algorithm on coordinates multiplied by `scale`, a power of two, when
 // kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
 // in the caller's units, like the result returned. The unscaled instance is
@@ -289,13 +315,18 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   // Features shorter or flatter than a few u R are reduced (closest_point.h).
   const KernelTolerance<double> tol = kernel_tolerance(r_local);
 
-  std::int32_t hint_a = valid_id(cache.hint_a, a.vertex_count()) ? cache.hint_a : 0;
-  std::int32_t hint_b = valid_id(cache.hint_b, b.vertex_count()) ? cache.hint_b : 0;
+  const int count_a = a.vertex_count();
+  const int count_b = b.vertex_count();
+  std::int32_t hint_a = valid_id(cache.hint_a, count_a) ? cache.hint_a : 0;
+  std::int32_t hint_b = valid_id(cache.hint_b, count_b) ? cache.hint_b : 0;
 
   FeatureSet fa;
   FeatureSet fb;
-  const bool warm = load_feature(cache.vertices_a, a.vertex_count(), fa, a_point) &&
-                    load_feature(cache.vertices_b, b.vertex_count(), fb, b_point);
+  // A warm start from the cached pair, unless B moved far since (then the
+  // pair says nothing: moved_far).
+  const bool warm = !moved_far(a, b, b_in_a, cache) &&
+                    load_feature(cache.vertices_a, count_a, fa, a_point) &&
+                    load_feature(cache.vertices_b, count_b, fb, b_point);
   if (!warm) {
     // Cold start: the support points along the line of centres.
     // In scaled units too: its dot products with vertices must not overflow.
@@ -392,6 +423,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
   cache.hint_a = hint_a;
   cache.hint_b = hint_b;
+  cache.rotation = rot;
+  cache.translation = tr;
   if constexpr (kScaled) {
     result.point_a *= unit;
     result.point_b *= unit;

@@ -148,6 +148,10 @@ struct DistanceCache {
   // re-certifies that tetrahedron in O(1) instead of searching again.
   std::array<std::int32_t, 4> contact_a = {-1, -1, -1, -1};
   std::array<std::int32_t, 4> contact_b = {-1, -1, -1, -1};
+  // B's pose in A's frame at the hybrid's last query (zero: none), so that
+  // a pose far from it starts cold instead of from a stale pair.
+  Mat3 rotation = Mat3::Zero();
+  Vec3 translation = Vec3::Zero();
 
   bool is_cold() const { return vertices_a[0] < 0 && hint_a < 0 && contact_a[0] < 0; }
   void reset() { *this = DistanceCache{}; }
