@@ -1,0 +1,244 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Time of impact (proxima/time_of_impact.h) against closed forms
+// (translating boxes) and against a dense sampling of the distance along
+// the motion: the reported t is never after the first sampled contact, no
+// sample before t is in contact, and at t the distance is within the
+// tolerance of the target.
+#include "proxima/time_of_impact.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "proxima/distance.h"
+
+namespace proxima {
+namespace {
+
+std::vector<Vec3> box(const Vec3& half) {
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 8; ++i) {
+    pts.emplace_back((i & 1 ? 1 : -1) * half.x(), (i & 2 ? 1 : -1) * half.y(),
+                     (i & 4 ? 1 : -1) * half.z());
+  }
+  return pts;
+}
+
+std::vector<Vec3> sphere_points(int n, std::uint32_t seed, double radius) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g;
+  std::vector<Vec3> pts;
+  for (int i = 0; i < n; ++i) pts.push_back(radius * Vec3(g(rng), g(rng), g(rng)).normalized());
+  return pts;
+}
+
+double distance_at(const ConvexPolytope& a, const Motion& ma, const ConvexPolytope& b,
+                   const Motion& mb, double t) {
+  return distance(a, ma.at(t), b, mb.at(t)).distance;
+}
+
+// The guarantee of time_of_impact checked against `samples` evenly spaced
+// times: no sample before the reported t within the target (minus a
+// rounding margin), the reported t not after the first sample within it,
+// and for contact the distance at t within the tolerance.
+void check_against_sampling(const ConvexPolytope& a, const Motion& ma, const ConvexPolytope& b,
+                            const Motion& mb, const ImpactOptions& options, const ImpactResult& r,
+                            int samples) {
+  const double margin = 1e-9;
+  double first_contact = 2.0;
+  for (int i = 0; i <= samples; ++i) {
+    const double s = static_cast<double>(i) / samples;
+    const double d = distance_at(a, ma, b, mb, s);
+    if (d <= options.target_separation && first_contact > 1.0) first_contact = s;
+    if (s < r.t) {
+      EXPECT_GT(d, options.target_separation - margin) << "contact missed at t = " << s;
+    }
+  }
+  EXPECT_LE(r.t, first_contact + 1e-15);
+  if (r.status == ImpactStatus::contact) {
+    EXPECT_LE(r.at_t.distance, options.target_separation + options.tolerance + margin);
+    EXPECT_GE(r.at_t.distance, options.target_separation - margin);
+  }
+  if (r.status == ImpactStatus::separated) {
+    EXPECT_GT(first_contact, 1.0);
+  }
+}
+
+TEST(TimeOfImpact, TranslatingBoxesMeetAtTheClosedFormTime) {
+  // B, a cube of half side 1, from x = 5 to x = -5 through A (the same cube
+  // at the origin): the faces meet when B's centre is at x = 2, t* = 0.3.
+  const ConvexPolytope cube(box(Vec3(1, 1, 1)));
+  const Motion ma = Motion::fixed(Pose::identity());
+  const Motion mb{Pose::from_translation(Vec3(5, 0.3, -0.2)),
+                  Pose::from_translation(Vec3(-5, 0.3, -0.2))};
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult r = time_of_impact(cube, ma, cube, mb, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  EXPECT_LE(r.t, 0.3);
+  EXPECT_GE(r.t, 0.3 - 1e-9 / 10 - 1e-14);
+  EXPECT_LE(r.at_t.distance, 1e-9);
+  EXPECT_NEAR(r.at_t.normal.x(), 1.0, 1e-12);  // from A towards B
+  EXPECT_LE(r.iterations, 3);                  // along the normal, one step lands there
+
+  // With a contact offset of 0.5: t* = (3 - 2.5) / 10 = 0.25.
+  options.target_separation = 0.5;
+  const ImpactResult o = time_of_impact(cube, ma, cube, mb, options);
+  ASSERT_EQ(o.status, ImpactStatus::contact);
+  EXPECT_LE(o.t, 0.25);
+  EXPECT_GE(o.t, 0.25 - 1e-10 - 1e-14);
+  EXPECT_NEAR(o.at_t.distance, 0.5, 1e-9);
+}
+
+// Tunnelling: a plate 1e-3 thick and a small cube that crosses it in one
+// step (from 10 on one side to 10 on the other); sampling the two ends only
+// (what a discrete step does) sees no contact.
+TEST(TimeOfImpact, AFastBodyDoesNotTunnelThroughAThinPlate) {
+  const ConvexPolytope plate(box(Vec3(5e-4, 3, 3)));
+  const ConvexPolytope bullet(box(Vec3(0.01, 0.01, 0.01)));
+  const Motion ma = Motion::fixed(Pose::identity());
+  const Motion mb{Pose::from_translation(Vec3(-10, 0.5, 0.5)),
+                  Pose::from_translation(Vec3(10, 0.5, 0.5))};
+  EXPECT_GT(distance_at(plate, ma, bullet, mb, 0.0), 9.0);
+  EXPECT_GT(distance_at(plate, ma, bullet, mb, 1.0), 9.0);
+  ImpactOptions options;
+  options.tolerance = 1e-10;
+  const ImpactResult r = time_of_impact(plate, ma, bullet, mb, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  const double t_star = (10.0 - 5e-4 - 0.01) / 20.0;
+  EXPECT_LE(r.t, t_star);
+  EXPECT_GE(r.t, t_star - 1e-11 - 1e-14);
+}
+
+TEST(TimeOfImpact, BodiesMovingApartAreSeparatedThroughout) {
+  const ConvexPolytope a(sphere_points(30, 1, 1.0));
+  const ConvexPolytope b(sphere_points(30, 2, 1.0));
+  const Motion ma = Motion::fixed(Pose::identity());
+  const Motion mb{Pose::from_translation(Vec3(3, 0, 0)), Pose::from_translation(Vec3(8, 1, 0))};
+  const ImpactResult r = time_of_impact(a, ma, b, mb);
+  EXPECT_EQ(r.status, ImpactStatus::separated);
+  EXPECT_EQ(r.t, 1.0);
+  EXPECT_LE(r.iterations, 2);
+  EXPECT_GT(r.at_t.distance, 5.0);
+}
+
+TEST(TimeOfImpact, OverlappingAtTheStartSaysSo) {
+  const ConvexPolytope cube(box(Vec3(1, 1, 1)));
+  const Motion ma = Motion::fixed(Pose::identity());
+  const Motion mb{Pose::from_translation(Vec3(1.5, 0, 0)), Pose::from_translation(Vec3(9, 0, 0))};
+  const ImpactResult r = time_of_impact(cube, ma, cube, mb);
+  EXPECT_EQ(r.status, ImpactStatus::overlapping);
+  EXPECT_EQ(r.t, 0.0);
+  EXPECT_EQ(r.at_t.status, Status::intersecting);
+}
+
+// A bar spinning a quarter turn about its centre sweeps into a cube beside
+// it: the distance is not monotone in t, the sampling referees.
+TEST(TimeOfImpact, ASpinningBarIsCaughtWhereItFirstReachesTheCube) {
+  const ConvexPolytope bar(box(Vec3(2, 0.05, 0.05)));
+  const ConvexPolytope cube(box(Vec3(0.5, 0.5, 0.5)));
+  const Motion mb = Motion::from_velocity(Pose::identity(), Vec3::Zero(), Vec3(0, 0, M_PI / 2));
+  const Motion mcube = Motion::fixed(Pose::from_translation(Vec3(1.2, 1.5, 0)));
+  ImpactOptions options;
+  options.tolerance = 1e-8;
+  const ImpactResult r = time_of_impact(cube, mcube, bar, mb, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  check_against_sampling(cube, mcube, bar, mb, options, r, 4000);
+}
+
+// Seeded random pairs and motions (translation up to 8, rotation up to a
+// half turn each, contact offsets 0 .. 0.2): the guarantee against 1,000
+// samples of each motion.
+TEST(TimeOfImpact, RandomMotionsNeverReportContactLate) {
+  std::mt19937 rng(2026);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int contacts = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const ConvexPolytope a(sphere_points(12 + trial % 20, 100 + trial, 0.5 + u(rng)));
+    const ConvexPolytope b(sphere_points(6 + trial % 30, 200 + trial, 0.2 + u(rng)));
+    const auto random_pose = [&](double spread) {
+      return Pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(),
+                  Vec3(spread * g(rng), spread * g(rng), spread * g(rng)));
+    };
+    const Pose a0 = random_pose(1.0);
+    const Motion ma = Motion::from_velocity(a0, Vec3(g(rng), g(rng), g(rng)),
+                                            M_PI / 2 * Vec3(g(rng), g(rng), g(rng)).normalized());
+    const Pose b0 = random_pose(4.0);
+    const Motion mb{b0, Pose(b0.rotation * Eigen::AngleAxisd(3.0 * u(rng), Vec3::UnitX()),
+                             Vec3(-b0.translation + 0.5 * Vec3(g(rng), g(rng), g(rng))))};
+    ImpactOptions options;
+    options.target_separation = trial % 3 == 0 ? 0.2 * u(rng) : 0.0;
+    options.tolerance = 1e-7;
+    const ImpactResult r = time_of_impact(a, ma, b, mb, options);
+    if (r.status == ImpactStatus::overlapping) continue;
+    ASSERT_NE(r.status, ImpactStatus::iteration_cap) << "trial " << trial;
+    contacts += r.status == ImpactStatus::contact ? 1 : 0;
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    check_against_sampling(a, ma, b, mb, options, r, 1000);
+  }
+  EXPECT_GT(contacts, 20);  // the motions cross: most trials meet
+}
+
+TEST(TimeOfImpact, TheCacheTracksAlongTheSteps) {
+  const ConvexPolytope a(sphere_points(200, 3, 1.0));
+  const ConvexPolytope b(sphere_points(200, 4, 1.0));
+  const Motion ma = Motion::fixed(Pose::identity());
+  const Motion mb = Motion::from_velocity(Pose::from_translation(Vec3(6, 0.4, 0)), Vec3(-8, 0, 0),
+                                          Vec3(0, 0.5, 2.0));
+  DistanceCache cache;
+  const ImpactResult tracked = time_of_impact(a, ma, b, mb, {}, &cache);
+  const ImpactResult cold = time_of_impact(a, ma, b, mb);
+  EXPECT_EQ(tracked.status, ImpactStatus::contact);
+  EXPECT_EQ(tracked.iterations, cold.iterations);
+  EXPECT_NEAR(tracked.t, cold.t, 1e-12);
+  EXPECT_FALSE(cache.is_cold());
+}
+
+TEST(TimeOfImpact, MotionFromVelocityMatchesItsEndPoses) {
+  const Pose p(Quat(0.3, 0.1, -0.5, 0.8).normalized(), Vec3(1, 2, 3));
+  const Motion m = Motion::from_velocity(p, Vec3(2, 0, -1), Vec3(0, 0, 1.0), 0.5);
+  EXPECT_TRUE(m.end.translation.isApprox(Vec3(2, 2, 2.5), 1e-15));
+  EXPECT_NEAR(m.angular_velocity().z(), 0.5, 1e-12);
+  const Pose half = m.at(0.5);
+  EXPECT_TRUE(half.translation.isApprox(Vec3(1.5, 2, 2.75), 1e-15));
+  const Mat3 expected = Eigen::AngleAxisd(0.25, Vec3::UnitZ()).toRotationMatrix() * p.rotation;
+  EXPECT_TRUE(half.rotation.isApprox(expected, 1e-14));
+  EXPECT_TRUE(m.at(0.0).rotation == p.rotation);
+}
+
+TEST(TimeOfImpact, BadInputIsRefusedByName) {
+  const ConvexPolytope cube(box(Vec3(1, 1, 1)));
+  const Motion still = Motion::fixed(Pose::from_translation(Vec3(5, 0, 0)));
+  const Motion origin = Motion::fixed(Pose::identity());
+  const auto message = [&](const ImpactOptions& o, const Motion& mb) {
+    try {
+      time_of_impact(cube, origin, cube, mb, o);
+    } catch (const InvalidInput& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  ImpactOptions o;
+  o.target_separation = -1.0;
+  EXPECT_NE(message(o, still).find("target_separation"), std::string::npos);
+  o = {};
+  o.tolerance = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(message(o, still).find("tolerance"), std::string::npos);
+  o = {};
+  o.max_iterations = 0;
+  EXPECT_NE(message(o, still).find("max_iterations"), std::string::npos);
+  Motion bad = still;
+  bad.end.translation.x() = std::numeric_limits<double>::infinity();
+  EXPECT_NE(message({}, bad).find("motion_b.end"), std::string::npos);
+  EXPECT_THROW(Motion::from_velocity(Pose::identity(), Vec3::Zero(), Vec3::Zero(), 0.0),
+               InvalidInput);
+}
+
+}  // namespace
+}  // namespace proxima
