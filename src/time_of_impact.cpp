@@ -35,6 +35,34 @@ double support_gap(const ConvexPolytope& a, const Pose& pose_a, const ConvexPoly
   return n.dot(pose_b.apply(b.vertex(ib))) - n.dot(pose_a.apply(a.vertex(ia)));
 }
 
+// A motion with its turn precomputed (Motion::at converts the rotation to
+// an angle and an axis on every call; a time of impact takes poses at a
+// dozen times).
+class Sweep {
+ public:
+  explicit Sweep(const Motion& m) : motion_(m) {
+    const Eigen::AngleAxisd turn(Mat3(m.end.rotation * m.start.rotation.transpose()));
+    angle_ = turn.angle();
+    axis_ = turn.axis();
+  }
+  Pose at(double t) const {
+    if (t <= 0.0) return motion_.start;
+    if (t >= 1.0) return motion_.end;
+    Pose p;
+    p.rotation = Eigen::AngleAxisd(t * angle_, axis_).toRotationMatrix() * motion_.start.rotation;
+    p.translation =
+        motion_.start.translation + t * (motion_.end.translation - motion_.start.translation);
+    return p;
+  }
+  Vec3 angular_velocity() const { return angle_ * axis_; }
+  Vec3 linear_velocity() const { return motion_.linear_velocity(); }
+
+ private:
+  Motion motion_;
+  double angle_ = 0.0;
+  Vec3 axis_ = Vec3::UnitX();
+};
+
 }  // namespace
 
 Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& angular,
@@ -58,16 +86,7 @@ Vec3 Motion::angular_velocity() const {
   return turn.angle() * turn.axis();
 }
 
-Pose Motion::at(double t) const {
-  t = std::clamp(t, 0.0, 1.0);
-  if (t == 0.0) return start;
-  if (t == 1.0) return end;
-  const Eigen::AngleAxisd turn(Mat3(end.rotation * start.rotation.transpose()));
-  Pose p;
-  p.rotation = Eigen::AngleAxisd(t * turn.angle(), turn.axis()).toRotationMatrix() * start.rotation;
-  p.translation = start.translation + t * (end.translation - start.translation);
-  return p;
-}
+Pose Motion::at(double t) const { return Sweep(*this).at(t); }
 
 ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
@@ -85,15 +104,19 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   }
   // The ends of both motions under the pose contract (re-orthonormalized
   // where the contract allows it).
-  const Motion ma{checked_pose(motion_a.start, "time_of_impact: motion_a.start"),
-                  checked_pose(motion_a.end, "time_of_impact: motion_a.end")};
-  const Motion mb{checked_pose(motion_b.start, "time_of_impact: motion_b.start"),
-                  checked_pose(motion_b.end, "time_of_impact: motion_b.end")};
+  const Sweep ma(Motion{checked_pose(motion_a.start, "time_of_impact: motion_a.start"),
+                        checked_pose(motion_a.end, "time_of_impact: motion_a.end")});
+  const Sweep mb(Motion{checked_pose(motion_b.start, "time_of_impact: motion_b.start"),
+                        checked_pose(motion_b.end, "time_of_impact: motion_b.end")});
 
   const Vec3 va = ma.linear_velocity();
   const Vec3 vb = mb.linear_velocity();
-  const double turn_a = ma.angular_velocity().norm() * reach(a);
-  const double turn_b = mb.angular_velocity().norm() * reach(b);
+  const Vec3 wa = ma.angular_velocity();
+  const Vec3 wb = mb.angular_velocity();
+  const double reach_a = reach(a);
+  const double reach_b = reach(b);
+  const double turn_a = wa.norm() * reach_a;
+  const double turn_b = wb.norm() * reach_b;
   // The fastest any point of B moves relative to any point of A: the
   // distance changes no faster (it is 1-Lipschitz in the bodies' motion).
   const double any_speed = (vb - va).norm() + turn_a + turn_b;
@@ -135,7 +158,11 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     // lower bound closes no faster than any_speed.
     const Vec3& n = r.normal;
     const double gap = support_gap(a, pa, b, pb, n, c) - band;
-    const double mu_n = (va - vb).dot(n) + turn_a + turn_b;
+    // A point r from a reference point moves along n at (w x r).n =
+    // (r x n).w, at most |w x n| |r|: a spin about the normal does not
+    // approach.
+    const double mu_n =
+        (va - vb).dot(n) + wa.cross(n).norm() * reach_a + wb.cross(n).norm() * reach_b;
     double step = 0.0;
     bool never = false;  // no approach: the target is never reached
     if (gap > target) {
