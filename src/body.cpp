@@ -33,7 +33,6 @@ double checked_length(double value, const char* what) {
 }
 
 std::shared_ptr<const CompoundBody> one_piece(const std::shared_ptr<const ConvexPolytope>& core) {
-  if (!core) throw InvalidInput("Body: null convex core");
   return std::make_shared<const CompoundBody>(std::vector<CompoundPiece>{{core, Pose::identity()}});
 }
 
@@ -286,8 +285,10 @@ class DeepestPair {
 
 BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                            const DistanceOptions& options, BodyCache& cache) {
-  const CompoundBody& ca = *a.compound();
-  const CompoundBody& cb = *b.compound();
+  const std::shared_ptr<const CompoundBody> hold_a = a.compound();
+  const std::shared_ptr<const CompoundBody> hold_b = b.compound();
+  const CompoundBody& ca = *hold_a;
+  const CompoundBody& cb = *hold_b;
   const CompoundResult cr = distance(ca, pose_a, cb, pose_b, options, &cache.compound);
   CoreAnswer c = from_distance(cr);
   c.piece_a = cr.piece_a;
@@ -319,9 +320,10 @@ BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, con
 
 Body::Body(std::shared_ptr<const ConvexPolytope> core, double radius, double approximation_error)
     : convex_(std::move(core)),
+      wrapper_(std::make_shared<Wrapper>()),
       radius_(checked_length(radius, "radius")),
       approximation_error_(checked_length(approximation_error, "approximation_error")) {
-  compound_ = one_piece(convex_);
+  if (!convex_) throw InvalidInput("Body: null convex core");
 }
 
 Body::Body(std::shared_ptr<const CompoundBody> core, double radius, double approximation_error)
@@ -341,6 +343,12 @@ Body Body::with_radius(double radius) const {
   Body copy = *this;
   copy.radius_ = checked_length(radius, "radius");
   return copy;
+}
+
+std::shared_ptr<const CompoundBody> Body::compound() const {
+  if (compound_) return compound_;
+  std::call_once(wrapper_->once, [this] { wrapper_->compound = one_piece(convex_); });
+  return wrapper_->compound;
 }
 
 double Body::scale() const { return (convex_ ? convex_->scale() : compound_->scale()) + radius_; }

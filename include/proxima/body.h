@@ -30,6 +30,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <mutex>
 
 #include "proxima/compound.h"
 #include "proxima/penetration.h"
@@ -58,9 +59,10 @@ class Body {
   Kind kind() const { return convex_ ? Kind::convex : Kind::compound; }
   // The convex core, or null for a compound.
   const std::shared_ptr<const ConvexPolytope>& convex() const { return convex_; }
-  // The compound core; for a convex body, the core as a one-piece compound
-  // (built once, shared by copies), so that it can meet a compound.
-  const std::shared_ptr<const CompoundBody>& compound() const { return compound_; }
+  // The compound core; for a convex body, the core as a one-piece compound,
+  // so that it can meet a compound: built on the first call (thread-safe)
+  // and shared by every copy of the body, O(N) once.
+  std::shared_ptr<const CompoundBody> compound() const;
 
   double radius() const { return radius_; }
   // The same core with another radius (padding: radius() + padding).
@@ -77,8 +79,15 @@ class Body {
   double scale() const;
 
  private:
+  // A convex core's one-piece compound, built once on demand.
+  struct Wrapper {
+    std::once_flag once;
+    std::shared_ptr<const CompoundBody> compound;
+  };
+
   std::shared_ptr<const ConvexPolytope> convex_;
-  std::shared_ptr<const CompoundBody> compound_;
+  std::shared_ptr<const CompoundBody> compound_;  // null for a convex core
+  std::shared_ptr<Wrapper> wrapper_;              // null for a compound core
   double radius_ = 0.0;
   double approximation_error_ = 0.0;
 };
