@@ -341,6 +341,55 @@ TEST(BodyCompound, OverlappingCompoundReportsItsDeepestPiecePair) {
   expect_consistent(r, 2.0);
 }
 
+TEST(BodyCompound, DeepestPairIsTheAllPairsTwins) {
+  // Overlapping compounds of a few random pieces: the signed distance is the
+  // smallest over every piece pair of the pair's own (minus its brute-force
+  // penetration depth where the pieces overlap, else its distance), minus
+  // the radii. Checks that the hierarchy walk misses no overlapping pair.
+  Rng rng(22);
+  int overlapping = 0;
+  for (int i = 0; i < count(60); ++i) {
+    const auto random_compound = [&](int pieces) {
+      std::vector<CompoundPiece> list;
+      for (int p = 0; p < pieces; ++p) {
+        list.push_back({hull(test::points_on_sphere(rng, test::uniform_int(rng, 4, 12),
+                                                    test::uniform(rng, 0.3, 1.0))),
+                        Pose(test::random_quaternion(rng),
+                             2.0 * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
+                                        test::uniform(rng, -1, 1)))});
+      }
+      return std::make_shared<const CompoundBody>(std::move(list));
+    };
+    const auto ca = random_compound(test::uniform_int(rng, 1, 8));
+    const auto cb = random_compound(test::uniform_int(rng, 1, 8));
+    const double ra = test::uniform(rng, 0, 0.2), rb = test::uniform(rng, 0, 0.2);
+    const Pose pa(test::random_quaternion(rng), Vec3::Zero());
+    const Pose pb(test::random_quaternion(rng),
+                  test::uniform(rng, 0, 2) * test::random_unit_vector(rng));
+    const BodyDistance r = distance(Body(ca, ra), pa, Body(cb, rb), pb);
+    double twin = std::numeric_limits<double>::infinity();
+    for (int x = 0; x < ca->piece_count(); ++x) {
+      for (int y = 0; y < cb->piece_count(); ++y) {
+        const Pose place_a = pa * ca->piece(x).pose;
+        const Pose place_b = pb * cb->piece(y).pose;
+        const DistanceResult d =
+            distance(*ca->piece(x).polytope, place_a, *cb->piece(y).polytope, place_b);
+        double value = d.distance;
+        if (d.status == Status::intersecting) {
+          value = -penetration_depth_brute_force(*ca->piece(x).polytope, *cb->piece(y).polytope,
+                                                 place_a.inverse() * place_b)
+                       .depth;
+        }
+        twin = std::min(twin, value);
+      }
+    }
+    EXPECT_NEAR(r.signed_distance, twin - ra - rb, 1e-12) << i;
+    expect_consistent(r, 6.0);
+    if (r.cores_overlap) ++overlapping;
+  }
+  EXPECT_GT(overlapping, count(60) / 4);
+}
+
 TEST(BodyCompound, MixedKindsAgreeWithTheirOnePieceCompounds) {
   Rng rng(18);
   for (int i = 0; i < count(100); ++i) {
