@@ -75,11 +75,21 @@ PolygonApproximation polygon_sides(double radius, double tolerance) {
     throw InvalidInput(message);
   }
   if (radius == 0.0) return approximation(0.0, 3);
+  // The corners reach at most twice the radius (a triangle's): refused
+  // where that overflows, before an infinite corner times sin(0) is NaN.
+  if (!is_finite_bits(approximation(radius, 3).circumradius)) {
+    char message[160];
+    std::snprintf(message, sizeof message,
+                  "polygon_sides: radius %g is too large: the polygon's corners overflow", radius);
+    throw InvalidInput(message);
+  }
   // r (1 / cos(pi / n) - 1) <= tol  <=>  cos(pi / n) >= r / (r + tol): the
   // closed form, then up by one side while the rounded deviation is above.
   const double ratio = radius / (radius + tolerance);
-  const double first = std::ceil(std::numbers::pi / std::acos(std::min(ratio, 1.0)));
-  if (!(first <= kMaxPolygonSides)) {
+  // The angle is 0 when the tolerance is below the radius's last digit (no
+  // division by it: that many sides are refused below anyway).
+  const double angle = std::acos(std::min(ratio, 1.0));
+  if (!(angle * kMaxPolygonSides >= std::numbers::pi)) {
     char message[240];
     std::snprintf(message, sizeof message,
                   "polygon_sides: tolerance %g for radius %g needs more than %d sides; the "
@@ -88,6 +98,7 @@ PolygonApproximation polygon_sides(double radius, double tolerance) {
                   approximation(radius, kMaxPolygonSides).deviation);
     throw InvalidInput(message);
   }
+  const double first = std::ceil(std::numbers::pi / angle);
   int sides = std::max(3, static_cast<int>(first));
   // The closed form may land one side below or above (rounding of acos):
   // settle on the smallest n that meets the tolerance.

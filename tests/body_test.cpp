@@ -561,6 +561,13 @@ TEST(BodyRefusals, BadRadiiAndTolerancesAreNamed) {
                  "make_cylinder: tolerance must be finite and > 0, got 0");
   expect_refusal([&] { return make_cone(1.0, 1.0, 1e-12); }, "make_cone: tolerance 1e-12");
   expect_refusal([&] { return make_cone(1.0, inf, 1e-3); }, "make_cone: half_length must be");
+  // A tolerance below the radius's last digit (r + tol == r, so acos(1) = 0
+  // sides' angle) divided by zero, and a radius near the largest double
+  // overflowed the corners to infinity and then to NaN (inf * sin(0)): both
+  // trapped (SIGFPE) in the test main instead of being refused.
+  expect_refusal([&] { return make_cylinder(1.0, 1.0, 1e-17); }, "make_cylinder: tolerance 1e-17");
+  expect_refusal([&] { return make_cylinder(1e308, 1.0, 1e307); },
+                 "make_cylinder: radius 1e+308 is too large");
 }
 
 TEST(BodyRefusals, BadPosesAreNamed) {
