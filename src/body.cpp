@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -19,6 +20,11 @@
 
 namespace proxima {
 namespace {
+
+// The largest coordinate magnitude of a rounded body (core plus radius)
+// accepted: the cores' query's own limit (distance.cpp), so that no sum of
+// radii, signed distance or offset point can overflow.
+constexpr double kMaxMagnitude = 0x1p1018;
 
 // A radius or an approximation error: finite and >= 0, else refused by
 // name. Finiteness on the bits first: no comparison with a NaN, which
@@ -359,6 +365,20 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
   BodyCache& c = cache != nullptr ? *cache : cold;
   const Pose pa = checked_pose(pose_a, "distance: pose_a");
   const Pose pb = checked_pose(pose_b, "distance: pose_b");
+  // The cores' query refuses coordinates beyond kMaxMagnitude; radii that
+  // take the rounded bodies there are refused too (their sum, the signed
+  // distance or the offset points could overflow to infinity).
+  for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
+    const double reach = magnitude_bound(*pose, body->scale());
+    if (!(reach <= kMaxMagnitude)) {
+      char message[200];
+      std::snprintf(message, sizeof message,
+                    "distance: body %s with radius %g reaches coordinates of magnitude %g, beyond "
+                    "the supported %g",
+                    name, body->radius(), reach, kMaxMagnitude);
+      throw InvalidInput(message);
+    }
+  }
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
     return convex_pair(a, pa, b, pb, options, c);
   }

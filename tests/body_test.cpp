@@ -576,6 +576,11 @@ TEST(BodyRefusals, BadPosesAreNamed) {
   bad.translation.x() = std::numeric_limits<double>::quiet_NaN();
   expect_refusal([&] { return distance(s, bad, s, Pose::identity()); }, "distance: pose_a");
   expect_refusal([&] { return distance(s, Pose::identity(), s, bad); }, "distance: pose_b");
+  // Radii near the largest double: their sum was infinite, and so was the
+  // signed distance (-inf), not refused.
+  const Body huge = make_sphere(1e308);
+  expect_refusal([&] { return distance(huge, Pose::identity(), huge, Pose::identity()); },
+                 "distance: body a with radius 1e+308 reaches coordinates of magnitude");
 }
 
 }  // namespace
