@@ -9,7 +9,8 @@
 // message that names where the problem is (`b.vertices[3][1]`), build both
 // hulls, run one cold distance query, print one answer line. Nothing but
 // buffers survives from one line to the next, so a bad line can never change
-// the answer to a good one.
+// the answer to a good one. A body with a "radius" is a rounded body
+// (proxima/body.h).
 #include "query.h"
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include <cstddef>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -28,6 +30,7 @@
 
 #include "answer_writer.h"
 #include "json_errors.h"
+#include "proxima/body.h"
 #include "proxima/distance.h"
 #include "proxima/polytope.h"
 
@@ -60,10 +63,10 @@ void read_numbers(const Json& v, const std::string& path, std::size_t n, const c
   }
 }
 
-// Reads body `name` ("a" or "b") of `query` into vertices and pose, its
-// rotation's four numbers in `order`.
+// Reads body `name` ("a" or "b") of `query` into vertices, pose and radius,
+// its rotation's four numbers in `order`.
 void read_body(const Json& query, const std::string& name, QuaternionOrder order,
-               std::vector<Vec3>& vertices, Pose& pose) {
+               std::vector<Vec3>& vertices, Pose& pose, double& radius) {
   const auto body = query.find(name);
   if (body == query.end()) fail("missing \"" + name + "\"");
   if (!body->is_object()) fail(name + " is not an object (it is " + kind(*body) + ")");
@@ -118,6 +121,14 @@ void read_body(const Json& query, const std::string& name, QuaternionOrder order
     read_numbers(*t, name + ".translation", 3, "3 numbers [x, y, z]", translation.data());
   }
   pose = Pose(rotation, translation);
+
+  // The body's radius (proxima/body.h): absent or null, 0.
+  radius = 0.0;
+  const auto r = body->find("radius");
+  if (r != body->end() && !r->is_null()) {
+    radius = read_finite(*r, name + ".radius");
+    if (radius < 0.0) fail(name + ".radius is negative: a radius must be >= 0");
+  }
 }
 
 // Largest absolute world coordinate of a hull: the R of DESIGN.md's
@@ -175,15 +186,25 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   try {
     Pose pose_a;
     Pose pose_b;
-    read_body(query, "a", order, work.vertices_a, pose_a);
-    read_body(query, "b", order, work.vertices_b, pose_b);
-    const ConvexPolytope a = build_hull(work.vertices_a, "a");
-    const ConvexPolytope b = build_hull(work.vertices_b, "b");
-    r = distance(a, pose_a, b, pose_b, options, nullptr);
+    double radius_a = 0.0;
+    double radius_b = 0.0;
+    read_body(query, "a", order, work.vertices_a, pose_a, radius_a);
+    read_body(query, "b", order, work.vertices_b, pose_b, radius_b);
+    const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
+    const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
+    if (radius_a > 0.0 || radius_b > 0.0) {
+      // Rounded bodies: the cores' answer offset by the radii, points on
+      // the rounded surfaces.
+      r = distance(Body(a, radius_a), pose_a, Body(b, radius_b), pose_b, options, nullptr);
+    } else {
+      r = distance(*a, pose_a, *b, pose_b, options, nullptr);
+    }
     capped = r.status == Status::iteration_cap;
     if (capped) {
-      // The same band the library uses for touching: 64 u R plus Ae.
-      const double scale = std::max(world_scale(a, pose_a), world_scale(b, pose_b));
+      // The same band the library uses for touching: 64 u R plus Ae, R of
+      // the rounded bodies.
+      const double scale =
+          std::max(world_scale(*a, pose_a) + radius_a, world_scale(*b, pose_b) + radius_b);
       contact_band = proxima::contact_band(scale, options.absolute_tolerance);
     }
   } catch (const QueryError& e) {

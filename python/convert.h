@@ -520,5 +520,7 @@ using PyDistanceCache = Guarded<DistanceCache>;
 // and PairBatch (pair_batch.cpp).
 void bind_compound_and_scene(py::module_& m);
 void bind_pair_batch(py::module_& m);
+// Body, the primitives and distance for any two bodies (body.cpp).
+void bind_bodies(py::module_& m);
 
 }  // namespace proxima::python

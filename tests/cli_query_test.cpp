@@ -790,6 +790,39 @@ TEST(CliDemo, RunsAndShowsEveryAlgorithm) {
   EXPECT_EQ(run_cli("demo").out, run.out);
 }
 
+TEST(CliQuery, RadiusMakesRoundedBodies) {
+  REQUIRE_CLI();
+  // Two points 5 apart with radii 1 and 1.5 (spheres): 2.5 apart, points on
+  // the spheres; with radii 3 and 3 they overlap (distance 0, intersecting);
+  // a radius of 0 or null is the plain hull. Bad radii are named.
+  const std::string text =
+      R"({"id": "spheres", "a": {"vertices": [[0,0,0]], "radius": 1}, "b": {"vertices": [[3,4,0]], "radius": 1.5}})"
+      "\n"
+      R"({"id": "overlap", "a": {"vertices": [[0,0,0]], "radius": 3}, "b": {"vertices": [[3,4,0]], "radius": 3}})"
+      "\n"
+      R"({"id": "plain", "a": {"vertices": [[0,0,0]], "radius": 0}, "b": {"vertices": [[3,4,0]], "radius": null}})"
+      "\n"
+      R"({"a": {"vertices": [[0,0,0]], "radius": -1}, "b": {"vertices": [[1,0,0]]}})"
+      "\n"
+      R"({"a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[1,0,0]], "radius": "big"}})"
+      "\n";
+  const TempFile file(text);
+  const CliRun run = run_cli("query " + shell_quote(file.path()));
+  ASSERT_EQ(run.exit_code, 0);
+  const std::vector<Json> answers = parse_answers(run.out);
+  ASSERT_EQ(answers.size(), 5U) << run.out;
+  EXPECT_EQ(answers[0].at("status"), "separated");
+  EXPECT_NEAR(check_answer_fields(answers[0]), 2.5, accuracy_bound(2.5, 5.5));
+  EXPECT_LE((point_of(answers[0], "point_a") - Vec3(0.6, 0.8, 0)).norm(), 1e-15);
+  EXPECT_LE((point_of(answers[0], "point_b") - Vec3(2.1, 2.8, 0)).norm(), 1e-15);
+  EXPECT_EQ(answers[1].at("status"), "intersecting");
+  EXPECT_EQ(answers[1].at("distance"), 0.0);
+  EXPECT_EQ(answers[2].at("status"), "separated");
+  EXPECT_NEAR(check_answer_fields(answers[2]), 5.0, accuracy_bound(5.0, 4.0));
+  EXPECT_EQ(answers[3].at("error"), "line 4: a.radius is negative: a radius must be >= 0");
+  EXPECT_EQ(answers[4].at("error"), "line 5: b.radius is not a number (it is a string)");
+}
+
 }  // namespace
 
 // Issue 11, rotations that cannot be misread: ROS's identity quaternion

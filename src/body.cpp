@@ -1,0 +1,388 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Bodies of any kind (a convex or compound core plus a radius) and the one
+// distance call between two of them: the cores' query (convex or compound),
+// their penetration depth where they overlap, and the offset by the radii
+// along the normal (proxima/body.h says why that is exact).
+#include "proxima/body.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "proxima/distance.h"
+
+namespace proxima {
+namespace {
+
+// The largest coordinate magnitude of a rounded body (core plus radius)
+// accepted: the cores' query's own limit (distance.cpp), so that no sum of
+// radii, signed distance or offset point can overflow.
+constexpr double kMaxMagnitude = 0x1p1018;
+
+// A radius or an approximation error: finite and >= 0, else refused by
+// name. Finiteness on the bits first: no comparison with a NaN, which
+// would raise FE_INVALID under a caller's traps.
+double checked_length(double value, const char* what) {
+  if (!is_finite_bits(value) || value < 0.0) {
+    char message[160];
+    std::snprintf(message, sizeof message, "Body: %s must be finite and >= 0, got %g", what, value);
+    throw InvalidInput(message);
+  }
+  return value;
+}
+
+std::shared_ptr<const CompoundBody> one_piece(const std::shared_ptr<const ConvexPolytope>& core) {
+  return std::make_shared<const CompoundBody>(std::vector<CompoundPiece>{{core, Pose::identity()}});
+}
+
+// The cores' answer in the world frame as a signed value with its bounds:
+// the distance of the cores (>= 0), or minus their penetration depth when
+// they overlap.
+struct CoreAnswer {
+  Status status = Status::separated;
+  double value = 0.0;
+  double lower = 0.0;
+  double upper = 0.0;
+  Vec3 point_a = Vec3::Zero();
+  Vec3 point_b = Vec3::Zero();
+  Vec3 normal = Vec3::UnitX();
+  Feature feature_a;
+  Feature feature_b;
+  int iterations = 0;
+  bool second_algorithm = false;
+  bool overlap = false;
+  std::int32_t piece_a = -1;
+  std::int32_t piece_b = -1;
+};
+
+CoreAnswer from_distance(const DistanceResult& r) {
+  CoreAnswer c;
+  c.status = r.status;
+  c.value = r.distance;
+  c.lower = r.lower_bound;
+  c.upper = r.distance;
+  c.point_a = r.point_a;
+  c.point_b = r.point_b;
+  c.normal = r.normal;
+  c.feature_a = r.feature_a;
+  c.feature_b = r.feature_b;
+  c.iterations = r.iterations;
+  c.second_algorithm = r.second_algorithm;
+  return c;
+}
+
+// Whether the cores' answer needs their penetration query: when they
+// overlap (its depth is the signed value), and, for rounded bodies, when
+// they touch without a certified gap: the normal of a distance answer is
+// trusted only when the support gap along it, the lower bound, is above 0
+// (the cores are then apart along it, and the offset points are the rounded
+// bodies' closest points); below that it is a direction of a few roundings.
+bool needs_depth(const CoreAnswer& c, double radii) {
+  if (c.status == Status::intersecting) return true;
+  return c.status == Status::touching && radii > 0.0 && !(c.lower > 0.0);
+}
+
+// Replaces the answer's value, bounds, points, normal and features by the
+// penetration query's (in the frame `frame_a`), unless it found the cores
+// apart (a disagreement of the two queries at the band's edge): then the
+// distance query's answer stands, with a depth of 0 if it called them
+// intersecting.
+void take_depth(CoreAnswer& c, const PenetrationResult& p, const Pose& frame_a) {
+  if (p.status == PenetrationStatus::separated) {
+    if (c.status == Status::intersecting) {
+      c.value = c.lower = c.upper = 0.0;
+      c.overlap = true;
+    }
+    return;
+  }
+  c.value = -p.depth;
+  c.lower = -p.upper_bound;
+  c.upper = -p.lower_bound;
+  c.point_a = frame_a.apply(p.point_a);
+  c.point_b = frame_a.apply(p.point_b);
+  c.normal = frame_a.rotation * p.normal;
+  c.feature_a = p.feature_a;
+  c.feature_b = p.feature_b;
+  c.overlap = c.status == Status::intersecting;
+}
+
+// B's pose in A's frame under the pose contract (the product of two rigid
+// poses is rigid to a few u; re-orthonormalized if not).
+Pose relative(const Pose& pose_a, const Pose& pose_b) {
+  return checked_pose(pose_a.inverse() * pose_b, "distance: relative pose");
+}
+
+// The largest coordinate magnitude of a polytope's vertices placed at `pose`
+// (the exact R of the accuracy standard). O(N).
+double placed_magnitude(const ConvexPolytope& p, const Pose& pose) {
+  double r = 0.0;
+  for (const Vec3& v : p.vertices()) r = std::max(r, pose.apply(v).cwiseAbs().maxCoeff());
+  return r;
+}
+
+// The pieces (or convex bodies) that gave the answer, placed: the accuracy
+// standard's R is theirs, as for the compound query.
+struct Placed {
+  const ConvexPolytope* polytope;
+  Pose pose;
+};
+
+// The status of the rounded bodies from their signed value s: the contact
+// band of the rounded pieces (core R plus radius; the largest coordinate of
+// a ball of radius r about x is |x|_inf + r). First from the O(1) bound on
+// R; a value inside that band is decided with the exact R (O(N), only near
+// contact).
+Status rounded_status(double s, const Placed& a, double ra, const Placed& b, double rb,
+                      const DistanceOptions& options) {
+  const double bound = std::max(magnitude_bound(a.pose, a.polytope->scale()) + ra,
+                                magnitude_bound(b.pose, b.polytope->scale()) + rb);
+  double band = contact_band(bound, options.absolute_tolerance);
+  if (std::abs(s) <= band) {
+    band = contact_band(std::max(placed_magnitude(*a.polytope, a.pose) + ra,
+                                 placed_magnitude(*b.polytope, b.pose) + rb),
+                        options.absolute_tolerance);
+  }
+  return s > band ? Status::separated : s >= -band ? Status::touching : Status::intersecting;
+}
+
+BodyDistance offset(const CoreAnswer& c, const Body& a, const Placed& pa, const Body& b,
+                    const Placed& pb, const DistanceOptions& options) {
+  const double ra = a.radius();
+  const double rb = b.radius();
+  const double radii = ra + rb;
+  BodyDistance r;
+  r.signed_distance = c.value - radii;
+  r.signed_lower_bound = c.lower - radii;
+  r.signed_upper_bound = c.upper - radii;
+  if (c.status == Status::iteration_cap || radii == 0.0) {
+    r.status = c.status;
+  } else {
+    r.status = rounded_status(r.signed_distance, pa, ra, pb, rb, options);
+  }
+  r.distance = std::max(r.signed_distance, 0.0);
+  r.lower_bound = std::max(r.signed_lower_bound, 0.0);
+  r.normal = c.normal;
+  r.point_a = c.point_a + ra * c.normal;
+  r.point_b = c.point_b - rb * c.normal;
+  r.feature_a = c.feature_a;
+  r.feature_b = c.feature_b;
+  r.iterations = c.iterations;
+  r.second_algorithm = c.second_algorithm;
+  r.piece_a = c.piece_a;
+  r.piece_b = c.piece_b;
+  r.cores_overlap = c.overlap;
+  r.approximation_error = a.approximation_error() + b.approximation_error();
+  return r;
+}
+
+BodyDistance convex_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                         const DistanceOptions& options, BodyCache& cache) {
+  const ConvexPolytope& ca = *a.convex();
+  const ConvexPolytope& cb = *b.convex();
+  CoreAnswer c = from_distance(
+      detail::distance_of_rigid_poses(ca, pose_a, cb, pose_b, options, &cache.convex));
+  if (needs_depth(c, a.radius() + b.radius())) {
+    take_depth(c, penetration_depth(ca, cb, relative(pose_a, pose_b), cache.penetration), pose_a);
+  }
+  return offset(c, a, {&ca, pose_a}, b, {&cb, pose_b}, options);
+}
+
+// The deepest overlapping piece pair of two compounds whose cores overlap:
+// every piece pair whose bounding spheres meet, by a traversal of both
+// hierarchies, gets a cold convex query and, if it overlaps, a cold
+// penetration query. The signed value is the smallest over pairs of the
+// pair's (minus the largest depth); its bounds are the smallest of the
+// pairs' bounds.
+class DeepestPair {
+ public:
+  DeepestPair(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
+              const DistanceOptions& options)
+      : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options) {}
+
+  // Updates `c` (the compound query's intersecting answer) to the deepest pair.
+  void run(CoreAnswer& c) {
+    std::vector<std::pair<std::int32_t, std::int32_t>> stack = {{0, 0}};
+    while (!stack.empty()) {
+      const auto [ia, ib] = stack.back();
+      stack.pop_back();
+      const CompoundBody::Node& na = a_.nodes()[static_cast<std::size_t>(ia)];
+      const CompoundBody::Node& nb = b_.nodes()[static_cast<std::size_t>(ib)];
+      if (!spheres_meet(na.center, na.radius, nb.center, nb.radius)) continue;
+      const bool leaf_a = na.left < 0;
+      const bool leaf_b = nb.left < 0;
+      if (leaf_a && leaf_b) {
+        for (std::int32_t i = 0; i < na.count; ++i) {
+          for (std::int32_t j = 0; j < nb.count; ++j) {
+            test(a_.piece_order()[static_cast<std::size_t>(na.first + i)],
+                 b_.piece_order()[static_cast<std::size_t>(nb.first + j)]);
+          }
+        }
+      } else if (!leaf_a && (leaf_b || na.radius >= nb.radius)) {
+        stack.push_back({na.left, ib});
+        stack.push_back({na.right, ib});
+      } else {
+        stack.push_back({ia, nb.left});
+        stack.push_back({ia, nb.right});
+      }
+    }
+    if (!found_) return;  // the compound query's pair stands (depth 0)
+    const int iterations = c.iterations;
+    const bool second = c.second_algorithm;
+    c = best_;
+    c.iterations = iterations;
+    c.second_algorithm = second;
+    c.lower = lower_;
+    c.upper = upper_;
+  }
+
+ private:
+  // Whether two spheres (body frames) may meet, with a slack for the
+  // rounding of the placed centers and of the norm: a pair tested more is
+  // only slower.
+  bool spheres_meet(const Vec3& center_a, double radius_a, const Vec3& center_b,
+                    double radius_b) const {
+    const Vec3 ca = pose_a_.apply(center_a);
+    const Vec3 cb = pose_b_.apply(center_b);
+    const double reach = radius_a + radius_b;
+    const double slack =
+        256.0 * kUnitRoundoff * (ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + reach);
+    return !((ca - cb).norm() > reach + slack);
+  }
+
+  void test(std::int32_t pa, std::int32_t pb) {
+    const CompoundPiece& piece_a = a_.piece(pa);
+    const CompoundPiece& piece_b = b_.piece(pb);
+    const Pose place_a = pose_a_ * piece_a.pose;
+    const Pose place_b = pose_b_ * piece_b.pose;
+    const DistanceResult r = detail::distance_of_rigid_poses(
+        *piece_a.polytope, place_a, *piece_b.polytope, place_b, options_, nullptr);
+    if (r.status != Status::intersecting) return;
+    CoreAnswer c = from_distance(r);
+    PenetrationCache cold;
+    take_depth(
+        c,
+        penetration_depth(*piece_a.polytope, *piece_b.polytope, relative(place_a, place_b), cold),
+        place_a);
+    c.piece_a = pa;
+    c.piece_b = pb;
+    if (!found_ || c.value < best_.value) best_ = c;
+    lower_ = found_ ? std::min(lower_, c.lower) : c.lower;
+    upper_ = found_ ? std::min(upper_, c.upper) : c.upper;
+    found_ = true;
+  }
+
+  const CompoundBody& a_;
+  const CompoundBody& b_;
+  const Pose& pose_a_;
+  const Pose& pose_b_;
+  const DistanceOptions& options_;
+  bool found_ = false;
+  CoreAnswer best_;
+  double lower_ = 0.0;
+  double upper_ = 0.0;
+};
+
+BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                           const DistanceOptions& options, BodyCache& cache) {
+  const std::shared_ptr<const CompoundBody> hold_a = a.compound();
+  const std::shared_ptr<const CompoundBody> hold_b = b.compound();
+  const CompoundBody& ca = *hold_a;
+  const CompoundBody& cb = *hold_b;
+  const CompoundResult cr = distance(ca, pose_a, cb, pose_b, options, &cache.compound);
+  CoreAnswer c = from_distance(cr);
+  c.piece_a = cr.piece_a;
+  c.piece_b = cr.piece_b;
+  if (c.status == Status::intersecting) {
+    c.overlap = true;
+    DeepestPair(ca, pose_a, cb, pose_b, options).run(c);
+  } else if (needs_depth(c, a.radius() + b.radius())) {
+    const CompoundPiece& piece_a = ca.piece(c.piece_a);
+    const CompoundPiece& piece_b = cb.piece(c.piece_b);
+    const Pose place_a = pose_a * piece_a.pose;
+    PenetrationCache cold;
+    take_depth(c,
+               penetration_depth(*piece_a.polytope, *piece_b.polytope,
+                                 relative(place_a, pose_b * piece_b.pose), cold),
+               place_a);
+  }
+  const CompoundPiece& piece_a = ca.piece(c.piece_a);
+  const CompoundPiece& piece_b = cb.piece(c.piece_b);
+  BodyDistance r = offset(c, a, {piece_a.polytope.get(), pose_a * piece_a.pose}, b,
+                          {piece_b.polytope.get(), pose_b * piece_b.pose}, options);
+  // A convex body met a compound as its one-piece wrapper: it has no pieces.
+  if (a.kind() == Body::Kind::convex) r.piece_a = -1;
+  if (b.kind() == Body::Kind::convex) r.piece_b = -1;
+  return r;
+}
+
+}  // namespace
+
+Body::Body(std::shared_ptr<const ConvexPolytope> core, double radius, double approximation_error)
+    : convex_(std::move(core)),
+      wrapper_(std::make_shared<Wrapper>()),
+      radius_(checked_length(radius, "radius")),
+      approximation_error_(checked_length(approximation_error, "approximation_error")) {
+  if (!convex_) throw InvalidInput("Body: null convex core");
+}
+
+Body::Body(std::shared_ptr<const CompoundBody> core, double radius, double approximation_error)
+    : compound_(std::move(core)),
+      radius_(checked_length(radius, "radius")),
+      approximation_error_(checked_length(approximation_error, "approximation_error")) {
+  if (!compound_) throw InvalidInput("Body: null compound core");
+}
+
+Body::Body(ConvexPolytope core, double radius)
+    : Body(std::make_shared<const ConvexPolytope>(std::move(core)), radius) {}
+
+Body::Body(CompoundBody core, double radius)
+    : Body(std::make_shared<const CompoundBody>(std::move(core)), radius) {}
+
+Body Body::with_radius(double radius) const {
+  Body copy = *this;
+  copy.radius_ = checked_length(radius, "radius");
+  return copy;
+}
+
+std::shared_ptr<const CompoundBody> Body::compound() const {
+  if (compound_) return compound_;
+  std::call_once(wrapper_->once, [this] { wrapper_->compound = one_piece(convex_); });
+  return wrapper_->compound;
+}
+
+double Body::scale() const { return (convex_ ? convex_->scale() : compound_->scale()) + radius_; }
+
+BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                      const DistanceOptions& options, BodyCache* cache) {
+  BodyCache cold;
+  BodyCache& c = cache != nullptr ? *cache : cold;
+  const Pose pa = checked_pose(pose_a, "distance: pose_a");
+  const Pose pb = checked_pose(pose_b, "distance: pose_b");
+  // The cores' query refuses coordinates beyond kMaxMagnitude; radii that
+  // take the rounded bodies there are refused too (their sum, the signed
+  // distance or the offset points could overflow to infinity).
+  for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
+    const double reach = magnitude_bound(*pose, body->scale());
+    if (!(reach <= kMaxMagnitude)) {
+      char message[200];
+      std::snprintf(message, sizeof message,
+                    "distance: body %s with radius %g reaches coordinates of magnitude %g, beyond "
+                    "the supported %g",
+                    name, body->radius(), reach, kMaxMagnitude);
+      throw InvalidInput(message);
+    }
+  }
+  if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
+    return convex_pair(a, pa, b, pb, options, c);
+  }
+  return compound_pair(a, pa, b, pb, options, c);
+}
+
+}  // namespace proxima
