@@ -522,5 +522,7 @@ void bind_compound_and_scene(py::module_& m);
 void bind_pair_batch(py::module_& m);
 // Body, the primitives and distance for any two bodies (body.cpp).
 void bind_bodies(py::module_& m);
+// Motion, ImpactResult and time_of_impact (time_of_impact.cpp).
+void bind_time_of_impact(py::module_& m);
 
 }  // namespace proxima::python
