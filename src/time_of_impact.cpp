@@ -19,8 +19,10 @@ bool finite(const Vec3& v) { return v.allFinite(); }
 
 // An upper bound on the distance of any hull vertex from the body's
 // reference point (its frame's origin): |centroid| + the bounding radius
-// about the centroid. O(1).
-double reach(const ConvexPolytope& p) { return p.centroid().norm() + p.bounding_radius(); }
+// about the centroid. O(1). Norms here and below without overflow or
+// underflow of their squares (stableNorm): speeds and sizes near 1e-300
+// and 1e300 are valid.
+double reach(const ConvexPolytope& p) { return p.centroid().stableNorm() + p.bounding_radius(); }
 
 // The gap between the support planes of the two placed hulls along the unit
 // direction n (world frame): min over B of n.y minus max over A of n.x, a
@@ -119,7 +121,7 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   const double turn_b = wb.norm() * reach_b;
   // The fastest any point of B moves relative to any point of A: the
   // distance changes no faster (it is 1-Lipschitz in the bodies' motion).
-  const double any_speed = (vb - va).norm() + turn_a + turn_b;
+  const double any_speed = (vb - va).stableNorm() + turn_a + turn_b;
   const double size = a.bounding_radius() + b.bounding_radius();
   double tolerance = options.tolerance;
   if (tolerance == 0.0) tolerance = 1e-6 * size;
@@ -144,7 +146,9 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     const bool in_contact = r.status == Status::intersecting || r.status == Status::touching ||
                             r.distance <= target + tolerance;
     if (in_contact) {
-      out.status = t == 0.0 && (r.status == Status::intersecting || r.distance <= target)
+      // At t = 0: overlapping when the hulls overlap or are strictly within
+      // the offset; touching (or at the offset) is a contact at t = 0.
+      out.status = t == 0.0 && (r.status == Status::intersecting || r.distance < target)
                        ? ImpactStatus::overlapping
                        : ImpactStatus::contact;
       return out;

@@ -12,10 +12,12 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
 #include "proxima/distance.h"
+#include "support/penetration_oracle.h"
 
 namespace proxima {
 namespace {
@@ -210,6 +212,136 @@ TEST(TimeOfImpact, MotionFromVelocityMatchesItsEndPoses) {
   const Mat3 expected = Eigen::AngleAxisd(0.25, Vec3::UnitZ()).toRotationMatrix() * p.rotation;
   EXPECT_TRUE(half.rotation.isApprox(expected, 1e-14));
   EXPECT_TRUE(m.at(0.0).rotation == p.rotation);
+}
+
+// The exact first time of contact of the hull of `a` (fixed) and the hull of
+// `b` translated by t u, t in [0, 1]: the ray t u entering M = A - B (CGAL's
+// exact hull of the differences of the given doubles), or nothing when it
+// misses M or enters after t = 1. Exact rationals throughout; rounded once
+// at the end.
+std::optional<double> exact_translation_toi(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
+                                            const Vec3& u) {
+  using test::ExactFT;
+  using test::ExactKernel;
+  using test::ExactPoint;
+  test::ScopedFpTrapsOff traps_off;
+  std::vector<ExactPoint> m;
+  for (const Vec3& x : a)
+    for (const Vec3& y : b)
+      m.emplace_back(ExactFT(x.x()) - ExactFT(y.x()), ExactFT(x.y()) - ExactFT(y.y()),
+                     ExactFT(x.z()) - ExactFT(y.z()));
+  CGAL::Polyhedron_3<ExactKernel> hull;
+  CGAL::convex_hull_3(m.begin(), m.end(), hull);
+  const ExactKernel::Vector_3 ue(ExactFT(u.x()), ExactFT(u.y()), ExactFT(u.z()));
+  ExactFT enter = 0;  // the ray t u is inside M for t in [enter, leave]
+  std::optional<ExactFT> leave;
+  const ExactPoint origin(0, 0, 0);
+  for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
+    auto h = f->facet_begin();
+    const ExactPoint& p0 = h->vertex()->point();
+    ++h;
+    const ExactPoint& p1 = h->vertex()->point();
+    ++h;
+    const ExactPoint& p2 = h->vertex()->point();
+    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);  // outward
+    const ExactFT offset = n * (p0 - origin);              // inside: n . x <= offset
+    const ExactFT along = n * ue;
+    if (along == 0) {
+      if (offset < 0) return std::nullopt;  // parallel and outside
+    } else if (along < 0) {
+      enter = CGAL::max(enter, offset / along);
+    } else {
+      const ExactFT t = offset / along;
+      leave = leave ? CGAL::min(*leave, t) : t;
+    }
+  }
+  if ((leave && enter > *leave) || enter > 1) return std::nullopt;
+  return CGAL::to_double(enter);
+}
+
+// Pure translation against the exact oracle: 80 seeded pairs, B moving
+// towards A (most hit, some miss by a margin, some graze). Every contact
+// found is never after t* and within the tolerance of it; every t* in
+// [0, 1] is found (no miss). Then the same motions at 2^-996 and 2^996
+// (near 1e-300 and 1e300): the same times.
+TEST(TimeOfImpact, PureTranslationAgreesWithTheExactRayAgainstTheMinkowskiHull) {
+  std::mt19937 rng(13);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  int hits = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    std::vector<Vec3> pa = sphere_points(8 + trial % 40, 300 + trial, 0.5 + u01(rng));
+    std::vector<Vec3> pb = sphere_points(5 + trial % 25, 400 + trial, 0.3 + u01(rng));
+    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
+    for (Vec3& y : pb) y += (3.0 + u01(rng)) * dir;  // B starts about 3 to 4 away
+    const Vec3 aim = 0.6 * Vec3(g(rng), g(rng), g(rng));
+    const Vec3 move = (aim - (pb[0] - 0.0 * dir)).normalized() * (4.0 + 4.0 * u01(rng));
+    const std::optional<double> t_star = exact_translation_toi(pa, pb, move);
+    for (const int e : {0, -996, 996}) {
+      SCOPED_TRACE("trial " + std::to_string(trial) + ", scale 2^" + std::to_string(e));
+      const double s = std::ldexp(1.0, e);
+      std::vector<Vec3> sa = pa, sb = pb;
+      for (Vec3& x : sa) x *= s;
+      for (Vec3& y : sb) y *= s;
+      const ConvexPolytope a(sa), b(sb);
+      const Motion ma = Motion::fixed(Pose::identity());
+      const Motion mb{Pose::identity(), Pose::from_translation(s * move)};
+      ImpactOptions options;
+      options.tolerance = 1e-10 * s;
+      const ImpactResult r = time_of_impact(a, ma, b, mb, options);
+      ASSERT_NE(r.status, ImpactStatus::iteration_cap);
+      ASSERT_NE(r.status, ImpactStatus::overlapping);
+      if (t_star) {
+        ASSERT_EQ(r.status, ImpactStatus::contact) << "missed the contact at t* = " << *t_star;
+        EXPECT_LE(r.t, *t_star * (1 + 1e-12));
+        EXPECT_GE(r.t, *t_star - 1e-10 / move.norm() - 1e-12);
+        hits += e == 0 ? 1 : 0;
+      } else if (r.status == ImpactStatus::contact) {
+        // Contact without t*: only a graze within the tolerance.
+        EXPECT_LE(r.at_t.distance, options.tolerance);
+      }
+    }
+  }
+  EXPECT_GT(hits, 30);
+}
+
+// Grazing and near misses: B slides past a cube's face at a clearance c.
+// Tolerance below c: separated; c within the tolerance: contact, at a time
+// where the distance is within it. Contact at t = 1 (B ends touching) and
+// at t = 0 (B starts touching), and no motion at all.
+TEST(TimeOfImpact, GrazesNearMissesAndContactsAtTheEnds) {
+  const ConvexPolytope cube(box(Vec3(1, 1, 1)));
+  const Motion still = Motion::fixed(Pose::identity());
+  for (const double c : {1e-3, 1e-9}) {
+    const Motion pass{Pose::from_translation(Vec3(-6, 2 + c, 0)),
+                      Pose::from_translation(Vec3(6, 2 + c, 0))};
+    ImpactOptions tight;
+    tight.tolerance = c / 4;
+    const ImpactResult miss = time_of_impact(cube, still, cube, pass, tight);
+    EXPECT_EQ(miss.status, ImpactStatus::separated) << c;
+    EXPECT_EQ(miss.t, 1.0);
+    ImpactOptions loose;
+    loose.tolerance = 4 * c;
+    const ImpactResult graze = time_of_impact(cube, still, cube, pass, loose);
+    EXPECT_EQ(graze.status, ImpactStatus::contact) << c;
+    EXPECT_LE(graze.at_t.distance, 4 * c + 1e-15);
+  }
+  // Ends touching at t = 1: B's face arrives at A's.
+  const Motion arrive{Pose::from_translation(Vec3(5, 0, 0)), Pose::from_translation(Vec3(2, 0, 0))};
+  const ImpactResult end = time_of_impact(cube, still, cube, arrive);
+  EXPECT_EQ(end.status, ImpactStatus::contact);
+  EXPECT_GT(end.t, 1.0 - 1e-6);
+  // Starts touching, moving away: contact at t = 0.
+  const Motion leave{Pose::from_translation(Vec3(2, 0.5, 0)),
+                     Pose::from_translation(Vec3(5, 0, 0))};
+  const ImpactResult start = time_of_impact(cube, still, cube, leave);
+  EXPECT_EQ(start.status, ImpactStatus::contact);
+  EXPECT_EQ(start.t, 0.0);
+  // No motion: one query (and the end's) decide.
+  const ImpactResult idle =
+      time_of_impact(cube, still, cube, Motion::fixed(Pose::from_translation(Vec3(3, 0, 0))));
+  EXPECT_EQ(idle.status, ImpactStatus::separated);
+  EXPECT_LE(idle.iterations, 2);
 }
 
 TEST(TimeOfImpact, BadInputIsRefusedByName) {

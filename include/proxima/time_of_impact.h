@@ -66,7 +66,7 @@ struct Motion {
 enum class ImpactStatus : std::uint8_t {
   separated,      // no contact over [0, 1]: the distance stays above the target
   contact,        // the distance reaches the target (within tolerance) at t
-  overlapping,    // already intersecting (or within the target) at t = 0
+  overlapping,    // already intersecting (or strictly within the target) at t = 0
   iteration_cap,  // stopped at options.max_iterations; t is still safe
 };
 
