@@ -24,13 +24,9 @@
 #include "proxima/primitives.h"
 
 namespace proxima::python {
-namespace {
-
-using PyBodyCache = Guarded<BodyCache>;
-
 // A Body from a Body, a ConvexPolytope or a CompoundBody (radius 0): the
 // core is shared, not copied. Anything else is a TypeError naming the
-// argument and its type.
+// argument and its type (declared in convert.h).
 Body to_body(py::handle obj, const char* name) {
   if (py::isinstance<Body>(obj)) return obj.cast<const Body&>();
   if (py::isinstance<ConvexPolytope>(obj)) {
@@ -43,6 +39,10 @@ Body to_body(py::handle obj, const char* name) {
                        ": expected a ConvexPolytope, a CompoundBody or a Body, got " +
                        py::str(py::type::handle_of(obj).attr("__name__")).cast<std::string>());
 }
+
+namespace {
+
+using PyBodyCache = Guarded<BodyCache>;
 
 // The core of Body(core, radius): a polytope, a compound, a Body (its core)
 // or an (N, 3) array of points (hulled).

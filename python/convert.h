@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "proxima/body.h"
 #include "proxima/io.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
@@ -522,6 +523,9 @@ void bind_compound_and_scene(py::module_& m);
 void bind_pair_batch(py::module_& m);
 // Body, the primitives and distance for any two bodies (body.cpp).
 void bind_bodies(py::module_& m);
+// A Body from a Body, a ConvexPolytope or a CompoundBody (body.cpp);
+// TypeError naming `name` otherwise.
+Body to_body(py::handle obj, const char* name);
 // Motion, ImpactResult and time_of_impact (time_of_impact.cpp).
 void bind_time_of_impact(py::module_& m);
 

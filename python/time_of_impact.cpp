@@ -14,6 +14,7 @@
 #include <string>
 
 #include "convert.h"
+#include "proxima/body.h"
 
 namespace proxima::python {
 namespace {
@@ -86,32 +87,56 @@ void bind_time_of_impact(py::module_& m) {
   const ImpactOptions defaults;
   m.def(
       "time_of_impact",
-      [](const ConvexPolytope& a, py::handle motion_a, const ConvexPolytope& b, py::handle motion_b,
-         double target_separation, double tolerance, int max_iterations, PyDistanceCache* cache) {
+      [](py::handle a, py::handle motion_a, py::handle b, py::handle motion_b,
+         double target_separation, double tolerance, int max_iterations, py::object cache) {
         const Motion ma = to_motion(motion_a, "motion_a");
         const Motion mb = to_motion(motion_b, "motion_b");
         ImpactOptions options;
         options.target_separation = target_separation;
         options.tolerance = tolerance;
         options.max_iterations = max_iterations;
-        if (cache == nullptr) {
+        const bool convex_pair =
+            py::isinstance<ConvexPolytope>(a) && py::isinstance<ConvexPolytope>(b);
+        if (convex_pair && (cache.is_none() || py::isinstance<PyDistanceCache>(cache))) {
+          const ConvexPolytope& pa = a.cast<const ConvexPolytope&>();
+          const ConvexPolytope& pb = b.cast<const ConvexPolytope&>();
+          if (cache.is_none()) {
+            const py::gil_scoped_release release;
+            return time_of_impact(pa, ma, pb, mb, options, nullptr);
+          }
+          PyDistanceCache& c = cache.cast<PyDistanceCache&>();
+          const InUse in_use(c, "DistanceCache");
           const py::gil_scoped_release release;
-          return time_of_impact(a, ma, b, mb, options, nullptr);
+          return time_of_impact(pa, ma, pb, mb, options, &c);
         }
-        const InUse in_use(*cache, "DistanceCache");
+        // Any other kinds: Bodies (a BodyCache, or none).
+        const Body ba = to_body(a, "a");
+        const Body bb = to_body(b, "b");
+        if (cache.is_none()) {
+          const py::gil_scoped_release release;
+          return time_of_impact(ba, ma, bb, mb, options, nullptr);
+        }
+        if (!py::isinstance<Guarded<BodyCache>>(cache)) {
+          throw py::type_error(
+              "cache: expected a DistanceCache for two ConvexPolytopes, else a "
+              "BodyCache");
+        }
+        Guarded<BodyCache>& c = cache.cast<Guarded<BodyCache>&>();
+        const InUse in_use(c, "BodyCache");
         const py::gil_scoped_release release;
-        return time_of_impact(a, ma, b, mb, options, cache);
+        return time_of_impact(ba, ma, bb, mb, options, &c);
       },
       py::arg("a"), py::arg("motion_a"), py::arg("b"), py::arg("motion_b"),
       py::arg("target_separation") = defaults.target_separation,
       py::arg("tolerance") = defaults.tolerance,
       py::arg("max_iterations") = defaults.max_iterations, py::arg("cache") = py::none(),
-      R"doc(First time of contact of hull a moving by motion_a and hull b moving by motion_b over t in [0, 1].
+      R"doc(First time of contact of body a moving by motion_a and body b moving by motion_b over t in [0, 1].
 
-Motions: a proxima.Motion or a (start, end) pair of poses. The reported t is never after the true
+Bodies: ConvexPolytope, CompoundBody or Body (a radius adds to the target separation). Motions: a proxima.Motion or a (start, end) pair of poses. The reported t is never after the true
 first time the distance comes within target_separation (no contact is missed, however fast or
 thin the bodies); for status 'contact' the distance at t is within tolerance of the target
-(tolerance 0: 1e-6 of the bodies' size). cache: a DistanceCache carried from step to step.)doc");
+(tolerance 0: 1e-6 of the bodies' size). cache: carried from step to step, a DistanceCache for
+two ConvexPolytopes, else a BodyCache.)doc");
 }
 
 }  // namespace proxima::python

@@ -10,6 +10,7 @@
 #include <limits>
 #include <string>
 
+#include "proxima/compound.h"
 #include "proxima/support.h"
 
 namespace proxima {
@@ -65,6 +66,33 @@ class Sweep {
   Vec3 axis_ = Vec3::UnitX();
 };
 
+void check_options(const ImpactOptions& options) {
+  const double target = options.target_separation;
+  if (!std::isfinite(target) || target < 0.0) {
+    throw InvalidInput("time_of_impact: options.target_separation must be finite and >= 0, not " +
+                       std::to_string(target));
+  }
+  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
+    throw InvalidInput("time_of_impact: options.tolerance must be finite and >= 0 (0: default)");
+  }
+  if (options.max_iterations < 1) {
+    throw InvalidInput("time_of_impact: options.max_iterations must be at least 1");
+  }
+}
+
+// Bound on the distance of any point of the body (its rounded surface
+// included) from its reference point.
+double body_reach(const Body& body) {
+  if (body.kind() == Body::Kind::convex) return reach(*body.convex()) + body.radius();
+  const CompoundBody& c = *body.compound();
+  return c.center().stableNorm() + c.bounding_radius() + body.radius();
+}
+
+double body_size(const Body& body) {
+  if (body.kind() == Body::Kind::convex) return body.convex()->bounding_radius() + body.radius();
+  return body.compound()->bounding_radius() + body.radius();
+}
+
 }  // namespace
 
 Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& angular,
@@ -93,17 +121,8 @@ Pose Motion::at(double t) const { return Sweep(*this).at(t); }
 ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
                             const ImpactOptions& options, DistanceCache* cache) {
+  check_options(options);
   const double target = options.target_separation;
-  if (!std::isfinite(target) || target < 0.0) {
-    throw InvalidInput("time_of_impact: options.target_separation must be finite and >= 0, not " +
-                       std::to_string(target));
-  }
-  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
-    throw InvalidInput("time_of_impact: options.tolerance must be finite and >= 0 (0: default)");
-  }
-  if (options.max_iterations < 1) {
-    throw InvalidInput("time_of_impact: options.max_iterations must be at least 1");
-  }
   // The ends of both motions under the pose contract (re-orthonormalized
   // where the contract allows it).
   const Sweep ma(Motion{checked_pose(motion_a.start, "time_of_impact: motion_a.start"),
@@ -202,6 +221,86 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     if (!(t + step > t)) {
       // No safe progress at this precision (bounds within rounding of the
       // target while the distance is not): stop, t is still safe.
+      out.status = ImpactStatus::iteration_cap;
+      return out;
+    }
+    t += step;
+  }
+}
+
+ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
+                            const Motion& motion_b, const ImpactOptions& options,
+                            BodyCache* cache) {
+  check_options(options);
+  BodyCache local;
+  BodyCache& c = cache != nullptr ? *cache : local;
+  const double ra = a.radius();
+  const double rb = b.radius();
+  if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
+    // The cores, with the radii added to the target; then the answer at t
+    // moved onto the rounded surfaces.
+    ImpactOptions cores = options;
+    cores.target_separation += ra + rb;
+    if (cores.tolerance == 0.0) cores.tolerance = 1e-6 * (body_size(a) + body_size(b));
+    ImpactResult r = time_of_impact(*a.convex(), motion_a, *b.convex(), motion_b, cores, &c.convex);
+    r.at_t = distance(a, r.pose_a, b, r.pose_b, options.distance, &c);
+    return r;
+  }
+
+  // A compound on either side: advancement by the certified lower bound of
+  // the Bodies' signed distance over the fastest point speed.
+  const double target = options.target_separation;
+  const Sweep ma(Motion{checked_pose(motion_a.start, "time_of_impact: motion_a.start"),
+                        checked_pose(motion_a.end, "time_of_impact: motion_a.end")});
+  const Sweep mb(Motion{checked_pose(motion_b.start, "time_of_impact: motion_b.start"),
+                        checked_pose(motion_b.end, "time_of_impact: motion_b.end")});
+  const double any_speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
+                           ma.angular_velocity().norm() * body_reach(a) +
+                           mb.angular_velocity().norm() * body_reach(b);
+  const double tolerance =
+      options.tolerance > 0.0 ? options.tolerance : 1e-6 * (body_size(a) + body_size(b));
+  ImpactResult out;
+  double t = 0.0;
+  for (;;) {
+    const Pose pa = ma.at(t);
+    const Pose pb = mb.at(t);
+    const BodyDistance r = distance(a, pa, b, pb, options.distance, &c);
+    ++out.iterations;
+    out.t = t;
+    out.pose_a = pa;
+    out.pose_b = pb;
+    out.at_t = r;
+    if (r.status == Status::intersecting || r.status == Status::touching ||
+        r.signed_distance <= target + tolerance) {
+      out.status = t == 0.0 && (r.status == Status::intersecting || r.signed_distance < target)
+                       ? ImpactStatus::overlapping
+                       : ImpactStatus::contact;
+      return out;
+    }
+    if (out.iterations >= options.max_iterations) {
+      out.status = ImpactStatus::iteration_cap;
+      return out;
+    }
+    const double band =
+        contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
+    const double lower = r.signed_lower_bound - band;
+    const bool never = !(any_speed > 0.0) && lower > target;
+    const double step = lower > target && any_speed > 0.0 ? (lower - target) / any_speed : 0.0;
+    if (never || t + step >= 1.0) {
+      const Pose ea = ma.at(1.0);
+      const Pose eb = mb.at(1.0);
+      const BodyDistance e = distance(a, ea, b, eb, options.distance, &c);
+      ++out.iterations;
+      out.pose_a = ea;
+      out.pose_b = eb;
+      out.at_t = e;
+      out.t = 1.0;
+      const bool end_contact = e.status == Status::intersecting || e.status == Status::touching ||
+                               e.signed_distance <= target + tolerance;
+      out.status = end_contact ? ImpactStatus::contact : ImpactStatus::separated;
+      return out;
+    }
+    if (!(t + step > t)) {
       out.status = ImpactStatus::iteration_cap;
       return out;
     }

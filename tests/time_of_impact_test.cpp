@@ -16,7 +16,10 @@
 #include <random>
 #include <vector>
 
+#include "proxima/body.h"
+#include "proxima/compound.h"
 #include "proxima/distance.h"
+#include "proxima/primitives.h"
 #include "support/penetration_oracle.h"
 
 namespace proxima {
@@ -342,6 +345,59 @@ TEST(TimeOfImpact, GrazesNearMissesAndContactsAtTheEnds) {
       time_of_impact(cube, still, cube, Motion::fixed(Pose::from_translation(Vec3(3, 0, 0))));
   EXPECT_EQ(idle.status, ImpactStatus::separated);
   EXPECT_LE(idle.iterations, 2);
+}
+
+// Bodies: two spheres head-on (closed form: the centres 0.75 apart), a
+// capsule swinging into a box, and a compound (two cubes) against a moving
+// cube, refereed by sampling the Bodies' signed distance.
+TEST(TimeOfImpact, RoundedAndCompoundBodies) {
+  const Body s1 = make_sphere(0.5);
+  const Body s2 = make_sphere(0.25);
+  const Motion still = Motion::fixed(Pose::identity());
+  const Motion head_on{Pose::from_translation(Vec3(4, 0, 0)),
+                       Pose::from_translation(Vec3(-4, 0, 0))};
+  ImpactOptions options;
+  options.tolerance = 1e-10;
+  const ImpactResult spheres = time_of_impact(s1, still, s2, head_on, options);
+  ASSERT_EQ(spheres.status, ImpactStatus::contact);
+  const double t_star = (4.0 - 0.75) / 8.0;
+  EXPECT_LE(spheres.t, t_star);
+  EXPECT_GE(spheres.t, t_star - 1e-10 / 8 - 1e-14);
+  EXPECT_NEAR(spheres.at_t.point_a.x(), 0.5, 1e-9);  // on the rounded surface
+
+  const auto sampled = [&](const Body& a, const Motion& ma, const Body& b, const Motion& mb,
+                           const ImpactResult& r) {
+    double first = 2.0;
+    for (int i = 0; i <= 2000; ++i) {
+      const double s = i / 2000.0;
+      const double d = distance(a, ma.at(s), b, mb.at(s)).signed_distance;
+      if (d <= 0.0 && first > 1.0) first = s;
+      if (s < r.t) EXPECT_GT(d, -1e-9) << "contact missed at " << s;
+    }
+    EXPECT_LE(r.t, first + 1e-15);
+    if (r.status == ImpactStatus::contact) EXPECT_LE(r.at_t.distance, 1e-6);
+  };
+  const Body capsule = make_capsule(1.0, 0.2);
+  const Body block = make_box(Vec3(0.5, 0.5, 0.5), 0.05);
+  const Motion swing = Motion::from_velocity(Pose::identity(), Vec3(0.5, 0, 0), Vec3(0, 2.5, 0));
+  const Motion block_still = Motion::fixed(Pose::from_translation(Vec3(1.2, 0, 0.9)));
+  const ImpactResult cap = time_of_impact(block, block_still, capsule, swing, options);
+  EXPECT_EQ(cap.status, ImpactStatus::contact);
+  sampled(block, block_still, capsule, swing, cap);
+
+  std::vector<std::vector<Vec3>> sets = {box(Vec3(0.5, 0.5, 0.5)), box(Vec3(0.5, 0.5, 0.5))};
+  for (Vec3& p : sets[1]) p += Vec3(0, 2.0, 0);
+  const Body pair(CompoundBody::from_point_sets(sets), 0.1);
+  const Body cube(ConvexPolytope(box(Vec3(0.3, 0.3, 0.3))));
+  const Motion through{
+      Pose::from_translation(Vec3(5, 2.2, 0.1)),
+      Pose(Quat(Eigen::AngleAxisd(2.0, Vec3(1, 1, 0).normalized())), Vec3(-5, 1.9, 0))};
+  BodyCache cache;
+  const ImpactResult comp = time_of_impact(pair, still, cube, through, options, &cache);
+  EXPECT_EQ(comp.status, ImpactStatus::contact);
+  sampled(pair, still, cube, through, comp);
+  const ImpactResult flipped = time_of_impact(cube, through, pair, still, options);
+  EXPECT_NEAR(flipped.t, comp.t, 1e-6);
 }
 
 TEST(TimeOfImpact, BadInputIsRefusedByName) {

@@ -34,6 +34,7 @@
 // Thread safety: as distance(); the cache belongs to one pair.
 #pragma once
 
+#include "proxima/body.h"
 #include "proxima/distance.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
@@ -124,5 +125,16 @@ struct ImpactResult {
 ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
                             const ImpactOptions& options = {}, DistanceCache* cache = nullptr);
+
+// The same for Bodies of any kinds (proxima/body.h): a rounded body's
+// radius adds to the target separation (the cores' distance must stay
+// above the target plus both radii), and at_t describes the rounded bodies
+// (BodyDistance's conventions, sliced to a DistanceResult: points on the
+// rounded surfaces). A compound on either side advances by its certified
+// lower bound over the fastest point speed only (no support gap along the
+// normal: more steps than a convex pair). `cache` may be null.
+ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
+                            const Motion& motion_b, const ImpactOptions& options = {},
+                            BodyCache* cache = nullptr);
 
 }  // namespace proxima

@@ -72,3 +72,22 @@ def test_bad_input_is_refused_by_name():
         proxima.time_of_impact(a, still, a, still, target_separation=-1.0)
     with pytest.raises(ValueError, match="duration"):
         proxima.Motion.from_velocity(None, (1, 0, 0), (0, 0, 0), 0.0)
+
+
+def test_bodies_of_any_kind():
+    # Two spheres head-on: the centres 0.75 apart at t* = (4 - 0.75) / 8.
+    r = proxima.time_of_impact(proxima.sphere(0.5), proxima.Motion.fixed(None),
+                               proxima.sphere(0.25), (T((4, 0, 0)), T((-4, 0, 0))),
+                               tolerance=1e-10)
+    assert r.status == "contact"
+    assert (4 - 0.75) / 8 - 1e-10 <= r.t <= (4 - 0.75) / 8
+    # A plain polytope against a compound, with a BodyCache.
+    pair = proxima.CompoundBody([cube(0.5).vertices, cube(0.5).vertices + [0, 2, 0]])
+    cache = proxima.BodyCache()
+    r = proxima.time_of_impact(pair, proxima.Motion.fixed(None), cube(0.3),
+                               (T((5, 2.2, 0)), T((-5, 2.2, 0))), cache=cache)
+    assert r.status == "contact"
+    assert r.t == pytest.approx((5 - 0.8) / 10, abs=1e-5)
+    with pytest.raises(TypeError, match="BodyCache"):
+        proxima.time_of_impact(pair, proxima.Motion.fixed(None), cube(), proxima.Motion.fixed(
+            T((5, 0, 0))), cache=proxima.DistanceCache())
