@@ -388,22 +388,38 @@ PYBIND11_MODULE(proxima, m) {
                     "Certified lower bound on the exact distance.")
       .def_property_readonly(
           "point_a", [](const DistanceResult& r) { return vec3_array(r.point_a); },
-          "Closest point on A, world frame.")
+          "Closest point on A, world frame (intersecting: the deepest point of A).")
       .def_property_readonly(
           "point_b", [](const DistanceResult& r) { return vec3_array(r.point_b); },
-          "Closest point on B, world frame.")
+          "Closest point on B, world frame (intersecting: the deepest point of B, "
+          "point_b + depth * normal == point_a).")
       .def_property_readonly(
           "normal", [](const DistanceResult& r) { return vec3_array(r.normal); },
-          "Unit normal from A towards B.")
+          "Unit normal from A towards B (intersecting: the direction that separates).")
       .def_readonly("feature_a", &DistanceResult::feature_a, "Witness feature on A (hull ids).")
       .def_readonly("feature_b", &DistanceResult::feature_b, "Witness feature on B (hull ids).")
+      .def_readonly("depth", &DistanceResult::depth,
+                    "Penetration depth of an intersecting answer (0 otherwise): the length of "
+                    "the shortest translation of B after which the bodies only touch.")
+      .def_readonly("depth_lower_bound", &DistanceResult::depth_lower_bound,
+                    "Certified lower bound on the depth.")
+      .def_readonly("depth_upper_bound", &DistanceResult::depth_upper_bound,
+                    "Certified upper bound on the depth (inf when it was not computed).")
+      .def_property_readonly("signed_distance", &DistanceResult::signed_distance,
+                             "distance when apart, minus the depth when intersecting.")
+      .def_property_readonly("signed_lower_bound", &DistanceResult::signed_lower_bound,
+                             "Certified lower bound on the signed distance.")
+      .def_property_readonly("signed_upper_bound", &DistanceResult::signed_upper_bound,
+                             "Certified upper bound on the signed distance.")
       .def_readonly("iterations", &DistanceResult::iterations, "Iterations the algorithm ran.")
       .def_readonly("second_algorithm", &DistanceResult::second_algorithm,
                     "True when the hybrid needed Enhanced GJK (contact classification or a "
                     "cross-check of an uncertified answer).")
       .def("__repr__", [](const DistanceResult& r) {
         return std::string("proxima.DistanceResult(status='") + to_string(r.status) +
-               "', distance=" + py::repr(py::float_(r.distance)).cast<std::string>() + ")";
+               "', distance=" + py::repr(py::float_(r.distance)).cast<std::string>() +
+               ", signed_distance=" +
+               py::repr(py::float_(r.signed_distance())).cast<std::string>() + ")";
       });
 
   // --- Queries --------------------------------------------------------------

@@ -729,3 +729,46 @@ def test_pair_batch_equals_single_tracked_queries():
         proxima.PairBatch(a[:2], [b[0], "x"])
     with pytest.raises(ValueError, match="poses_b"):
         batch.distance(None, poses_b[:3])
+
+
+# --- signed distance ---------------------------------------------------------
+# Every result carries the signed distance (distance when apart, minus the
+# penetration depth when overlapping) and its certificate; the batch and the
+# PairBatch give them as arrays.
+def test_signed_distance_of_overlapping_and_separated_cubes():
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    over = proxima.distance(a, None, b, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    assert over.status == "intersecting" and over.distance == 0.0
+    assert math.isclose(over.signed_distance, -0.25, abs_tol=1e-15)
+    assert math.isclose(over.depth, 0.25, abs_tol=1e-15)
+    assert over.signed_lower_bound <= over.signed_distance <= over.signed_upper_bound
+    np.testing.assert_allclose(over.normal, [1, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(over.point_b + over.depth * over.normal, over.point_a, atol=1e-15)
+    apart = proxima.distance(a, None, b, ((1, 0, 0, 0), (1.5, 0.1, 0.2)))
+    assert apart.signed_distance == apart.distance and apart.depth == 0.0
+    assert apart.signed_lower_bound == apart.lower_bound
+    assert "signed_distance=" in repr(over)
+
+
+def test_batch_and_pair_batch_carry_signed_distance_arrays(bodies):
+    a, b = bodies
+    rng = np.random.default_rng(11)
+    k = 200
+    pa, pb = random_scene(rng, k)
+    out = proxima.distance_batch(a, pa, b, pb, threads=2)
+    assert out["signed_distance"].shape == (k,)
+    negative = 0
+    for i in range(k):
+        r = proxima.distance(a, pa[i], b, pb[i])
+        assert out["signed_distance"][i] == r.signed_distance
+        assert out["signed_lower_bound"][i] == r.signed_lower_bound
+        assert out["signed_upper_bound"][i] == r.signed_upper_bound
+        assert out["signed_lower_bound"][i] <= out["signed_distance"][i] <= out["signed_upper_bound"][i]
+        assert (out["signed_distance"][i] < 0) == (r.status == "intersecting" and r.depth > 0)
+        negative += r.signed_distance < 0
+    assert negative >= 10
+    batch = proxima.PairBatch([a] * k, [b] * k)
+    out = batch.distance(pa, pb, threads=2)
+    for i in range(k):
+        assert out["signed_distance"][i] == proxima.distance(a, pa[i], b, pb[i]).signed_distance
