@@ -34,6 +34,7 @@
 #include "proxima/distance.h"
 #include "proxima/io.h"
 #include "proxima/polytope.h"
+#include "proxima/signed_distance.h"
 #include "proxima/types.h"
 
 namespace py = pybind11;
@@ -422,6 +423,28 @@ PYBIND11_MODULE(proxima, m) {
                py::repr(py::float_(r.signed_distance())).cast<std::string>() + ")";
       });
 
+  m.def(
+      "signed_distance_gradient",
+      [](const DistanceResult& r, py::object pose_a, py::object pose_b) {
+        const SignedDistanceGradient g =
+            signed_distance_gradient(r, to_pose(pose_a, "pose_a"), to_pose(pose_b, "pose_b"));
+        py::array_t<double> out({py::ssize_t{2}, py::ssize_t{6}});
+        auto o = out.mutable_unchecked<2>();
+        for (int k = 0; k < 6; ++k) {
+          o(0, k) = g.a[k];
+          o(1, k) = g.b[k];
+        }
+        return out;
+      },
+      py::arg("result"), py::arg("pose_a"), py::arg("pose_b"),
+      R"doc(The gradient of result.signed_distance with respect to each body's pose.
+
+result: the answer of distance() (or of the compound distance) at pose_a, pose_b (the bodies'
+poses of that query). Returns a (2, 6) array: row 0 for A, row 1 for B, each the derivative
+along world translations (3) then along small rotations about world axes through the body's
+origin (3). Exact where the witness pair is unique, else one-sided (a subgradient); raises
+InvalidInput for an intersecting answer computed without the depth.)doc");
+
   // --- Queries --------------------------------------------------------------
   const DistanceOptions defaults;
   m.def(
@@ -529,7 +552,8 @@ poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices; one of them m
 (quaternion, translation) pair, a Pose) or None, used for all K.
 caches: None (all cold) or a list of K DistanceCache, updated in place (tracking across calls).
 threads: 0 for all cores, 1 for the calling thread only, n for n threads.
-Returns a dict of arrays with K rows: status (str), distance, lower_bound, point_a (K, 3),
+Returns a dict of arrays with K rows: status (str), distance, lower_bound, signed_distance,
+signed_lower_bound, signed_upper_bound, point_a (K, 3),
 point_b (K, 3), normal (K, 3), feature_a_type (str), feature_a_vertices (K, 3; -1 unused),
 feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k], b, poses_b[k]).)doc");
 

@@ -103,7 +103,8 @@ void bind_pair_batch(py::module_& m) {
 
 poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices, or one pose (or None) for all K.
 threads: 0 for all cores, 1 for the calling thread only, n for n threads.
-Returns the dict of distance_batch: arrays with K rows (status, distance, lower_bound, point_a,
+Returns the dict of distance_batch: arrays with K rows (status, distance, lower_bound,
+signed_distance and its bounds, point_a,
 point_b, normal, features, iterations). Row k equals
 distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).)doc")
       .def(

@@ -772,3 +772,22 @@ def test_batch_and_pair_batch_carry_signed_distance_arrays(bodies):
     out = batch.distance(pa, pb, threads=2)
     for i in range(k):
         assert out["signed_distance"][i] == proxima.distance(a, pa[i], b, pb[i]).signed_distance
+
+
+def test_signed_distance_gradient_matches_central_differences():
+    # B translated along x out of an overlap of 0.25: d sd / d t_b = normal.
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    for t_b in ([0.75, 0.1, 0.2], [1.6, 0.3, -0.2]):
+        pb = matrix(np.eye(3), t_b)
+        r = proxima.distance(a, None, b, pb)
+        g = proxima.signed_distance_gradient(r, None, pb)
+        assert g.shape == (2, 6)
+        h = 1e-6
+        for k in range(3):
+            plus, minus = pb.copy(), pb.copy()
+            plus[k, 3] += h
+            minus[k, 3] -= h
+            fd = (proxima.distance(a, None, b, plus).signed_distance - proxima.distance(a, None, b, minus).signed_distance) / (2 * h)
+            assert abs(fd - g[1, k]) <= 1e-6
+            assert abs(g[0, k] + g[1, k]) == 0.0
