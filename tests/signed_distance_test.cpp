@@ -299,6 +299,38 @@ TEST(SignedDistanceOracle, SeparatedRandomPairsBracketTheExactDistance) {
   }
 }
 
+TEST(SignedDistanceOracle, IterationCapBoundsBracketTheExactValue) {
+  // A query stopped by the cap (max_iterations 1) certifies separation only
+  // with a positive lower bound; otherwise the pair may overlap, and the
+  // signed lower bound falls back to the bounding balls' depth. Either way
+  // the bounds hold the exact signed distance.
+  Rng rng(77);
+  ExactOracle oracle;
+  DistanceOptions capped;
+  capped.max_iterations = 1;
+  int cases = 0, unsure = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Points a = points_on_sphere(rng, 60);
+    const Points b = translated(points_on_sphere(rng, 60, 0.7),
+                                uniform(rng, 0.0, 2.5) * random_unit_vector(rng));
+    const ConvexPolytope pa(a), pb(b);
+    const DistanceResult r = distance(pa, Pose::identity(), pb, Pose::identity(), capped);
+    if (r.status != Status::iteration_cap) continue;
+    ++cases;
+    unsure += !(r.lower_bound > 0.0);
+    const std::optional<ExactDistance> d = oracle.distance(a, b);
+    ASSERT_TRUE(d) << trial;
+    const ExactDepth depth = exact_depth(a, b);
+    const double exact = !d->is_zero()                                      ? d->distance()
+                         : depth.origin == OriginInM::inside && !depth.flat ? -depth.depth()
+                                                                            : 0.0;
+    ASSERT_TRUE(std::isfinite(r.signed_lower_bound())) << trial;
+    ASSERT_TRUE(brackets(r, exact, band_of(a, b))) << trial;
+  }
+  EXPECT_GE(cases, 20);
+  EXPECT_GE(unsure, 3);
+}
+
 // ---------------------------------------------------------------------------
 // Continuity through contact.
 
