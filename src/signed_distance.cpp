@@ -12,6 +12,7 @@
 
 #include "proxima/penetration.h"
 #include "proxima/signed_distance.h"
+#include "proxima/support.h"
 
 namespace proxima {
 namespace detail {
@@ -55,6 +56,41 @@ void take_depth(const PenetrationResult& p, DistanceResult& result) {
   result.feature_b = p.feature_b;
 }
 
+// Whether the overlap of the supports of a and b (placed by b_in_a) along
+// the unit direction n (A's frame) is within `band`: then the depth is too.
+bool overlap_within(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                    const DistanceCache& cache, const Vec3& n, double band) {
+  const Vec3 n_in_b = b_in_a.rotation.transpose() * n;
+  const int ia = support_hill_climb(a, n, cache.hint_a);
+  const int ib = support_hill_climb(b, -n_in_b, cache.hint_b);
+  const double overlap =
+      n.dot(a.vertex(ia)) - (n_in_b.dot(b.vertex(ib)) + n.dot(b_in_a.translation));
+  return overlap <= band;
+}
+
+// Whether a touching answer is certified touching in O(1): the overlap of
+// the supports along one of a few directions (the answer's normal, which at
+// a distance of a few roundings may be noise, and the outward normals of
+// its witness faces, which for a resting contact face on face are the
+// contact's) is within the contact band of the bodies' magnitude bound.
+bool touching_certified(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                        const DistanceOptions& options, const DistanceCache& cache,
+                        const DistanceResult& result) {
+  const double magnitude =
+      std::max(magnitude_bound(Pose::identity(), a.scale()), magnitude_bound(b_in_a, b.scale()));
+  const double band = contact_band(magnitude, options.absolute_tolerance);
+  if (overlap_within(a, b, b_in_a, cache, result.normal, band)) return true;
+  const Feature& fa = result.feature_a;
+  if (fa.type == FeatureType::face && fa.face >= 0 && fa.face < a.face_count() &&
+      overlap_within(a, b, b_in_a, cache, a.face_plane(fa.face).normal, band)) {
+    return true;
+  }
+  const Feature& fb = result.feature_b;
+  return fb.type == FeatureType::face && fb.face >= 0 && fb.face < b.face_count() &&
+         overlap_within(a, b, b_in_a, cache,
+                        Vec3(-(b_in_a.rotation * b.face_plane(fb.face).normal)), band);
+}
+
 }  // namespace
 
 void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
@@ -79,7 +115,14 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
     // origin on planes of A - B's vertex differences: faces of A and B
     // coplanar, as stacked cubes shifted along one axis; found by
     // SignedDistanceHand.CoplanarOverlapCalledTouchingGetsItsDepth). The
-    // depth decides, tracked like an overlap's (resting contacts repeat).
+    // depth decides, tracked like an overlap's. First a certificate in O(1)
+    // from the answer's normal n: depth <= h_A(n) + h_B(-n) (the overlap of
+    // the supports along any unit direction bounds it), so when that
+    // overlap is within the contact band of the magnitude bound the pair
+    // is touching and the depth is not computed (resting contacts: face on
+    // face, n the face normal; hill climbing from the algorithm's support
+    // hints, which are read, not updated).
+    if (touching_certified(a, b, b_in_a, options, cache, result)) return;
     const PenetrationResult p = penetration_depth(a, b, b_in_a, cache.penetration.get_or_create());
     if (p.status != PenetrationStatus::penetrating) return;
     result.status = Status::intersecting;
