@@ -295,9 +295,13 @@ inline Algorithm to_algorithm(const std::string& name) {
   value_error("algorithm must be 'hybrid', 'gjk' or 'enhanced_gjk', got '" + name + "'");
 }
 
+// `penetration`: DistanceOptions::penetration (the depth of intersecting
+// answers; False skips it).
 inline DistanceOptions make_options(const std::string& algorithm, double relative_tolerance,
-                                    double absolute_tolerance, int max_iterations) {
+                                    double absolute_tolerance, int max_iterations,
+                                    bool penetration) {
   DistanceOptions options;
+  options.penetration = penetration;
   options.algorithm = to_algorithm(algorithm);
   options.relative_tolerance = relative_tolerance;
   options.absolute_tolerance = absolute_tolerance;

@@ -451,9 +451,9 @@ InvalidInput for an intersecting answer computed without the depth.)doc");
       "distance",
       [](const ConvexPolytope& a, py::object pose_a, const ConvexPolytope& b, py::object pose_b,
          PyDistanceCache* cache, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations) {
-        const DistanceOptions options =
-            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+         double absolute_tolerance, int max_iterations, bool penetration) {
+        const DistanceOptions options = make_options(
+            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
         const Pose pa = to_pose(pose_a, "pose_a");
         const Pose pb = to_pose(pose_b, "pose_b");
         if (cache == nullptr) return distance(a, pa, b, pb, options, nullptr);
@@ -467,6 +467,7 @@ InvalidInput for an intersecting answer computed without the depth.)doc");
       py::arg("relative_tolerance") = defaults.relative_tolerance,
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
+      py::arg("penetration") = defaults.penetration,
       R"doc(Minimum distance, closest points and features of hulls a and b placed at pose_a and pose_b.
 
 Poses: None (identity), a 4x4 or 3x4 rigid matrix, a scipy Rotation, a (rotation, translation)
@@ -480,9 +481,9 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
       "distance_batch",
       [](const ConvexPolytope& a, py::object poses_a, const ConvexPolytope& b, py::object poses_b,
          py::object caches, int threads, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations) {
-        const DistanceOptions options =
-            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+         double absolute_tolerance, int max_iterations, bool penetration) {
+        const DistanceOptions options = make_options(
+            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
         py::ssize_t k = batch_size(poses_a);
         if (k < 0) k = batch_size(poses_b);
         const std::vector<Pose> pa = to_poses(poses_a, k, "poses_a");
@@ -546,6 +547,7 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
       py::arg("relative_tolerance") = defaults.relative_tolerance,
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
+      py::arg("penetration") = defaults.penetration,
       R"doc(K distance queries of one pair of polytopes, run on the thread pool without the GIL.
 
 poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices; one of them may be a single pose (4x4, a

@@ -791,3 +791,34 @@ def test_signed_distance_gradient_matches_central_differences():
             fd = (proxima.distance(a, None, b, plus).signed_distance - proxima.distance(a, None, b, minus).signed_distance) / (2 * h)
             assert abs(fd - g[1, k]) <= 1e-6
             assert abs(g[0, k] + g[1, k]) == 0.0
+
+
+def test_penetration_false_skips_the_depth_everywhere():
+    # DistanceOptions.penetration as a keyword: an intersecting answer
+    # without its depth, signed distance 0 in [-inf, 0]; separated answers
+    # are the same either way.
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    over = ((1, 0, 0, 0), (0.75, 0.1, 0.2))
+    r = proxima.distance(a, None, b, over, penetration=False)
+    assert r.status == "intersecting" and r.signed_distance == 0.0 and r.depth == 0.0
+    assert r.signed_lower_bound == -math.inf and r.signed_upper_bound == 0.0
+    with pytest.raises(proxima.InvalidInput, match="penetration"):
+        proxima.signed_distance_gradient(r, None, over)
+    apart = ((1, 0, 0, 0), (1.5, 0.1, 0.2))
+    x = proxima.distance(a, None, b, apart, penetration=False)
+    y = proxima.distance(a, None, b, apart)
+    assert x.signed_distance == y.signed_distance and np.array_equal(x.point_a, y.point_a)
+    poses_b = np.tile(np.eye(4), (2, 1, 1))
+    poses_b[0, :3, 3] = over[1]
+    poses_b[1, :3, 3] = apart[1]
+    out = proxima.distance_batch(a, None, b, poses_b, penetration=False)
+    assert list(out["signed_distance"]) == [0.0, y.signed_distance]
+    batch = proxima.PairBatch([a, a], [b, b])
+    out = batch.distance(None, poses_b, penetration=False)
+    assert out["signed_lower_bound"][0] == -math.inf
+    scene = proxima.Scene(margin=0.1, penetration=False)
+    scene.add(a)
+    scene.add(b, over)
+    (pair,) = scene.step()
+    assert pair.result.status == "intersecting" and pair.result.signed_distance == 0.0
