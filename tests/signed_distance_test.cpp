@@ -589,6 +589,45 @@ TEST(SignedDistanceCompound, WithoutTheDepthTheSearchStopsAtTheFirstOverlap) {
   EXPECT_LT(full.signed_distance(), -0.4);
 }
 
+TEST(SignedDistanceCompound, GradientWithRespectToTheBodiesPosesMatchesFiniteDifferences) {
+  // The gradient takes the bodies' poses (not the pieces'): rotating a
+  // compound about its origin moves the reported pair's witness points
+  // about that origin. B overlapping A's pieces, then apart, turned a
+  // little so that the reported pair and its witnesses are unique.
+  const CompoundBody a = two_cubes(0.5);
+  const CompoundBody b = two_cubes(0.5);
+  const Pose pa(Quat(Eigen::AngleAxisd(0.05, Vec3(1, 0, 2).normalized())), Vec3(0.1, 0.0, 0.0));
+  for (const double height : {0.8, 1.3}) {
+    const Pose pb(Quat(Eigen::AngleAxisd(0.15, Vec3(2, 1, 3).normalized())),
+                  Vec3(0.3, 0.1, height));
+    const CompoundResult r = distance(a, pa, b, pb);
+    ASSERT_EQ(r.status, height < 1.0 ? Status::intersecting : Status::separated);
+    const SignedDistanceGradient g = signed_distance_gradient(r, pa, pb);
+    const double h = 1e-6;
+    for (int which = 0; which < 2; ++which) {
+      for (int k = 0; k < 6; ++k) {
+        Pose plus = which == 0 ? pa : pb;
+        Pose minus = plus;
+        if (k < 3) {
+          plus.translation[k] += h;
+          minus.translation[k] -= h;
+        } else {
+          plus.rotation =
+              Eigen::AngleAxisd(h, Vec3::Unit(k - 3)).toRotationMatrix() * plus.rotation;
+          minus.rotation =
+              Eigen::AngleAxisd(-h, Vec3::Unit(k - 3)).toRotationMatrix() * minus.rotation;
+        }
+        const double fp = which == 0 ? distance(a, plus, b, pb).signed_distance()
+                                     : distance(a, pa, b, plus).signed_distance();
+        const double fm = which == 0 ? distance(a, minus, b, pb).signed_distance()
+                                     : distance(a, pa, b, minus).signed_distance();
+        const double exact = which == 0 ? g.a[k] : g.b[k];
+        EXPECT_NEAR((fp - fm) / (2 * h), exact, 1e-6) << height << " body " << which << " " << k;
+      }
+    }
+  }
+}
+
 TEST(SignedDistanceScene, ClosePairsCarryTheSignedDistance) {
   Scene scene;
   const auto cube_shape = std::make_shared<const ConvexPolytope>(cube(1.0));
