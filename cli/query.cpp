@@ -221,7 +221,9 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   // A JSON line can carry no NaN or infinity. Finite inputs whose products
   // overflow (coordinates near 1e308) are the only way to get one; say so
   // rather than print an invalid line.
-  if (!std::isfinite(r.distance) || !r.point_a.allFinite() || !r.point_b.allFinite()) {
+  if (!std::isfinite(r.distance) || !std::isfinite(r.signed_distance()) ||
+      !std::isfinite(r.signed_lower_bound()) || !std::isfinite(r.signed_upper_bound()) ||
+      !r.point_a.allFinite() || !r.point_b.allFinite() || !r.normal.allFinite()) {
     append_error_answer(out, id, line_number,
                         "the result is not finite: the coordinates are too large for double "
                         "arithmetic");
@@ -237,10 +239,18 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   out += status;
   out += "\",\"distance\":";
   append_number(out, r.distance);
+  out += ",\"signed_distance\":";
+  append_number(out, r.signed_distance());
+  out += ",\"signed_lower_bound\":";
+  append_number(out, r.signed_lower_bound());
+  out += ",\"signed_upper_bound\":";
+  append_number(out, r.signed_upper_bound());
   out += ",\"point_a\":";
   append_point(out, r.point_a);
   out += ",\"point_b\":";
   append_point(out, r.point_b);
+  out += ",\"normal\":";
+  append_point(out, r.normal);
   out += ",\"iterations\":";
   out += std::to_string(r.iterations);
   if (capped) out += ",\"iteration_cap\":true";

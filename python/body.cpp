@@ -154,14 +154,8 @@ void bind_bodies(py::module_& m) {
   py::class_<BodyDistance, DistanceResult>(
       m, "BodyDistance",
       "The answer for two bodies with radii: distance, points (on the rounded surfaces), "
-      "normal and status of the rounded bodies; features of the cores.")
-      .def_readonly("signed_distance", &BodyDistance::signed_distance,
-                    "Negative when the bodies overlap: minus the shortest translation of B that "
-                    "makes them touch. Equals distance otherwise.")
-      .def_readonly("signed_lower_bound", &BodyDistance::signed_lower_bound,
-                    "Certified lower bound on the signed distance.")
-      .def_readonly("signed_upper_bound", &BodyDistance::signed_upper_bound,
-                    "Certified upper bound on the signed distance.")
+      "normal, status and signed distance (with its bounds) of the rounded bodies; features of "
+      "the cores.")
       .def_readonly("piece_a", &BodyDistance::piece_a, "Piece of A (compound), else -1.")
       .def_readonly("piece_b", &BodyDistance::piece_b, "Piece of B (compound), else -1.")
       .def_readonly("cores_overlap", &BodyDistance::cores_overlap,
@@ -172,8 +166,8 @@ void bind_bodies(py::module_& m) {
                     "shapes' answer.")
       .def("__repr__", [](const BodyDistance& r) {
         return std::string("proxima.BodyDistance(status='") + to_string(r.status) +
-               "', signed_distance=" + py::repr(py::float_(r.signed_distance)).cast<std::string>() +
-               ")";
+               "', signed_distance=" +
+               py::repr(py::float_(r.signed_distance())).cast<std::string>() + ")";
       });
 
   const DistanceOptions defaults;
@@ -181,9 +175,9 @@ void bind_bodies(py::module_& m) {
       "distance",
       [](py::object a, py::object pose_a, py::object b, py::object pose_b, PyBodyCache* cache,
          const std::string& algorithm, double relative_tolerance, double absolute_tolerance,
-         int max_iterations) {
-        const DistanceOptions options =
-            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+         int max_iterations, bool penetration) {
+        const DistanceOptions options = make_options(
+            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
         const Body body_a = to_body(a, "a");
         const Body body_b = to_body(b, "b");
         const Pose pa = to_pose(pose_a, "pose_a");
@@ -198,9 +192,11 @@ void bind_bodies(py::module_& m) {
       py::arg("relative_tolerance") = defaults.relative_tolerance,
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
+      py::arg("penetration") = defaults.penetration,
       "Any two bodies: a ConvexPolytope, a CompoundBody or a Body on either side (two polytopes "
       "or two compounds take the overloads above). cache: a BodyCache or None. Returns a "
-      "BodyDistance. A ConvexPolytope met with a compound is wrapped on every call (O(N)): for "
+      "BodyDistance (overlapping cores always get their depth: penetration=False has no effect "
+      "here). A ConvexPolytope met with a compound is wrapped on every call (O(N)): for "
       "tracked queries, wrap it once as a Body.");
 }
 

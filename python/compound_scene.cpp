@@ -244,9 +244,9 @@ void bind_compound_and_scene(py::module_& m) {
       "distance",
       [](const CompoundBody& a, py::object pose_a, const CompoundBody& b, py::object pose_b,
          PyCompoundCache* cache, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations) {
-        const DistanceOptions options =
-            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+         double absolute_tolerance, int max_iterations, bool penetration) {
+        const DistanceOptions options = make_options(
+            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
         const Pose pa = to_pose(pose_a, "pose_a");
         const Pose pb = to_pose(pose_b, "pose_b");
         std::optional<InUse> in_use;
@@ -259,6 +259,7 @@ void bind_compound_and_scene(py::module_& m) {
       py::arg("relative_tolerance") = defaults.relative_tolerance,
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
+      py::arg("penetration") = defaults.penetration,
       "Minimum distance between two CompoundBody objects (branch and bound over piece pairs); "
       "cache: a CompoundCache or None. Returns a CompoundResult.");
   m.def(
@@ -308,13 +309,13 @@ void bind_compound_and_scene(py::module_& m) {
       "raises RuntimeError.")
       .def(py::init([](double margin, const std::string& broad_phase, int threads,
                        const std::string& algorithm, double relative_tolerance,
-                       double absolute_tolerance, int max_iterations) {
+                       double absolute_tolerance, int max_iterations, bool penetration) {
              SceneOptions options;
              options.margin = margin;
              options.broad_phase = to_broad_phase(broad_phase);
              options.threads = threads;
-             options.distance =
-                 make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+             options.distance = make_options(algorithm, relative_tolerance, absolute_tolerance,
+                                             max_iterations, penetration);
              return PyScene(options);
            }),
            py::arg("margin") = 0.0, py::arg("broad_phase") = to_string(SceneOptions{}.broad_phase),
@@ -323,6 +324,7 @@ void bind_compound_and_scene(py::module_& m) {
            py::arg("relative_tolerance") = defaults.relative_tolerance,
            py::arg("absolute_tolerance") = defaults.absolute_tolerance,
            py::arg("max_iterations") = defaults.max_iterations,
+           py::arg("penetration") = defaults.penetration,
            "margin: pairs at distance <= margin are reported. broad_phase: 'dynamic_aabb_tree' or "
            "'sweep_and_prune'. threads: narrow-phase threads (1: the calling thread, 0: all "
            "cores).")

@@ -296,9 +296,13 @@ inline Algorithm to_algorithm(const std::string& name) {
   value_error("algorithm must be 'hybrid', 'gjk' or 'enhanced_gjk', got '" + name + "'");
 }
 
+// `penetration`: DistanceOptions::penetration (the depth of intersecting
+// answers; False skips it).
 inline DistanceOptions make_options(const std::string& algorithm, double relative_tolerance,
-                                    double absolute_tolerance, int max_iterations) {
+                                    double absolute_tolerance, int max_iterations,
+                                    bool penetration) {
   DistanceOptions options;
+  options.penetration = penetration;
   options.algorithm = to_algorithm(algorithm);
   options.relative_tolerance = relative_tolerance;
   options.absolute_tolerance = absolute_tolerance;
@@ -379,13 +383,17 @@ inline int check_index(int i, int count, const char* what) {
 // The batch result as a dict of arrays (K rows each).
 inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   const auto k = static_cast<py::ssize_t>(results.size());
-  py::array_t<double> distance_(k), lower_bound(k), point_a({k, py::ssize_t{3}}),
-      point_b({k, py::ssize_t{3}}), normal({k, py::ssize_t{3}});
+  py::array_t<double> distance_(k), lower_bound(k), signed_distance(k), signed_lower_bound(k),
+      signed_upper_bound(k), point_a({k, py::ssize_t{3}}), point_b({k, py::ssize_t{3}}),
+      normal({k, py::ssize_t{3}});
   Int32Array iterations(k), face_a(k), face_b(k), vertices_a({k, py::ssize_t{3}}),
       vertices_b({k, py::ssize_t{3}});
   py::array_t<std::uint8_t> status_code(k), type_a(k), type_b(k);
   auto d = distance_.mutable_unchecked<1>();
   auto lb = lower_bound.mutable_unchecked<1>();
+  auto sd = signed_distance.mutable_unchecked<1>();
+  auto slb = signed_lower_bound.mutable_unchecked<1>();
+  auto sub = signed_upper_bound.mutable_unchecked<1>();
   auto pa = point_a.mutable_unchecked<2>();
   auto pb = point_b.mutable_unchecked<2>();
   auto n = normal.mutable_unchecked<2>();
@@ -401,6 +409,9 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
     const DistanceResult& r = results[static_cast<std::size_t>(i)];
     d(i) = r.distance;
     lb(i) = r.lower_bound;
+    sd(i) = r.signed_distance();
+    slb(i) = r.signed_lower_bound();
+    sub(i) = r.signed_upper_bound();
     for (int j = 0; j < 3; ++j) {
       pa(i, j) = r.point_a[j];
       pb(i, j) = r.point_b[j];
@@ -438,6 +449,9 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   out["status"] = status_table[status_code];
   out["distance"] = distance_;
   out["lower_bound"] = lower_bound;
+  out["signed_distance"] = signed_distance;
+  out["signed_lower_bound"] = signed_lower_bound;
+  out["signed_upper_bound"] = signed_upper_bound;
   out["point_a"] = point_a;
   out["point_b"] = point_b;
   out["normal"] = normal;

@@ -34,6 +34,7 @@
 #include "proxima/distance.h"
 #include "proxima/io.h"
 #include "proxima/polytope.h"
+#include "proxima/signed_distance.h"
 #include "proxima/types.h"
 
 namespace py = pybind11;
@@ -388,23 +389,61 @@ PYBIND11_MODULE(proxima, m) {
                     "Certified lower bound on the exact distance.")
       .def_property_readonly(
           "point_a", [](const DistanceResult& r) { return vec3_array(r.point_a); },
-          "Closest point on A, world frame.")
+          "Closest point on A, world frame (intersecting: the deepest point of A).")
       .def_property_readonly(
           "point_b", [](const DistanceResult& r) { return vec3_array(r.point_b); },
-          "Closest point on B, world frame.")
+          "Closest point on B, world frame (intersecting: the deepest point of B, "
+          "point_b + depth * normal == point_a).")
       .def_property_readonly(
           "normal", [](const DistanceResult& r) { return vec3_array(r.normal); },
-          "Unit normal from A towards B.")
+          "Unit normal from A towards B (intersecting: the direction that separates).")
       .def_readonly("feature_a", &DistanceResult::feature_a, "Witness feature on A (hull ids).")
       .def_readonly("feature_b", &DistanceResult::feature_b, "Witness feature on B (hull ids).")
+      .def_readonly("depth", &DistanceResult::depth,
+                    "Penetration depth of an intersecting answer (0 otherwise): the length of "
+                    "the shortest translation of B after which the bodies only touch.")
+      .def_readonly("depth_lower_bound", &DistanceResult::depth_lower_bound,
+                    "Certified lower bound on the depth.")
+      .def_readonly("depth_upper_bound", &DistanceResult::depth_upper_bound,
+                    "Certified upper bound on the depth (inf when it was not computed).")
+      .def_property_readonly("signed_distance", &DistanceResult::signed_distance,
+                             "distance when apart, minus the depth when intersecting.")
+      .def_property_readonly("signed_lower_bound", &DistanceResult::signed_lower_bound,
+                             "Certified lower bound on the signed distance.")
+      .def_property_readonly("signed_upper_bound", &DistanceResult::signed_upper_bound,
+                             "Certified upper bound on the signed distance.")
       .def_readonly("iterations", &DistanceResult::iterations, "Iterations the algorithm ran.")
       .def_readonly("second_algorithm", &DistanceResult::second_algorithm,
                     "True when the hybrid needed Enhanced GJK (contact classification or a "
                     "cross-check of an uncertified answer).")
       .def("__repr__", [](const DistanceResult& r) {
         return std::string("proxima.DistanceResult(status='") + to_string(r.status) +
-               "', distance=" + py::repr(py::float_(r.distance)).cast<std::string>() + ")";
+               "', distance=" + py::repr(py::float_(r.distance)).cast<std::string>() +
+               ", signed_distance=" +
+               py::repr(py::float_(r.signed_distance())).cast<std::string>() + ")";
       });
+
+  m.def(
+      "signed_distance_gradient",
+      [](const DistanceResult& r, py::object pose_a, py::object pose_b) {
+        const SignedDistanceGradient g =
+            signed_distance_gradient(r, to_pose(pose_a, "pose_a"), to_pose(pose_b, "pose_b"));
+        py::array_t<double> out({py::ssize_t{2}, py::ssize_t{6}});
+        auto o = out.mutable_unchecked<2>();
+        for (int k = 0; k < 6; ++k) {
+          o(0, k) = g.a[k];
+          o(1, k) = g.b[k];
+        }
+        return out;
+      },
+      py::arg("result"), py::arg("pose_a"), py::arg("pose_b"),
+      R"doc(The gradient of result.signed_distance with respect to each body's pose.
+
+result: the answer of distance() (or of the compound distance) at pose_a, pose_b (the bodies'
+poses of that query). Returns a (2, 6) array: row 0 for A, row 1 for B, each the derivative
+along world translations (3) then along small rotations about world axes through the body's
+origin (3). Exact where the witness pair is unique, else one-sided (a subgradient); raises
+InvalidInput for an intersecting answer computed without the depth.)doc");
 
   // --- Queries --------------------------------------------------------------
   const DistanceOptions defaults;
@@ -412,9 +451,9 @@ PYBIND11_MODULE(proxima, m) {
       "distance",
       [](const ConvexPolytope& a, py::object pose_a, const ConvexPolytope& b, py::object pose_b,
          PyDistanceCache* cache, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations) {
-        const DistanceOptions options =
-            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+         double absolute_tolerance, int max_iterations, bool penetration) {
+        const DistanceOptions options = make_options(
+            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
         const Pose pa = to_pose(pose_a, "pose_a");
         const Pose pb = to_pose(pose_b, "pose_b");
         if (cache == nullptr) return distance(a, pa, b, pb, options, nullptr);
@@ -428,6 +467,7 @@ PYBIND11_MODULE(proxima, m) {
       py::arg("relative_tolerance") = defaults.relative_tolerance,
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
+      py::arg("penetration") = defaults.penetration,
       R"doc(Minimum distance, closest points and features of hulls a and b placed at pose_a and pose_b.
 
 Poses: None (identity), a 4x4 or 3x4 rigid matrix, a scipy Rotation, a (rotation, translation)
@@ -441,9 +481,9 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
       "distance_batch",
       [](const ConvexPolytope& a, py::object poses_a, const ConvexPolytope& b, py::object poses_b,
          py::object caches, int threads, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations) {
-        const DistanceOptions options =
-            make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+         double absolute_tolerance, int max_iterations, bool penetration) {
+        const DistanceOptions options = make_options(
+            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
         py::ssize_t k = batch_size(poses_a);
         if (k < 0) k = batch_size(poses_b);
         const std::vector<Pose> pa = to_poses(poses_a, k, "poses_a");
@@ -507,13 +547,15 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
       py::arg("relative_tolerance") = defaults.relative_tolerance,
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
+      py::arg("penetration") = defaults.penetration,
       R"doc(K distance queries of one pair of polytopes, run on the thread pool without the GIL.
 
 poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices; one of them may be a single pose (4x4, a
 (quaternion, translation) pair, a Pose) or None, used for all K.
 caches: None (all cold) or a list of K DistanceCache, updated in place (tracking across calls).
 threads: 0 for all cores, 1 for the calling thread only, n for n threads.
-Returns a dict of arrays with K rows: status (str), distance, lower_bound, point_a (K, 3),
+Returns a dict of arrays with K rows: status (str), distance, lower_bound, signed_distance,
+signed_lower_bound, signed_upper_bound, point_a (K, 3),
 point_b (K, 3), normal (K, 3), feature_a_type (str), feature_a_vertices (K, 3; -1 unused),
 feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k], b, poses_b[k]).)doc");
 

@@ -78,10 +78,10 @@ void bind_pair_batch(py::module_& m) {
           "distance",
           [](PyPairBatch& s, py::object poses_a, py::object poses_b, int threads,
              const std::string& algorithm, double relative_tolerance, double absolute_tolerance,
-             int max_iterations) {
+             int max_iterations, bool penetration) {
             const InUse in_use(s, "PairBatch");
-            const DistanceOptions options =
-                make_options(algorithm, relative_tolerance, absolute_tolerance, max_iterations);
+            const DistanceOptions options = make_options(
+                algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
             const auto k = static_cast<py::ssize_t>(s.pairs.size());
             const std::vector<Pose> pa = to_poses(poses_a, k, "poses_a");
             const std::vector<Pose> pb = to_poses(poses_b, k, "poses_b");
@@ -99,11 +99,13 @@ void bind_pair_batch(py::module_& m) {
           py::arg("relative_tolerance") = defaults.relative_tolerance,
           py::arg("absolute_tolerance") = defaults.absolute_tolerance,
           py::arg("max_iterations") = defaults.max_iterations,
+          py::arg("penetration") = defaults.penetration,
           R"doc(Distance of every pair k at poses_a[k], poses_b[k], tracked from the previous call.
 
 poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices, or one pose (or None) for all K.
 threads: 0 for all cores, 1 for the calling thread only, n for n threads.
-Returns the dict of distance_batch: arrays with K rows (status, distance, lower_bound, point_a,
+Returns the dict of distance_batch: arrays with K rows (status, distance, lower_bound,
+signed_distance and its bounds, point_a,
 point_b, normal, features, iterations). Row k equals
 distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).)doc")
       .def(

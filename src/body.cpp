@@ -158,16 +158,29 @@ BodyDistance offset(const CoreAnswer& c, const Body& a, const Placed& pa, const 
   const double rb = b.radius();
   const double radii = ra + rb;
   BodyDistance r;
-  r.signed_distance = c.value - radii;
-  r.signed_lower_bound = c.lower - radii;
-  r.signed_upper_bound = c.upper - radii;
+  const double value = c.value - radii;
+  const double lower = c.lower - radii;
+  const double upper = c.upper - radii;
   if (c.status == Status::iteration_cap || radii == 0.0) {
     r.status = c.status;
   } else {
-    r.status = rounded_status(r.signed_distance, pa, ra, pb, rb, options);
+    r.status = rounded_status(value, pa, ra, pb, rb, options);
   }
-  r.distance = std::max(r.signed_distance, 0.0);
-  r.lower_bound = std::max(r.signed_lower_bound, 0.0);
+  // The signed values in DistanceResult's fields, so that its
+  // signed_distance(), signed_lower_bound() and signed_upper_bound() give
+  // them: distance - depth, lower_bound - depth_upper_bound and
+  // distance - depth_lower_bound.
+  if (value >= 0.0) {
+    r.distance = value;
+    r.depth = 0.0;
+    r.depth_lower_bound = value - upper;  // 0 when the upper bound is the distance
+  } else {
+    r.distance = 0.0;
+    r.depth = -value;
+    r.depth_lower_bound = -upper;  // negative when the overlap is not certified
+  }
+  r.lower_bound = std::max(lower, 0.0);
+  r.depth_upper_bound = r.lower_bound - lower;
   r.normal = c.normal;
   r.point_a = c.point_a + ra * c.normal;
   r.point_b = c.point_b - rb * c.normal;
@@ -379,10 +392,14 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
       throw InvalidInput(message);
     }
   }
+  // The cores' queries without their own depth: the depth of overlapping
+  // cores is taken here (take_depth, DeepestPair), once.
+  DistanceOptions cores = options;
+  cores.penetration = false;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
-    return convex_pair(a, pa, b, pb, options, c);
+    return convex_pair(a, pa, b, pb, cores, c);
   }
-  return compound_pair(a, pa, b, pb, options, c);
+  return compound_pair(a, pa, b, pb, cores, c);
 }
 
 }  // namespace proxima

@@ -278,11 +278,14 @@ double world_magnitude_bound(const CompoundBody& body, const Pose& pose) {
   return magnitude_bound(pose, body.scale());
 }
 
-// Whether (distance, intersecting, pair) orders `r` before the current best:
-// the smaller distance, then an intersecting pair before a touching one at
-// the same distance, then the smaller (piece_a, piece_b).
+// Whether (signed distance, intersecting, pair) orders `r` before the
+// current best: the smaller signed distance (the distance when apart, minus
+// the depth when overlapping), then an intersecting pair before a touching
+// one at the same value, then the smaller (piece_a, piece_b).
 bool better(const DistanceResult& r, std::int32_t pa, std::int32_t pb, const CompoundResult& best) {
-  if (r.distance != best.distance) return r.distance < best.distance;
+  const double sr = r.signed_distance();
+  const double sb = best.signed_distance();
+  if (sr != sb) return sr < sb;
   const bool ri = r.status == Status::intersecting;
   const bool bi = best.status == Status::intersecting;
   if (ri != bi) return ri;
@@ -327,7 +330,7 @@ class Search {
     // A near list the caller did not keep sorted is ignored (a binary search
     // on it could miss entries): slower, never wrong.
     if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
-      old_near_ = std::span<const CompoundCache::Entry>(cache_->near);
+      old_near_ = std::span<CompoundCache::Entry>(cache_->near);
     }
   }
 
@@ -351,7 +354,14 @@ class Search {
     double key;  // lower bound minus slack, in scaled units
   };
 
-  bool done() const { return have_best_ && best_.status == Status::intersecting; }
+  // An overlap ends the search only when the depth is not asked for: with
+  // it, a deeper piece pair may still come (the pruning keys below are
+  // lower bounds on the signed distance too: a piece pair inside two
+  // spheres is at most as deep as the spheres, whose depth is
+  // r_a + r_b - |c_a - c_b|, depth being monotone under inclusion).
+  bool done() const {
+    return have_best_ && best_.status == Status::intersecting && !options_.penetration;
+  }
 
   // The pruning key of two spheres (body frames): their scaled lower bound
   // minus its rounding slack. An overflowing distance cannot occur on scaled
@@ -432,7 +442,10 @@ class Search {
     t.entry.piece_b = pb;
     const CompoundCache::Entry probe{pa, pb, {}};
     const auto it = std::lower_bound(old_near_.begin(), old_near_.end(), probe, pair_less);
-    if (it != old_near_.end() && it->piece_a == pa && it->piece_b == pb) t.entry.cache = it->cache;
+    // Moved, not copied: the near list is rebuilt from the tested pairs,
+    // and a copy of a cache that holds penetration state is a deep copy.
+    if (it != old_near_.end() && it->piece_a == pa && it->piece_b == pb)
+      t.entry.cache = std::move(it->cache);
     const CompoundPiece& piece_a = a_.piece(pa);
     const CompoundPiece& piece_b = b_.piece(pb);
     // Both factors are under the pose contract (checked where the body and
@@ -440,11 +453,11 @@ class Search {
     const DistanceResult r = detail::distance_of_rigid_poses(
         *piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope, pose_b_ * piece_b.pose,
         options_, &t.entry.cache);
-    t.distance = r.distance;
+    t.distance = r.signed_distance();
     if (!have_best_ || better(r, pa, pb, best_)) {
       take(best_, r, pa, pb);
       have_best_ = true;
-      best_scaled_ = factor_ * r.distance;
+      best_scaled_ = factor_ * r.signed_distance();
     }
   }
 
@@ -461,7 +474,7 @@ class Search {
     std::sort(tested_.begin(), tested_.end(),
               [](const NearEntry& x, const NearEntry& y) { return pair_less(x.entry, y.entry); });
     cache_->near.clear();
-    for (const NearEntry& t : tested_) cache_->near.push_back(t.entry);
+    for (NearEntry& t : tested_) cache_->near.push_back(std::move(t.entry));
     cache_->piece_a = best_.piece_a;
     cache_->piece_b = best_.piece_b;
   }
@@ -472,11 +485,11 @@ class Search {
   const Pose& pose_b_;
   const DistanceOptions& options_;
   CompoundCache* cache_;
-  std::span<const CompoundCache::Entry> old_near_;
+  std::span<CompoundCache::Entry> old_near_;
   double factor_ = 1.0;       // 2^-e, e the exponent of the magnitude bound
   Mat3 rotation_;             // B's frame -> A's frame
   Vec3 translation_;          // scaled by factor_
-  double best_scaled_ = 0.0;  // best_.distance * factor_
+  double best_scaled_ = 0.0;  // best_.signed_distance() * factor_
   double slack_ = 0.0;        // scaled
   std::int32_t hint_a_ = -1;
   std::int32_t hint_b_ = -1;

@@ -271,8 +271,8 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
     out.pose_b = pb;
     out.at_t = r;
     if (r.status == Status::intersecting || r.status == Status::touching ||
-        r.signed_distance <= target + tolerance) {
-      out.status = t == 0.0 && (r.status == Status::intersecting || r.signed_distance < target)
+        r.signed_distance() <= target + tolerance) {
+      out.status = t == 0.0 && (r.status == Status::intersecting || r.signed_distance() < target)
                        ? ImpactStatus::overlapping
                        : ImpactStatus::contact;
       return out;
@@ -283,7 +283,7 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
     }
     const double band =
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
-    const double lower = r.signed_lower_bound - band;
+    const double lower = r.signed_lower_bound() - band;
     const bool never = !(any_speed > 0.0) && lower > target;
     const double step = lower > target && any_speed > 0.0 ? (lower - target) / any_speed : 0.0;
     if (never || t + step >= 1.0) {
@@ -296,7 +296,7 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
       out.at_t = e;
       out.t = 1.0;
       const bool end_contact = e.status == Status::intersecting || e.status == Status::touching ||
-                               e.signed_distance <= target + tolerance;
+                               e.signed_distance() <= target + tolerance;
       out.status = end_contact ? ImpactStatus::contact : ImpactStatus::separated;
       return out;
     }

@@ -52,13 +52,13 @@ double bound(double d, double magnitude) { return 1e-12 * std::abs(d) + kBand * 
 // point_b - point_a along the normal with the sign of signed, distance and
 // lower bound from the signed values, the bounds around the value.
 void expect_consistent(const BodyDistance& r, double magnitude) {
-  const double tol = bound(r.signed_distance, magnitude);
-  EXPECT_NEAR((r.point_b - r.point_a).norm(), std::abs(r.signed_distance), tol);
-  EXPECT_NEAR((r.point_b - r.point_a - r.signed_distance * r.normal).norm(), 0.0, tol);
+  const double tol = bound(r.signed_distance(), magnitude);
+  EXPECT_NEAR((r.point_b - r.point_a).norm(), std::abs(r.signed_distance()), tol);
+  EXPECT_NEAR((r.point_b - r.point_a - r.signed_distance() * r.normal).norm(), 0.0, tol);
   EXPECT_NEAR(r.normal.norm(), 1.0, 1e-12);
-  EXPECT_EQ(r.distance, std::max(r.signed_distance, 0.0));
-  EXPECT_LE(r.signed_lower_bound, r.signed_distance + tol);
-  EXPECT_GE(r.signed_upper_bound, r.signed_distance - tol);
+  EXPECT_EQ(r.distance, std::max(r.signed_distance(), 0.0));
+  EXPECT_LE(r.signed_lower_bound(), r.signed_distance() + tol);
+  EXPECT_GE(r.signed_upper_bound(), r.signed_distance() - tol);
   EXPECT_LE(r.lower_bound, r.distance + tol);
 }
 
@@ -79,7 +79,7 @@ TEST(BodyClosedForm, SphereSphere) {
     const BodyDistance r = distance(a, pa, b, pb);
     const double exact = (cb - ca).norm() - ra - rb;
     const double magnitude = std::max(ca.cwiseAbs().maxCoeff() + ra, cb.cwiseAbs().maxCoeff() + rb);
-    EXPECT_NEAR(r.signed_distance, exact, bound(exact, magnitude)) << i;
+    EXPECT_NEAR(r.signed_distance(), exact, bound(exact, magnitude)) << i;
     EXPECT_EQ(r.status, exact > 0 ? Status::separated : Status::intersecting) << i;
     EXPECT_FALSE(r.cores_overlap);
     const Vec3 n = (cb - ca).normalized();
@@ -96,7 +96,7 @@ TEST(BodyClosedForm, ConcentricSpheresOverlapByTheirRadii) {
   const BodyDistance r = distance(make_sphere(1.0), Pose::identity(), make_sphere(0.5),
                                   Pose::from_translation(Vec3::Zero()));
   EXPECT_EQ(r.status, Status::intersecting);
-  EXPECT_DOUBLE_EQ(r.signed_distance, -1.5);
+  EXPECT_DOUBLE_EQ(r.signed_distance(), -1.5);
   EXPECT_EQ(r.distance, 0.0);
   expect_consistent(r, 1.0);
 }
@@ -139,7 +139,7 @@ TEST(BodyClosedForm, CapsuleCapsuleIsSegmentsMinusRadii) {
     const BodyDistance r = distance(make_capsule(ha, ra), pa, make_capsule(hb, rb), pb);
     if (core <= 1e-9) continue;  // crossing cores: the depth cases below
     const double exact = core - ra - rb;
-    EXPECT_NEAR(r.signed_distance, exact, 1e-9) << i;
+    EXPECT_NEAR(r.signed_distance(), exact, 1e-9) << i;
     EXPECT_EQ(r.status, exact > 0 ? Status::separated : Status::intersecting) << i;
     (exact > 0 ? separated : overlapping)++;
     expect_consistent(r, 6.0);
@@ -164,7 +164,7 @@ TEST(BodyClosedForm, AxisAlignedBoxes) {
     const double exact = gap.norm() - ra - rb;
     const BodyDistance r =
         distance(make_box(ha, ra), Pose::identity(), make_box(hb, rb), Pose::from_translation(c));
-    EXPECT_NEAR(r.signed_distance, exact, bound(exact, 9.0)) << i;
+    EXPECT_NEAR(r.signed_distance(), exact, bound(exact, 9.0)) << i;
     expect_consistent(r, 9.0);
   }
 }
@@ -190,7 +190,7 @@ TEST(BodyOracle, RoundedHullsAreTheConvexOracleOffsetByTheRadii) {
         distance(Body(hull(a), ra), Pose::identity(), Body(hull(b), rb), Pose::identity());
     const double magnitude =
         std::max(test::max_abs_coordinate(a) + ra, test::max_abs_coordinate(b) + rb);
-    EXPECT_NEAR(r.signed_distance, d - ra - rb, bound(d, magnitude)) << i;
+    EXPECT_NEAR(r.signed_distance(), d - ra - rb, bound(d, magnitude)) << i;
     EXPECT_FALSE(r.cores_overlap);
     expect_consistent(r, magnitude);
     // The points lie on the rounded bodies: within the radius of the core.
@@ -216,8 +216,8 @@ TEST(BodyOracle, PosesMoveTheRoundedBodiesAsTheirCores) {
     const BodyDistance r = distance(Body(hull(a), ra), pa, Body(hull(b), rb), pb);
     const DistanceResult core = distance(*hull(a), pa, *hull(b), pb);
     if (core.status != Status::separated) continue;
-    EXPECT_NEAR(r.signed_distance, core.distance - ra - rb, 1e-13) << i;
-    EXPECT_NEAR(r.signed_lower_bound, core.lower_bound - ra - rb, 1e-13) << i;
+    EXPECT_NEAR(r.signed_distance(), core.distance - ra - rb, 1e-13) << i;
+    EXPECT_NEAR(r.signed_lower_bound(), core.lower_bound - ra - rb, 1e-13) << i;
     EXPECT_NEAR((r.point_a - (core.point_a + ra * core.normal)).norm(), 0.0, 1e-13);
     EXPECT_NEAR((r.point_b - (core.point_b - rb * core.normal)).norm(), 0.0, 1e-13);
     EXPECT_EQ(r.feature_a.vertices, core.feature_a.vertices);
@@ -242,13 +242,13 @@ TEST(BodyOracle, OverlappingCoresGiveMinusTheExactDepthMinusTheRadii) {
     const double depth = exact.depth();
     EXPECT_EQ(r.status, Status::intersecting) << i;
     EXPECT_TRUE(r.cores_overlap) << i;
-    EXPECT_NEAR(r.signed_distance, -depth - ra - rb, bound(depth, 2.5)) << i;
-    EXPECT_LE(r.signed_lower_bound, -depth - ra - rb + bound(depth, 2.5)) << i;
-    EXPECT_GE(r.signed_upper_bound, -depth - ra - rb - bound(depth, 2.5)) << i;
+    EXPECT_NEAR(r.signed_distance(), -depth - ra - rb, bound(depth, 2.5)) << i;
+    EXPECT_LE(r.signed_lower_bound(), -depth - ra - rb + bound(depth, 2.5)) << i;
+    EXPECT_GE(r.signed_upper_bound(), -depth - ra - rb - bound(depth, 2.5)) << i;
     expect_consistent(r, 2.5);
     // Translating B by -signed along the normal makes the rounded bodies
     // touch: the cores are then ra + rb apart.
-    const Points moved = test::translated(b, -r.signed_distance * r.normal);
+    const Points moved = test::translated(b, -r.signed_distance() * r.normal);
     const DistanceResult after =
         distance(*hull(a), Pose::identity(), *hull(moved), Pose::identity());
     EXPECT_NEAR(after.distance, ra + rb, 1e-9) << i;
@@ -279,11 +279,11 @@ TEST(BodyOracle, TouchingCoresTakeTheNormalOfTheirContact) {
     const BodyDistance r =
         distance(make_box(ha, ra), Pose::identity(), make_box(hb, rb), Pose::from_translation(c));
     EXPECT_EQ(r.status, Status::intersecting) << i;
-    EXPECT_NEAR(r.signed_distance, -ra - rb, 1e-14) << i;
+    EXPECT_NEAR(r.signed_distance(), -ra - rb, 1e-14) << i;
     EXPECT_NEAR(std::abs(r.normal[axis]), 1.0, 1e-14) << i;
     const DistanceResult after =
         distance(*make_box(ha).convex(), Pose::identity(), *make_box(hb).convex(),
-                 Pose::from_translation(c - r.signed_distance * r.normal));
+                 Pose::from_translation(c - r.signed_distance() * r.normal));
     EXPECT_NEAR(after.distance, ra + rb, 1e-14) << i;
     ++cases;
   }
@@ -313,9 +313,9 @@ TEST(BodyCompound, RoundedCompoundIsItsClosestRoundedPiece) {
     for (int p = 0; p < compound->piece_count(); ++p) {
       const BodyDistance piece =
           distance(Body(compound->piece(p).polytope, rc), pa * compound->piece(p).pose, b, pb);
-      best = std::min(best, piece.signed_distance);
+      best = std::min(best, piece.signed_distance());
     }
-    EXPECT_NEAR(r.signed_distance, best, 1e-12) << i;
+    EXPECT_NEAR(r.signed_distance(), best, 1e-12) << i;
     EXPECT_GE(r.piece_a, 0);
     EXPECT_EQ(r.piece_b, -1);  // a convex body has no pieces
     expect_consistent(r, 8.0);
@@ -337,7 +337,7 @@ TEST(BodyCompound, OverlappingCompoundReportsItsDeepestPiecePair) {
   EXPECT_EQ(r.status, Status::intersecting);
   EXPECT_TRUE(r.cores_overlap);
   EXPECT_EQ(r.piece_a, 1);
-  EXPECT_NEAR(r.signed_distance, -0.4 - 0.1 - 0.5, 1e-14);
+  EXPECT_NEAR(r.signed_distance(), -0.4 - 0.1 - 0.5, 1e-14);
   expect_consistent(r, 2.0);
 }
 
@@ -383,7 +383,7 @@ TEST(BodyCompound, DeepestPairIsTheAllPairsTwins) {
         twin = std::min(twin, value);
       }
     }
-    EXPECT_NEAR(r.signed_distance, twin - ra - rb, 1e-12) << i;
+    EXPECT_NEAR(r.signed_distance(), twin - ra - rb, 1e-12) << i;
     expect_consistent(r, 6.0);
     if (r.cores_overlap) ++overlapping;
   }
@@ -405,7 +405,7 @@ TEST(BodyCompound, MixedKindsAgreeWithTheirOnePieceCompounds) {
     const BodyDistance convex = distance(convex_a, pa, convex_b, pb);
     const BodyDistance mixed = distance(convex_a, pa, compound_b, pb);
     EXPECT_EQ(convex.status, mixed.status) << i;
-    EXPECT_NEAR(convex.signed_distance, mixed.signed_distance, bound(convex.signed_distance, 4.0))
+    EXPECT_NEAR(convex.signed_distance(), mixed.signed_distance(), bound(convex.signed_distance(), 4.0))
         << i;
     EXPECT_EQ(mixed.piece_b, 0);
     EXPECT_EQ(mixed.piece_a, -1);
@@ -429,14 +429,14 @@ TEST(BodyTracking, TrackedAnswersAreTheColdAnswers) {
     const BodyDistance tracked_b = distance(a, pa, b, pb, {}, &ab);
     const BodyDistance cold_b = distance(a, pa, b, pb);
     EXPECT_EQ(tracked_b.status, cold_b.status) << step;
-    EXPECT_NEAR(tracked_b.signed_distance, cold_b.signed_distance,
-                bound(cold_b.signed_distance, 4.0))
+    EXPECT_NEAR(tracked_b.signed_distance(), cold_b.signed_distance(),
+                bound(cold_b.signed_distance(), 4.0))
         << step;
     const BodyDistance tracked_c = distance(a, pa, c, pc, {}, &ac);
     const BodyDistance cold_c = distance(a, pa, c, pc);
     EXPECT_EQ(tracked_c.status, cold_c.status) << step;
-    EXPECT_NEAR(tracked_c.signed_distance, cold_c.signed_distance,
-                bound(cold_c.signed_distance, 6.0))
+    EXPECT_NEAR(tracked_c.signed_distance(), cold_c.signed_distance(),
+                bound(cold_c.signed_distance(), 6.0))
         << step;
   }
 }
@@ -523,7 +523,7 @@ TEST(Primitives, ShapesAreTheirDefinitions) {
   const BodyDistance r =
       distance(make_box(Vec3(1, 1, 1), 1.0), Pose::identity(), make_box(Vec3(1, 1, 1), 1.0),
                Pose::from_translation(Vec3(7, 0, 0)));
-  EXPECT_DOUBLE_EQ(r.signed_distance, 3.0);
+  EXPECT_DOUBLE_EQ(r.signed_distance(), 3.0);
   EXPECT_DOUBLE_EQ(r.point_a.x(), 2.0);
   EXPECT_DOUBLE_EQ(r.point_b.x(), 5.0);
   // The answer carries the approximation error of both bodies.

@@ -138,8 +138,24 @@ double check_answer_fields(const Json& answer) {
   EXPECT_GE(d, 0.0);
   const Vec3 a = point_of(answer, "point_a");
   const Vec3 b = point_of(answer, "point_b");
-  EXPECT_NEAR((a - b).norm(), d,
-              accuracy_bound(d, std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff())) * 4);
+  const Vec3 n = point_of(answer, "normal");
+  const double sd = answer.at("signed_distance").get<double>();
+  const double lo = answer.at("signed_lower_bound").get<double>();
+  const double hi = answer.at("signed_upper_bound").get<double>();
+  const double r = std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(n.norm(), 1.0, 1e-12) << answer.dump();
+  EXPECT_LE(lo, sd) << answer.dump();
+  EXPECT_LE(sd, hi) << answer.dump();
+  // The signed distance: the distance when apart, minus the depth when
+  // intersecting; the points differ by it along the normal either way.
+  if (answer.at("status") == "intersecting") {
+    EXPECT_EQ(d, 0.0);
+    EXPECT_LE(sd, 0.0) << answer.dump();
+  } else {
+    EXPECT_EQ(sd, d) << answer.dump();
+  }
+  EXPECT_NEAR((a - b).norm(), std::abs(sd), accuracy_bound(std::abs(sd), r) * 4);
+  EXPECT_NEAR(n.dot(b - a), sd, accuracy_bound(std::abs(sd), r) * 4) << answer.dump();
   return d;
 }
 
@@ -661,6 +677,12 @@ TEST(CliQuery, ContainedBodiesIntersectWithEveryAlgorithm) {
     for (const Json& answer : answers) {
       EXPECT_EQ(answer.at("status"), "intersecting") << answer.dump();
       EXPECT_EQ(check_answer_fields(answer), 0.0);
+    }
+    // The cube holds the small tetrahedron: the shortest way out of either
+    // is through the cube's nearest face, 0.4 + 0.2 = 0.6 away (the
+    // tetrahedron spans 0.4..0.6 on every axis).
+    for (std::size_t k : {std::size_t{2}, std::size_t{3}}) {
+      EXPECT_NEAR(answers[k].at("signed_distance").get<double>(), -0.6, 1e-15) << answers[k].dump();
     }
   }
 }

@@ -126,7 +126,12 @@ void check_against_twin(const CompoundBody& a, const Pose& pa, const CompoundBod
   const DistanceResult pair =
       distance(*piece_a.polytope, pa * piece_a.pose, *piece_b.polytope, pb * piece_b.pose);
   EXPECT_NEAR(pair.distance, r.distance, tol);
-  EXPECT_NEAR((r.point_a - r.point_b).norm(), r.distance, tol);
+  // Apart: the closest points; intersecting: the deepest points of the
+  // pair, |point_a - point_b| the depth (the signed distance's negative).
+  EXPECT_NEAR((r.point_a - r.point_b).norm(), std::abs(r.signed_distance()),
+              tol + 1e-12 * std::abs(r.signed_distance()));
+  EXPECT_NEAR(r.signed_distance(), twin.signed_distance(),
+              tol + 1e-12 * std::abs(twin.signed_distance()));
   const ConvexPolytope at_a(Points{r.point_a});
   const ConvexPolytope at_b(Points{r.point_b});
   EXPECT_LE(distance(at_a, Pose::identity(), *piece_a.polytope, pa * piece_a.pose).lower_bound,

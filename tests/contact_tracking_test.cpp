@@ -64,8 +64,12 @@ std::array<int, 4> check_sequence(const Points& pa, const Points& pb,
       const double tol = 1e-12 * cold.distance + band(pa, Pose::identity(), pb, pose_b);
       EXPECT_NEAR(warm.distance, cold.distance, tol) << at;
       if (warm.status == Status::intersecting) {
+        // The deepest points (the penetration depth, types.h): B moved by
+        // depth * normal carries point_b onto point_a.
         EXPECT_EQ(warm.distance, 0.0) << at;
-        EXPECT_EQ(warm.point_a, warm.point_b) << at;
+        EXPECT_NEAR((warm.point_b + warm.depth * warm.normal - warm.point_a).norm(), 0.0, 1e-12)
+            << at;
+        EXPECT_NEAR(warm.depth, cold.depth, 1e-12 * cold.depth + 1e-13) << at;
       }
     }
   }

@@ -370,7 +370,7 @@ TEST(TimeOfImpact, RoundedAndCompoundBodies) {
     double first = 2.0;
     for (int i = 0; i <= 2000; ++i) {
       const double s = i / 2000.0;
-      const double d = distance(a, ma.at(s), b, mb.at(s)).signed_distance;
+      const double d = distance(a, ma.at(s), b, mb.at(s)).signed_distance();
       if (d <= 0.0 && first > 1.0) first = s;
       if (s < r.t) EXPECT_GT(d, -1e-9) << "contact missed at " << s;
     }

@@ -14,7 +14,7 @@
 //   proxima::Body ball = proxima::make_sphere(0.1);
 //   proxima::BodyCache cache;                             // cold; keep it per pair
 //   auto r = proxima::distance(link, pose_a, ball, pose_b, {}, &cache);
-//   r.signed_distance, r.point_a, r.point_b, r.normal ...
+//   r.signed_distance(), r.point_a, r.point_b, r.normal ...
 //
 // The answer is the cores' answer offset along the normal, exact: with the
 // cores' distance d, closest points p_a, p_b and unit normal n (from A
@@ -128,14 +128,12 @@ struct BodyCache {
 //                 pieces piece_a, piece_b for compounds)
 // and beyond them:
 struct BodyDistance : DistanceResult {
-  // Negative when the rounded bodies overlap: minus the overlap depth
-  // (the shortest translation of B that makes them touch). Equal to
-  // distance when they do not overlap.
-  double signed_distance = 0.0;
-  // Certified bounds on the exact signed distance (of the approximations,
-  // see approximation_error), up to 64 u R.
-  double signed_lower_bound = 0.0;
-  double signed_upper_bound = 0.0;
+  // The signed distance of the rounded bodies and its certificate are
+  // DistanceResult's signed_distance(), signed_lower_bound() and
+  // signed_upper_bound() (distance - depth ...): negative when the rounded
+  // bodies overlap, minus the overlap depth (the shortest translation of B
+  // that makes them touch); the bounds are certified for the
+  // approximations (see approximation_error) up to 64 u R.
   // The pieces of the closest (or deepest) pair, -1 for a convex body.
   std::int32_t piece_a = -1;
   std::int32_t piece_b = -1;

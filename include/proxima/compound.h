@@ -45,10 +45,10 @@ class CompoundBody {
   struct Node {
     Vec3 center = Vec3::Zero();  // bounding sphere of every piece below
     double radius = 0.0;
-    std::int32_t left = -1;   // child node ids, -1 for a leaf
+    std::int32_t left = -1;  // child node ids, -1 for a leaf
     std::int32_t right = -1;
-    std::int32_t first = 0;   // leaf: first index into piece_order()
-    std::int32_t count = 0;   // leaf: number of pieces
+    std::int32_t first = 0;  // leaf: first index into piece_order()
+    std::int32_t count = 0;  // leaf: number of pieces
   };
 
   // Throws InvalidInput naming the piece index: no pieces, a null polytope,
@@ -75,7 +75,9 @@ class CompoundBody {
     Vec3 center = Vec3::Zero();
     double radius = 0.0;
   };
-  const PieceSphere& piece_sphere(int i) const { return piece_spheres_[static_cast<std::size_t>(i)]; }
+  const PieceSphere& piece_sphere(int i) const {
+    return piece_spheres_[static_cast<std::size_t>(i)];
+  }
 
   // Bounding sphere of the whole body, in its frame (the root's).
   const Vec3& center() const { return nodes_.front().center; }
@@ -128,19 +130,32 @@ struct CompoundResult : DistanceResult {
 };
 
 // Minimum distance between two compound bodies. Status is the convex
-// status of the closest pair (intersecting as soon as any two pieces
-// overlap: the search stops at the first such pair). The distance is the
-// twin's within the accuracy standard, R being the largest coordinate of
-// both bodies' placed vertices; which pair is reported may differ from the
-// twin's when two pairs are that close. Throws InvalidInput for non-finite
-// poses or bad options.
+// status of the reported pair. The distance is the twin's within the
+// accuracy standard, R being the largest coordinate of both bodies' placed
+// vertices; which pair is reported may differ from the twin's when two
+// pairs are that close. Throws InvalidInput for non-finite poses or bad
+// options.
+//
+// Signed distance: the minimum over piece pairs of the convex signed
+// distance (the piecewise definition FCL and Coal use for unions). When
+// pieces overlap it is minus the depth of the deepest overlapping piece
+// pair, reported with that pair's deepest points, normal, features and
+// certificate (which brackets that pair's signed distance). It is NOT the
+// penetration depth of the two unions: moving B by that pair's depth along
+// its normal separates that pair but may leave other pieces overlapping
+// (the union's depth is at least every pair's depth). With the depth
+// (DistanceOptions::penetration, the default) the search goes on after the
+// first overlapping pair, pruning node pairs whose sphere bound (a lower
+// bound on the signed distance as well) cannot beat the deepest pair found;
+// without it, it stops at the first overlapping pair as a status query
+// should.
 CompoundResult distance(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                         const Pose& pose_b, const DistanceOptions& options = {},
                         CompoundCache* cache = nullptr);
 
 // The slow, obvious twin: the convex query on every piece pair, cold, and the
-// minimum (ties broken by an intersecting pair first, then by the smaller
-// (piece_a, piece_b)). For tests and benchmarks.
+// minimum of the signed distance (ties broken by an intersecting pair first,
+// then by the smaller (piece_a, piece_b)). For tests and benchmarks.
 CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                                   const Pose& pose_b, const DistanceOptions& options = {});
 

@@ -80,7 +80,10 @@ struct CollisionFilter {
 };
 
 // One close pair: a < b, and the answer of the distance query between them
-// (for two convex bodies piece_a == piece_b == 0 and pairs_tested == 1).
+// (for two convex bodies piece_a == piece_b == 0 and pairs_tested == 1),
+// with its signed distance (negative for an overlap: minus the depth, as
+// distance() and the compound query define it; skipped with
+// SceneOptions::distance.penetration false).
 struct ClosePair {
   BodyId a = -1;
   BodyId b = -1;

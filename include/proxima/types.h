@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "proxima/pose.h"
 
@@ -121,6 +122,70 @@ struct DistanceOptions {
   // iterations plus Enhanced GJK's where its answer is the one reported (an
   // intersection it certified, or the closer pair of the cross-check).
   int max_iterations = 64;
+  // Whether an intersecting answer gets its penetration depth (the signed
+  // distance's negative side, proxima/penetration.h): the deepest points,
+  // the separating normal and the Minkowski face's features. Costs nothing
+  // for separated or touching pairs (the depth is computed only after the
+  // algorithm answered intersecting or touching). False: an intersecting answer is
+  // reported as without it, distance 0, signed_distance() 0 in the
+  // certificate [-infinity, 0] (depth_upper_bound +infinity: not computed);
+  // for a caller that only needs the status (a scene of resting contacts).
+  bool penetration = true;
+};
+
+struct PenetrationCache;  // proxima/penetration.h
+
+namespace detail {
+// Out of line (src/signed_distance.cpp), where PenetrationCache is complete.
+PenetrationCache* new_penetration_cache();
+PenetrationCache* copy_penetration_cache(const PenetrationCache& c);
+void delete_penetration_cache(PenetrationCache* c) noexcept;
+}  // namespace detail
+
+// The penetration-depth state of one pair (a PenetrationCache), owned by
+// its DistanceCache and allocated on the pair's first overlap, so that a
+// cache of a pair that never overlapped stays one null pointer (cheap to
+// copy; scenes keep one cache per pair). Value semantics: a copy is a deep
+// copy (an independent cache, so that the rule "distinct caches may be used
+// concurrently" holds for copies too; O(size of the state) when present,
+// one null test when not); a move takes the state and leaves the source
+// empty (cold for the depth).
+class PenetrationState {
+ public:
+  PenetrationState() = default;
+  PenetrationState(const PenetrationState& other)
+      : cache_(other.cache_ != nullptr ? detail::copy_penetration_cache(*other.cache_) : nullptr) {}
+  PenetrationState(PenetrationState&& other) noexcept
+      : cache_(std::exchange(other.cache_, nullptr)) {}
+  PenetrationState& operator=(const PenetrationState& other) {
+    if (this != &other) {
+      PenetrationState copy(other);
+      std::swap(cache_, copy.cache_);
+    }
+    return *this;
+  }
+  PenetrationState& operator=(PenetrationState&& other) noexcept {
+    if (this != &other) {
+      PenetrationState old(std::move(*this));
+      cache_ = std::exchange(other.cache_, nullptr);
+    }
+    return *this;
+  }
+  ~PenetrationState() {
+    if (cache_ != nullptr) detail::delete_penetration_cache(cache_);
+  }
+
+  // Null until the pair first overlapped (or after reset()).
+  PenetrationCache* get() const { return cache_; }
+  // The state, allocated (cold) if there is none yet.
+  PenetrationCache& get_or_create() {
+    if (cache_ == nullptr) cache_ = detail::new_penetration_cache();
+    return *cache_;
+  }
+  explicit operator bool() const { return cache_ != nullptr; }
+
+ private:
+  PenetrationCache* cache_ = nullptr;
 };
 
 // Coherence between queries of one pair, owned by the caller (Box2D's
@@ -148,30 +213,94 @@ struct DistanceCache {
   // re-certifies that tetrahedron in O(1) instead of searching again.
   std::array<std::int32_t, 4> contact_a = {-1, -1, -1, -1};
   std::array<std::int32_t, 4> contact_b = {-1, -1, -1, -1};
+  // The penetration depth's tracking state (Minkowski faces of A - B),
+  // allocated when the pair first answers intersecting with
+  // DistanceOptions::penetration; null for a pair that never overlapped.
+  // Copying a cache copies it (see PenetrationState).
+  PenetrationState penetration;
   // B's pose in A's frame at the hybrid's last query (zero: none), so that
   // a pose far from it starts cold instead of from a stale pair.
   Mat3 rotation = Mat3::Zero();
   Vec3 translation = Vec3::Zero();
 
-  bool is_cold() const { return vertices_a[0] < 0 && hint_a < 0 && contact_a[0] < 0; }
+  bool is_cold() const {
+    return vertices_a[0] < 0 && hint_a < 0 && contact_a[0] < 0 && !penetration;
+  }
   void reset() { *this = DistanceCache{}; }
 };
 
+// The answer of a query. Separated and touching answers: the closest
+// points, their features and distance = |point_a - point_b|. Intersecting
+// answers (with DistanceOptions::penetration, the default) report the
+// penetration depth instead: the deepest points, the separating normal and
+// the features of the face of the Minkowski difference A - B that realizes
+// it (proxima/penetration.h); distance stays 0. The signed distance ties
+// both: distance when apart, minus the depth when overlapping, continuous
+// through contact: signed_distance() = distance - depth.
 struct DistanceResult {
   Status status = Status::separated;
-  double distance = 0.0;        // upper bound: |point_a - point_b|
-  double lower_bound = 0.0;     // certified: lower_bound <= exact distance (up to rounding)
-  Vec3 point_a = Vec3::Zero();  // closest point on A, world frame
-  Vec3 point_b = Vec3::Zero();  // closest point on B, world frame
-  Vec3 normal = Vec3::UnitX();  // unit, from A towards B
+  // Separated, touching, iteration cap: an upper bound on the distance,
+  // |point_a - point_b|. Intersecting: 0.
+  double distance = 0.0;
+  // Certified: lower_bound <= exact distance (up to rounding); 0 for an
+  // intersecting answer.
+  double lower_bound = 0.0;
+  // Separated, touching: the closest points, world frame. Intersecting: the
+  // deepest points, point_b + depth * normal == point_a (up to rounding):
+  // B translated by depth * normal carries point_b onto point_a, and the
+  // bodies then touch. point_a lies on A's supporting plane along normal,
+  // point_b on B's along -normal. Without the depth
+  // (DistanceOptions::penetration false): a point of the overlap on both.
+  Vec3 point_a = Vec3::Zero();
+  Vec3 point_b = Vec3::Zero();
+  // Unit, from A towards B, world frame. Separated: along point_b - point_a.
+  // Intersecting: the direction that separates, translating B by
+  // depth * normal makes the hulls touch (a plane with this normal then
+  // separates them). In both cases signed_distance is
+  // normal . (point_b - point_a) up to rounding (signed_distance()).
+  Vec3 normal = Vec3::UnitX();
+  // The hull features that realize the answer (hull ids of each body).
+  // Intersecting: the two features of the Minkowski face (a face of A and a
+  // vertex of B, a vertex of A and a face of B, or two edges; for a face, the
+  // ids of the fan triangle that holds the witness point).
   Feature feature_a;
   Feature feature_b;
+  // The penetration depth: the length of the shortest translation of B
+  // after which a plane separates the hulls (they then touch), with a
+  // certificate depth_lower_bound <= exact depth <= depth_upper_bound (up
+  // to the contact band 64 u R; the upper bound is the overlap of the
+  // supports along normal). Computed for intersecting answers (with
+  // DistanceOptions::penetration, the default); 0, 0, 0 for separated and
+  // touching ones. (With the depth, a touching answer of the algorithm is
+  // checked by it: an overlap deeper than the contact band that the contact
+  // classification could not certify, faces of A and B coplanar, is
+  // reported intersecting with its depth.) Intersecting without the depth: 0, 0, +infinity (not
+  // computed). Iteration cap: 0, 0, and when lower_bound > 0 does not
+  // certify separation, the depth of the bodies' bounding balls as the
+  // upper bound (the pair may overlap).
+  double depth = 0.0;
+  double depth_lower_bound = 0.0;
+  double depth_upper_bound = 0.0;
+
+  // The signed distance: distance when separated or touching, minus the
+  // penetration depth when intersecting; continuous through contact,
+  // Lipschitz 1 in the translation. Equal to normal . (point_b - point_a)
+  // up to rounding. Functions of the fields above, so that a separated
+  // answer pays nothing for them.
+  double signed_distance() const { return distance - depth; }
+  // The certificate: signed_lower_bound() <= exact signed distance <=
+  // signed_upper_bound() (up to the contact band 64 u R). Separated and
+  // touching: [lower_bound, distance]. Intersecting: [-depth_upper_bound,
+  // -depth_lower_bound]; without the depth, [-infinity, 0].
+  double signed_lower_bound() const { return lower_bound - depth_upper_bound; }
+  double signed_upper_bound() const { return distance - depth_lower_bound; }
+
   int iterations = 0;
   // Whether a second algorithm ran in this query: for the hybrid, Enhanced
   // GJK's contact classification (touching or intersecting; not when a
   // cached contact tetrahedron re-certified intersection in O(1)) or its
   // cross-check of an answer the hybrid could not certify. Always false for
-  // GJK and Enhanced GJK.
+  // GJK and Enhanced GJK. The penetration depth is not counted here.
   bool second_algorithm = false;
 };
 

@@ -302,3 +302,21 @@ def test_scene_nearest_pair_and_pairs_within():
                       if body in (p.a, p.b) and p.result.distance <= 1.0)
     assert [p.b if p.a == body else p.a for p in within] == expected
     assert proxima.Scene().nearest_pair() is None
+
+
+def test_compound_and_scene_results_carry_the_signed_distance():
+    # The compound's signed distance is the smallest over its piece pairs
+    # (the deepest overlapping pair); a scene's close pair carries it.
+    rng = np.random.default_rng(5)
+    a = random_compound(rng, 5, spread=1.0)
+    r = proxima.distance(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
+    assert r.status == "intersecting" and r.signed_distance < 0
+    assert r.signed_lower_bound <= r.signed_distance <= r.signed_upper_bound
+    twin = proxima.distance_all_pairs(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
+    assert abs(twin.signed_distance - r.signed_distance) <= 1e-12
+    hull = proxima.ConvexPolytope(np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]))
+    scene = proxima.Scene(margin=0.1)
+    scene.add(hull)
+    scene.add(hull, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    pairs = scene.step()
+    assert len(pairs) == 1 and abs(pairs[0].result.signed_distance + 0.25) <= 1e-15

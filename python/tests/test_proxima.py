@@ -729,3 +729,96 @@ def test_pair_batch_equals_single_tracked_queries():
         proxima.PairBatch(a[:2], [b[0], "x"])
     with pytest.raises(ValueError, match="poses_b"):
         batch.distance(None, poses_b[:3])
+
+
+# --- signed distance ---------------------------------------------------------
+# Every result carries the signed distance (distance when apart, minus the
+# penetration depth when overlapping) and its certificate; the batch and the
+# PairBatch give them as arrays.
+def test_signed_distance_of_overlapping_and_separated_cubes():
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    over = proxima.distance(a, None, b, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    assert over.status == "intersecting" and over.distance == 0.0
+    assert math.isclose(over.signed_distance, -0.25, abs_tol=1e-15)
+    assert math.isclose(over.depth, 0.25, abs_tol=1e-15)
+    assert over.signed_lower_bound <= over.signed_distance <= over.signed_upper_bound
+    np.testing.assert_allclose(over.normal, [1, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(over.point_b + over.depth * over.normal, over.point_a, atol=1e-15)
+    apart = proxima.distance(a, None, b, ((1, 0, 0, 0), (1.5, 0.1, 0.2)))
+    assert apart.signed_distance == apart.distance and apart.depth == 0.0
+    assert apart.signed_lower_bound == apart.lower_bound
+    assert "signed_distance=" in repr(over)
+
+
+def test_batch_and_pair_batch_carry_signed_distance_arrays(bodies):
+    a, b = bodies
+    rng = np.random.default_rng(11)
+    k = 200
+    pa, pb = random_scene(rng, k)
+    out = proxima.distance_batch(a, pa, b, pb, threads=2)
+    assert out["signed_distance"].shape == (k,)
+    negative = 0
+    for i in range(k):
+        r = proxima.distance(a, pa[i], b, pb[i])
+        assert out["signed_distance"][i] == r.signed_distance
+        assert out["signed_lower_bound"][i] == r.signed_lower_bound
+        assert out["signed_upper_bound"][i] == r.signed_upper_bound
+        assert out["signed_lower_bound"][i] <= out["signed_distance"][i] <= out["signed_upper_bound"][i]
+        assert (out["signed_distance"][i] < 0) == (r.status == "intersecting" and r.depth > 0)
+        negative += r.signed_distance < 0
+    assert negative >= 10
+    batch = proxima.PairBatch([a] * k, [b] * k)
+    out = batch.distance(pa, pb, threads=2)
+    for i in range(k):
+        assert out["signed_distance"][i] == proxima.distance(a, pa[i], b, pb[i]).signed_distance
+
+
+def test_signed_distance_gradient_matches_central_differences():
+    # B translated along x out of an overlap of 0.25: d sd / d t_b = normal.
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    for t_b in ([0.75, 0.1, 0.2], [1.6, 0.3, -0.2]):
+        pb = matrix(np.eye(3), t_b)
+        r = proxima.distance(a, None, b, pb)
+        g = proxima.signed_distance_gradient(r, None, pb)
+        assert g.shape == (2, 6)
+        h = 1e-6
+        for k in range(3):
+            plus, minus = pb.copy(), pb.copy()
+            plus[k, 3] += h
+            minus[k, 3] -= h
+            fd = (proxima.distance(a, None, b, plus).signed_distance - proxima.distance(a, None, b, minus).signed_distance) / (2 * h)
+            assert abs(fd - g[1, k]) <= 1e-6
+            assert abs(g[0, k] + g[1, k]) == 0.0
+
+
+def test_penetration_false_skips_the_depth_everywhere():
+    # DistanceOptions.penetration as a keyword: an intersecting answer
+    # without its depth, signed distance 0 in [-inf, 0]; separated answers
+    # are the same either way.
+    a = proxima.ConvexPolytope(cube())
+    b = proxima.ConvexPolytope(cube())
+    over = ((1, 0, 0, 0), (0.75, 0.1, 0.2))
+    r = proxima.distance(a, None, b, over, penetration=False)
+    assert r.status == "intersecting" and r.signed_distance == 0.0 and r.depth == 0.0
+    assert r.signed_lower_bound == -math.inf and r.signed_upper_bound == 0.0
+    with pytest.raises(proxima.InvalidInput, match="penetration"):
+        proxima.signed_distance_gradient(r, None, over)
+    apart = ((1, 0, 0, 0), (1.5, 0.1, 0.2))
+    x = proxima.distance(a, None, b, apart, penetration=False)
+    y = proxima.distance(a, None, b, apart)
+    assert x.signed_distance == y.signed_distance and np.array_equal(x.point_a, y.point_a)
+    poses_b = np.tile(np.eye(4), (2, 1, 1))
+    poses_b[0, :3, 3] = over[1]
+    poses_b[1, :3, 3] = apart[1]
+    out = proxima.distance_batch(a, None, b, poses_b, penetration=False)
+    assert list(out["signed_distance"]) == [0.0, y.signed_distance]
+    batch = proxima.PairBatch([a, a], [b, b])
+    out = batch.distance(None, poses_b, penetration=False)
+    assert out["signed_lower_bound"][0] == -math.inf
+    scene = proxima.Scene(margin=0.1, penetration=False)
+    scene.add(a)
+    scene.add(b, over)
+    (pair,) = scene.step()
+    assert pair.result.status == "intersecting" and pair.result.signed_distance == 0.0

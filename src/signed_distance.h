@@ -1,0 +1,26 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Internal: the signed distance of an answer the algorithm did not finish
+// (intersecting: the penetration depth; iteration cap: its bounds), called
+// by distance() after its algorithm answered.
+#pragma once
+
+#include "proxima/polytope.h"
+#include "proxima/types.h"
+
+namespace proxima::detail {
+
+// Fills the signed distance of `result` (A's frame; distance() maps it to
+// the world afterwards) when result.status is not separated. Intersecting:
+// with options.penetration, the penetration depth of a and b (b_in_a,
+// rigid) replaces the answer's points, normal and features, tracked in
+// cache.penetration (allocated here on the first overlap). Touching: with
+// options.penetration, the depth too, and a depth beyond the contact band
+// turns the answer into intersecting (the contact classification can call
+// an overlap of coplanar faces touching). Iteration cap: the bounds.
+void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                            const DistanceOptions& options, DistanceCache& cache,
+                            DistanceResult& result);
+
+}  // namespace proxima::detail
