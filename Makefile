@@ -4,7 +4,7 @@
 #   make test  installs what is missing, builds, runs every test (release + sanitizers)
 JOBS ?= $(shell nproc)
 
-.PHONY: all run test setup release asan dev bench fuzz clean results results-quick
+.PHONY: all run test setup release asan dev bench fuzz clean results results-quick compare
 
 all: release
 
@@ -58,6 +58,14 @@ results: setup
 
 results-quick: setup
 	/usr/bin/python3 scripts/results --quick
+
+# HEAD (this working tree) against REF, benchmarks interleaved in one run:
+# tracked and cold queries, Scene::step, callgrind instruction counts.
+#   make compare REF=<commit>   (ROUNDS=5 by default)
+ROUNDS ?= 5
+compare:
+	@test -n "$(REF)" || { echo "usage: make compare REF=<commit> [ROUNDS=5]"; exit 2; }
+	python3 scripts/compare_builds $(REF) --rounds $(ROUNDS)
 
 bench: release
 	@for b in build/release/bench/*_bench; do echo "== $$b =="; $$b; done

@@ -46,6 +46,14 @@
 // hull instead, to separate the broad-phase part of the ratio from the
 // narrow-phase part.
 //
+// Thread scaling (issue 14): with --threads T (T != 1), a second proxima
+// Scene with T narrow-phase threads runs the same steps on the same poses,
+// right after the 1-thread scene in each step (the two then share the
+// caches, so the 1-thread CPU row is a little slower than without it). Both are timed in wall time
+// (the clock a multi-threaded step saves), and the output prints the two medians and their ratio
+// side by side, and whether the two scenes' close pairs were identical (they must be, bit for bit).
+// Wall time scaling only means something on an otherwise idle machine: the load average is printed.
+//
 // Writes out/scene_bench.csv (one row per size and system) and
 // out/scene_bench_steps.csv (one row per step), unless --out "" is given.
 #include <algorithm>
@@ -90,6 +98,7 @@ struct Options {
   FclSolver fcl_solver = FclSolver::libccd;
   FclBoxes fcl_boxes = FclBoxes::fcl;
   std::string out_dir = "out";
+  int threads = 1;  // the second scene's threads; 1: no second scene
 };
 
 // CPU time of the calling thread, in ns (see the file header).
@@ -191,7 +200,10 @@ struct SizeResult {
   int steps = 0;
   Series proxima;
   Series fcl;
-  PairSetDifference total;  // summed over the compared steps
+  Series proxima_wall;            // the 1-thread scene, wall time
+  Series proxima_threads_wall;    // the --threads scene, wall time
+  int thread_mismatch_steps = 0;  // steps where the two scenes' close pairs differ
+  PairSetDifference total;        // summed over the compared steps
   int compared_steps = 0;
   double setup_seconds = 0.0;
   std::vector<Mismatch> mismatch_details;
@@ -224,6 +236,14 @@ SizeResult run_size(int n, const Options& options) {
   ids.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i)
     ids.push_back(scene.add(scenario.body_shape(i), poses[static_cast<std::size_t>(i)]));
+  std::unique_ptr<Scene> threaded;
+  if (options.threads != 1) {
+    SceneOptions threaded_options = scene_options;
+    threaded_options.threads = options.threads;
+    threaded = std::make_unique<Scene>(threaded_options);
+    for (int i = 0; i < n; ++i)
+      threaded->add(scenario.body_shape(i), poses[static_cast<std::size_t>(i)]);
+  }
   FclScene fcl(scenario.shapes(), scenario.shape_of(), poses, kMargin, options.fcl_solver,
                options.fcl_boxes);
 
@@ -243,11 +263,37 @@ SizeResult run_size(int n, const Options& options) {
   for (int k = 0; k < options.steps; ++k) {
     scenario.step(k, poses);
 
+    const double w0 = wall_seconds();
     const double p0 = thread_cpu_ns();
     for (int i = 0; i < n; ++i)
       scene.set_pose(ids[static_cast<std::size_t>(i)], poses[static_cast<std::size_t>(i)]);
     const std::span<const ClosePair> pairs = scene.step();
     const double p1 = thread_cpu_ns();
+    const double w1 = wall_seconds();
+    if (threaded) {
+      const double t0 = wall_seconds();
+      for (int i = 0; i < n; ++i)
+        threaded->set_pose(ids[static_cast<std::size_t>(i)], poses[static_cast<std::size_t>(i)]);
+      const std::span<const ClosePair> threaded_pairs = threaded->step();
+      const double t1 = wall_seconds();
+      const auto intersecting_in = [](std::span<const ClosePair> found) {
+        return static_cast<int>(std::count_if(found.begin(), found.end(), [](const ClosePair& p) {
+          return p.result.status == Status::intersecting;
+        }));
+      };
+      r.proxima_wall.add((w1 - w0) * 1e3, scene.stats().candidate_pairs, scene.stats().close_pairs,
+                         intersecting_in(pairs));
+      r.proxima_threads_wall.add((t1 - t0) * 1e3, threaded->stats().candidate_pairs,
+                                 threaded->stats().close_pairs, intersecting_in(threaded_pairs));
+      const bool same = std::equal(
+          pairs.begin(), pairs.end(), threaded_pairs.begin(), threaded_pairs.end(),
+          [](const ClosePair& x, const ClosePair& y) {
+            return x.a == y.a && x.b == y.b && x.result.status == y.result.status &&
+                   x.result.distance == y.result.distance && x.result.point_a == y.result.point_a &&
+                   x.result.point_b == y.result.point_b;
+          });
+      if (!same) ++r.thread_mismatch_steps;
+    }
     int intersecting = 0;
     reference.clear();
     for (const ClosePair& p : pairs) {
@@ -303,6 +349,12 @@ void print_size(const SizeResult& r, const Options& options) {
     std::cout << line;
   };
   row("proxima Scene (1 thread)", r.proxima);
+  if (!r.proxima_threads_wall.ms.empty()) {
+    const std::string threaded_name =
+        "proxima Scene (" + std::to_string(options.threads) + " threads, wall)";
+    row("proxima Scene (1 thread, wall)", r.proxima_wall);
+    row(threaded_name.c_str(), r.proxima_threads_wall);
+  }
   const std::string fcl_name = std::string("FCL DynamicAABBTree + ") +
                                (options.fcl_solver == FclSolver::libccd ? "libccd" : "GJK") +
                                (options.fcl_boxes == FclBoxes::tight ? " (tight)" : "");
@@ -311,6 +363,16 @@ void print_size(const SizeResult& r, const Options& options) {
     std::cout << "  FCL ran the first " << common_steps << " of " << r.steps
               << " steps (its time budget, --fcl-budget " << fixed(options.fcl_budget_seconds, 0)
               << " s, was used up); the ratio compares those steps\n";
+  }
+  if (!r.proxima_threads_wall.ms.empty()) {
+    const double one = quantile(r.proxima_wall.ms, 0.5);
+    const double many = quantile(r.proxima_threads_wall.ms, 0.5);
+    std::cout << "  proxima 1 thread / " << options.threads
+              << " threads, median wall ms per step: " << fixed(one, 3) << " / " << fixed(many, 3)
+              << " = " << fixed(many > 0.0 ? one / many : 0.0, 2)
+              << "x (target >= 1.8x on 2 threads, "
+              << "meaningful on an idle machine only); close pairs identical in "
+              << r.steps - r.thread_mismatch_steps << " of " << r.steps << " steps\n";
   }
   const double proxima_median = quantile(r.proxima.first_ms(common_steps), 0.5);
   const double fcl_median = quantile(r.fcl.ms, 0.5);
@@ -390,15 +452,19 @@ bool write_csv(const std::vector<SizeResult>& results, const Options& options) {
 void usage(std::ostream& out) {
   out << "usage: scene_bench [--bodies N[,N...]]... [--steps S] [--quick] [--seed K]\n"
          "                   [--fcl-budget SECONDS] [--fcl-solver libccd|gjk]\n"
-         "                   [--fcl-boxes fcl|tight] [--out DIR]\n"
+         "                   [--fcl-boxes fcl|tight] [--threads T] [--out DIR]\n"
          "  --bodies      scene sizes, repeatable or comma-separated (default 1000,10000)\n"
          "  --steps       steps per size (default 1000; --quick: 50)\n"
          "  --fcl-budget  FCL stops after this much CPU time per size (default 240)\n"
          "  --fcl-solver  FCL's GJK solver in the callback (default libccd, its faster one)\n"
          "  --fcl-boxes   FCL's world boxes: fcl (computeAABB, default) or tight (the hull's\n"
          "                transformed vertices; shows how much FCL's loose boxes cost it)\n"
+         "  --threads     a second proxima scene with T narrow-phase threads (0: all cores)\n"
+         "                on the same steps, wall time beside the 1-thread scene's, and the\n"
+         "                ratio (default 1: no second scene)\n"
          "  --out         directory of the CSV files (default out; \"\" writes none)\n"
-         "example: scene_bench --bodies 1000 --steps 200\n";
+         "example: scene_bench --bodies 1000 --steps 200\n"
+         "         scene_bench --quick --threads 2     (1 against 2 threads, wall time)\n";
 }
 
 // Parses the command line; returns false (after printing why) on bad usage.
@@ -473,6 +539,11 @@ bool parse(int argc, char** argv, Options& o) {
         o.fcl_boxes = FclBoxes::tight;
       } else {
         std::cerr << "scene_bench: --fcl-boxes is fcl or tight, got '" << v << "'\n";
+        return false;
+      }
+    } else if (arg == "--threads" && value(v)) {
+      if (!to_int(v, 0, 1024, o.threads)) {
+        std::cerr << "scene_bench: --threads wants an integer in [0, 1024], got '" << v << "'\n";
         return false;
       }
     } else if (arg == "--out" && value(v)) {

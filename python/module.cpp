@@ -216,7 +216,8 @@ PYBIND11_MODULE(proxima, m) {
           "vertices", [](const ConvexPolytope& p) { return points_array(p.vertices()); },
           "Hull vertices, (V, 3) float64, in hull order.")
       .def_property_readonly(
-          "input_index", [](const ConvexPolytope& p) { return int32_array(p.input_index()); },
+          "input_index",
+          [](const ConvexPolytope& p) { return int32_array(p.input_index().to_vector()); },
           "input_index[i]: the index in the input points of hull vertex i, (V,) int32.")
       .def_property_readonly("vertex_count", &ConvexPolytope::vertex_count,
                              "Number of hull vertices.")

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "parallel_ranges.h"
 #include "proxima/support.h"
 
 namespace proxima::detail {
@@ -67,7 +68,8 @@ class SweepAndPrune final : public PairFinder {
   }
   void remove(std::int32_t id) override { members_.remove(id); }
 
-  void find_pairs(std::span<const Aabb> boxes, std::vector<std::uint64_t>& pairs) override {
+  void find_pairs(std::span<const Aabb> boxes, std::vector<std::uint64_t>& pairs,
+                  int /*threads*/) override {
     update_entries(boxes);
     sort_entries();
     // The sweep reads the sorted lower ends as a packed array (the inner
@@ -219,6 +221,14 @@ class SweepAndPrune final : public PairFinder {
 // 0.02, 0.05, 0.1, 0.25 and 0.5, 0.25 slightly ahead with support boxes.
 constexpr double kFatFraction = 0.25;
 
+// Fixed chunks of the tree's parallel loops (parallel_ranges.h): ids checked
+// against their fat boxes, moved leaves that query the tree, and fat pairs
+// tested on the boxes. Each chunk's output is its own list, joined in chunk
+// order, so the pairs come out the same on any number of threads.
+constexpr std::size_t kIdChunk = 1024;
+constexpr std::size_t kQueryChunk = 32;
+constexpr std::size_t kPairChunk = 4096;
+
 Aabb merged(const Aabb& a, const Aabb& b) { return {a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}; }
 
 // Half the surface area: the insertion cost of the surface-area heuristic
@@ -268,11 +278,12 @@ class AabbTree final : public PairFinder {
     }
   }
 
-  void find_pairs(std::span<const Aabb> boxes, std::vector<std::uint64_t>& pairs) override {
+  void find_pairs(std::span<const Aabb> boxes, std::vector<std::uint64_t>& pairs,
+                  int threads) override {
     for (const std::int32_t id : members_.pending()) {
       if (members_.member(id) && leaf_of_[index(id)] < 0) {
         const std::int32_t leaf = allocate_node();
-        nodes_[index(leaf)].box = fattened(boxes[index(id)]);
+        set_fat_box(id, leaf, boxes[index(id)]);
         nodes_[index(leaf)].id = id;
         leaf_of_[index(id)] = leaf;
         insert_leaf(leaf);
@@ -280,22 +291,32 @@ class AabbTree final : public PairFinder {
       }
     }
     members_.pending().clear();
-    // Leaves whose box left the fat box move in the tree.
-    for (std::size_t k = 0; k < leaf_of_.size(); ++k) {
+    // Leaves whose box left the fat box move in the tree: found in parallel
+    // (a read of the id-ordered fat boxes), moved in id order.
+    parallel_gather(leaf_of_.size(), kIdChunk, threads, chunk_out_, left_fat_,
+                    [&](std::size_t begin, std::size_t end, std::vector<std::uint64_t>& out) {
+                      for (std::size_t k = begin; k < end; ++k) {
+                        if (leaf_of_[k] >= 0 && !contains(fat_[k], boxes[k])) out.push_back(k);
+                      }
+                    });
+    for (const std::uint64_t k : left_fat_) {
+      const auto id = static_cast<std::int32_t>(k);
       const std::int32_t leaf = leaf_of_[k];
-      if (leaf < 0 || contains(nodes_[index(leaf)].box, boxes[k])) continue;
       remove_leaf(leaf);
-      nodes_[index(leaf)].box = fattened(boxes[k]);
+      set_fat_box(id, leaf, boxes[k]);
       insert_leaf(leaf);
-      mark_moved(static_cast<std::int32_t>(k));
+      mark_moved(id);
     }
-    if (!moved_list_.empty()) update_fat_pairs();
-    pairs.clear();
-    for (const std::uint64_t key : fat_pairs_) {
-      if (overlaps(boxes[index(pair_first(key))], boxes[index(pair_second(key))])) {
-        pairs.push_back(key);
-      }
-    }
+    if (!moved_list_.empty()) update_fat_pairs(threads);
+    // The fat pairs whose boxes overlap.
+    parallel_gather(fat_pairs_.size(), kPairChunk, threads, chunk_out_, pairs,
+                    [&](std::size_t begin, std::size_t end, std::vector<std::uint64_t>& out) {
+                      for (std::size_t k = begin; k < end; ++k) {
+                        const std::uint64_t key = fat_pairs_[k];
+                        if (overlaps(boxes[index(pair_first(key))], boxes[index(pair_second(key))]))
+                          out.push_back(key);
+                      }
+                    });
   }
 
  private:
@@ -313,7 +334,15 @@ class AabbTree final : public PairFinder {
     if (index(id) >= leaf_of_.size()) {
       leaf_of_.resize(index(id) + 1, -1);
       moved_.resize(index(id) + 1, 0);
+      fat_.resize(index(id) + 1);
     }
+  }
+
+  // A leaf's fat box lives in its node (for the tree) and by id in fat_
+  // (read in id order by find_pairs' containment test).
+  void set_fat_box(std::int32_t id, std::int32_t leaf, const Aabb& box) {
+    fat_[index(id)] = fattened(box);
+    nodes_[index(leaf)].box = fat_[index(id)];
   }
 
   void mark_moved(std::int32_t id) {
@@ -326,7 +355,9 @@ class AabbTree final : public PairFinder {
   // Every pair of overlapping fat boxes, kept sorted: the pairs of leaves
   // that did not move are still right; those of moved leaves are dropped and
   // found again by querying the tree with each moved leaf's fat box.
-  void update_fat_pairs() {
+  // The moved leaves query the tree in parallel chunks (the tree is only
+  // read), each chunk into its own list.
+  void update_fat_pairs(int threads) {
     std::size_t kept = 0;
     for (const std::uint64_t key : fat_pairs_) {
       if (moved_[index(pair_first(key))] == 0 && moved_[index(pair_second(key))] == 0) {
@@ -334,28 +365,35 @@ class AabbTree final : public PairFinder {
       }
     }
     fat_pairs_.resize(kept);
-    new_pairs_.clear();
-    for (const std::int32_t id : moved_list_) {
-      const std::int32_t leaf = leaf_of_[index(id)];
-      if (leaf < 0) continue;  // removed
-      const Aabb query = nodes_[index(leaf)].box;
-      stack_.clear();
-      stack_.push_back(root_);
-      while (!stack_.empty()) {
-        const Node& node = nodes_[index(stack_.back())];
-        stack_.pop_back();
-        if (!overlaps(node.box, query)) continue;
-        if (!node.leaf()) {
-          stack_.push_back(node.left);
-          stack_.push_back(node.right);
-          continue;
-        }
-        const std::int32_t other = node.id;
-        // Two moved leaves find each other twice: keep the smaller id's find.
-        if (other == id || (moved_[index(other)] != 0 && other < id)) continue;
-        new_pairs_.push_back(id < other ? pair_key(id, other) : pair_key(other, id));
-      }
-    }
+    const std::size_t moved = moved_list_.size();
+    if (stacks_.size() < chunk_count(moved, kQueryChunk))
+      stacks_.resize(chunk_count(moved, kQueryChunk));
+    parallel_gather(moved, kQueryChunk, threads, chunk_out_, new_pairs_,
+                    [&](std::size_t begin, std::size_t end, std::vector<std::uint64_t>& out) {
+                      std::vector<std::int32_t>& stack = stacks_[begin / kQueryChunk];
+                      for (std::size_t m = begin; m < end; ++m) {
+                        const std::int32_t id = moved_list_[m];
+                        const std::int32_t leaf = leaf_of_[index(id)];
+                        if (leaf < 0) continue;  // removed
+                        const Aabb query = nodes_[index(leaf)].box;
+                        stack.clear();
+                        stack.push_back(root_);
+                        while (!stack.empty()) {
+                          const Node& node = nodes_[index(stack.back())];
+                          stack.pop_back();
+                          if (!overlaps(node.box, query)) continue;
+                          if (!node.leaf()) {
+                            stack.push_back(node.left);
+                            stack.push_back(node.right);
+                            continue;
+                          }
+                          const std::int32_t other = node.id;
+                          // Two moved leaves find each other twice: keep the smaller id's find.
+                          if (other == id || (moved_[index(other)] != 0 && other < id)) continue;
+                          out.push_back(id < other ? pair_key(id, other) : pair_key(other, id));
+                        }
+                      }
+                    });
     std::sort(new_pairs_.begin(), new_pairs_.end());
     merged_pairs_.resize(fat_pairs_.size() + new_pairs_.size());
     std::merge(fat_pairs_.begin(), fat_pairs_.end(), new_pairs_.begin(), new_pairs_.end(),
@@ -513,7 +551,10 @@ class AabbTree final : public PairFinder {
   std::vector<std::uint64_t> fat_pairs_;
   std::vector<std::uint64_t> new_pairs_;
   std::vector<std::uint64_t> merged_pairs_;
-  std::vector<std::int32_t> stack_;
+  std::vector<Aabb> fat_;                              // by id: the leaf's fat box
+  std::vector<std::uint64_t> left_fat_;                // ids whose box left the fat box
+  std::vector<std::vector<std::uint64_t>> chunk_out_;  // per chunk of a parallel loop
+  std::vector<std::vector<std::int32_t>> stacks_;      // per chunk of the tree queries
 };
 
 }  // namespace

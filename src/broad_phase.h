@@ -58,8 +58,10 @@ class PairFinder {
   virtual void remove(std::int32_t id) = 0;
   // boxes[id] is the current box of every id in the set (boxes of other ids
   // are ignored). Replaces `pairs` by the keys of every pair of ids in the
-  // set whose boxes overlap, increasing.
-  virtual void find_pairs(std::span<const Aabb> boxes, std::vector<std::uint64_t>& pairs) = 0;
+  // set whose boxes overlap, increasing. `threads` as SceneOptions::threads
+  // (1: the calling thread only); the pairs are the same whatever it is.
+  virtual void find_pairs(std::span<const Aabb> boxes, std::vector<std::uint64_t>& pairs,
+                          int threads = 1) = 0;
 };
 
 std::unique_ptr<PairFinder> make_pair_finder(BroadPhase kind);

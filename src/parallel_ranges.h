@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #if defined(__SANITIZE_THREAD__)
 #define PROXIMA_TSAN 1
@@ -72,6 +73,57 @@ void parallel_ranges(std::size_t n, std::size_t grain, int threads, const RunRan
   } after{&ranges_done};
   tsan_release(&range);
   parallel_ranges(n, grain, threads, &call_range<decltype(range)>, &range);
+}
+
+// Fixed chunks for work whose output must come out in index order (a
+// parallel filter or copy): [0, n) cut into chunks of `chunk` indices (the
+// last one shorter), run_chunk(c, begin, end) called once for chunk c, on
+// TBB's pool as parallel_ranges above when threads != 1 and there are two
+// chunks or more, in the calling thread otherwise. Chunk c's output goes to
+// slot c of the caller's per-chunk storage, so joining the slots in order
+// gives the sequential loop's order whatever the threads.
+inline std::size_t chunk_count(std::size_t n, std::size_t chunk) { return (n + chunk - 1) / chunk; }
+
+template <class RunChunk>
+void parallel_chunks(std::size_t n, std::size_t chunk, int threads, const RunChunk& run_chunk) {
+  const std::size_t chunks = chunk_count(n, chunk);
+  const auto run_range = [&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c < last; ++c) {
+      run_chunk(c, c * chunk, c + 1 == chunks ? n : (c + 1) * chunk);
+    }
+  };
+  if (threads == 1 || chunks < 2) {
+    run_range(0, chunks);
+  } else {
+    parallel_ranges(chunks, 1, threads, run_range);
+  }
+}
+
+// An order-preserving parallel gather: emit(begin, end, into) appends to
+// `into` what the indices [begin, end) give, in order; `out` becomes the
+// outputs of [0, n) in index order. With threads == 1 or a single chunk,
+// emit(0, n, out) runs in the calling thread straight into `out`; else each
+// chunk appends to its own list of `scratch` (kept by the caller between
+// calls) and the lists are joined.
+template <class T, class Emit>
+void parallel_gather(std::size_t n, std::size_t chunk, int threads,
+                     std::vector<std::vector<T>>& scratch, std::vector<T>& out, const Emit& emit) {
+  out.clear();
+  const std::size_t chunks = chunk_count(n, chunk);
+  if (threads == 1 || chunks < 2) {
+    emit(std::size_t{0}, n, out);
+    return;
+  }
+  if (scratch.size() < chunks) scratch.resize(chunks);
+  parallel_chunks(n, chunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    scratch[c].clear();
+    emit(begin, end, scratch[c]);
+  });
+  std::size_t total = 0;
+  for (std::size_t c = 0; c < chunks; ++c) total += scratch[c].size();
+  out.reserve(total);
+  for (std::size_t c = 0; c < chunks; ++c)
+    out.insert(out.end(), scratch[c].begin(), scratch[c].end());
 }
 
 }  // namespace proxima::detail

@@ -24,8 +24,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -168,16 +170,18 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   }
 
   // Renumber: unique-point ids -> hull vertex ids.
-  dimension_ = boundary.dimension;
+  dimension_ = static_cast<std::int8_t>(boundary.dimension);
   const auto vertex_count = static_cast<Index>(boundary.vertices.size());
   std::vector<Index> local(pts.size(), -1);
-  vertices_.reserve(boundary.vertices.size());
-  input_index_.reserve(boundary.vertices.size());
+  std::vector<Vec3> vertices;
+  std::vector<std::int32_t> input_index;
+  vertices.reserve(boundary.vertices.size());
+  input_index.reserve(boundary.vertices.size());
   for (Index v = 0; v < vertex_count; ++v) {
     const Index u = boundary.vertices[static_cast<std::size_t>(v)];
     local[static_cast<std::size_t>(u)] = v;
-    vertices_.push_back(pts[static_cast<std::size_t>(u)]);
-    input_index_.push_back(distinct[static_cast<std::size_t>(u)]);
+    vertices.push_back(pts[static_cast<std::size_t>(u)]);
+    input_index.push_back(distinct[static_cast<std::size_t>(u)]);
   }
   Cycles faces;
   faces.offsets = std::move(boundary.faces.offsets);
@@ -185,45 +189,134 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   for (const Index u : boundary.faces.vertices)
     faces.vertices.push_back(local[static_cast<std::size_t>(u)]);
 
+  Adjacency adjacency;
+  std::vector<std::int32_t> face_offsets{0};
+  std::vector<std::int32_t> face_vertices;
   if (dimension_ == 1) {
-    adjacency_offsets_ = {0, 1, 2};
-    adjacency_ = {1, 0};
-    adjacency_faces_ = {-1, -1};
+    adjacency.offsets = {0, 1, 2};
+    adjacency.neighbors = {1, 0};
+    adjacency.faces = {-1, -1};
   } else if (dimension_ == 0) {
-    adjacency_offsets_ = {0, 0};
+    adjacency.offsets = {0, 0};
   } else {
-    Adjacency adjacency;
     if (!build_adjacency(faces, vertex_count, adjacency)) {
       throw InvalidInput("ConvexPolytope: the hull of " + std::to_string(points.size()) +
                          " points is not a closed surface after cleaning (internal error)");
     }
-    adjacency_offsets_ = std::move(adjacency.offsets);
-    adjacency_ = std::move(adjacency.neighbors);
-    adjacency_faces_ = std::move(adjacency.faces);
-    face_offsets_ = std::move(faces.offsets);
-    face_vertices_ = std::move(faces.vertices);
+    face_offsets = std::move(faces.offsets);
+    face_vertices = std::move(faces.vertices);
   }
-  for (auto* v : {&input_index_, &adjacency_offsets_, &adjacency_, &adjacency_faces_,
-                  &face_offsets_, &face_vertices_}) {
-    v->shrink_to_fit();
+
+  // Into the one allocation (polytope.h), without what follows from the
+  // counts: the offsets of triangle-only faces, an identity input index.
+  vertex_count_ = vertex_count;
+  if (3 * static_cast<std::uint64_t>(vertex_count) > std::numeric_limits<std::uint32_t>::max()) {
+    throw InvalidInput("ConvexPolytope: the hull of " + std::to_string(points.size()) +
+                       " points has " + std::to_string(vertex_count) + " vertices, more than " +
+                       std::to_string(std::numeric_limits<std::uint32_t>::max() / 3) +
+                       " (the most one polytope can hold)");
   }
-  vertices_.shrink_to_fit();
+  ints_at_ = 3 * static_cast<std::uint32_t>(vertex_count);
+  adjacency_size_ = static_cast<std::int32_t>(adjacency.neighbors.size());
+  face_count_ = static_cast<std::int32_t>(face_offsets.size()) - 1;
+  triangles_only_ = true;
+  for (std::size_t f = 0; f + 1 < face_offsets.size(); ++f)
+    triangles_only_ = triangles_only_ && face_offsets[f + 1] - face_offsets[f] == 3;
+  identity_input_ = true;
+  for (Index v = 0; v < vertex_count; ++v)
+    identity_input_ = identity_input_ && input_index[static_cast<std::size_t>(v)] == v;
+  allocate(doubles_for(vertex_count_, adjacency.offsets.size() + 2 * adjacency.neighbors.size() +
+                                          (triangles_only_ ? 0 : face_offsets.size()) +
+                                          face_vertices.size() +
+                                          (identity_input_ ? 0 : input_index.size())));
+  std::uninitialized_copy(vertices.begin(), vertices.end(), reinterpret_cast<Vec3*>(data_.get()));
+  auto* out = const_cast<std::int32_t*>(ints());
+  const auto put = [&out](const std::vector<std::int32_t>& values) {
+    out = std::uninitialized_copy(values.begin(), values.end(), out);
+  };
+  put(adjacency.offsets);
+  put(adjacency.neighbors);
+  put(adjacency.faces);
+  if (!triangles_only_) put(face_offsets);
+  put(face_vertices);
+  if (!identity_input_) put(input_index);
 
   // Centroid and radius on power-of-two scaled copies: exact scaling, and no
   // sum or square can overflow near the largest doubles.
-  const int exponent = magnitude_exponent(max_abs_coordinate(vertices_));
+  const int exponent = magnitude_exponent(max_abs_coordinate(vertices));
   Vec3 sum = Vec3::Zero();
-  for (const Vec3& v : vertices_) sum += times_pow2(v, -exponent);
-  const Vec3 mean = sum / static_cast<double>(vertices_.size());
+  for (const Vec3& v : vertices) sum += times_pow2(v, -exponent);
+  const Vec3 mean = sum / static_cast<double>(vertices.size());
   double radius = 0.0;
-  for (const Vec3& v : vertices_)
+  for (const Vec3& v : vertices)
     radius = std::max(radius, (times_pow2(v, -exponent) - mean).norm());
   // Scale back per value: 2^exponent itself overflows for coordinates
   // beyond 2^1023 (found by the reader fuzzer: a vertex at -1e308).
   centroid_ = times_pow2(mean, exponent);
   bounding_radius_ = std::ldexp(radius, exponent);
-  scale_ = max_abs_coordinate(vertices_);
+  scale_ = max_abs_coordinate(vertices);
   interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
+}
+
+std::size_t ConvexPolytope::int_count() const {
+  return input_index_at() + (identity_input_ ? 0 : static_cast<std::size_t>(vertex_count_));
+}
+
+std::size_t ConvexPolytope::doubles_for(std::int32_t vertex_count, std::size_t int_count) {
+  return 3 * static_cast<std::size_t>(vertex_count) + (int_count + 1) / 2;
+}
+
+void ConvexPolytope::allocate(std::size_t doubles) {
+  static_assert(sizeof(Vec3) == 3 * sizeof(double) && alignof(Vec3) <= alignof(double));
+  static_assert(std::is_trivially_destructible_v<Vec3>);
+  data_ = std::make_unique_for_overwrite<double[]>(doubles);
+}
+
+ConvexPolytope::ConvexPolytope(const ConvexPolytope& other)
+    : vertex_count_(other.vertex_count_),
+      adjacency_size_(other.adjacency_size_),
+      face_count_(other.face_count_),
+      interior_point_count_(other.interior_point_count_),
+      ints_at_(other.ints_at_),
+      dimension_(other.dimension_),
+      triangles_only_(other.triangles_only_),
+      identity_input_(other.identity_input_),
+      centroid_(other.centroid_),
+      bounding_radius_(other.bounding_radius_),
+      scale_(other.scale_) {
+  if (!other.data_) return;  // moved from
+  allocate(doubles_for(vertex_count_, other.int_count()));
+  const std::span<const Vec3> v = other.vertices();
+  std::uninitialized_copy(v.begin(), v.end(), reinterpret_cast<Vec3*>(data_.get()));
+  std::uninitialized_copy(other.ints(), other.ints() + other.int_count(),
+                          const_cast<std::int32_t*>(ints()));
+}
+
+ConvexPolytope::ConvexPolytope(ConvexPolytope&& other) noexcept { take(other); }
+
+ConvexPolytope& ConvexPolytope::operator=(ConvexPolytope&& other) noexcept {
+  if (this != &other) take(other);
+  return *this;
+}
+
+void ConvexPolytope::take(ConvexPolytope& other) noexcept {
+  data_ = std::move(other.data_);
+  vertex_count_ = std::exchange(other.vertex_count_, 0);
+  adjacency_size_ = std::exchange(other.adjacency_size_, 0);
+  face_count_ = std::exchange(other.face_count_, 0);
+  interior_point_count_ = std::exchange(other.interior_point_count_, 0);
+  ints_at_ = std::exchange(other.ints_at_, 0);
+  dimension_ = std::exchange(other.dimension_, 0);
+  triangles_only_ = std::exchange(other.triangles_only_, true);
+  identity_input_ = std::exchange(other.identity_input_, true);
+  centroid_ = other.centroid_;
+  bounding_radius_ = other.bounding_radius_;
+  scale_ = other.scale_;
+}
+
+ConvexPolytope& ConvexPolytope::operator=(const ConvexPolytope& other) {
+  if (this != &other) *this = ConvexPolytope(other);
+  return *this;
 }
 
 // Newell's normal: for a planar polygon, sum over edges (p_i x p_(i+1)) is
@@ -310,9 +403,16 @@ Plane ConvexPolytope::face_plane(int f) const {
   return {normal, std::ldexp(normal.dot(mean), exponent)};
 }
 
+std::vector<std::int32_t> ConvexPolytope::face_offsets() const {
+  std::vector<std::int32_t> out;
+  out.reserve(static_cast<std::size_t>(face_count_) + 1);
+  for (int f = 0; f <= face_count_; ++f) out.push_back(static_cast<std::int32_t>(face_begin(f)));
+  return out;
+}
+
 std::vector<std::array<std::int32_t, 3>> ConvexPolytope::triangles() const {
   std::vector<std::array<std::int32_t, 3>> out;
-  out.reserve(face_vertices_.size());
+  out.reserve(face_vertices().size());
   for (int f = 0; f < face_count(); ++f) {
     const auto c = face(f);
     for (std::size_t i = 1; i + 1 < c.size(); ++i) out.push_back({c[0], c[i], c[i + 1]});
@@ -322,7 +422,7 @@ std::vector<std::array<std::int32_t, 3>> ConvexPolytope::triangles() const {
 
 std::vector<std::int32_t> ConvexPolytope::triangle_face() const {
   std::vector<std::int32_t> out;
-  out.reserve(face_vertices_.size());
+  out.reserve(face_vertices().size());
   for (int f = 0; f < face_count(); ++f) {
     const auto n = face(f).size();
     out.insert(out.end(), n >= 2 ? n - 2 : 0, f);
@@ -332,7 +432,7 @@ std::vector<std::int32_t> ConvexPolytope::triangle_face() const {
 
 std::vector<std::array<std::int32_t, 2>> ConvexPolytope::edges() const {
   std::vector<std::array<std::int32_t, 2>> out;
-  out.reserve(adjacency_.size() / 2);
+  out.reserve(static_cast<std::size_t>(adjacency_size_) / 2);
   for (int v = 0; v < vertex_count(); ++v) {
     for (const std::int32_t w : neighbors(v)) {
       if (v < w) out.push_back({v, w});
@@ -342,12 +442,7 @@ std::vector<std::array<std::int32_t, 2>> ConvexPolytope::edges() const {
 }
 
 std::size_t ConvexPolytope::memory_bytes() const {
-  const auto index_bytes = [](const std::vector<std::int32_t>& v) {
-    return v.capacity() * sizeof(std::int32_t);
-  };
-  return sizeof(*this) + vertices_.capacity() * sizeof(Vec3) + index_bytes(input_index_) +
-         index_bytes(adjacency_offsets_) + index_bytes(adjacency_) + index_bytes(adjacency_faces_) +
-         index_bytes(face_offsets_) + index_bytes(face_vertices_);
+  return sizeof(*this) + (data_ ? doubles_for(vertex_count_, int_count()) * sizeof(double) : 0);
 }
 
 }  // namespace proxima

@@ -142,6 +142,48 @@ TEST_P(PairFinderTest, FollowsTheSceneWhenItsLongAxisTurns) {
   EXPECT_FALSE(pairs.empty());
 }
 
+// The tree's loops run in fixed chunks on 2 threads (1,024 ids, 32 moved
+// leaves, 4,096 fat pairs a chunk): a set large enough for many chunks of
+// each, with members leaving and joining, must give the 1-thread finder's
+// pairs, which are the all-pairs loop's.
+TEST_P(PairFinderTest, TwoThreadsGiveTheSamePairsOnALargeSet) {
+  Rng rng(20261125);
+  constexpr int kIds = 5000;
+  const Vec3 extent(16, 16, 16);
+  auto one = detail::make_pair_finder(GetParam());
+  auto two = detail::make_pair_finder(GetParam());
+  std::vector<Aabb> boxes(kIds);
+  std::vector<std::uint8_t> member(kIds, 1);
+  for (int i = 0; i < kIds; ++i) {
+    boxes[static_cast<std::size_t>(i)] = random_box(rng, extent);
+    one->add(i);
+    two->add(i);
+  }
+  std::vector<std::uint64_t> pairs_one;
+  std::vector<std::uint64_t> pairs_two;
+  for (int step = 0; step < 4; ++step) {
+    one->find_pairs(boxes, pairs_one, 1);
+    two->find_pairs(boxes, pairs_two, 2);
+    ASSERT_EQ(pairs_two, pairs_one) << "step " << step;
+    ASSERT_EQ(pairs_one, all_pairs(boxes, member)) << "step " << step;
+    EXPECT_GT(pairs_one.size(), 3u * 4096u) << "too few pairs for several chunks";
+    // Every box moves by up to a quarter (many leave their fat boxes), some
+    // ids leave and come back.
+    for (int i = 0; i < kIds; ++i) {
+      Aabb& b = boxes[static_cast<std::size_t>(i)];
+      const Vec3 d(grid(rng, -1, 1) / 4, grid(rng, -1, 1) / 4, grid(rng, -1, 1) / 4);
+      b.lo += d;
+      b.hi += d;
+    }
+    for (int k = 0; k < 50; ++k) {
+      const int i = test::uniform_int(rng, 0, kIds - 1);
+      auto& m = member[static_cast<std::size_t>(i)];
+      for (auto* f : {one.get(), two.get()}) m != 0 ? f->remove(i) : f->add(i);
+      m = m != 0 ? 0 : 1;
+    }
+  }
+}
+
 TEST_P(PairFinderTest, EmptyAndSingleSets) {
   auto finder = detail::make_pair_finder(GetParam());
   std::vector<std::uint64_t> pairs{42};

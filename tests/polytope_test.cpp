@@ -891,6 +891,69 @@ TEST(Polytope, SliverFacePlanesHoldTheirOwnVertices) {
 // Degenerate inputs
 // ---------------------------------------------------------------------------
 
+// Issue 14's memory target: a polytope holds at most twice its raw vertices
+// plus its adjacency (CSR offsets and neighbour ids). It held 2.58x at 8
+// points on a sphere, 2.20x at 64 and 2.15x at 4,096 (bench/polytope_bench):
+// seven vectors (168 bytes of headers), the offsets of faces that are all
+// triangles, and an input index that is the identity. Now one allocation
+// holds the arrays, without what follows from the counts.
+TEST(Polytope, MemoryIsAtMostTwiceTheVerticesPlusAdjacency) {
+  Rng rng(14);
+  for (const int n : {8, 64, 512, 4096}) {
+    const ConvexPolytope p(sphere_points(rng, n));
+    const double core =
+        static_cast<double>(p.vertices().size_bytes() + p.adjacency_offsets().size_bytes() +
+                            p.adjacency().size_bytes());
+    EXPECT_LE(static_cast<double>(p.memory_bytes()), 2.0 * core) << n << " points";
+  }
+}
+
+// The arrays the polytope no longer stores are still there to read: face
+// offsets of a hull of triangles and of one with quads, the identity input
+// index and a stored one; copies hold the same arrays, a moved-from
+// polytope is empty.
+TEST(Polytope, DerivedArraysCopiesAndMoves) {
+  Rng rng(15);
+  const Points sphere = sphere_points(rng, 50);
+  const ConvexPolytope tri(sphere);
+  std::vector<std::int32_t> expected{0};
+  for (int f = 0; f < tri.face_count(); ++f) {
+    EXPECT_EQ(tri.face(f).size(), 3u);
+    expected.push_back(expected.back() + 3);
+  }
+  EXPECT_EQ(tri.face_offsets(), expected);
+  EXPECT_EQ(tri.face_vertices().size(), static_cast<std::size_t>(3 * tri.face_count()));
+  for (int v = 0; v < tri.vertex_count(); ++v)
+    EXPECT_EQ(tri.input_index()[static_cast<std::size_t>(v)], v);
+
+  Points cube;  // a cube and its centre, first: every input index moves by one
+  cube.emplace_back(0, 0, 0);
+  for (int i = 0; i < 8; ++i) cube.emplace_back(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+  const ConvexPolytope quads(cube);
+  ASSERT_EQ(quads.face_count(), 6);
+  EXPECT_EQ(quads.face_offsets(), (std::vector<std::int32_t>{0, 4, 8, 12, 16, 20, 24}));
+  EXPECT_EQ(quads.input_index().to_vector(), (std::vector<std::int32_t>{1, 2, 3, 4, 5, 6, 7, 8}));
+  check_polytope(quads, cube);
+
+  for (const ConvexPolytope* original : {&tri, &quads}) {
+    ConvexPolytope copy = *original;
+    EXPECT_EQ(copy.memory_bytes(), original->memory_bytes());
+    EXPECT_TRUE(std::ranges::equal(copy.vertices(), original->vertices()));
+    EXPECT_TRUE(std::ranges::equal(copy.adjacency(), original->adjacency()));
+    EXPECT_TRUE(std::ranges::equal(copy.adjacency_faces(), original->adjacency_faces()));
+    EXPECT_TRUE(std::ranges::equal(copy.face_vertices(), original->face_vertices()));
+    EXPECT_EQ(copy.face_offsets(), original->face_offsets());
+    EXPECT_EQ(copy.input_index().to_vector(), original->input_index().to_vector());
+    const ConvexPolytope moved(std::move(copy));
+    EXPECT_EQ(copy.vertex_count(), 0);  // NOLINT(bugprone-use-after-move): the documented state
+    EXPECT_EQ(copy.face_count(), 0);
+    EXPECT_EQ(copy.edge_count(), 0);
+    EXPECT_EQ(moved.face_offsets(), original->face_offsets());
+    copy = moved;
+    EXPECT_EQ(copy.input_index().to_vector(), original->input_index().to_vector());
+  }
+}
+
 TEST(Polytope, SinglePoint) {
   const Points pts = {{0.1, -2.5, 3e7}};
   const ConvexPolytope p(pts);

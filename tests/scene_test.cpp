@@ -288,6 +288,59 @@ TEST_P(RandomScene, StepEqualsTheAllPairsTwinWhileBodiesMoveJoinAndLeave) {
   }
 }
 
+// The step's other parallel loops run in fixed chunks (512 world boxes,
+// 1,024 pairs gathered, and the tree's own, broad_phase.cpp): a scene of
+// 2,000 bodies spans several chunks of each, and its 2-thread steps must
+// equal the 1-thread ones bit for bit (the small scenes above fit in one
+// chunk, where the loops run in the calling thread).
+TEST(SceneThreads, TwoThreadsEqualOneOnAScenePastTheChunkSizes) {
+  Rng rng(20261125);
+  constexpr int kBodies = 2000;
+  constexpr double kSide = 24.0;  // about 5 candidates per body
+  std::vector<std::shared_ptr<const ConvexPolytope>> pool;
+  for (int i = 0; i < 20; ++i) {
+    pool.push_back(std::make_shared<const ConvexPolytope>(
+        test::points_on_sphere(rng, test::uniform_int(rng, 12, 40))));
+  }
+  SceneOptions o;
+  o.margin = 0.05;
+  o.threads = 1;
+  Scene one(o);
+  o.threads = 2;
+  Scene two(o);
+  std::vector<Pose> poses;
+  for (int i = 0; i < kBodies; ++i) {
+    poses.push_back(random_pose(rng, kSide, Vec3::Zero()));
+    const auto& body = pool[static_cast<std::size_t>(i) % pool.size()];
+    ASSERT_EQ(one.add(body, poses.back()), two.add(body, poses.back()));
+  }
+  for (int step = 0; step < 3; ++step) {
+    const std::span<const ClosePair> a = one.step();
+    const std::span<const ClosePair> b = two.step();
+    EXPECT_GT(one.stats().candidate_pairs, 2 * 1024) << "too few pairs for several chunks";
+    EXPECT_EQ(two.stats().candidate_pairs, one.stats().candidate_pairs);
+    EXPECT_EQ(two.stats().convex_queries, one.stats().convex_queries);
+    EXPECT_EQ(two.stats().warm_pairs, one.stats().warm_pairs);
+    ASSERT_EQ(a.size(), b.size()) << "step " << step;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      ASSERT_TRUE(a[i].a == b[i].a && a[i].b == b[i].b &&
+                  a[i].result.status == b[i].result.status &&
+                  same_bits(a[i].result.distance, b[i].result.distance) &&
+                  same_bits(a[i].result.point_a, b[i].result.point_a) &&
+                  same_bits(a[i].result.point_b, b[i].result.point_b) &&
+                  same_feature(a[i].result.feature_a, b[i].result.feature_a) &&
+                  same_feature(a[i].result.feature_b, b[i].result.feature_b))
+          << "step " << step << ", close pair " << i;
+    }
+    for (int i = 0; i < kBodies; ++i) {
+      Pose& p = poses[static_cast<std::size_t>(i)];
+      p = moved(rng, p);
+      one.set_pose(i, p);
+      two.set_pose(i, p);
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, RandomScene,
     testing::Values(RandomSceneCase{0.0, 0.0, 0}, RandomSceneCase{0.05, 0.0, 0},
