@@ -10,7 +10,8 @@
 // hulls, run one cold distance query, print one answer line. Nothing but
 // buffers survives from one line to the next, so a bad line can never change
 // the answer to a good one. A body with a "radius" is a rounded body
-// (proxima/body.h).
+// (proxima/body.h); a body with a motion ("pose_end" or velocities) makes
+// the line a time-of-impact query (proxima/time_of_impact.h).
 #include "query.h"
 
 #include <algorithm>
@@ -21,6 +22,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -33,6 +35,7 @@
 #include "proxima/body.h"
 #include "proxima/distance.h"
 #include "proxima/polytope.h"
+#include "proxima/time_of_impact.h"
 
 namespace proxima::cli {
 namespace {
@@ -65,8 +68,41 @@ void read_numbers(const Json& v, const std::string& path, std::size_t n, const c
 
 // Reads body `name` ("a" or "b") of `query` into vertices, pose and radius,
 // its rotation's four numbers in `order`.
+// A pose object's "rotation" and "translation" fields (absent or null:
+// identity), named `path` in errors.
+Pose read_pose(const Json& object, const std::string& path, QuaternionOrder order) {
+  Quat rotation = Quat::Identity();
+  const auto q = object.find("rotation");
+  if (q != object.end() && !q->is_null()) {
+    double numbers[4];
+    read_numbers(*q, path + "rotation", 4,
+                 order == QuaternionOrder::wxyz
+                     ? "4 numbers [w, x, y, z]"
+                     : "4 numbers [x, y, z, w] (--quaternion-order xyzw)",
+                 numbers);
+    // Normalized at any magnitude, a zero quaternion refused: the pose
+    // contract's own function (proxima/pose.h), as in Python.
+    try {
+      rotation = unit_quaternion(quaternion_in_order(numbers, order), path + "rotation");
+    } catch (const InvalidInput& e) {
+      fail(e.what());
+    }
+  }
+  Vec3 translation = Vec3::Zero();
+  const auto t = object.find("translation");
+  if (t != object.end() && !t->is_null()) {
+    read_numbers(*t, path + "translation", 3, "3 numbers [x, y, z]", translation.data());
+  }
+  return Pose(rotation, translation);
+}
+
+// Reads body `name` ("a" or "b") of `query` into vertices, pose, radius and
+// motion (time of impact, proxima/time_of_impact.h: "pose_end", or
+// "linear_velocity" and "angular_velocity" per unit t; none: no motion),
+// its rotations' four numbers in `order`.
 void read_body(const Json& query, const std::string& name, QuaternionOrder order,
-               std::vector<Vec3>& vertices, Pose& pose, double& radius) {
+               std::vector<Vec3>& vertices, Pose& pose, double& radius,
+               std::optional<Motion>& motion) {
   const auto body = query.find(name);
   if (body == query.end()) fail("missing \"" + name + "\"");
   if (!body->is_object()) fail(name + " is not an object (it is " + kind(*body) + ")");
@@ -98,29 +134,7 @@ void read_body(const Json& query, const std::string& name, QuaternionOrder order
 
   // Absent and null both mean identity, so that writers with optional
   // fields need not special-case them.
-  Quat rotation = Quat::Identity();
-  const auto q = body->find("rotation");
-  if (q != body->end() && !q->is_null()) {
-    double numbers[4];
-    read_numbers(*q, name + ".rotation", 4,
-                 order == QuaternionOrder::wxyz
-                     ? "4 numbers [w, x, y, z]"
-                     : "4 numbers [x, y, z, w] (--quaternion-order xyzw)",
-                 numbers);
-    // Normalized at any magnitude, a zero quaternion refused: the pose
-    // contract's own function (proxima/pose.h), as in Python.
-    try {
-      rotation = unit_quaternion(quaternion_in_order(numbers, order), name + ".rotation");
-    } catch (const InvalidInput& e) {
-      fail(e.what());
-    }
-  }
-  Vec3 translation = Vec3::Zero();
-  const auto t = body->find("translation");
-  if (t != body->end() && !t->is_null()) {
-    read_numbers(*t, name + ".translation", 3, "3 numbers [x, y, z]", translation.data());
-  }
-  pose = Pose(rotation, translation);
+  pose = read_pose(*body, name + ".", order);
 
   // The body's radius (proxima/body.h): absent or null, 0.
   radius = 0.0;
@@ -129,6 +143,60 @@ void read_body(const Json& query, const std::string& name, QuaternionOrder order
     radius = read_finite(*r, name + ".radius");
     if (radius < 0.0) fail(name + ".radius is negative: a radius must be >= 0");
   }
+
+  // The motion: an end pose, or velocities, or none.
+  motion.reset();
+  const auto end = body->find("pose_end");
+  const auto linear = body->find("linear_velocity");
+  const auto angular = body->find("angular_velocity");
+  const bool has_end = end != body->end() && !end->is_null();
+  const bool has_linear = linear != body->end() && !linear->is_null();
+  const bool has_angular = angular != body->end() && !angular->is_null();
+  if (has_end && (has_linear || has_angular)) {
+    fail(name + " has both \"pose_end\" and a velocity: give one motion");
+  }
+  if (has_end) {
+    if (!end->is_object()) {
+      fail(name + ".pose_end is not an object {\"rotation\": ..., \"translation\": ...} (it is " +
+           kind(*end) + ")");
+    }
+    motion = Motion{pose, read_pose(*end, name + ".pose_end.", order)};
+  } else if (has_linear || has_angular) {
+    Vec3 v = Vec3::Zero();
+    Vec3 w = Vec3::Zero();
+    if (has_linear)
+      read_numbers(*linear, name + ".linear_velocity", 3, "3 numbers [x, y, z]", v.data());
+    if (has_angular) {
+      read_numbers(*angular, name + ".angular_velocity", 3, "3 numbers [x, y, z]", w.data());
+    }
+    motion = Motion::from_velocity(pose, v, w, 1.0);
+  }
+}
+
+// A query-level number that must be finite and >= 0: absent or null gives
+// `otherwise`.
+double read_nonnegative(const Json& query, const char* field, double otherwise) {
+  const auto f = query.find(field);
+  if (f == query.end() || f->is_null()) return otherwise;
+  const double x = read_finite(*f, field);
+  if (x < 0.0) fail(std::string(field) + " is negative: it must be >= 0");
+  return x;
+}
+
+// {"rotation":[4 numbers in `order`],"translation":[x,y,z]}.
+void append_pose(std::string& out, const Pose& pose, QuaternionOrder order) {
+  const Quat q(pose.rotation);
+  const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+  const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
+  const double* numbers = order == QuaternionOrder::wxyz ? wxyz : xyzw;
+  out += "{\"rotation\":[";
+  for (int i = 0; i < 4; ++i) {
+    if (i > 0) out += ',';
+    append_number(out, numbers[i]);
+  }
+  out += "],\"translation\":";
+  append_point(out, pose.translation);
+  out += '}';
 }
 
 // Largest absolute world coordinate of a hull: the R of DESIGN.md's
@@ -188,10 +256,51 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
     Pose pose_b;
     double radius_a = 0.0;
     double radius_b = 0.0;
-    read_body(query, "a", order, work.vertices_a, pose_a, radius_a);
-    read_body(query, "b", order, work.vertices_b, pose_b, radius_b);
+    std::optional<Motion> motion_a;
+    std::optional<Motion> motion_b;
+    read_body(query, "a", order, work.vertices_a, pose_a, radius_a, motion_a);
+    read_body(query, "b", order, work.vertices_b, pose_b, radius_b, motion_b);
     const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
     const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
+    if (motion_a || motion_b) {
+      // A time-of-impact query: its own answer line.
+      ImpactOptions impact;
+      impact.distance = options;
+      impact.target_separation = read_nonnegative(query, "target_separation", 0.0);
+      impact.tolerance = read_nonnegative(query, "tolerance", 0.0);
+      const ImpactResult hit =
+          time_of_impact(Body(a, radius_a), motion_a.value_or(Motion::fixed(pose_a)),
+                         Body(b, radius_b), motion_b.value_or(Motion::fixed(pose_b)), impact);
+      const DistanceResult& at = hit.at_t;
+      if (!std::isfinite(at.distance) || !std::isfinite(at.signed_distance()) ||
+          !at.point_a.allFinite() || !at.point_b.allFinite()) {
+        fail("the result is not finite: the coordinates are too large for double arithmetic");
+      }
+      out += "{\"id\":";
+      append_id(out, id);
+      out += ",\"status\":\"";
+      out += to_string(hit.status);
+      out += "\",\"t\":";
+      append_number(out, hit.t);
+      out += ",\"distance\":";
+      append_number(out, at.distance);
+      out += ",\"signed_distance\":";
+      append_number(out, at.signed_distance());
+      out += ",\"point_a\":";
+      append_point(out, at.point_a);
+      out += ",\"point_b\":";
+      append_point(out, at.point_b);
+      out += ",\"normal\":";
+      append_point(out, at.normal);
+      out += ",\"pose_a\":";
+      append_pose(out, hit.pose_a, order);
+      out += ",\"pose_b\":";
+      append_pose(out, hit.pose_b, order);
+      out += ",\"iterations\":";
+      out += std::to_string(hit.iterations);
+      out += '}';
+      return true;
+    }
     if (radius_a > 0.0 || radius_b > 0.0) {
       // Rounded bodies: the cores' answer offset by the radii, points on
       // the rounded surfaces.

@@ -324,10 +324,11 @@ void bind_compound_and_scene(py::module_& m) {
            py::arg("relative_tolerance") = defaults.relative_tolerance,
            py::arg("absolute_tolerance") = defaults.absolute_tolerance,
            py::arg("max_iterations") = defaults.max_iterations,
-           py::arg("penetration") = defaults.penetration,
+           py::arg("penetration") = SceneOptions{}.distance.penetration,
            "margin: pairs at distance <= margin are reported. broad_phase: 'dynamic_aabb_tree' or "
            "'sweep_and_prune'. threads: narrow-phase threads (1: the calling thread, 0: all "
-           "cores).")
+           "cores). penetration: overlapping pairs get their depth (signed distance); off by "
+           "default in a scene, where it costs 5 to 60 us per overlapping pair and step.")
       .def(
           "add",
           [](PyScene& s, std::shared_ptr<ConvexPolytope> body, py::object pose) {

@@ -845,6 +845,58 @@ TEST(CliQuery, RadiusMakesRoundedBodies) {
   EXPECT_EQ(answers[4].at("error"), "line 5: b.radius is not a number (it is a string)");
 }
 
+// Issue 13: a body with a motion makes the line a time-of-impact query.
+// Two unit cubes, B from x = 5 to x = -5 (pose_end) or at velocity -10:
+// the faces meet at t = 0.3; with a contact offset of 0.5 at t = 0.25; B
+// moving away: separated at t = 1; a bad motion is named.
+TEST(CliQuery, MotionMakesATimeOfImpactQuery) {
+  REQUIRE_CLI();
+  const std::string cube =
+      R"("vertices": [[-1,-1,-1],[1,-1,-1],[-1,1,-1],[1,1,-1],[-1,-1,1],[1,-1,1],[-1,1,1],[1,1,1]])";
+  const std::string text =
+      "{\"id\": \"end\", \"tolerance\": 1e-9, \"a\": {" + cube + "}, \"b\": {" + cube +
+      R"(, "translation": [5, 0.3, 0], "pose_end": {"translation": [-5, 0.3, 0]}}})"
+      "\n"
+      "{\"id\": \"velocity\", \"target_separation\": 0.5, \"tolerance\": 1e-9, \"a\": {" +
+      cube + "}, \"b\": {" + cube +
+      R"(, "translation": [5, 0, 0], "linear_velocity": [-10, 0, 0]}})"
+      "\n"
+      "{\"id\": \"away\", \"a\": {" +
+      cube + "}, \"b\": {" + cube +
+      R"(, "translation": [3, 0, 0], "pose_end": {"translation": [9, 0, 0]}}})"
+      "\n"
+      "{\"a\": {" +
+      cube + "}, \"b\": {" + cube +
+      R"(, "pose_end": {"translation": [1, 0, 0]}, "linear_velocity": [1, 0, 0]}})"
+      "\n"
+      "{\"a\": {" +
+      cube + "}, \"b\": {" + cube +
+      R"(, "pose_end": [1, 0, 0]}})"
+      "\n";
+  const TempFile file(text);
+  const CliRun run = run_cli("query " + shell_quote(file.path()));
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::vector<Json> answers = parse_answers(run.out);
+  ASSERT_EQ(answers.size(), 5U) << run.out;
+  EXPECT_EQ(answers[0].at("status"), "contact");
+  const double t = answers[0].at("t").get<double>();
+  EXPECT_LE(t, 0.3);
+  EXPECT_GE(t, 0.3 - 1e-9);
+  EXPECT_NEAR(answers[0].at("pose_b").at("translation")[0].get<double>(), 2.0, 1e-8);
+  EXPECT_EQ(answers[0].at("pose_b").at("rotation")[0], 1.0);  // w first by default
+  EXPECT_LE(answers[0].at("distance").get<double>(), 1e-9);
+  EXPECT_EQ(answers[1].at("status"), "contact");
+  EXPECT_NEAR(answers[1].at("t").get<double>(), 0.25, 1e-9);
+  EXPECT_NEAR(answers[1].at("distance").get<double>(), 0.5, 1e-9);
+  EXPECT_EQ(answers[2].at("status"), "separated");
+  EXPECT_EQ(answers[2].at("t"), 1.0);
+  EXPECT_EQ(answers[3].at("error"),
+            "line 4: b has both \"pose_end\" and a velocity: give one motion");
+  EXPECT_EQ(answers[4].at("error"),
+            "line 5: b.pose_end is not an object {\"rotation\": ..., \"translation\": ...} (it "
+            "is an array)");
+}
+
 }  // namespace
 
 // Issue 11, rotations that cannot be misread: ROS's identity quaternion

@@ -629,7 +629,22 @@ TEST(SignedDistanceCompound, GradientWithRespectToTheBodiesPosesMatchesFiniteDif
 }
 
 TEST(SignedDistanceScene, ClosePairsCarryTheSignedDistance) {
-  Scene scene;
+  // A scene skips the depth by default (SceneOptions::distance): an
+  // overlapping pair is intersecting with signed distance 0; with the depth
+  // on, its pairs carry the signed distance of distance().
+  {
+    Scene plain;
+    const auto shape = std::make_shared<const ConvexPolytope>(cube(1.0));
+    plain.add(shape, Pose::identity());
+    plain.add(shape, Pose::from_translation(Vec3(0.7, 0.1, 0.0)));
+    const auto pairs = plain.step();
+    ASSERT_EQ(pairs.size(), 1U);
+    EXPECT_EQ(pairs[0].result.status, Status::intersecting);
+    EXPECT_EQ(pairs[0].result.signed_distance(), 0.0);
+  }
+  SceneOptions with_depth;
+  with_depth.distance.penetration = true;
+  Scene scene(with_depth);
   const auto cube_shape = std::make_shared<const ConvexPolytope>(cube(1.0));
   const BodyId p = scene.add(cube_shape, Pose::identity());
   const BodyId q = scene.add(cube_shape, Pose::from_translation(Vec3(0.7, 0.1, 0.0)));

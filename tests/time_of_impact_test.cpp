@@ -372,10 +372,14 @@ TEST(TimeOfImpact, RoundedAndCompoundBodies) {
       const double s = i / 2000.0;
       const double d = distance(a, ma.at(s), b, mb.at(s)).signed_distance();
       if (d <= 0.0 && first > 1.0) first = s;
-      if (s < r.t) EXPECT_GT(d, -1e-9) << "contact missed at " << s;
+      if (s < r.t) {
+        EXPECT_GT(d, -1e-9) << "contact missed at " << s;
+      }
     }
     EXPECT_LE(r.t, first + 1e-15);
-    if (r.status == ImpactStatus::contact) EXPECT_LE(r.at_t.distance, 1e-6);
+    if (r.status == ImpactStatus::contact) {
+      EXPECT_LE(r.at_t.distance, 1e-6);
+    }
   };
   const Body capsule = make_capsule(1.0, 0.2);
   const Body block = make_box(Vec3(0.5, 0.5, 0.5), 0.05);

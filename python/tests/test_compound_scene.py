@@ -315,7 +315,14 @@ def test_compound_and_scene_results_carry_the_signed_distance():
     twin = proxima.distance_all_pairs(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
     assert abs(twin.signed_distance - r.signed_distance) <= 1e-12
     hull = proxima.ConvexPolytope(np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]))
-    scene = proxima.Scene(margin=0.1)
+    # A scene skips the depth unless asked (its overlapping pairs would pay
+    # for it every step).
+    plain = proxima.Scene(margin=0.1)
+    plain.add(hull)
+    plain.add(hull, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    pairs = plain.step()
+    assert len(pairs) == 1 and pairs[0].result.signed_distance == 0.0
+    scene = proxima.Scene(margin=0.1, penetration=True)
     scene.add(hull)
     scene.add(hull, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
     pairs = scene.step()
