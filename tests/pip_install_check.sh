@@ -1,25 +1,32 @@
 #!/usr/bin/env bash
-# proxima installs the way Python users expect (issue 15): from a checkout,
-# without network, with Debian's pip, setuptools and wheel,
-#   1. `pip install --no-build-isolation .` into a fresh virtual environment
-#      created with --system-site-packages (Debian's numpy stays visible);
-#   2. `pip wheel .`, and the wheel installed into another fresh one.
-# In each the installed package answers a distance query, `python -m proxima
-# --help` runs the bundled CLI, and the type stubs are there and name every
-# public name. Before issue 15 there was no package: the module ran only from
-# a build folder through PYTHONPATH.
+# proxima installs the way Python users expect (issue 15), through the
+# commands of docs/install.md: from a checkout, without network, with
+# Debian's pip, setuptools and wheel,
+#   - `pip install --no-build-isolation .` into a fresh virtual environment
+#     created with --system-site-packages (Debian's numpy stays visible);
+#   - `pip wheel .`, and the wheel installed into another fresh one;
+#   - the same with PROXIMA_CMAKE_BUILD_DIR, and from the build tree.
+# Every `sh` block of docs/install.md is run, in order, in a copy of the
+# checkout (its files as git lists them, committed or not) whose
+# build/release is the build under test. Then, in both environments, the
+# installed package (not the copy) answers a distance query, `python -m
+# proxima --help` runs the bundled CLI, and the type stubs are there and name
+# every public name. Before issue 15 there was no package: `pip install .`
+# failed (no setup.py, no pyproject.toml) and the module ran only from a
+# build folder through PYTHONPATH.
 #
-# The CMake build this test runs in is reused (PROXIMA_CMAKE_BUILD_DIR, see
-# setup.py): nothing is compiled again. Run as a CTest test:
-#   tests/pip_install_check.sh SOURCE_DIR BUILD_DIR PYTHON
+# PROXIMA_CMAKE_BUILD_DIR (see setup.py) makes pip reuse the build under
+# test: nothing is compiled again. Run as a CTest test:
+#   tests/pip_install_check.sh SOURCE_DIR BUILD_DIR
+# The build must be for Debian's /usr/bin/python3, the interpreter the page
+# uses (the presets' default).
 set -euo pipefail
-if [ $# -ne 3 ]; then
-  echo "usage: $0 SOURCE_DIR BUILD_DIR PYTHON" >&2
+if [ $# -ne 2 ]; then
+  echo "usage: $0 SOURCE_DIR BUILD_DIR" >&2
   exit 2
 fi
 src=$1
 build=$2
-python=$3
 
 work=$(mktemp -d "${TMPDIR:-/tmp}/proxima-pip.XXXXXX")
 trap 'rm -rf "$work"' EXIT
@@ -69,17 +76,24 @@ PY
   echo "python -m proxima --help: $(head -n 1 <<<"$help")"
 }
 
-echo "== pip install --no-build-isolation $src"
-"$python" -m venv --system-site-packages "$work/venv-install"
-"$work/venv-install/bin/python" -m pip install -q --no-build-isolation "$src"
-check "$work/venv-install"
+# A copy of the checkout, as a clone would have it (plus uncommitted work).
+copy=$work/proxima
+mkdir -p "$copy/build"
+(cd "$src" && git ls-files -z --cached --others --exclude-standard |
+  xargs -0 sh -c 'for f; do [ -e "$f" ] && printf "%s\0" "$f"; done' files |  # not the deleted ones
+  xargs -0 cp --parents -t "$copy")
+ln -s "$build" "$copy/build/release"
 
-echo "== pip wheel --no-build-isolation $src, installed into a fresh venv"
-"$python" -m venv --system-site-packages "$work/venv-wheel"
-"$work/venv-wheel/bin/python" -m pip wheel -q --no-build-isolation --no-deps -w "$work/wheels" "$src"
-wheels=("$work"/wheels/proxima-*.whl)
-[ ${#wheels[@]} -eq 1 ] && [ -f "${wheels[0]}" ] || { echo "expected one wheel, got: ${wheels[*]}" >&2; exit 1; }
-echo "wheel: $(basename "${wheels[0]}")"
-"$work/venv-wheel/bin/python" -m pip install -q "${wheels[0]}"
-check "$work/venv-wheel"
-echo "pip install and pip wheel: OK"
+# The page's sh blocks, in order.
+awk '/^```sh$/ { inside = 1; next } /^```$/ { inside = 0; next } inside' "$copy/docs/install.md" >"$work/install.sh"
+blocks=$(grep -c '^```sh$' "$copy/docs/install.md")
+if [ "$blocks" -lt 4 ]; then
+  echo "docs/install.md has $blocks sh blocks, expected at least 4 (venv, wheel, PROXIMA_CMAKE_BUILD_DIR, build tree)" >&2
+  exit 1
+fi
+echo "== docs/install.md: $blocks sh blocks, $(wc -l <"$work/install.sh") commands, run in $copy"
+(cd "$copy" && PIP_QUIET=1 bash -euxo pipefail "$work/install.sh")
+
+check "$copy/venv"
+check "$copy/other-venv"
+echo "docs/install.md: pip install, pip wheel, PROXIMA_CMAKE_BUILD_DIR and the build tree: OK"
