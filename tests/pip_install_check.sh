@@ -96,4 +96,14 @@ echo "== docs/install.md: $blocks sh blocks, $(wc -l <"$work/install.sh") comman
 
 check "$copy/venv"
 check "$copy/other-venv"
+
+echo "== a PROXIMA_CMAKE_BUILD_DIR that is no build is named"
+if out=$(cd "$copy" && PROXIMA_CMAKE_BUILD_DIR=$work/no-build venv/bin/pip install --no-build-isolation . 2>&1); then
+  echo "pip install with PROXIMA_CMAKE_BUILD_DIR=$work/no-build succeeded" >&2
+  exit 1
+fi
+grep -q "PROXIMA_CMAKE_BUILD_DIR=$work/no-build is not a configured CMake build" <<<"$out" || {
+  echo "unexpected failure: $out" >&2
+  exit 1
+}
 echo "docs/install.md: pip install, pip wheel, PROXIMA_CMAKE_BUILD_DIR and the build tree: OK"

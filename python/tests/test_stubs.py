@@ -16,7 +16,6 @@ import sys
 import textwrap
 import types
 
-import pytest
 
 import proxima
 
