@@ -16,7 +16,6 @@ import sys
 import textwrap
 import types
 
-
 import proxima
 
 PACKAGE = os.path.dirname(os.path.abspath(proxima.__file__))
