@@ -68,7 +68,8 @@ def python_type(text):
     for prefix in MODULE_PREFIXES:
         t = t.replace(prefix, "")
     # numpy.ndarray[numpy.float64] (py::array_t<double>), with or without shape and flags.
-    t = re.sub(r"numpy\.ndarray\[numpy\.(\w+)[^\]]*\]", r"numpy.typing.NDArray[numpy.\1]", t)
+    # numpy.ndarray[numpy.float64[3, 1], flags.writeable] (Eigen) too.
+    t = re.sub(r"numpy\.ndarray\[numpy\.(\w+)(?:\[[^\]]*\])?[^\]]*\]", r"numpy.typing.NDArray[numpy.\1]", t)
     t = re.sub(r"\bnumpy\.ndarray\b(?!\[)", "numpy.typing.NDArray[typing.Any]", t)
     t = re.sub(r"(?<![\w.])object(?![\w.])", "typing.Any", t)
     t = re.sub(r"(\w)\[\d+\]", r"\1", t)  # std::array<int, 4>: List[int[4]] -> List[int]
@@ -240,7 +241,8 @@ def main(argv):
 
     try:
         text = generate(_proxima)
-    except StubError as e:
+        compile(text, "_proxima.pyi", "exec")  # a stub that is not Python stops the build here
+    except (StubError, SyntaxError) as e:
         sys.stderr.write(f"stubgen.py: {e}\n")
         return 1
     out_path = argv[1]
