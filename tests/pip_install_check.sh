@@ -76,12 +76,17 @@ PY
   echo "python -m proxima --help: $(head -n 1 <<<"$help")"
 }
 
-# A copy of the checkout, as a clone would have it (plus uncommitted work).
+# A copy of the checkout, as a clone would have it (plus uncommitted work);
+# a source tree that is no git checkout is copied whole but for build/.
 copy=$work/proxima
 mkdir -p "$copy/build"
-(cd "$src" && git ls-files -z --cached --others --exclude-standard |
-  xargs -0 sh -c 'for f; do [ -e "$f" ] && printf "%s\0" "$f"; done' files |  # not the deleted ones
-  xargs -0 cp --parents -t "$copy")
+if [ "$(git -C "$src" rev-parse --show-toplevel 2>/dev/null)" = "$(cd "$src" && pwd -P)" ]; then
+  (cd "$src" && git ls-files -z --cached --others --exclude-standard |
+    xargs -0 sh -c 'for f; do [ -e "$f" ] && printf "%s\0" "$f"; done' files |  # not the deleted ones
+    xargs -0 -r cp --parents -t "$copy")
+else
+  tar -C "$src" --exclude=./build -cf - . | tar -C "$copy" -xf -
+fi
 ln -s "$build" "$copy/build/release"
 
 # The page's sh blocks, in order.
