@@ -419,7 +419,8 @@ void bind_compound_and_scene(py::module_& m) {
             const InUse in_use(s, "Scene");
             return s.is_excluded(a, b);
           },
-          py::arg("a"), py::arg("b"))
+          py::arg("a"), py::arg("b"),
+          "Whether exclude_pair(a, b) excluded the pair (not undone by include_pair).")
       .def(
           "tests_pair",
           [](const PyScene& s, BodyId a, BodyId b) {
@@ -440,7 +441,7 @@ void bind_compound_and_scene(py::module_& m) {
             const InUse in_use(s, "Scene");
             return s.contains(id);
           },
-          py::arg("id"))
+          py::arg("id"), "Whether body id is in the scene (`id in scene` says the same).")
       .def("__contains__",
            [](const PyScene& s, BodyId id) {
              const InUse in_use(s, "Scene");

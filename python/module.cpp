@@ -63,9 +63,11 @@ ValueError) with the C++ message; a missing file raises FileNotFoundError.
 }  // namespace
 }  // namespace proxima
 
-PYBIND11_MODULE(proxima, m) {
+PYBIND11_MODULE(_proxima, m) {
   using namespace proxima;
   using namespace proxima::python;
+  // The package proxima re-exports every name: classes and functions say they are proxima.X.
+  m.attr("__name__") = "proxima";
   m.doc() = kModuleDoc;
 
   const auto invalid_input =
