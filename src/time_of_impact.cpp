@@ -118,56 +118,47 @@ Vec3 Motion::angular_velocity() const {
 
 Pose Motion::at(double t) const { return Sweep(*this).at(t); }
 
-ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
-                            const ConvexPolytope& b, const Motion& motion_b,
-                            const ImpactOptions& options, DistanceCache* cache) {
-  check_options(options);
+namespace {
+
+// Both motions under the pose contract (re-orthonormalized where the
+// contract allows it).
+Sweep checked_sweep(const Motion& m, const char* start, const char* end) {
+  return Sweep(Motion{checked_pose(m.start, start), checked_pose(m.end, end)});
+}
+
+// A step that is safe from time t: no contact before t + step, or none at
+// all before the end (never).
+struct SafeStep {
+  double step = 0.0;
+  bool never = false;
+};
+
+// The advancement loop shared by every body kind: `query(pa, pb)` is the
+// distance query at the poses (its signed distance and status decide
+// contact), `safe_step(r, pa, pb)` how far time may advance after answer r.
+template <class Query, class Step>
+ImpactResult advance(const Sweep& ma, const Sweep& mb, const ImpactOptions& options,
+                     double tolerance, const Query& query, const Step& safe_step) {
   const double target = options.target_separation;
-  // The ends of both motions under the pose contract (re-orthonormalized
-  // where the contract allows it).
-  const Sweep ma(Motion{checked_pose(motion_a.start, "time_of_impact: motion_a.start"),
-                        checked_pose(motion_a.end, "time_of_impact: motion_a.end")});
-  const Sweep mb(Motion{checked_pose(motion_b.start, "time_of_impact: motion_b.start"),
-                        checked_pose(motion_b.end, "time_of_impact: motion_b.end")});
-
-  const Vec3 va = ma.linear_velocity();
-  const Vec3 vb = mb.linear_velocity();
-  const Vec3 wa = ma.angular_velocity();
-  const Vec3 wb = mb.angular_velocity();
-  const double reach_a = reach(a);
-  const double reach_b = reach(b);
-  const double turn_a = wa.norm() * reach_a;
-  const double turn_b = wb.norm() * reach_b;
-  // The fastest any point of B moves relative to any point of A: the
-  // distance changes no faster (it is 1-Lipschitz in the bodies' motion).
-  const double any_speed = (vb - va).stableNorm() + turn_a + turn_b;
-  const double size = a.bounding_radius() + b.bounding_radius();
-  double tolerance = options.tolerance;
-  if (tolerance == 0.0) tolerance = 1e-6 * size;
-
-  DistanceCache local;
-  DistanceCache& c = cache != nullptr ? *cache : local;
+  const auto in_contact = [&](const DistanceResult& r) {
+    return r.status == Status::intersecting || r.status == Status::touching ||
+           r.signed_distance() <= target + tolerance;
+  };
   ImpactResult out;
   double t = 0.0;
   for (;;) {
     const Pose pa = ma.at(t);
     const Pose pb = mb.at(t);
-    const DistanceResult r = distance(a, pa, b, pb, options.distance, &c);
+    const DistanceResult r = query(pa, pb);
     ++out.iterations;
     out.t = t;
     out.pose_a = pa;
     out.pose_b = pb;
     out.at_t = r;
-    // Rounding of the query's coordinates: the contact band of the accuracy
-    // standard at these poses, kept off every bound below.
-    const double band =
-        contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
-    const bool in_contact = r.status == Status::intersecting || r.status == Status::touching ||
-                            r.distance <= target + tolerance;
-    if (in_contact) {
-      // At t = 0: overlapping when the hulls overlap or are strictly within
+    if (in_contact(r)) {
+      // At t = 0: overlapping when the bodies overlap or are strictly within
       // the offset; touching (or at the offset) is a contact at t = 0.
-      out.status = t == 0.0 && (r.status == Status::intersecting || r.distance < target)
+      out.status = t == 0.0 && (r.status == Status::intersecting || r.signed_distance() < target)
                        ? ImpactStatus::overlapping
                        : ImpactStatus::contact;
       return out;
@@ -176,9 +167,71 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
       out.status = ImpactStatus::iteration_cap;
       return out;
     }
-    // Two safe steps; the longer is taken. Along the normal: the support
-    // gap s closes no faster than mu_n. In any direction: the certified
-    // lower bound closes no faster than any_speed.
+    const SafeStep s = safe_step(r, pa, pb);
+    if (s.never || t + s.step >= 1.0) {
+      // Safe up to the end: the answer at t = 1.
+      out.pose_a = ma.at(1.0);
+      out.pose_b = mb.at(1.0);
+      out.at_t = query(out.pose_a, out.pose_b);
+      ++out.iterations;
+      out.t = 1.0;
+      out.status = in_contact(out.at_t) ? ImpactStatus::contact : ImpactStatus::separated;
+      return out;
+    }
+    if (!(t + s.step > t)) {
+      // No safe progress at this precision (bounds within rounding of the
+      // target while the distance is not): stop, t is still safe.
+      out.status = ImpactStatus::iteration_cap;
+      return out;
+    }
+    t += s.step;
+  }
+}
+
+// The step that the certified lower bound allows, closing no faster than
+// `speed` (the fastest any point of B moves relative to any point of A:
+// the distance is 1-Lipschitz in the bodies' motion).
+SafeStep lower_bound_step(double lower, double target, double speed) {
+  if (!(lower > target)) return {};
+  if (!(speed > 0.0)) return {0.0, true};
+  return {(lower - target) / speed, false};
+}
+
+}  // namespace
+
+ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
+                            const ConvexPolytope& b, const Motion& motion_b,
+                            const ImpactOptions& options, DistanceCache* cache) {
+  check_options(options);
+  const double target = options.target_separation;
+  const Sweep ma =
+      checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
+  const Sweep mb =
+      checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
+  const Vec3 va = ma.linear_velocity();
+  const Vec3 vb = mb.linear_velocity();
+  const Vec3 wa = ma.angular_velocity();
+  const Vec3 wb = mb.angular_velocity();
+  const double reach_a = reach(a);
+  const double reach_b = reach(b);
+  const double any_speed = (vb - va).stableNorm() + wa.norm() * reach_a + wb.norm() * reach_b;
+  const double tolerance = options.tolerance > 0.0
+                               ? options.tolerance
+                               : 1e-6 * (a.bounding_radius() + b.bounding_radius());
+
+  DistanceCache local;
+  DistanceCache& c = cache != nullptr ? *cache : local;
+  const auto query = [&](const Pose& pa, const Pose& pb) {
+    return distance(a, pa, b, pb, options.distance, &c);
+  };
+  // Two safe steps; the longer is taken. Along the normal: the support gap
+  // closes no faster than mu_n. In any direction: the certified lower bound
+  // closes no faster than any_speed. Both keep off the contact band of the
+  // accuracy standard at these poses (the rounding of the query's
+  // coordinates).
+  const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
+    const double band =
+        contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
     const Vec3& n = r.normal;
     const double gap = support_gap(a, pa, b, pb, n, c) - band;
     // A point r from a reference point moves along n at (w x r).n =
@@ -186,46 +239,11 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     // approach.
     const double mu_n =
         (va - vb).dot(n) + wa.cross(n).norm() * reach_a + wb.cross(n).norm() * reach_b;
-    double step = 0.0;
-    bool never = false;  // no approach: the target is never reached
-    if (gap > target) {
-      if (mu_n > 0.0) {
-        step = std::max(step, (gap - target) / mu_n);
-      } else {
-        never = true;
-      }
-    }
-    const double lower = r.lower_bound - band;
-    if (lower > target) {
-      if (any_speed > 0.0) {
-        step = std::max(step, (lower - target) / any_speed);
-      } else {
-        never = true;
-      }
-    }
-    if (never || t + step >= 1.0) {
-      // Safe up to the end: the answer at t = 1.
-      const Pose ea = ma.at(1.0);
-      const Pose eb = mb.at(1.0);
-      const DistanceResult e = distance(a, ea, b, eb, options.distance, &c);
-      ++out.iterations;
-      out.pose_a = ea;
-      out.pose_b = eb;
-      out.at_t = e;
-      out.t = 1.0;
-      const bool end_contact = e.status == Status::intersecting || e.status == Status::touching ||
-                               e.distance <= target + tolerance;
-      out.status = end_contact ? ImpactStatus::contact : ImpactStatus::separated;
-      return out;
-    }
-    if (!(t + step > t)) {
-      // No safe progress at this precision (bounds within rounding of the
-      // target while the distance is not): stop, t is still safe.
-      out.status = ImpactStatus::iteration_cap;
-      return out;
-    }
-    t += step;
-  }
+    const SafeStep along = lower_bound_step(gap, target, mu_n);
+    const SafeStep any = lower_bound_step(r.lower_bound - band, target, any_speed);
+    return SafeStep{std::max(along.step, any.step), along.never || any.never};
+  };
+  return advance(ma, mb, options, tolerance, query, safe_step);
 }
 
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
@@ -236,12 +254,13 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
   BodyCache& c = cache != nullptr ? *cache : local;
   const double ra = a.radius();
   const double rb = b.radius();
+  const double default_tolerance = 1e-6 * (body_size(a) + body_size(b));
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
     // The cores, with the radii added to the target; then the answer at t
     // moved onto the rounded surfaces.
     ImpactOptions cores = options;
     cores.target_separation += ra + rb;
-    if (cores.tolerance == 0.0) cores.tolerance = 1e-6 * (body_size(a) + body_size(b));
+    if (cores.tolerance == 0.0) cores.tolerance = default_tolerance;
     ImpactResult r = time_of_impact(*a.convex(), motion_a, *b.convex(), motion_b, cores, &c.convex);
     r.at_t = distance(a, r.pose_a, b, r.pose_b, options.distance, &c);
     return r;
@@ -249,63 +268,23 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
 
   // A compound on either side: advancement by the certified lower bound of
   // the Bodies' signed distance over the fastest point speed.
-  const double target = options.target_separation;
-  const Sweep ma(Motion{checked_pose(motion_a.start, "time_of_impact: motion_a.start"),
-                        checked_pose(motion_a.end, "time_of_impact: motion_a.end")});
-  const Sweep mb(Motion{checked_pose(motion_b.start, "time_of_impact: motion_b.start"),
-                        checked_pose(motion_b.end, "time_of_impact: motion_b.end")});
+  const Sweep ma =
+      checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
+  const Sweep mb =
+      checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
   const double any_speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
                            ma.angular_velocity().norm() * body_reach(a) +
                            mb.angular_velocity().norm() * body_reach(b);
-  const double tolerance =
-      options.tolerance > 0.0 ? options.tolerance : 1e-6 * (body_size(a) + body_size(b));
-  ImpactResult out;
-  double t = 0.0;
-  for (;;) {
-    const Pose pa = ma.at(t);
-    const Pose pb = mb.at(t);
-    const BodyDistance r = distance(a, pa, b, pb, options.distance, &c);
-    ++out.iterations;
-    out.t = t;
-    out.pose_a = pa;
-    out.pose_b = pb;
-    out.at_t = r;
-    if (r.status == Status::intersecting || r.status == Status::touching ||
-        r.signed_distance() <= target + tolerance) {
-      out.status = t == 0.0 && (r.status == Status::intersecting || r.signed_distance() < target)
-                       ? ImpactStatus::overlapping
-                       : ImpactStatus::contact;
-      return out;
-    }
-    if (out.iterations >= options.max_iterations) {
-      out.status = ImpactStatus::iteration_cap;
-      return out;
-    }
+  const double tolerance = options.tolerance > 0.0 ? options.tolerance : default_tolerance;
+  const auto query = [&](const Pose& pa, const Pose& pb) -> DistanceResult {
+    return distance(a, pa, b, pb, options.distance, &c);
+  };
+  const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
     const double band =
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
-    const double lower = r.signed_lower_bound() - band;
-    const bool never = !(any_speed > 0.0) && lower > target;
-    const double step = lower > target && any_speed > 0.0 ? (lower - target) / any_speed : 0.0;
-    if (never || t + step >= 1.0) {
-      const Pose ea = ma.at(1.0);
-      const Pose eb = mb.at(1.0);
-      const BodyDistance e = distance(a, ea, b, eb, options.distance, &c);
-      ++out.iterations;
-      out.pose_a = ea;
-      out.pose_b = eb;
-      out.at_t = e;
-      out.t = 1.0;
-      const bool end_contact = e.status == Status::intersecting || e.status == Status::touching ||
-                               e.signed_distance() <= target + tolerance;
-      out.status = end_contact ? ImpactStatus::contact : ImpactStatus::separated;
-      return out;
-    }
-    if (!(t + step > t)) {
-      out.status = ImpactStatus::iteration_cap;
-      return out;
-    }
-    t += step;
-  }
+    return lower_bound_step(r.signed_lower_bound() - band, options.target_separation, any_speed);
+  };
+  return advance(ma, mb, options, tolerance, query, safe_step);
 }
 
 }  // namespace proxima
