@@ -25,6 +25,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -380,8 +381,10 @@ inline int check_index(int i, int count, const char* what) {
   return i;
 }
 
-// The batch result as a dict of arrays (K rows each).
-inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
+// The batch result as a dict of arrays (K rows each); for Bodies also the
+// pieces of the closest pairs (piece_a, piece_b; -1 for a convex body).
+template <class Result>
+py::dict batch_dict(const std::vector<Result>& results) {
   const auto k = static_cast<py::ssize_t>(results.size());
   py::array_t<double> distance_(k), lower_bound(k), signed_distance(k), signed_lower_bound(k),
       signed_upper_bound(k), point_a({k, py::ssize_t{3}}), point_b({k, py::ssize_t{3}}),
@@ -406,7 +409,7 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   auto ta = type_a.mutable_unchecked<1>();
   auto tb = type_b.mutable_unchecked<1>();
   for (py::ssize_t i = 0; i < k; ++i) {
-    const DistanceResult& r = results[static_cast<std::size_t>(i)];
+    const Result& r = results[static_cast<std::size_t>(i)];
     d(i) = r.distance;
     lb(i) = r.lower_bound;
     sd(i) = r.signed_distance();
@@ -462,6 +465,17 @@ inline py::dict batch_dict(const std::vector<DistanceResult>& results) {
   out["feature_b_vertices"] = vertices_b;
   out["feature_b_face"] = face_b;
   out["iterations"] = iterations;
+  if constexpr (std::is_same_v<Result, BodyDistance>) {
+    Int32Array piece_a(k), piece_b(k);
+    auto ia = piece_a.mutable_unchecked<1>();
+    auto ib = piece_b.mutable_unchecked<1>();
+    for (py::ssize_t i = 0; i < k; ++i) {
+      ia(i) = results[static_cast<std::size_t>(i)].piece_a;
+      ib(i) = results[static_cast<std::size_t>(i)].piece_b;
+    }
+    out["piece_a"] = piece_a;
+    out["piece_b"] = piece_b;
+  }
   return out;
 }
 

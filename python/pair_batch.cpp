@@ -1,11 +1,13 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Python bindings: PairBatch, K different pairs of polytopes answered in one
-// call (C++'s distance_batch over BatchPair), their caches kept across calls
-// inside the object, numpy in and numpy out, the GIL released. A planner
-// checking 1,000 link pairs per configuration pays the Python call once,
-// not 1,000 times.
+// Python bindings: PairBatch, K different pairs of bodies answered in one
+// call (C++'s distance_batch), their caches kept across calls inside the
+// object, numpy in and numpy out, the GIL released. A planner checking 1,000
+// link pairs per configuration pays the Python call once, not 1,000 times.
+// Pairs of plain polytopes take the BatchPair batch (the fastest); as soon
+// as one body is something else (a Body: rounded, compound, primitive) every
+// pair becomes a BodyPair.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
@@ -21,28 +23,34 @@ namespace proxima::python {
 namespace {
 
 struct PairBatchState {
+  // Polytope pairs (when every body is a ConvexPolytope).
   std::vector<std::shared_ptr<const ConvexPolytope>> held;  // keeps the polytopes alive
   std::vector<BatchPair> pairs;
   std::vector<DistanceCache> caches;
   std::vector<DistanceResult> results;
+  // Body pairs (otherwise); `bodies` is never resized after the pointers
+  // into it are taken.
+  std::vector<Body> bodies;
+  std::vector<BodyPair> body_pairs;
+  std::vector<BodyCache> body_caches;
+  std::vector<BodyDistance> body_results;
   double last_call_seconds = 0.0;
+
+  std::size_t size() const { return pairs.size() + body_pairs.size(); }
 };
 using PyPairBatch = Guarded<PairBatchState>;
 
-std::vector<std::shared_ptr<const ConvexPolytope>> polytope_list(py::handle list,
-                                                                 const std::string& name) {
+py::sequence body_list(py::handle list, const std::string& name) {
   if (!py::isinstance<py::sequence>(list) || py::isinstance<py::str>(list))
-    value_error(name + ": expected a list of ConvexPolytope");
-  const py::sequence seq = py::reinterpret_borrow<py::sequence>(list);
-  std::vector<std::shared_ptr<const ConvexPolytope>> out;
-  out.reserve(py::len(seq));
+    value_error(name + ": expected a list of bodies (ConvexPolytope, CompoundBody or Body)");
+  return py::reinterpret_borrow<py::sequence>(list);
+}
+
+bool all_polytopes(const py::sequence& seq) {
   for (std::size_t i = 0; i < py::len(seq); ++i) {
-    const py::object item = seq[i];
-    if (!py::isinstance<ConvexPolytope>(item))
-      value_error(name + "[" + std::to_string(i) + "] is not a ConvexPolytope");
-    out.push_back(item.cast<std::shared_ptr<ConvexPolytope>>());
+    if (!py::isinstance<ConvexPolytope>(seq[i])) return false;
   }
-  return out;
+  return true;
 }
 
 }  // namespace
@@ -51,29 +59,51 @@ void bind_pair_batch(py::module_& m) {
   const DistanceOptions defaults;
   py::class_<PyPairBatch>(
       m, "PairBatch",
-      "K pairs of ConvexPolytope (a[k], b[k]), answered together by distance(): one Python "
-      "call, the queries on the thread pool without the GIL, each pair's DistanceCache kept "
+      "K pairs of bodies (a[k], b[k]), answered together by distance(): one Python "
+      "call, the queries on the thread pool without the GIL, each pair's cache kept "
       "inside the object from call to call (tracking). Use from one thread at a time.")
-      .def(py::init([](py::object a, py::object b) {
-             const auto list_a = polytope_list(a, "a");
-             const auto list_b = polytope_list(b, "b");
-             if (list_a.size() != list_b.size()) {
-               value_error("PairBatch: " + std::to_string(list_a.size()) + " bodies a but " +
-                           std::to_string(list_b.size()) + " bodies b");
-             }
-             auto state = std::make_unique<PyPairBatch>();
-             state->pairs.reserve(list_a.size());
-             for (std::size_t k = 0; k < list_a.size(); ++k) {
-               state->pairs.push_back(BatchPair{list_a[k].get(), list_b[k].get()});
-               state->held.push_back(list_a[k]);
-               state->held.push_back(list_b[k]);
-             }
-             state->caches.resize(list_a.size());
-             state->results.resize(list_a.size());
-             return state;
-           }),
-           py::arg("a"), py::arg("b"),
-           "a, b: lists of K ConvexPolytope (the same polytope may appear in many pairs).")
+      .def(
+          py::init([](py::object a, py::object b) {
+            const py::sequence list_a = body_list(a, "a");
+            const py::sequence list_b = body_list(b, "b");
+            const std::size_t k = py::len(list_a);
+            if (k != py::len(list_b)) {
+              value_error("PairBatch: " + std::to_string(k) + " bodies a but " +
+                          std::to_string(py::len(list_b)) + " bodies b");
+            }
+            auto state = std::make_unique<PyPairBatch>();
+            if (all_polytopes(list_a) && all_polytopes(list_b)) {
+              state->pairs.reserve(k);
+              for (std::size_t i = 0; i < k; ++i) {
+                const py::object item_a = list_a[i];
+                const py::object item_b = list_b[i];
+                state->held.push_back(item_a.cast<std::shared_ptr<ConvexPolytope>>());
+                state->held.push_back(item_b.cast<std::shared_ptr<ConvexPolytope>>());
+                state->pairs.push_back(
+                    BatchPair{state->held[2 * i].get(), state->held[2 * i + 1].get()});
+              }
+              state->caches.resize(k);
+              state->results.resize(k);
+              return state;
+            }
+            state->bodies.reserve(2 * k);
+            for (std::size_t i = 0; i < k; ++i) {
+              state->bodies.push_back(to_body(list_a[i], ("a[" + std::to_string(i) + "]").c_str()));
+              state->bodies.push_back(to_body(list_b[i], ("b[" + std::to_string(i) + "]").c_str()));
+            }
+            for (std::size_t i = 0; i < k; ++i) {
+              state->body_pairs.push_back(
+                  BodyPair{&state->bodies[2 * i], &state->bodies[2 * i + 1]});
+            }
+            state->body_caches.resize(k);
+            state->body_results.resize(k);
+            return state;
+          }),
+          py::arg("a"), py::arg("b"),
+          "a, b: lists of K bodies, each a ConvexPolytope, a CompoundBody or a Body (rounded, "
+          "primitive); the same body may appear in many pairs. All polytopes: the polytope "
+          "batch; otherwise every pair is answered as distance(Body, Body), and the result dict "
+          "also has piece_a and piece_b.")
       .def(
           "distance",
           [](PyPairBatch& s, py::object poses_a, py::object poses_b, int threads,
@@ -82,17 +112,23 @@ void bind_pair_batch(py::module_& m) {
             const InUse in_use(s, "PairBatch");
             const DistanceOptions options = make_options(
                 algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
-            const auto k = static_cast<py::ssize_t>(s.pairs.size());
+            const auto k = static_cast<py::ssize_t>(s.size());
             const std::vector<Pose> pa = to_poses(poses_a, k, "poses_a");
             const std::vector<Pose> pb = to_poses(poses_b, k, "poses_b");
+            const bool bodies = !s.body_pairs.empty();
             {
               py::gil_scoped_release release;
               const auto start = std::chrono::steady_clock::now();
-              distance_batch(s.pairs, pa, pb, s.results, s.caches, options, threads);
+              if (bodies) {
+                distance_batch(s.body_pairs, pa, pb, s.body_results, s.body_caches, options,
+                               threads);
+              } else {
+                distance_batch(s.pairs, pa, pb, s.results, s.caches, options, threads);
+              }
               s.last_call_seconds =
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             }
-            return batch_dict(s.results);
+            return bodies ? batch_dict(s.body_results) : batch_dict(s.results);
           },
           py::arg("poses_a"), py::arg("poses_b"), py::arg("threads") = 0,
           py::arg("algorithm") = to_string(defaults.algorithm),
@@ -113,6 +149,7 @@ distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).)doc")
           [](PyPairBatch& s) {
             const InUse in_use(s, "PairBatch");
             for (DistanceCache& c : s.caches) c.reset();
+            for (BodyCache& c : s.body_caches) c.reset();
           },
           "Makes every pair's cache cold (the next call tracks nothing).")
       .def_property_readonly(
@@ -126,11 +163,11 @@ distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).)doc")
       .def("__len__",
            [](const PyPairBatch& s) {
              const InUse in_use(s, "PairBatch");
-             return s.pairs.size();
+             return s.size();
            })
       .def("__repr__", [](const PyPairBatch& s) {
         const InUse in_use(s, "PairBatch");
-        return "proxima.PairBatch(pairs=" + std::to_string(s.pairs.size()) + ")";
+        return "proxima.PairBatch(pairs=" + std::to_string(s.size()) + ")";
       });
 }
 

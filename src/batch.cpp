@@ -13,6 +13,7 @@
 #include <string>
 
 #include "parallel_ranges.h"
+#include "proxima/body.h"
 #include "proxima/distance.h"
 
 namespace proxima {
@@ -46,12 +47,13 @@ void check_poses(std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
   }
 }
 
-// The shared part of both overloads. `pair(k)` returns the BatchPair of
-// index k (a span lookup or the one fixed pair).
-template <class PairOf>
+// The shared part of every overload. `pair(k)` returns the pair of index k
+// (a span lookup or the one fixed pair): a BatchPair or a BodyPair, whose
+// distance() overload answers into Result with a Cache.
+template <class PairOf, class Result, class Cache>
 void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
-               std::span<const Pose> poses_b, std::span<DistanceResult> results,
-               std::span<DistanceCache> caches, const DistanceOptions& options, int threads) {
+               std::span<const Pose> poses_b, std::span<Result> results, std::span<Cache> caches,
+               const DistanceOptions& options, int threads) {
   check_size(poses_a.size(), n, "poses_a");
   check_size(poses_b.size(), n, "poses_b");
   check_size(results.size(), n, "results");
@@ -61,7 +63,7 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
                        std::to_string(threads));
   }
   for (std::size_t k = 0; k < n; ++k) {
-    const BatchPair p = pair(k);
+    const auto p = pair(k);
     if (p.a == nullptr || p.b == nullptr) {
       throw InvalidInput("distance_batch: pairs[" + at(k) + "]." + (p.a == nullptr ? "a" : "b") +
                          " is null");
@@ -75,7 +77,7 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
   // message arrives whole.
   const auto run_range = [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) {
-      const BatchPair p = pair(k);
+      const auto p = pair(k);
       try {
         results[k] = distance(*p.a, poses_a[k], *p.b, poses_b[k], options,
                               caches.empty() ? nullptr : &caches[k]);
@@ -108,6 +110,14 @@ void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, cons
   const BatchPair fixed{&a, &b};
   run_batch(
       poses_a.size(), [fixed](std::size_t) { return fixed; }, poses_a, poses_b, results, caches,
+      options, threads);
+}
+
+void distance_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
+                    std::span<const Pose> poses_b, std::span<BodyDistance> results,
+                    std::span<BodyCache> caches, const DistanceOptions& options, int threads) {
+  run_batch(
+      pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b, results, caches,
       options, threads);
 }
 

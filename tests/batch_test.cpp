@@ -25,6 +25,7 @@
 
 #include "../src/parallel_ranges.h"
 #include "proxima/distance.h"
+#include "proxima/primitives.h"
 #include "support/generators.h"
 #include "support/same_bits.h"
 
@@ -304,6 +305,76 @@ TEST(Batch, BadInputIsRefusedWithItsIndexBeforeAnythingIsWritten) {
             }).find("poses_b has 7 elements, expected 300"),
             std::string::npos);
   EXPECT_TRUE(untouched()) << "a refused batch wrote results or caches";
+}
+
+// Bodies of every kind (convex, rounded, compound, primitives) mixed in one
+// batch: the batch is the loop of distance(Body, ...) bit for bit, cold and
+// tracking, with pairs that overlap (signed distance, depth) and pairs apart.
+TEST(Batch, BodyPairsEqualSequentialBitForBit) {
+  Rng rng(20261125);
+  std::vector<Body> pool;
+  for (int i = 0; i < 4; ++i) {
+    pool.emplace_back(ConvexPolytope(test::points_on_sphere(rng, 30 + 10 * i)), 0.1 * i);
+  }
+  std::vector<CompoundPiece> pieces;
+  for (int i = 0; i < 3; ++i) {
+    pieces.push_back({std::make_shared<const ConvexPolytope>(test::points_in_cube(rng, 20)),
+                      Pose(Mat3::Identity(), Vec3(1.5 * i, 0, 0))});
+  }
+  pool.emplace_back(CompoundBody(std::move(pieces)), 0.05);
+  pool.push_back(make_box(Vec3(0.5, 0.3, 0.2), 0.02));
+  pool.push_back(make_sphere(0.4));
+  pool.push_back(make_capsule(0.6, 0.2));
+  std::vector<BodyPair> pairs;
+  std::vector<Pose> poses_a;
+  std::vector<Pose> poses_b;
+  for (int k = 0; k < 300; ++k) {
+    const auto pick = [&] {
+      return &pool[static_cast<std::size_t>(test::uniform_int(rng, 0, int(pool.size()) - 1))];
+    };
+    pairs.push_back({pick(), pick()});
+    poses_a.push_back(random_pose(rng, 2.0));
+    poses_b.push_back(random_pose(rng, 2.0));
+  }
+  const std::size_t n = pairs.size();
+  for (int threads : kThreadCounts) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    std::vector<BodyCache> loop_caches(n);
+    std::vector<BodyCache> batch_caches(n);
+    std::vector<Pose> pa = poses_a;
+    std::vector<Pose> pb = poses_b;
+    Rng motion(5);
+    bool overlaps = false;
+    bool apart = false;
+    for (int frame = 0; frame < 3; ++frame) {
+      std::vector<BodyDistance> batch(n);
+      distance_batch(pairs, pa, pb, batch, batch_caches, {}, threads);
+      std::vector<BodyDistance> cold(n);
+      distance_batch(pairs, pa, pb, cold, {}, {}, threads);
+      for (std::size_t k = 0; k < n; ++k) {
+        const BodyDistance loop =
+            distance(*pairs[k].a, pa[k], *pairs[k].b, pb[k], {}, &loop_caches[k]);
+        expect_same_result(batch[k], loop, k);
+        EXPECT_TRUE(same_bits(batch[k].depth, loop.depth)) << "pair " << k;
+        EXPECT_EQ(batch[k].piece_a, loop.piece_a) << "pair " << k;
+        EXPECT_EQ(batch[k].piece_b, loop.piece_b) << "pair " << k;
+        const BodyDistance once = distance(*pairs[k].a, pa[k], *pairs[k].b, pb[k]);
+        expect_same_result(cold[k], once, k);
+        overlaps = overlaps || loop.signed_distance() < 0;
+        apart = apart || loop.signed_distance() > 0;
+      }
+      step(motion, pa);
+      step(motion, pb);
+    }
+    EXPECT_TRUE(overlaps && apart) << "the scene should mix overlapping and separated pairs";
+  }
+  // A null body is refused with its index, before anything is written.
+  std::vector<BodyPair> bad = pairs;
+  bad[7].b = nullptr;
+  std::vector<BodyDistance> results(n);
+  EXPECT_EQ(
+      invalid_input_message([&] { distance_batch(bad, poses_a, poses_b, results, {}, {}, 2); }),
+      "distance_batch: pairs[7].b is null");
 }
 
 TEST(Batch, ExceptionInsideAWorkerReachesTheCallerWithItsMessage) {

@@ -33,6 +33,7 @@
 
 #include <span>
 
+#include "proxima/body.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
@@ -69,6 +70,23 @@ void distance_batch(std::span<const BatchPair> pairs, std::span<const Pose> pose
 void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, const ConvexPolytope& b,
                     std::span<const Pose> poses_b, std::span<DistanceResult> results,
                     std::span<DistanceCache> caches, const DistanceOptions& options = {},
+                    int threads = 0);
+
+// One pair of Bodies of any kinds (convex, rounded, compound). Both
+// pointers must be non-null and outlive the call; a Body may appear in any
+// number of pairs.
+struct BodyPair {
+  const Body* a = nullptr;
+  const Body* b = nullptr;
+};
+
+// results[k] = distance(*pairs[k].a, poses_a[k], *pairs[k].b, poses_b[k],
+// options, caches.empty() ? nullptr : &caches[k]) for every k (proxima/body.h),
+// bit for bit. Same sizes, errors and threads as the polytope batch above; a
+// Body's lazily built one-piece compound (Body::compound()) is thread-safe.
+void distance_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
+                    std::span<const Pose> poses_b, std::span<BodyDistance> results,
+                    std::span<BodyCache> caches, const DistanceOptions& options = {},
                     int threads = 0);
 
 }  // namespace proxima

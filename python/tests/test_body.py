@@ -128,3 +128,36 @@ def test_bad_input_is_named(make, words):
 def test_wrong_kinds_raise_type_error():
     with pytest.raises(TypeError, match="b: expected a ConvexPolytope, a CompoundBody or a Body"):
         proxima.distance(proxima.sphere(1.0), None, "sphere", None)
+
+
+# Issue 11: a PairBatch of bodies of any kinds (rounded, compound, primitives
+# mixed with plain polytopes) answers row k as the single tracked
+# distance(Body, Body) of pair k, bit for bit, with the pieces of the pair.
+def test_pair_batch_of_any_body_kinds_equals_single_tracked_queries():
+    rng = np.random.default_rng(8)
+    convex = proxima.ConvexPolytope(rng.normal(size=(30, 3)))
+    compound = proxima.CompoundBody([rng.normal(size=(12, 3)) * 0.3 + (x, 0, 0) for x in (-1, 1)])
+    kinds = [convex, proxima.Body(convex, 0.2), compound, proxima.Body(compound, 0.1),
+             proxima.sphere(0.3), proxima.capsule(0.5, 0.1), proxima.box((0.4, 0.2, 0.3))]
+    k = 49
+    a = [kinds[i % 7] for i in range(k)]
+    b = [kinds[(i // 7) % 7] for i in range(k)]
+    batch = proxima.PairBatch(a, b)
+    assert len(batch) == k
+    caches = [proxima.BodyCache() for _ in range(k)]
+    poses_b = np.tile(np.eye(4), (k, 1, 1))
+    poses_b[:, :3, 3] = rng.uniform(-2.5, 2.5, size=(k, 3))
+    signs = set()
+    for step in range(3):
+        poses_b[:, :3, 3] += rng.normal(size=(k, 3)) * 0.05
+        out = batch.distance(None, poses_b, threads=2)
+        for i in range(k):
+            single = proxima.distance(proxima.Body(a[i]) if isinstance(a[i], proxima.ConvexPolytope) else a[i],
+                                      None, b[i], poses_b[i], cache=caches[i])
+            assert out["signed_distance"][i] == single.signed_distance
+            assert out["status"][i] == single.status
+            assert out["piece_a"][i] == single.piece_a and out["piece_b"][i] == single.piece_b
+            np.testing.assert_array_equal(out["point_a"][i], single.point_a)
+            np.testing.assert_array_equal(out["normal"][i], single.normal)
+            signs.add(single.signed_distance > 0)
+    assert signs == {True, False}  # premise: overlapping and separated pairs
