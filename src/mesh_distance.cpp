@@ -17,6 +17,7 @@
 #include "proxima/closest_point.h"
 #include "proxima/detail/exact_predicates.h"
 #include "proxima/mesh.h"
+#include "triangle_distance.h"
 
 namespace proxima {
 namespace {
@@ -156,49 +157,92 @@ bool triangles_cross(const std::array<Vec3, 3>& ta, const std::array<Vec3, 3>& t
 
 struct Best {
   double d2 = std::numeric_limits<double>::infinity();
-  ClosestPoints<double> points;
   std::int32_t ta = -1, tb = -1;
   bool crossing = false;
 };
 
+// A triangle placed in the query's scaled frame, prepared for the fast
+// kernel, with a bounding sphere (centroid, radius inflated by a few u).
 struct Triangles {
   std::array<Vec3, 3> v;
-  std::int32_t id;
+  detail::FastTriangle fast;
+  Vec3 center;
+  double radius = 0.0;
+  // Unit normal and offset of the plane (zero normal for a degenerate
+  // triangle): every point x has |unit_normal . x - offset| within rounding
+  // of its distance to the plane.
+  Vec3 unit_normal = Vec3::Zero();
+  double offset = 0.0;
+  std::int32_t id = -1;
 };
 
-// One triangle pair: the kernel, and the crossing test when in the band.
-// Returns the pair's squared distance (scaled).
-double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& best, int& tested) {
+// Whether the plane of t has all three vertices of `other` on one side,
+// farther than `limit` (a lower bound on the pair's distance: the plane
+// separates the triangles by at least the nearest of those vertices).
+bool plane_separates(const Triangles& t, const Triangles& other, double limit) {
+  const double s0 = t.unit_normal.dot(other.v[0]) - t.offset;
+  const double s1 = t.unit_normal.dot(other.v[1]) - t.offset;
+  const double s2 = t.unit_normal.dot(other.v[2]) - t.offset;
+  return (s0 > limit && s1 > limit && s2 > limit) || (s0 < -limit && s1 < -limit && s2 < -limit);
+}
+
+Triangles prepared(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::int32_t id,
+                   const KernelTolerance<double>& tol) {
+  Triangles t;
+  t.v = {p0, p1, p2};
+  t.fast = detail::FastTriangle(p0, p1, p2, tol.min_sin_squared);
+  t.center = (p0 + p1 + p2) / 3.0;
+  const double r2 = std::max({(p0 - t.center).squaredNorm(), (p1 - t.center).squaredNorm(),
+                              (p2 - t.center).squaredNorm()});
+  t.radius = std::sqrt(r2) * (1.0 + 16.0 * kUnitRoundoff) + 16.0 * kUnitRoundoff;
+  if (t.fast.planar) {
+    const Vec3 n(t.fast.n.x, t.fast.n.y, t.fast.n.z);
+    t.unit_normal = n / n.norm();
+    t.offset = t.unit_normal.dot(p0);
+  }
+  t.id = id;
+  return t;
+}
+
+// One triangle pair: skipped when its spheres are farther apart than
+// `limit` (scaled; the caller needs only pairs within it), else the fast
+// kernel, and the crossing test when in the band. Returns the pair's squared
+// distance (infinity when skipped).
+double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& best, int& tested,
+                 double limit = std::numeric_limits<double>::infinity()) {
+  if ((a.center - b.center).norm() - a.radius - b.radius > limit)
+    return std::numeric_limits<double>::infinity();
+  // The planes' bound, with the slack of its rounding (a few u of the
+  // scaled magnitudes, about 1).
+  const double plane_limit = limit + 16.0 * kUnitRoundoff;
+  if (plane_separates(a, b, plane_limit) || plane_separates(b, a, plane_limit))
+    return std::numeric_limits<double>::infinity();
   ++tested;
-  ClosestPoints<double> r =
-      closest_triangle_triangle(a.v[0], a.v[1], a.v[2], b.v[0], b.v[1], b.v[2], q.tol);
-  if (r.distance_squared <= q.band_s * q.band_s && !best.crossing &&
-      triangles_cross(a.v, b.v, q.band_s)) {
-    best.d2 = r.distance_squared;
-    best.points = r;
+  const double d2 = detail::triangle_distance_squared(a.fast, b.fast, q.tol);
+  if (d2 <= q.band_s * q.band_s && !best.crossing && triangles_cross(a.v, b.v, q.band_s)) {
+    best.d2 = d2;
     best.ta = a.id;
     best.tb = b.id;
     best.crossing = true;
-    return r.distance_squared;
+    return d2;
   }
   if (!best.crossing &&
-      (r.distance_squared < best.d2 || (r.distance_squared == best.d2 &&
-                                        (a.id < best.ta || (a.id == best.ta && b.id < best.tb))))) {
-    best.d2 = r.distance_squared;
-    best.points = r;
+      (d2 < best.d2 ||
+       (d2 == best.d2 && (a.id < best.ta || (a.id == best.ta && b.id < best.tb))))) {
+    best.d2 = d2;
     best.ta = a.id;
     best.tb = b.id;
   }
-  return r.distance_squared;
+  return d2;
 }
 
 Triangles a_triangle(const Query& q, std::int32_t t) {
   const auto& tri = q.a.triangle(t);
-  return {{q.a_vertex(tri[0]), q.a_vertex(tri[1]), q.a_vertex(tri[2])}, t};
+  return prepared(q.a_vertex(tri[0]), q.a_vertex(tri[1]), q.a_vertex(tri[2]), t, q.tol);
 }
 Triangles b_triangle(const Query& q, std::int32_t t) {
   const auto& tri = q.b.triangle(t);
-  return {{q.b_vertex(tri[0]), q.b_vertex(tri[1]), q.b_vertex(tri[2])}, t};
+  return prepared(q.b_vertex(tri[0]), q.b_vertex(tri[1]), q.b_vertex(tri[2]), t, q.tol);
 }
 
 Feature feature_of(const TriangleMesh& mesh, std::int32_t t, std::uint8_t active) {
@@ -235,14 +279,20 @@ MeshResult finish(const Query& q, const Pose& pose_a, const Best& best, bool ins
   MeshResult r;
   r.triangle_a = best.ta;
   r.triangle_b = best.tb;
-  r.feature_a = feature_of(q.a, best.ta, best.points.active_a);
-  r.feature_b = feature_of(q.b, best.tb, best.points.active_b);
-  const double d_s = std::sqrt(best.d2);
-  const Vec3 pa_local = times_pow2(best.points.point_a, q.exponent);
-  const Vec3 pb_local = times_pow2(best.points.point_b, q.exponent);
+  // The winner's points and features from the slow twin (the traversal
+  // ranked pairs by the fast kernel).
+  const Triangles ta = a_triangle(q, best.ta);
+  const Triangles tb = b_triangle(q, best.tb);
+  const ClosestPoints<double> points =
+      closest_triangle_triangle(ta.v[0], ta.v[1], ta.v[2], tb.v[0], tb.v[1], tb.v[2], q.tol);
+  r.feature_a = feature_of(q.a, best.ta, points.active_a);
+  r.feature_b = feature_of(q.b, best.tb, points.active_b);
+  const double d_s = std::sqrt(points.distance_squared);
+  const Vec3 pa_local = times_pow2(points.point_a, q.exponent);
+  const Vec3 pb_local = times_pow2(points.point_b, q.exponent);
   r.point_a = pa.apply(pa_local);
   r.point_b = pa.apply(pb_local);
-  const Vec3 diff = best.points.point_b - best.points.point_a;
+  const Vec3 diff = points.point_b - points.point_a;
   if (d_s > 0.0) {
     r.normal = pa.rotation * (diff / d_s);
   } else {
@@ -406,7 +456,9 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
         for (std::int32_t j = 0; j < nb.count; ++j) {
           const Triangles& ti = leaf_a[static_cast<std::size_t>(i)];
           const Triangles& tj = leaf_b[static_cast<std::size_t>(j)];
-          const double d2 = test_pair(q, ti, tj, best, tested);
+          const double before = best.d2;
+          const double d2 = test_pair(q, ti, tj, best, tested, std::sqrt(prune2));
+          if (best.d2 < before) prune2 = threshold2();
           if (best.crossing) break;
           if (margin > 0.0 && !overflow && d2 <= prune2) {
             // Every tested pair that may end within the margin; filtered

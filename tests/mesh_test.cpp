@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "../src/triangle_distance.h"
 #include "proxima/closest_point.h"
 #include "support/generators.h"
 
@@ -293,6 +294,43 @@ TEST(MeshDistanceExact, DegenerateTrianglesAreSegmentsAndPoints) {
   EXPECT_EQ(r.triangle_a, 0);
   EXPECT_EQ(r.feature_a.type, FeatureType::vertex);
   expect_standard(r.distance, exact_sqrt(exact_distance_squared(a, b), 0), 7, "degenerate");
+}
+
+// The traversal's fast triangle-triangle kernel against its slow twin in
+// rational arithmetic: random pairs, and the hard ones: touching, crossing,
+// parallel and coplanar pairs, shared vertices, degenerate triangles.
+TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
+  Rng rng(31);
+  const auto q = [](const Vec3& v) {
+    return Vec3q(Rational(v.x()), Rational(v.y()), Rational(v.z()));
+  };
+  const auto grid = [&] {
+    return Vec3(test::uniform_int(rng, -2, 2), test::uniform_int(rng, -2, 2),
+                test::uniform_int(rng, -2, 2));
+  };
+  const KernelTolerance<double> tol = kernel_tolerance(4.0);
+  int zero = 0, degenerate = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::array<Vec3, 6> p;
+    // Half the pairs on a small integer grid: coplanar, parallel, touching,
+    // shared and repeated vertices are frequent there.
+    for (Vec3& v : p)
+      v = trial % 2 == 0 ? grid()
+                         : Vec3(test::uniform(rng, -2, 2), test::uniform(rng, -2, 2),
+                                test::uniform(rng, -2, 2));
+    const detail::FastTriangle a(p[0], p[1], p[2], tol.min_sin_squared);
+    const detail::FastTriangle b(p[3], p[4], p[5], tol.min_sin_squared);
+    const double fast = std::sqrt(detail::triangle_distance_squared(a, b, tol));
+    const auto exact =
+        closest_triangle_triangle<Rational>(q(p[0]), q(p[1]), q(p[2]), q(p[3]), q(p[4]), q(p[5]));
+    const double d = exact_sqrt(exact.distance_squared, 0);
+    ASSERT_LE(std::abs(fast - d), 1e-12 * d + 64 * kU * 2.0)
+        << "trial " << trial << ": fast " << fast << " exact " << d;
+    zero += d == 0.0 ? 1 : 0;
+    degenerate += (!a.planar || !b.planar) ? 1 : 0;
+  }
+  EXPECT_GT(zero, 100);        // touching and crossing pairs are in the set
+  EXPECT_GT(degenerate, 40);  // and degenerate triangles
 }
 
 // --- 4. branch and bound against brute force ------------------------------------
