@@ -162,12 +162,13 @@ struct Best {
 };
 
 // A triangle placed in the query's scaled frame, prepared for the fast
-// kernel, with a bounding sphere (centroid, radius inflated by a few u).
+// kernel, with its box and plane.
 struct Triangles {
   std::array<Vec3, 3> v;
   detail::FastTriangle fast;
-  Vec3 center;
-  double radius = 0.0;
+  // The triangle's box in the query frame (A's, scaled): two triangles are
+  // at least as far apart as their boxes.
+  Vec3 lo, hi;
   // Unit normal and offset of the plane (zero normal for a degenerate
   // triangle): every point x has |unit_normal . x - offset| within rounding
   // of its distance to the plane.
@@ -191,10 +192,8 @@ Triangles prepared(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::int32_t 
   Triangles t;
   t.v = {p0, p1, p2};
   t.fast = detail::FastTriangle(p0, p1, p2, tol.min_sin_squared);
-  t.center = (p0 + p1 + p2) / 3.0;
-  const double r2 = std::max({(p0 - t.center).squaredNorm(), (p1 - t.center).squaredNorm(),
-                              (p2 - t.center).squaredNorm()});
-  t.radius = std::sqrt(r2) * (1.0 + 16.0 * kUnitRoundoff) + 16.0 * kUnitRoundoff;
+  t.lo = p0.cwiseMin(p1).cwiseMin(p2);
+  t.hi = p0.cwiseMax(p1).cwiseMax(p2);
   if (t.fast.planar) {
     const Vec3 n(t.fast.n.x, t.fast.n.y, t.fast.n.z);
     t.unit_normal = n / n.norm();
@@ -210,8 +209,15 @@ Triangles prepared(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::int32_t 
 // distance (infinity when skipped).
 double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& best, int& tested,
                  double limit = std::numeric_limits<double>::infinity()) {
-  if ((a.center - b.center).norm() - a.radius - b.radius > limit)
-    return std::numeric_limits<double>::infinity();
+  // The boxes' gap (exact differences of stored coordinates, rounded once
+  // each; the slack below covers them).
+  double gap2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double g = std::max(a.lo[k] - b.hi[k], b.lo[k] - a.hi[k]);
+    if (g > 0.0) gap2 += g * g;
+  }
+  const double box_limit = limit + 16.0 * kUnitRoundoff;
+  if (gap2 > box_limit * box_limit) return std::numeric_limits<double>::infinity();
   // The planes' bound, with the slack of its rounding (a few u of the
   // scaled magnitudes, about 1).
   const double plane_limit = limit + 16.0 * kUnitRoundoff;
@@ -438,7 +444,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   };
   double prune2 = threshold2();
   stack.push_back({0, 0, 0.0});
-  std::array<Triangles, 4> leaf_a, leaf_b;
+  std::array<Triangles, TriangleMesh::kLeafSize> leaf_a, leaf_b;
   while (!stack.empty() && !best.crossing) {
     const Entry e = stack.back();
     stack.pop_back();
