@@ -1,0 +1,288 @@
+// Triangle-mesh distance benchmark (issue 12): FCL's protocol on its own
+// test meshes, proxima's TriangleMesh against FCL 0.7's BVHModel with
+// fcl::distance, side by side in one run.
+//
+//   ./build/release/bench/mesh_bench [--poses N] [--steps S] [--referee K] [mesh directory]
+//   (defaults: N = 200 random poses, S = 2000 motion steps, K = 10 refereed
+//   poses of each kind, directory /work/shared/meshes/fcl)
+//
+// Workloads, env.obj at the identity, rob.obj at each pose:
+//   random   translations uniform in [-3000, 3000] x [-3000, 3000] x
+//            [0, 3000] and uniform random rotations (FCL's and Coal's test
+//            protocol), seeded;
+//   motion   rob along a smooth path through env: translation on a
+//            Lissajous curve across the box, rotation turning slowly, S steps.
+// Systems:
+//   proxima cold      distance(mesh, pose, mesh, pose) without a cache;
+//   proxima tracked   the same with one MeshCache kept over the sequence;
+//   FCL OBBRSS, RSS   fcl::distance on BVHModel<OBBRSS> / <RSS> (built from
+//                     the same vertices and triangles), DistanceRequest with
+//                     enable_nearest_points, rel_err = abs_err = 0 (exact).
+//                     FCL's mesh distance has no tracking: its row is cold.
+// Per system: median time per query (each pose timed separately, medians over
+// 3 repetitions of the sequence), median triangle pairs tested (proxima),
+// and the largest disagreement with the referee, distance_all_pairs (every
+// triangle pair with the closed-form kernel), on K poses of each kind.
+// Then: the triangle-triangle kernel's time, and the build of a ~10^6
+// triangle mesh (time, bytes against the raw vertices + triangles).
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/narrowphase/distance.h>
+#include <proxima/closest_point.h>
+#include <proxima/io.h>
+#include <proxima/mesh.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using proxima::Pose;
+using proxima::TriangleMesh;
+using proxima::Vec3;
+using Clock = std::chrono::steady_clock;
+
+struct MeshFile {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::int32_t, 3>> triangles;
+};
+
+MeshFile load(const std::string& path) {
+  proxima::PointCloud cloud = proxima::read_points(path);
+  return {std::move(cloud.points), std::move(cloud.triangles)};
+}
+
+template <class BV>
+std::shared_ptr<fcl::BVHModel<BV>> fcl_model(const MeshFile& m) {
+  auto model = std::make_shared<fcl::BVHModel<BV>>();
+  std::vector<fcl::Vector3d> v(m.vertices.begin(), m.vertices.end());
+  std::vector<fcl::Triangle> t;
+  for (const auto& tri : m.triangles)
+    t.emplace_back(static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
+                   static_cast<std::size_t>(tri[2]));
+  model->beginModel();
+  model->addSubModel(v, t);
+  model->endModel();
+  return model;
+}
+
+fcl::Transform3d to_fcl(const Pose& p) {
+  fcl::Transform3d tf = fcl::Transform3d::Identity();
+  tf.linear() = p.rotation;
+  tf.translation() = p.translation;
+  return tf;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng);
+}
+
+proxima::Quat random_rotation(std::mt19937_64& rng) {
+  std::normal_distribution<double> n;
+  return proxima::Quat(n(rng), n(rng), n(rng), n(rng)).normalized();
+}
+
+struct Row {
+  std::string name;
+  std::vector<double> times;  // per query, microseconds
+  std::vector<double> pairs;
+  double worst = 0.0;  // largest |distance - referee|
+};
+
+void print_row(const Row& r, double fcl_time) {
+  std::printf("  %-18s %10.2f us  %8.0f pairs  %7.2fx FCL OBBRSS  max |d - ref| %.3g\n",
+              r.name.c_str(), median(r.times), median(r.pairs), fcl_time / median(r.times),
+              r.worst);
+}
+
+template <class F>
+double time_us(F&& f) {
+  const auto t0 = Clock::now();
+  f();
+  return std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+}
+
+void run(const char* title, const TriangleMesh& env, const TriangleMesh& rob,
+         const std::vector<Pose>& poses, const fcl::BVHModel<fcl::OBBRSSd>& env_obbrss,
+         const fcl::BVHModel<fcl::OBBRSSd>& rob_obbrss, const fcl::BVHModel<fcl::RSSd>& env_rss,
+         const fcl::BVHModel<fcl::RSSd>& rob_rss, int referee_count) {
+  Row cold{"proxima cold", {}, {}, 0}, tracked{"proxima tracked", {}, {}, 0};
+  Row obbrss{"FCL OBBRSS", {}, {}, 0}, rss{"FCL RSS", {}, {}, 0};
+  std::vector<double> d_cold(poses.size()), d_tracked(poses.size()), d_obbrss(poses.size()),
+      d_rss(poses.size());
+  int intersecting = 0;
+  std::vector<double> pairs_in, pairs_out, nodes_in, nodes_out;
+  for (int rep = 0; rep < 3; ++rep) {
+    proxima::MeshCache cache;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      proxima::MeshResult r;
+      cold.times.push_back(time_us([&] { r = proxima::distance(env, Pose(), rob, poses[i]); }));
+      if (rep == 0) {
+        cold.pairs.push_back(r.pairs_tested);
+        d_cold[i] = r.distance;
+        intersecting += r.status == proxima::Status::intersecting ? 1 : 0;
+        (r.status == proxima::Status::intersecting ? pairs_in : pairs_out)
+            .push_back(r.pairs_tested);
+        (r.status == proxima::Status::intersecting ? nodes_in : nodes_out)
+            .push_back(r.nodes_tested);
+      }
+      tracked.times.push_back(
+          time_us([&] { r = proxima::distance(env, Pose(), rob, poses[i], {}, &cache); }));
+      if (rep == 0) {
+        tracked.pairs.push_back(r.pairs_tested);
+        d_tracked[i] = r.distance;
+      }
+      const fcl::Transform3d tf_a = fcl::Transform3d::Identity(), tf_b = to_fcl(poses[i]);
+      fcl::DistanceRequestd request(true, false, 0.0, 0.0);
+      fcl::DistanceResultd res1, res2;
+      obbrss.times.push_back(
+          time_us([&] { fcl::distance(&env_obbrss, tf_a, &rob_obbrss, tf_b, request, res1); }));
+      rss.times.push_back(
+          time_us([&] { fcl::distance(&env_rss, tf_a, &rob_rss, tf_b, request, res2); }));
+      if (rep == 0) {
+        d_obbrss[i] = std::max(res1.min_distance, 0.0);
+        d_rss[i] = std::max(res2.min_distance, 0.0);
+      }
+    }
+  }
+  // The referee on evenly spaced poses.
+  const std::size_t stride =
+      std::max<std::size_t>(1, poses.size() / static_cast<std::size_t>(referee_count));
+  int refereed = 0;
+  double referee_time = 0.0;
+  for (std::size_t i = 0; i < poses.size() && refereed < referee_count; i += stride, ++refereed) {
+    proxima::MeshResult ref;
+    referee_time += time_us([&] { ref = proxima::distance_all_pairs(env, Pose(), rob, poses[i]); });
+    const double d = ref.distance;
+    cold.worst = std::max(cold.worst, std::abs(d_cold[i] - d));
+    tracked.worst = std::max(tracked.worst, std::abs(d_tracked[i] - d));
+    obbrss.worst = std::max(obbrss.worst, std::abs(d_obbrss[i] - d));
+    rss.worst = std::max(rss.worst, std::abs(d_rss[i] - d));
+  }
+  const double fcl_time = median(obbrss.times);
+  std::printf("%s: %zu poses (%d intersecting), refereed on %d (brute force %.0f ms each)\n", title,
+              poses.size(), intersecting, refereed, referee_time / 1000.0 / refereed);
+  for (const Row* r : {&cold, &tracked, &obbrss, &rss}) print_row(*r, fcl_time);
+  std::printf(
+      "  cold, median triangle pairs / node pairs tested: intersecting %.0f / %.0f, apart %.0f / "
+      "%.0f\n",
+      median(pairs_in), median(nodes_in), median(pairs_out), median(nodes_out));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int pose_count = 200, steps = 2000, referee = 10;
+  std::string dir = "/work/shared/meshes/fcl";
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--poses" && i + 1 < argc) {
+      pose_count = std::atoi(argv[++i]);
+    } else if (arg == "--steps" && i + 1 < argc) {
+      steps = std::atoi(argv[++i]);
+    } else if (arg == "--referee" && i + 1 < argc) {
+      referee = std::atoi(argv[++i]);
+    } else {
+      dir = arg;
+    }
+  }
+  const MeshFile env_file = load(dir + "/env.obj");
+  const MeshFile rob_file = load(dir + "/rob.obj");
+  const TriangleMesh env(env_file.vertices, env_file.triangles);
+  const TriangleMesh rob(rob_file.vertices, rob_file.triangles);
+  std::printf("env: %d vertices, %d triangles, closed %d, %zu degenerate, %zu components\n",
+              env.vertex_count(), env.triangle_count(), env.is_closed() ? 1 : 0,
+              env.degenerate_triangles().size(), env.component_vertices().size());
+  std::printf("rob: %d vertices, %d triangles, closed %d, %zu degenerate, %zu components\n",
+              rob.vertex_count(), rob.triangle_count(), rob.is_closed() ? 1 : 0,
+              rob.degenerate_triangles().size(), rob.component_vertices().size());
+  const auto env_obbrss = fcl_model<fcl::OBBRSSd>(env_file);
+  const auto rob_obbrss = fcl_model<fcl::OBBRSSd>(rob_file);
+  const auto env_rss = fcl_model<fcl::RSSd>(env_file);
+  const auto rob_rss = fcl_model<fcl::RSSd>(rob_file);
+
+  std::mt19937_64 rng(20261125);
+  std::vector<Pose> random_poses;
+  for (int i = 0; i < pose_count; ++i) {
+    random_poses.emplace_back(
+        random_rotation(rng),
+        Vec3(uniform(rng, -3000, 3000), uniform(rng, -3000, 3000), uniform(rng, 0, 3000)));
+  }
+  run("random poses", env, rob, random_poses, *env_obbrss, *rob_obbrss, *env_rss, *rob_rss,
+      referee);
+
+  std::vector<Pose> motion;
+  const proxima::Quat q0 = random_rotation(rng);
+  for (int i = 0; i < steps; ++i) {
+    const double s = 2.0 * M_PI * i / steps;
+    const proxima::Quat turn(Eigen::AngleAxisd(s, Vec3(0.3, 0.5, 0.8).normalized()));
+    motion.emplace_back(turn * q0, Vec3(2500 * std::sin(s), 2500 * std::sin(2 * s + 0.4),
+                                        1500 + 1200 * std::sin(3 * s + 1.1)));
+  }
+  run("smooth motion", env, rob, motion, *env_obbrss, *rob_obbrss, *env_rss, *rob_rss, referee);
+
+  // The triangle-triangle kernel alone, on rob's triangles against env's.
+  {
+    std::vector<double> times;
+    double sink = 0.0;
+    const auto t0 = Clock::now();
+    int n = 0;
+    for (int i = 0; i < env.triangle_count(); i += 7) {
+      for (int j = 0; j < rob.triangle_count(); ++j, ++n) {
+        const auto& ta = env.triangle(i);
+        const auto& tb = rob.triangle(j);
+        const auto r = proxima::closest_triangle_triangle(
+            env.vertex(static_cast<int>(ta[0])), env.vertex(static_cast<int>(ta[1])),
+            env.vertex(static_cast<int>(ta[2])), rob.vertex(static_cast<int>(tb[0])),
+            rob.vertex(static_cast<int>(tb[1])), rob.vertex(static_cast<int>(tb[2])));
+        sink += r.distance_squared;
+      }
+    }
+    const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n;
+    std::printf("triangle-triangle kernel: %.0f ns per pair (%d pairs, checksum %g)\n", ns, n,
+                sink);
+  }
+
+  // Build of a ~10^6-triangle mesh: a wavy height field of 708 x 708 cells.
+  {
+    const int n = 708;
+    std::vector<Vec3> v;
+    std::vector<TriangleMesh::Triangle> t;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j)
+        v.emplace_back(i, j, 20.0 * std::sin(0.05 * i) * std::cos(0.07 * j));
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const auto a = static_cast<std::uint32_t>(i * (n + 1) + j);
+        const auto b = a + 1, c = a + static_cast<std::uint32_t>(n + 1), d = c + 1;
+        t.push_back({a, b, d});
+        t.push_back({a, d, c});
+      }
+    }
+    std::vector<double> times;
+    std::size_t bytes = 0;
+    for (int rep = 0; rep < 3; ++rep) {
+      const auto t0 = Clock::now();
+      const TriangleMesh m(v, t);
+      times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+      bytes = m.memory_bytes();
+    }
+    const double raw = static_cast<double>(v.size() * sizeof(Vec3) + t.size() * sizeof(t[0]));
+    std::printf(
+        "build: %zu triangles, %zu vertices: %.3f s (median of 3), %.1f MB = %.2fx the raw "
+        "vertices and triangles (%.1f MB)\n",
+        t.size(), v.size(), median(times), bytes / 1e6, bytes / raw, raw / 1e6);
+  }
+  return 0;
+}
