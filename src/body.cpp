@@ -1,10 +1,11 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// Bodies of any kind (a convex or compound core plus a radius) and the one
-// distance call between two of them: the cores' query (convex or compound),
-// their penetration depth where they overlap, and the offset by the radii
-// along the normal (proxima/body.h says why that is exact).
+// Bodies of any kind (a convex, compound or mesh core plus a radius) and the
+// one distance call between two of them: the cores' query (convex, compound
+// or mesh), their penetration depth where convex cores overlap, and the
+// offset by the radii along the normal (proxima/body.h says why that is
+// exact).
 #include "proxima/body.h"
 
 #include <algorithm>
@@ -36,6 +37,32 @@ double checked_length(double value, const char* what) {
     throw InvalidInput(message);
   }
   return value;
+}
+
+// A hull as a closed triangle mesh with the hull's vertex ids: each face
+// fanned from its first vertex (a convex polygon, counter-clockwise seen from
+// outside, so the mesh is consistently oriented), each triangle's face kept.
+// A polygon (dimension 2) has no inside: one side only, an open mesh. A
+// segment or a point is one degenerate triangle (the mesh measures it as
+// the segment or point it is).
+Body::MeshOfPiece hull_mesh(const ConvexPolytope& p, const Pose& pose) {
+  std::vector<TriangleMesh::Triangle> triangles;
+  std::vector<std::int32_t> faces;
+  const int face_count = p.dimension() == 2 ? std::min(p.face_count(), 1) : p.face_count();
+  for (int f = 0; f < face_count; ++f) {
+    const std::span<const std::int32_t> face = p.face(f);
+    for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+      triangles.push_back({static_cast<std::uint32_t>(face[0]), static_cast<std::uint32_t>(face[k]),
+                           static_cast<std::uint32_t>(face[k + 1])});
+      faces.push_back(f);
+    }
+  }
+  if (triangles.empty()) {  // a segment or a point
+    const auto last = static_cast<std::uint32_t>(p.vertex_count() - 1);
+    triangles.push_back({0, last, last});
+    faces.push_back(-1);
+  }
+  return {std::make_shared<const TriangleMesh>(p.vertices(), triangles), std::move(faces), pose};
 }
 
 std::shared_ptr<const CompoundBody> one_piece(const std::shared_ptr<const ConvexPolytope>& core) {
@@ -152,8 +179,11 @@ Status rounded_status(double s, const Placed& a, double ra, const Placed& b, dou
   return s > band ? Status::separated : s >= -band ? Status::touching : Status::intersecting;
 }
 
-BodyDistance offset(const CoreAnswer& c, const Body& a, const Placed& pa, const Body& b,
-                    const Placed& pb, const DistanceOptions& options) {
+// The rounded bodies' answer from the cores' one. `rounded` gives the
+// status of the rounded bodies from their signed value (used only when a
+// radius is not 0).
+template <class RoundedStatus>
+BodyDistance offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedStatus rounded) {
   const double ra = a.radius();
   const double rb = b.radius();
   const double radii = ra + rb;
@@ -164,7 +194,7 @@ BodyDistance offset(const CoreAnswer& c, const Body& a, const Placed& pa, const 
   if (c.status == Status::iteration_cap || radii == 0.0) {
     r.status = c.status;
   } else {
-    r.status = rounded_status(value, pa, ra, pb, rb, options);
+    r.status = rounded(value);
   }
   // The signed values in DistanceResult's fields, so that its
   // signed_distance(), signed_lower_bound() and signed_upper_bound() give
@@ -204,7 +234,9 @@ BodyDistance convex_pair(const Body& a, const Pose& pose_a, const Body& b, const
   if (needs_depth(c, a.radius() + b.radius())) {
     take_depth(c, penetration_depth(ca, cb, relative(pose_a, pose_b), cache.penetration), pose_a);
   }
-  return offset(c, a, {&ca, pose_a}, b, {&cb, pose_b}, options);
+  return offset(c, a, b, [&](double value) {
+    return rounded_status(value, {&ca, pose_a}, a.radius(), {&cb, pose_b}, b.radius(), options);
+  });
 }
 
 // The deepest overlapping piece pair of two compounds whose cores overlap:
@@ -327,11 +359,119 @@ BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, con
   }
   const CompoundPiece& piece_a = ca.piece(c.piece_a);
   const CompoundPiece& piece_b = cb.piece(c.piece_b);
-  BodyDistance r = offset(c, a, {piece_a.polytope.get(), pose_a * piece_a.pose}, b,
-                          {piece_b.polytope.get(), pose_b * piece_b.pose}, options);
+  BodyDistance r = offset(c, a, b, [&](double value) {
+    return rounded_status(value, {piece_a.polytope.get(), pose_a * piece_a.pose}, a.radius(),
+                          {piece_b.polytope.get(), pose_b * piece_b.pose}, b.radius(), options);
+  });
   // A convex body met a compound as its one-piece wrapper: it has no pieces.
   if (a.kind() == Body::Kind::convex) r.piece_a = -1;
   if (b.kind() == Body::Kind::convex) r.piece_b = -1;
+  return r;
+}
+
+// The largest coordinate magnitude of a mesh's vertices placed at `pose`
+// (the exact R of the accuracy standard). O(V).
+double placed_magnitude(const TriangleMesh& m, const Pose& pose) {
+  double r = 0.0;
+  for (const Vec3& v : m.vertices()) r = std::max(r, pose.apply(v).cwiseAbs().maxCoeff());
+  return r;
+}
+
+// A pair with a mesh on at least one side: every pair of meshes of
+// Body::meshes() (one per convex piece, one for a mesh), each tracked by its
+// own MeshCache, the closest (or a crossing) pair kept. A pair is skipped
+// when a lower bound on its distance, from the pieces' bounding spheres, is
+// above the best distance found: only slower if the bound were loose, never
+// wrong.
+BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                       const DistanceOptions& options, BodyCache& cache) {
+  const std::vector<Body::MeshOfPiece>& ma = a.meshes();
+  const std::vector<Body::MeshOfPiece>& mb = b.meshes();
+  const std::size_t pairs = ma.size() * mb.size();
+  if (cache.mesh.size() != pairs) cache.mesh.assign(pairs, MeshCache{});
+  // Each piece's placed bounding sphere: the root box's center and half
+  // diagonal, placed.
+  const auto sphere = [](const Body::MeshOfPiece& m, const Pose& pose) {
+    Vec3 lo, hi;
+    m.mesh->box(0, lo, hi);
+    const Pose placed = pose * m.pose;
+    return std::pair<Vec3, double>(placed.apply(0.5 * (lo + hi)), 0.5 * (hi - lo).norm());
+  };
+  MeshResult best;
+  bool have = false;
+  std::size_t best_i = 0, best_j = 0;
+  // The last answer's pair first: its distance prunes the others.
+  const std::size_t first =
+      cache.mesh_closest >= 0 && static_cast<std::size_t>(cache.mesh_closest) < pairs
+          ? static_cast<std::size_t>(cache.mesh_closest)
+          : 0;
+  for (std::size_t n = 0; n < pairs; ++n) {
+    const std::size_t k = n == 0 ? first : n <= first ? n - 1 : n;
+    const std::size_t i = k / mb.size();
+    const std::size_t j = k % mb.size();
+    const Pose place_a = pose_a * ma[i].pose;
+    const Pose place_b = pose_b * mb[j].pose;
+    if (have && pairs > 1) {
+      const auto [ca, ra] = sphere(ma[i], pose_a);
+      const auto [cb, rb] = sphere(mb[j], pose_b);
+      const double gap = (ca - cb).norm() - ra - rb;
+      // Rounding of the placed centers and norm: a relative 1e-12 slack.
+      if (gap * (1.0 - 1e-12) - 1e-300 > best.distance) continue;
+    }
+    MeshResult r = distance(*ma[i].mesh, place_a, *mb[j].mesh, place_b, options, &cache.mesh[k]);
+    const bool better = !have ||
+                        (r.status == Status::intersecting && best.status != Status::intersecting) ||
+                        (best.status != Status::intersecting && r.distance < best.distance);
+    if (better) {
+      if (have) r.lower_bound = std::min(r.lower_bound, best.lower_bound);
+      best = r;
+      best_i = i;
+      best_j = j;
+      have = true;
+    } else {
+      best.lower_bound = std::min(best.lower_bound, r.lower_bound);
+    }
+  }
+  cache.mesh_closest = static_cast<std::int32_t>(best_i * mb.size() + best_j);
+  CoreAnswer c;
+  c.status = best.status;
+  c.point_a = best.point_a;
+  c.point_b = best.point_b;
+  c.normal = best.normal;
+  c.feature_a = best.feature_a;
+  c.feature_b = best.feature_b;
+  c.iterations = best.iterations;
+  if (best.status == Status::intersecting) {
+    c.value = 0.0;
+    c.lower = -std::numeric_limits<double>::infinity();
+    c.upper = 0.0;
+    c.overlap = true;
+  } else {
+    c.value = best.distance;
+    c.lower = best.lower_bound;
+    c.upper = best.distance;
+  }
+  // A convex core's features in its hull's terms: mesh vertex ids are hull
+  // vertex ids; a triangle's face is the hull face it came from.
+  const auto hull_face = [](Feature& f, const Body::MeshOfPiece& m) {
+    if (!m.faces.empty() && f.face >= 0) f.face = m.faces[static_cast<std::size_t>(f.face)];
+  };
+  hull_face(c.feature_a, ma[best_i]);
+  hull_face(c.feature_b, mb[best_j]);
+  if (a.kind() == Body::Kind::compound) c.piece_a = static_cast<std::int32_t>(best_i);
+  if (b.kind() == Body::Kind::compound) c.piece_b = static_cast<std::int32_t>(best_j);
+  const Pose place_a = pose_a * ma[best_i].pose;
+  const Pose place_b = pose_b * mb[best_j].pose;
+  BodyDistance r = offset(c, a, b, [&](double value) {
+    const double reach = std::max(placed_magnitude(*ma[best_i].mesh, place_a) + a.radius(),
+                                  placed_magnitude(*mb[best_j].mesh, place_b) + b.radius());
+    const double band = contact_band(reach, options.absolute_tolerance);
+    return value > band     ? Status::separated
+           : value >= -band ? Status::touching
+                            : Status::intersecting;
+  });
+  if (a.kind() == Body::Kind::mesh) r.triangle_a = best.triangle_a;
+  if (b.kind() == Body::Kind::mesh) r.triangle_b = best.triangle_b;
   return r;
 }
 
@@ -347,9 +487,17 @@ Body::Body(std::shared_ptr<const ConvexPolytope> core, double radius, double app
 
 Body::Body(std::shared_ptr<const CompoundBody> core, double radius, double approximation_error)
     : compound_(std::move(core)),
+      wrapper_(std::make_shared<Wrapper>()),
       radius_(checked_length(radius, "radius")),
       approximation_error_(checked_length(approximation_error, "approximation_error")) {
   if (!compound_) throw InvalidInput("Body: null compound core");
+}
+
+Body::Body(std::shared_ptr<const TriangleMesh> core, double radius)
+    : mesh_(std::move(core)),
+      wrapper_(std::make_shared<Wrapper>()),
+      radius_(checked_length(radius, "radius")) {
+  if (!mesh_) throw InvalidInput("Body: null mesh core");
 }
 
 Body::Body(ConvexPolytope core, double radius)
@@ -358,6 +506,9 @@ Body::Body(ConvexPolytope core, double radius)
 Body::Body(CompoundBody core, double radius)
     : Body(std::make_shared<const CompoundBody>(std::move(core)), radius) {}
 
+Body::Body(TriangleMesh core, double radius)
+    : Body(std::make_shared<const TriangleMesh>(std::move(core)), radius) {}
+
 Body Body::with_radius(double radius) const {
   Body copy = *this;
   copy.radius_ = checked_length(radius, "radius");
@@ -365,12 +516,31 @@ Body Body::with_radius(double radius) const {
 }
 
 std::shared_ptr<const CompoundBody> Body::compound() const {
-  if (compound_) return compound_;
+  if (compound_ || !convex_) return compound_;
   std::call_once(wrapper_->once, [this] { wrapper_->compound = one_piece(convex_); });
   return wrapper_->compound;
 }
 
-double Body::scale() const { return (convex_ ? convex_->scale() : compound_->scale()) + radius_; }
+const std::vector<Body::MeshOfPiece>& Body::meshes() const {
+  std::call_once(wrapper_->meshes_once, [this] {
+    std::vector<MeshOfPiece>& out = wrapper_->meshes;
+    if (mesh_) {
+      out.push_back({mesh_, {}, Pose::identity()});
+    } else if (convex_) {
+      out.push_back(hull_mesh(*convex_, Pose::identity()));
+    } else {
+      for (int i = 0; i < compound_->piece_count(); ++i) {
+        const CompoundPiece& piece = compound_->piece(i);
+        out.push_back(hull_mesh(*piece.polytope, piece.pose));
+      }
+    }
+  });
+  return wrapper_->meshes;
+}
+
+double Body::scale() const {
+  return (convex_ ? convex_->scale() : compound_ ? compound_->scale() : mesh_->scale()) + radius_;
+}
 
 BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options, BodyCache* cache) {
@@ -398,6 +568,9 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
   cores.penetration = false;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
     return convex_pair(a, pa, b, pb, cores, c);
+  }
+  if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
+    return mesh_pair(a, pa, b, pb, cores, c);
   }
   return compound_pair(a, pa, b, pb, cores, c);
 }

@@ -3,7 +3,8 @@
 //
 // Layer 6: any body, and one distance call for any two of them.
 //
-// A Body is a core, a ConvexPolytope or a CompoundBody, plus a radius r >= 0:
+// A Body is a core, a ConvexPolytope, a CompoundBody or a TriangleMesh, plus
+// a radius r >= 0:
 // the Minkowski sum of the core with a ball of radius r (Coal's swept-sphere
 // radius, Jolt's convex radius, MuJoCo's margin). For a compound, every piece
 // gets the radius. r = 0 is the plain core. A sphere is a point with a radius,
@@ -33,6 +34,7 @@
 #include <mutex>
 
 #include "proxima/compound.h"
+#include "proxima/mesh.h"
 #include "proxima/penetration.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
@@ -41,7 +43,7 @@ namespace proxima {
 
 class Body {
  public:
-  enum class Kind : std::uint8_t { convex, compound };
+  enum class Kind : std::uint8_t { convex, compound, mesh };
 
   // Throws InvalidInput for a null core, or a radius or approximation error
   // that is negative, NaN or infinite (the message names the value).
@@ -52,17 +54,36 @@ class Body {
                 double approximation_error = 0.0);
   explicit Body(std::shared_ptr<const CompoundBody> core, double radius = 0.0,
                 double approximation_error = 0.0);
+  // A triangle mesh (proxima/mesh.h): its surface, and for a closed mesh
+  // its inside, plus the radius.
+  explicit Body(std::shared_ptr<const TriangleMesh> core, double radius = 0.0);
   // Copies the core into shared storage.
   explicit Body(ConvexPolytope core, double radius = 0.0);
   explicit Body(CompoundBody core, double radius = 0.0);
+  explicit Body(TriangleMesh core, double radius = 0.0);
 
-  Kind kind() const { return convex_ ? Kind::convex : Kind::compound; }
-  // The convex core, or null for a compound.
+  Kind kind() const { return convex_ ? Kind::convex : compound_ ? Kind::compound : Kind::mesh; }
+  // The convex core, or null for another kind.
   const std::shared_ptr<const ConvexPolytope>& convex() const { return convex_; }
   // The compound core; for a convex body, the core as a one-piece compound,
   // so that it can meet a compound: built on the first call (thread-safe)
-  // and shared by every copy of the body, O(N) once.
+  // and shared by every copy of the body, O(N) once. Null for a mesh.
   std::shared_ptr<const CompoundBody> compound() const;
+  // The mesh core, or null for another kind.
+  const std::shared_ptr<const TriangleMesh>& mesh() const { return mesh_; }
+
+  // A convex core or piece as a closed triangle mesh, to meet a mesh: the
+  // hull's faces fanned into triangles, with the hull's vertex ids, and
+  // each triangle's hull face (`faces`; a segment or a point is one
+  // degenerate triangle, face -1; a polygon its one side, an open mesh).
+  struct MeshOfPiece {
+    std::shared_ptr<const TriangleMesh> mesh;
+    std::vector<std::int32_t> faces;  // per triangle, the hull face id
+    Pose pose;                        // the piece's pose in the body (identity for convex)
+  };
+  // One per piece (one for a convex body; the core itself for a mesh, faces
+  // empty), built on the first call (thread-safe), shared by every copy.
+  const std::vector<MeshOfPiece>& meshes() const;
 
   double radius() const { return radius_; }
   // The same core with another radius (padding: radius() + padding).
@@ -79,15 +100,19 @@ class Body {
   double scale() const;
 
  private:
-  // A convex core's one-piece compound, built once on demand.
+  // A convex core's one-piece compound and any core's meshes, built once on
+  // demand.
   struct Wrapper {
     std::once_flag once;
     std::shared_ptr<const CompoundBody> compound;
+    std::once_flag meshes_once;
+    std::vector<MeshOfPiece> meshes;
   };
 
   std::shared_ptr<const ConvexPolytope> convex_;
-  std::shared_ptr<const CompoundBody> compound_;  // null for a convex core
-  std::shared_ptr<Wrapper> wrapper_;              // null for a compound core
+  std::shared_ptr<const CompoundBody> compound_;  // null for another core
+  std::shared_ptr<const TriangleMesh> mesh_;      // null for another core
+  std::shared_ptr<Wrapper> wrapper_;
   double radius_ = 0.0;
   double approximation_error_ = 0.0;
 };
@@ -101,7 +126,15 @@ struct BodyCache {
   DistanceCache convex;
   CompoundCache compound;
   PenetrationCache penetration;
-  bool is_cold() const { return convex.is_cold() && compound.is_cold() && penetration.is_cold(); }
+  // Mesh pairs: one per pair of meshes (piece of A, piece of B) of
+  // Body::meshes(), A's index major.
+  std::vector<MeshCache> mesh;
+  std::int32_t mesh_closest = -1;  // the index in `mesh` of the last answer's pair
+  bool is_cold() const {
+    bool cold = convex.is_cold() && compound.is_cold() && penetration.is_cold();
+    for (const MeshCache& m : mesh) cold = cold && m.is_cold();
+    return cold;
+  }
   void reset() { *this = BodyCache{}; }
 };
 
@@ -125,7 +158,8 @@ struct BodyCache {
 //                 points' direction, or the penetration normal when the
 //                 cores overlap)
 //   feature_a, feature_b  the cores' witness features (hull ids of the
-//                 pieces piece_a, piece_b for compounds)
+//                 pieces piece_a, piece_b for compounds; mesh vertex ids
+//                 and, for a face, the triangle index for a mesh)
 // and beyond them:
 struct BodyDistance : DistanceResult {
   // The signed distance of the rounded bodies and its certificate are
@@ -137,6 +171,9 @@ struct BodyDistance : DistanceResult {
   // The pieces of the closest (or deepest) pair, -1 for a convex body.
   std::int32_t piece_a = -1;
   std::int32_t piece_b = -1;
+  // The closest triangles of mesh bodies (-1 for other kinds).
+  std::int32_t triangle_a = -1;
+  std::int32_t triangle_b = -1;
   // Whether the cores overlap (then signed_distance <= -(r_a + r_b), from
   // their penetration depth).
   bool cores_overlap = false;
@@ -150,6 +187,15 @@ struct BodyDistance : DistanceResult {
 // any kinds placed at pose_a and pose_b. Throws InvalidInput for a pose
 // outside the contract of proxima/pose.h or bad options. `cache` may be
 // null (cold).
+//
+// Mesh bodies (proxima/mesh.h): against any kind, the distance between the
+// mesh's surface and the other body's surface (a convex core or piece as
+// the closed triangle mesh of its hull, Body::meshes()), and intersecting
+// when the surfaces cross or one lies inside the other, closed, one. The
+// depth of an overlap involving a mesh is not computed: the cores'
+// signed value is then 0 with certificate [-infinity, 0] (so
+// signed_distance() is minus the radii, and signed_upper_bound() is
+// certified). Each pair of meshes is tracked by its own MeshCache.
 //
 // Compound bodies: the signed distance is the smallest over piece pairs of
 // the pair's signed distance (the deepest overlapping pair when cores
