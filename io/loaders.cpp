@@ -127,4 +127,31 @@ LoadedCompound load_compound(const std::string& path, const ReadOptions& options
   return compound_from_cloud(read_points(path, options));
 }
 
+LoadedMesh mesh_from_cloud(const PointCloud& cloud) {
+  if (cloud.points.empty()) throw FileError::in_file(cloud.source, "no points");
+  if (cloud.triangles.empty()) {
+    const bool faces_unread =
+        cloud.format != MeshFormat::obj && cloud.format != MeshFormat::stl_ascii &&
+        cloud.format != MeshFormat::stl_binary && cloud.format != MeshFormat::unknown;
+    throw FileError::in_file(
+        cloud.source,
+        std::string("no faces to make a mesh of") +
+            (faces_unread ? " (the " + std::string(to_string(cloud.format)) +
+                                " reader reads points only; use OBJ or STL for a mesh)"
+                          : ": a point cloud has no surface; load it as its hull instead"));
+  }
+  try {
+    TriangleMesh mesh(cloud.points, cloud.triangles);
+    const int degenerate = static_cast<int>(mesh.degenerate_triangles().size());
+    const bool closed = mesh.is_closed();
+    return LoadedMesh{std::move(mesh), static_cast<int>(cloud.points.size()), degenerate, closed};
+  } catch (const InvalidInput& e) {
+    throw FileError::in_file(cloud.source, e.what());
+  }
+}
+
+LoadedMesh load_mesh(const std::string& path, const ReadOptions& options) {
+  return mesh_from_cloud(read_points(path, options));
+}
+
 }  // namespace proxima

@@ -1015,5 +1015,42 @@ TEST_F(IoTest, MutatedFilesRaiseOnlyInvalidInput) {
   EXPECT_GT(refused, 10000);
 }
 
+// Issue 12: a file as a triangle mesh, as given. A closed cube mesh is
+// closed; the same without two faces is open; a point cloud or a format
+// whose faces are not read is refused with the reason; a bad face index
+// names the file and the triangle.
+TEST_F(IoTest, LoadMeshKeepsTheFacesAndRefusesWhatHasNone) {
+  const LoadedMesh cube = load_mesh(write("cube_mesh.obj", cube_obj_with_faces("")));
+  EXPECT_EQ(cube.mesh.triangle_count(), 12);
+  EXPECT_EQ(cube.input_points, 8);
+  EXPECT_TRUE(cube.closed);
+  EXPECT_EQ(cube.degenerate_triangles, 0);
+  std::string open = cube_obj_with_faces("");
+  open = open.substr(0, open.rfind("f 2 4 8"));
+  const LoadedMesh opened = load_mesh(write("open_mesh.obj", open));
+  EXPECT_EQ(opened.mesh.triangle_count(), 10);
+  EXPECT_FALSE(opened.closed);
+  const LoadedMesh sliver = load_mesh(write("sliver.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"));
+  EXPECT_EQ(sliver.degenerate_triangles, 1);
+
+  const auto message = [](auto&& run) -> std::string {
+    try {
+      run();
+    } catch (const FileError& e) {
+      return e.what();
+    }
+    return "no FileError";
+  };
+  const std::string cloud = write("cloud.xyz", "0 0 0\n1 0 0\n0 1 0\n");
+  EXPECT_NE(message([&] { load_mesh(cloud); }).find("no faces to make a mesh of"),
+            std::string::npos)
+      << message([&] { load_mesh(cloud); });
+  const std::string off = write("tet.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n");
+  EXPECT_NE(message([&] { load_mesh(off); }).find("reads points only"), std::string::npos)
+      << message([&] { load_mesh(off); });
+  const std::string no_faces = write("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  EXPECT_NE(message([&] { load_mesh(no_faces); }).find("load it as its hull"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace proxima

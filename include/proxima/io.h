@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "proxima/compound.h"
+#include "proxima/mesh.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
@@ -185,5 +186,24 @@ LoadedCompound load_compound(const std::string& path, const ReadOptions& options
 // the points, one name each; triangle indices inside the points) and
 // hulled; errors name cloud.source and the group.
 LoadedCompound compound_from_cloud(const PointCloud& cloud);
+
+// A file as a triangle mesh (proxima/mesh.h): its vertices and faces as
+// given, nothing merged or replaced (STL corners are merged by the reader,
+// see PointCloud). Degenerate triangles are kept and counted.
+struct LoadedMesh {
+  TriangleMesh mesh;
+  int input_points = 0;          // points read (vertices of the mesh, used or not)
+  int degenerate_triangles = 0;  // zero-area triangles, measured as segments or points
+  bool closed = false;           // TriangleMesh::is_closed(): the mesh has an inside
+};
+
+// read_points, then the mesh of its points and triangles. A file without
+// faces (a point cloud: XYZ, or OBJ without `f` lines; OFF and PLY faces are
+// not read) is a FileError saying so; an index or coordinate the mesh
+// refuses is a FileError naming the file and the triangle or vertex.
+LoadedMesh load_mesh(const std::string& path, const ReadOptions& options = {});
+
+// The same from a point cloud already read; errors name cloud.source.
+LoadedMesh mesh_from_cloud(const PointCloud& cloud);
 
 }  // namespace proxima
