@@ -154,4 +154,37 @@ LoadedMesh load_mesh(const std::string& path, const ReadOptions& options) {
   return mesh_from_cloud(read_points(path, options));
 }
 
+const char* to_string(LoadAs as) {
+  switch (as) {
+    case LoadAs::mesh:
+      return "mesh";
+    case LoadAs::hull:
+      return "hull";
+    case LoadAs::pieces:
+      return "pieces";
+  }
+  return "?";
+}
+
+LoadAs load_as_from_string(std::string_view name) {
+  for (const LoadAs as : {LoadAs::mesh, LoadAs::hull, LoadAs::pieces}) {
+    if (name == to_string(as)) return as;
+  }
+  throw InvalidInput("load as '" + std::string(name) +
+                     "': expected 'mesh' (the surface as given), 'hull' (the convex hull) or "
+                     "'pieces' (one hull per group)");
+}
+
+Body load_body(const std::string& path, LoadAs as, const ReadOptions& options) {
+  switch (as) {
+    case LoadAs::mesh:
+      return Body(std::make_shared<const TriangleMesh>(load_mesh(path, options).mesh));
+    case LoadAs::hull:
+      return Body(std::make_shared<const ConvexPolytope>(load_convex(path, options).polytope));
+    case LoadAs::pieces:
+      return Body(std::make_shared<const CompoundBody>(load_compound(path, options).body));
+  }
+  throw InvalidInput("load_body: unknown LoadAs");
+}
+
 }  // namespace proxima

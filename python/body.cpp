@@ -35,20 +35,36 @@ Body to_body(py::handle obj, const char* name) {
   if (py::isinstance<CompoundBody>(obj)) {
     return Body(std::shared_ptr<const CompoundBody>(obj.cast<std::shared_ptr<CompoundBody>>()));
   }
-  throw py::type_error(std::string(name) +
-                       ": expected a ConvexPolytope, a CompoundBody or a Body, got " +
-                       py::str(py::type::handle_of(obj).attr("__name__")).cast<std::string>());
+  if (py::isinstance<TriangleMesh>(obj)) {
+    return Body(std::shared_ptr<const TriangleMesh>(obj.cast<std::shared_ptr<TriangleMesh>>()));
+  }
+  throw py::type_error(
+      std::string(name) +
+      ": expected a ConvexPolytope, a CompoundBody, a TriangleMesh or a Body, got " +
+      py::str(py::type::handle_of(obj).attr("__name__")).cast<std::string>());
 }
 
 namespace {
 
 using PyBodyCache = Guarded<BodyCache>;
 
+const char* kind_name(const Body& b) {
+  switch (b.kind()) {
+    case Body::Kind::convex:
+      return "convex";
+    case Body::Kind::compound:
+      return "compound";
+    case Body::Kind::mesh:
+      return "mesh";
+  }
+  return "?";
+}
+
 // The core of Body(core, radius): a polytope, a compound, a Body (its core)
 // or an (N, 3) array of points (hulled).
 Body core_body(py::handle obj) {
   if (py::isinstance<Body>(obj) || py::isinstance<ConvexPolytope>(obj) ||
-      py::isinstance<CompoundBody>(obj)) {
+      py::isinstance<CompoundBody>(obj) || py::isinstance<TriangleMesh>(obj)) {
     return to_body(obj, "core");
   }
   return Body(std::make_shared<const ConvexPolytope>(to_points(obj)));
@@ -57,33 +73,40 @@ Body core_body(py::handle obj) {
 }  // namespace
 
 void bind_bodies(py::module_& m) {
-  py::class_<Body>(m, "Body",
-                   "A convex or compound core plus a radius: the Minkowski sum of the core with a "
-                   "ball (a sphere is a point with a radius, a capsule a segment with one). "
-                   "Immutable; shares its core; shareable between threads.")
+  py::class_<Body>(
+      m, "Body",
+      "A convex, compound or mesh core plus a radius: the Minkowski sum of the core with a "
+      "ball (a sphere is a point with a radius, a capsule a segment with one). "
+      "Immutable; shares its core; shareable between threads.")
       .def(py::init([](py::object core, double radius) {
              const Body body = core_body(core);
              return Body(body).with_radius(radius);
            }),
            py::arg("core"), py::arg("radius") = 0.0,
-           "core: a ConvexPolytope, a CompoundBody (every piece gets the radius), a Body (its "
+           "core: a ConvexPolytope, a CompoundBody (every piece gets the radius), a TriangleMesh, "
+           "a Body (its "
            "core) or an (N, 3) array of points (hulled). radius: finite and >= 0, in the "
            "core's units; raises InvalidInput otherwise.")
       .def_property_readonly(
-          "kind",
-          [](const Body& b) { return b.kind() == Body::Kind::convex ? "convex" : "compound"; },
-          "'convex' or 'compound'.")
+          "kind", [](const Body& b) { return kind_name(b); }, "'convex', 'compound' or 'mesh'.")
+      .def_property_readonly(
+          "mesh",
+          [](const Body& b) -> py::object {
+            if (!b.mesh()) return py::none();
+            return py::cast(std::const_pointer_cast<TriangleMesh>(b.mesh()));
+          },
+          "The mesh core (TriangleMesh), or None for another kind.")
       .def_property_readonly(
           "convex",
           [](const Body& b) -> py::object {
             if (!b.convex()) return py::none();
             return py::cast(std::const_pointer_cast<ConvexPolytope>(b.convex()));
           },
-          "The convex core (ConvexPolytope), or None for a compound.")
+          "The convex core (ConvexPolytope), or None for another kind.")
       .def_property_readonly(
           "compound",
           [](const Body& b) { return std::const_pointer_cast<CompoundBody>(b.compound()); },
-          "The compound core; for a convex body, its one-piece compound.")
+          "The compound core; for a convex body, its one-piece compound; None for a mesh.")
       .def_property_readonly("radius", &Body::radius, "The radius (>= 0).")
       .def_property_readonly(
           "approximation_error", &Body::approximation_error,
@@ -94,8 +117,7 @@ void bind_bodies(py::module_& m) {
       .def("with_radius", &Body::with_radius, py::arg("radius"),
            "The same core with another radius.")
       .def("__repr__", [](const Body& b) {
-        return std::string("proxima.Body(") +
-               (b.kind() == Body::Kind::convex ? "convex" : "compound") +
+        return std::string("proxima.Body(") + kind_name(b) +
                ", radius=" + py::repr(py::float_(b.radius())).cast<std::string>() + ")";
       });
 
@@ -158,6 +180,10 @@ void bind_bodies(py::module_& m) {
       "the cores.")
       .def_readonly("piece_a", &BodyDistance::piece_a, "Piece of A (compound), else -1.")
       .def_readonly("piece_b", &BodyDistance::piece_b, "Piece of B (compound), else -1.")
+      .def_readonly("triangle_a", &BodyDistance::triangle_a,
+                    "Closest triangle of A (mesh), else -1.")
+      .def_readonly("triangle_b", &BodyDistance::triangle_b,
+                    "Closest triangle of B (mesh), else -1.")
       .def_readonly("cores_overlap", &BodyDistance::cores_overlap,
                     "Whether the cores themselves overlap (the value is then from their "
                     "penetration depth).")
@@ -193,7 +219,8 @@ void bind_bodies(py::module_& m) {
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
       py::arg("penetration") = defaults.penetration,
-      "Any two bodies: a ConvexPolytope, a CompoundBody or a Body on either side (two polytopes "
+      "Any two bodies: a ConvexPolytope, a CompoundBody, a TriangleMesh or a Body on either side "
+      "(two polytopes "
       "or two compounds take the overloads above). cache: a BodyCache or None. Returns a "
       "BodyDistance (overlapping cores always get their depth: penetration=False has no effect "
       "here). A ConvexPolytope met with a compound is wrapped on every call (O(N)): for "

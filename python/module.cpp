@@ -565,5 +565,6 @@ feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k],
   bind_compound_and_scene(m);
   bind_pair_batch(m);
   bind_bodies(m);
+  bind_mesh(m);
   bind_time_of_impact(m);
 }

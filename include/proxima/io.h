@@ -35,6 +35,7 @@
 #include <string_view>
 #include <vector>
 
+#include "proxima/body.h"
 #include "proxima/compound.h"
 #include "proxima/mesh.h"
 #include "proxima/polytope.h"
@@ -205,5 +206,18 @@ LoadedMesh load_mesh(const std::string& path, const ReadOptions& options = {});
 
 // The same from a point cloud already read; errors name cloud.source.
 LoadedMesh mesh_from_cloud(const PointCloud& cloud);
+
+// How a file becomes a body; the caller says which (nothing is silently
+// replaced by its hull):
+//   mesh    the surface as given (load_mesh): exact for any shape
+//   hull    the convex hull of every point (load_convex)
+//   pieces  one convex hull per OBJ group (load_compound)
+enum class LoadAs : std::uint8_t { mesh, hull, pieces };
+const char* to_string(LoadAs as);
+// "mesh", "hull" or "pieces"; anything else is an InvalidInput naming it.
+LoadAs load_as_from_string(std::string_view name);
+
+// The file as a Body of that kind (radius 0).
+Body load_body(const std::string& path, LoadAs as, const ReadOptions& options = {});
 
 }  // namespace proxima

@@ -126,7 +126,7 @@ def test_bad_input_is_named(make, words):
 
 
 def test_wrong_kinds_raise_type_error():
-    with pytest.raises(TypeError, match="b: expected a ConvexPolytope, a CompoundBody or a Body"):
+    with pytest.raises(TypeError, match="b: expected a ConvexPolytope, a CompoundBody, a TriangleMesh or a Body"):
         proxima.distance(proxima.sphere(1.0), None, "sphere", None)
 
 

@@ -725,7 +725,7 @@ def test_pair_batch_equals_single_tracked_queries():
     batch.reset()
     with pytest.raises(ValueError, match="PairBatch: 2 bodies a but 1 bodies b"):
         proxima.PairBatch(a[:2], b[:1])
-    with pytest.raises(TypeError, match=r"b\[1\]: expected a ConvexPolytope, a CompoundBody or a Body, got str"):
+    with pytest.raises(TypeError, match=r"b\[1\]: expected a ConvexPolytope, a CompoundBody, a TriangleMesh or a Body, got str"):
         proxima.PairBatch(a[:2], [b[0], "x"])
     with pytest.raises(ValueError, match="poses_b"):
         batch.distance(None, poses_b[:3])
