@@ -204,6 +204,20 @@ def main():
     run([proxima, "view", "--query", w("overlap.jsonl"), "--out", w("overlap.html")])
     pages.append(("overlap", w("overlap.html"), -answer["signed_distance"]))  # the depth
 
+    # 2b. Bodies at 1e39 (the paper scales cubes to 1e39): float32 vertices
+    # overflow past 3.4e38. The first viewer sent the world coordinates to
+    # the GPU as they were: this page was blank and three.js logged NaN
+    # bounding spheres. It now draws every point as (p - center) / extent,
+    # computed in doubles; the label keeps the answer's numbers.
+    big = 1e39
+    query = {"id": "huge", "a": {"vertices": [[big * c for c in p] for p in box_points([-1, -1, -1], [1, 1, 1])]},
+             "b": {"vertices": [[big * c for c in p] for p in tetrahedron([0, 0, 0], 1.5)],
+                   "translation": [2.5 * big, 0.4 * big, 0.2 * big], "rotation": [0.9, 0.2, 0.3, 0.1]}}
+    open(w("huge.jsonl"), "w").write(json.dumps(query) + "\n")
+    answer = json.loads(run([proxima, "query", w("huge.jsonl")]))
+    run([proxima, "view", "--query", w("huge.jsonl"), "--out", w("huge.html")])
+    pages.append(("huge", w("huge.html"), answer["distance"]))
+
     # 3. Two compound bodies (OBJ groups): a table and an L-shaped bracket.
     table = [("top", box_points([-1, -1, 0.9], [1, 1, 1]))] + [
         (f"leg{i}", box_points([sx * 0.9 - 0.05, sy * 0.9 - 0.05, 0], [sx * 0.9 + 0.05, sy * 0.9 + 0.05, 0.9]))

@@ -91,9 +91,13 @@
       update();
     }, { passive: false });
     return {
-      frame(center, size) {
+      // Looks at `center` from far enough to see a ball of radius `size`;
+      // with `across` (the pair's normal), from a side square to it, so that
+      // the segment and the normal are not foreshortened.
+      frame(center, size, across) {
         target.copy(center);
-        radius = 1.15 * size / Math.tan((camera.fov * Math.PI) / 360);
+        if (across) theta = Math.atan2(across[1], across[0]) + Math.PI / 2;
+        radius = 1.35 * size / Math.tan((camera.fov * Math.PI) / 360);
         update();
       },
     };
@@ -120,7 +124,7 @@
     const lines = new THREE.BufferGeometry();
     lines.setAttribute('position', positions);
     lines.setIndex(piece.edges);
-    objects.push(new THREE.LineSegments(lines, new THREE.LineBasicMaterial({ color })));
+    objects.push(new THREE.LineSegments(lines, new THREE.LineBasicMaterial({ color, transparent: true, opacity: 0.5 })));
     if (piece.triangles.length === 0) {
       const points = new THREE.BufferGeometry();
       points.setAttribute('position', positions);
@@ -189,7 +193,50 @@
     return new THREE.Color(stops[stops.length - 1][1]);
   }
 
+  // The drawing's coordinates: every point as (p - center) / extent, in
+  // doubles, before anything becomes a float32 vertex. Bodies from 1e-23 to
+  // 1e39 (the paper's stress cases) then draw alike; the label keeps the
+  // data's own numbers.
+  function normalize(data) {
+    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+    for (const body of data.bodies) {
+      for (const piece of body.pieces) {
+        const q = piece.positions;
+        for (let i = 0; i < q.length; ++i) {
+          lo[i % 3] = Math.min(lo[i % 3], q[i]);
+          hi[i % 3] = Math.max(hi[i % 3], q[i]);
+        }
+      }
+    }
+    if (!(lo[0] <= hi[0])) return;  // no vertex at all
+    // Halves first: hi - lo may overflow near 1e308.
+    const center = [0, 1, 2].map((k) => lo[k] / 2 + hi[k] / 2);
+    let extent = Math.max(...[0, 1, 2].map((k) => hi[k] / 2 - lo[k] / 2)) * 2;
+    if (!(extent > 0) || !isFinite(extent)) extent = Math.max(...center.map(Math.abs), 1);
+    const f = (p) => [0, 1, 2].map((k) => p[k] / extent - center[k] / extent);
+    for (const body of data.bodies) {
+      for (const piece of body.pieces) {
+        const q = piece.positions;
+        for (let i = 0; i < q.length; ++i) q[i] = q[i] / extent - center[i % 3] / extent;
+      }
+    }
+    const pair = data.pair;
+    if (pair) {
+      pair.point_a = f(pair.point_a);
+      pair.point_b = f(pair.point_b);
+      for (const feature of [pair.feature_a, pair.feature_b]) {
+        feature.points = feature.points.map(f);
+        feature.face = feature.face.map(f);
+      }
+    }
+    for (const p of data.pairs || []) {
+      p.point_a = f(p.point_a);
+      p.point_b = f(p.point_b);
+    }
+  }
+
   function show(THREE, data) {
+    normalize(data);
     const container = document.getElementById('view');
     const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
     renderer.setPixelRatio(window.devicePixelRatio || 1);
@@ -236,7 +283,7 @@
 
     const render = () => renderer.render(scene, camera);
     const control = OrbitControl(THREE, camera, renderer.domElement, render);
-    control.frame(center, size / 2);
+    control.frame(center, size / 2, data.kind === 'pair' ? data.pair.normal : null);
     wireframe.addEventListener('change', () => {
       for (const m of faceMeshes) m.visible = !wireframe.checked;
       render();
@@ -279,13 +326,21 @@
     scene.add(ball(THREE, pair.point_a, size * 0.01, COLOR_SEGMENT));
     scene.add(ball(THREE, pair.point_b, size * 0.01, COLOR_SEGMENT));
     scene.add(rod(THREE, pair.point_a, pair.point_b, size * 0.003, COLOR_SEGMENT));
-    // The normal, from A towards B, drawn from B's point on (beyond the
-    // segment, which lies along it when the bodies are apart).
+    // The normal, from A towards B, drawn from A's closest point: it runs
+    // along the segment when the bodies are apart, and past it.
     const n = new THREE.Vector3(...pair.normal);
     if (n.lengthSq() > 0) {
-      const length = size * 0.2;
-      scene.add(new THREE.ArrowHelper(n.normalize(), new THREE.Vector3(...pair.point_b), length,
-                                      COLOR_NORMAL, length * 0.25, length * 0.12));
+      // At least the segment's length, drawn over the bodies (no depth
+      // test) so that B's faces do not hide it.
+      const segment = new THREE.Vector3(...pair.point_a).distanceTo(new THREE.Vector3(...pair.point_b));
+      const length = Math.max(size * 0.15, segment * 1.25);
+      const arrow = new THREE.ArrowHelper(n.normalize(), new THREE.Vector3(...pair.point_a), length,
+                                          COLOR_NORMAL, size * 0.04, size * 0.02);
+      arrow.traverse((o) => {
+        if (o.material) o.material.depthTest = false;
+        o.renderOrder = 10;
+      });
+      scene.add(arrow);
     }
   }
 
