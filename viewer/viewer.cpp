@@ -7,8 +7,11 @@
 // does no pose arithmetic of its own: what it draws is what was queried.
 #include "viewer.h"
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string_view>
 
 #include "proxima/polytope.h"
@@ -35,17 +38,20 @@ void append_flat(Json& out, const Vec3& p) {
   out.push_back(p.z());
 }
 
-// One convex piece placed in the world: its hull's vertices, the facets as
-// triangles and the edges, as indices into the vertices.
-Json piece_json(const ConvexPolytope& hull, const Pose& to_world) {
+// One piece placed in the world: its vertices, its surface as triangles and
+// its edges, as indices into the vertices. A convex piece gives its hull's
+// (facets fan-triangulated); a mesh body would give its own triangles.
+Json piece_json(std::span<const Vec3> vertices,
+                std::span<const std::array<std::int32_t, 3>> surface,
+                std::span<const std::array<std::int32_t, 2>> edge_list, const Pose& to_world) {
   Json positions = Json::array();
-  for (const Vec3& v : hull.vertices()) append_flat(positions, to_world.apply(v));
+  for (const Vec3& v : vertices) append_flat(positions, to_world.apply(v));
   Json triangles = Json::array();
-  for (const auto& t : hull.triangles()) {
+  for (const auto& t : surface) {
     for (const std::int32_t i : t) triangles.push_back(i);
   }
   Json edges = Json::array();
-  for (const auto& e : hull.edges()) {
+  for (const auto& e : edge_list) {
     edges.push_back(e[0]);
     edges.push_back(e[1]);
   }
@@ -54,8 +60,15 @@ Json piece_json(const ConvexPolytope& hull, const Pose& to_world) {
               {"edges", std::move(edges)}};
 }
 
+Json piece_json(const ConvexPolytope& hull, const Pose& to_world) {
+  return piece_json(hull.vertices(), hull.triangles(), hull.edges(), to_world);
+}
+
 // The pieces of a body and where each sits in the body's frame. Mesh bodies
-// (issue 15's third kind) join here: their triangles as one piece.
+// (issue 15's third kind, added beside this viewer) join here: a new
+// Body::Kind makes this switch warn (-Wswitch) until it has its case, which
+// gives the mesh's triangles to piece_json (vertices, triangles, edges) and
+// its closest triangle to feature_json as the witness.
 struct PlacedPiece {
   const ConvexPolytope* hull = nullptr;
   Pose pose;  // piece frame -> body frame
