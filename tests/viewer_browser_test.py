@@ -14,7 +14,9 @@
 #     through it);
 #   - the label shows the answer's distance (or depth), the same double;
 #   - the canvas is not blank: the screenshot below the text panel is far
-#     from one flat colour (pixel variance).
+#     from one flat colour (pixel variance);
+#   - the wireframe toggle hides the faces (the compound page opened as
+#     page.html#wireframe covers less of the canvas).
 # Two pages built to fail (a script error; the canvas hidden) must fail the
 # same checks, so the checks can fail.
 #
@@ -50,7 +52,7 @@ def page_data(path):
     return json.loads(m.group(1))
 
 
-def browse(chromium, page, work, name):
+def browse(chromium, page, work, name, fragment=""):
     """Opens `page` headless; returns (body state, label value, errors, console lines, png)."""
     png = os.path.join(work, name + ".png")
     if os.path.exists(png):
@@ -66,7 +68,7 @@ def browse(chromium, page, work, name):
             # reached after three.js is parsed and the frame drawn, however
             # slow the machine.
             "--virtual-time-budget=10000", "--enable-logging=stderr", "--v=0",
-            "--dump-dom", "--screenshot=" + png, "file://" + os.path.abspath(page)]
+            "--dump-dom", "--screenshot=" + png, "file://" + os.path.abspath(page) + fragment]
     r = subprocess.run(args, capture_output=True, text=True, timeout=90)
     if r.returncode != 0 or not os.path.exists(png):
         sys.exit(f"FAILED: chromium on {page} exited {r.returncode}\n{r.stderr[-3000:]}")
@@ -93,9 +95,10 @@ def canvas_variance(png):
     return variance, drawn
 
 
-def check_rendered(chromium, page, work, name, expected_label=None):
-    """Returns a list of what is wrong with the rendered page (empty: fine)."""
-    state, label, errors, console, png = browse(chromium, page, work, name)
+def check_rendered(chromium, page, work, name, expected_label=None, fragment=""):
+    """Returns what is wrong with the rendered page (empty: fine), the
+    screenshot and the share of the canvas drawn."""
+    state, label, errors, console, png = browse(chromium, page, work, name, fragment)
     problems = []
     if state != "yes":
         problems.append(f"the page did not render (data-rendered={state!r}, errors: {errors!r})")
@@ -113,7 +116,7 @@ def check_rendered(chromium, page, work, name, expected_label=None):
                         f"{100 * drawn:.2f} % of pixels drawn)")
     print(f"  {name}: rendered={state} label={label} console={len(console)} "
           f"variance={variance:.1f} drawn={100 * drawn:.1f}%")
-    return problems, png
+    return problems, png, drawn
 
 
 def tetrahedron(offset, s=1.0):
@@ -270,10 +273,20 @@ def main():
         sys.exit("FAILED: no chromium (scripts/setup installs Debian's chromium)")
     failures = []
     shots = {}
+    drawn = {}
     for name, page, label in pages:
-        problems, png = check_rendered(opt.chromium, page, opt.work, name, label)
+        problems, png, drawn[name] = check_rendered(opt.chromium, page, opt.work, name, label)
         failures += [f"{name}: {p}" for p in problems]
         shots[name] = png
+
+    # The wireframe toggle (opened checked through #wireframe): the faces
+    # hidden, the edges and the witness still drawn, less canvas covered.
+    problems, _, wire = check_rendered(opt.chromium, w("compound.html"), opt.work, "wireframe",
+                                       {n: l for n, _, l in pages}["compound"], fragment="#wireframe")
+    failures += [f"wireframe: {p}" for p in problems]
+    if not wire < 0.7 * drawn["compound"]:
+        failures.append(f"wireframe: {100 * wire:.1f} % of the canvas drawn, with faces "
+                        f"{100 * drawn['compound']:.1f} %: the faces were not hidden")
 
     # The checks can fail: a page whose script throws, and one whose canvas
     # is hidden, must each be caught.
@@ -283,10 +296,10 @@ def main():
     assert broken != html and hidden != html, "the page template changed: update the controls"
     open(w("broken.html"), "w", encoding="utf-8").write(broken)
     open(w("hidden.html"), "w", encoding="utf-8").write(hidden)
-    problems, _ = check_rendered(opt.chromium, w("broken.html"), opt.work, "broken", pages[0][2])
+    problems, _, _ = check_rendered(opt.chromium, w("broken.html"), opt.work, "broken", pages[0][2])
     if not any("console" in p for p in problems) or not any("did not render" in p for p in problems):
         failures.append(f"control: a script error went unnoticed ({problems})")
-    problems, _ = check_rendered(opt.chromium, w("hidden.html"), opt.work, "hidden", pages[0][2])
+    problems, _, _ = check_rendered(opt.chromium, w("hidden.html"), opt.work, "hidden", pages[0][2])
     if not any("blank" in p for p in problems):
         failures.append(f"control: a hidden canvas went unnoticed ({problems})")
 

@@ -265,6 +265,8 @@
     const size = Math.max(box.getSize(new THREE.Vector3()).length(), 1e-300);
 
     const wireframe = document.getElementById('wireframe');
+    // page.html#wireframe opens with the faces hidden (a link can say so).
+    if (window.location.hash === '#wireframe') wireframe.checked = true;
     const faceMeshes = [];
     const colors = data.kind === 'pair' ? [COLOR_A, COLOR_B] : null;
     data.bodies.forEach((body, i) => {
