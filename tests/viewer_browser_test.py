@@ -262,6 +262,19 @@ def main():
 
     check_bad_input(proxima, w)
 
+    # A time-of-impact line: the bodies drawn at the time found (the
+    # answer's poses), no bounds (null).
+    hit = {"id": "hit", "a": {"vertices": box_points([-1, -1, -1], [1, 1, 1])},
+           "b": {"vertices": box_points([-1, -1, -1], [1, 1, 1]), "translation": [5, 0, 0],
+                 "pose_end": {"translation": [-5, 0, 0]}}}
+    open(w("hit.jsonl"), "w").write(json.dumps(hit) + "\n")
+    answer = json.loads(run([proxima, "query", w("hit.jsonl")]))
+    run([proxima, "view", "--query", w("hit.jsonl"), "--out", w("hit.html")])
+    data = page_data(w("hit.html"))
+    assert data["pair"]["status"].startswith("contact, t = ") and data["pair"]["signed_lower_bound"] is None
+    b_x = data["bodies"][1]["pieces"][0]["positions"][0::3]
+    assert min(b_x) == answer["pose_b"]["translation"][0] - 1, (min(b_x), answer["pose_b"])
+
     # The pages' data say what the answers said.
     pair = page_data(w("pair.html"))["pair"]
     assert pair["distance"] == pages[0][2] and pair["feature_a"]["points"], pair

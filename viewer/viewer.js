@@ -306,9 +306,13 @@
     label.textContent = depth ? 'penetration depth ' + num(-pair.signed_distance)
                               : 'distance ' + num(pair.distance);
     label.dataset.value = num(depth ? -pair.signed_distance : pair.distance);
-    document.getElementById('certificate').textContent =
-        'certificate: ' + num(pair.signed_lower_bound) + ' \u2264 signed distance \u2264 ' +
-        num(pair.signed_upper_bound) + '  (' + pair.status + ')';
+    // A time-of-impact answer carries no bounds (null in the data).
+    const bounded = pair.signed_lower_bound !== null && pair.signed_upper_bound !== null;
+    document.getElementById('certificate').textContent = (bounded
+        ? 'certificate: ' + num(pair.signed_lower_bound) + ' \u2264 signed distance \u2264 ' +
+          num(pair.signed_upper_bound)
+        : 'signed distance ' + num(pair.signed_distance) + ', no bounds in this answer') +
+        '  (' + pair.status + ')';
     const names = data.bodies.map((b) => b.name + (b.radius > 0 ? ' (radius ' + num(b.radius) + ')' : ''));
     document.getElementById('detail').textContent =
         'A: ' + names[0] + ', witness ' + pair.feature_a.type +
