@@ -91,3 +91,12 @@ def test_in_a_notebook_the_page_shows_inline(monkeypatch):
     proxima.view(cube(), cube())
     assert len(shown) == 1
     assert page
+
+
+def test_names_cannot_end_the_data_script():
+    # The data sits in a <script> element, which the first "</script" ends:
+    # the writer writes "</" as "<\/" (the same JSON string).
+    name = "</script><script>alert(1)</script>"
+    data = data_of(proxima.view(cube(), cube(), pose_b=([1, 0, 0, 0], [2, 0, 0]), name_a=name,
+                                inline=False))
+    assert data["bodies"][0]["name"] == name
