@@ -6,6 +6,7 @@
 //   proxima query [FILE] [--algorithm NAME] ...    JSON Lines in, JSON Lines out
 //   proxima distance A B [--pose-a ...] [--json]   distance between two mesh files
 //   proxima hull FILE [--out FILE.obj|.off]        hull statistics and export
+//   proxima view A B | --query FILE | --scene FILE --out page.html   one HTML page
 //
 // The paper's experiments and the scene demo, which measure the peers (FCL,
 // libccd, Bullet), are the benchmark executables bench/paper_experiments and
@@ -29,6 +30,7 @@
 #include "proxima/types.h"
 #include "query.h"
 #include "tools.h"
+#include "view.h"
 
 namespace {
 
@@ -202,6 +204,50 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   hull->footer("Example:\n  proxima hull body.stl --out hull.off");
 
+  CLI::App* view = app.add_subcommand(
+      "view",
+      "Write one self-contained HTML page (three.js inline, no network) showing two bodies, "
+      "their closest points, witness features, normal and certificate, or one scene step "
+      "(docs/viewer.md)");
+  proxima::cli::ViewCommand view_command;
+  std::string view_order = "wxyz";
+  std::string view_algorithm = "hybrid";
+  view->add_option("A", view_command.file_a, "First body's mesh file (OBJ groups: a compound)");
+  view->add_option("B", view_command.file_b, "Second body's mesh file");
+  view->add_option("--pose-a", view_command.pose_a, "Pose of A, as for `proxima distance`")
+      ->expected(7)
+      ->type_name("x y z qw qx qy qz");
+  view->add_option("--pose-b", view_command.pose_b, "Pose of B, as for `proxima distance`")
+      ->expected(7)
+      ->type_name("x y z qw qx qy qz");
+  view->add_option("--query", view_command.query_file,
+                   "A file ('-': standard input) holding one `proxima query` line, then "
+                   "optionally its answer line; without one the query is answered here");
+  view->add_option("--scene", view_command.scene_file,
+                   "A file of JSON Lines, one body per line ({\"vertices\": ..., \"rotation\": "
+                   "..., \"translation\": ...}): one step of a Scene, close pairs coloured by "
+                   "distance");
+  view->add_option("--margin", view_command.margin,
+                   "With --scene: pairs within this distance are drawn")
+      ->capture_default_str();
+  view->add_option("--quaternion-order", view_order,
+                   "Order of the quaternions (poses, query rotations): wxyz or xyzw")
+      ->check(CLI::IsMember(orders))
+      ->capture_default_str();
+  view->add_option("--algorithm", view_algorithm, "Algorithm answering the query")
+      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
+      ->capture_default_str();
+  view->add_option("--max-file-size", view_command.max_file_bytes,
+                   "Refuse an input file larger than this many bytes")
+      ->capture_default_str();
+  view->add_option("-o,--out", view_command.out_file, "The page to write ('-': standard output)")
+      ->required();
+  view->footer(
+      "Examples:\n"
+      "  proxima view a.obj b.stl --pose-b 0 0 2 1 0 0 0 --out pair.html\n"
+      "  proxima view --query query.jsonl --out query.html\n"
+      "  proxima view --scene bodies.jsonl --margin 0.1 --out scene.html");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -222,6 +268,24 @@ int main(int argc, char** argv) {
       return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
     }
     if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);
+    if (*view) {
+      // Exactly one input: two files, a query file or a scene file.
+      const bool files = !view_command.file_a.empty();
+      const int inputs = (files ? 1 : 0) + (view_command.query_file.empty() ? 0 : 1) +
+                         (view_command.scene_file.empty() ? 0 : 1);
+      if (inputs != 1 || (files && view_command.file_b.empty())) {
+        std::cerr << "proxima view: give two mesh files A B, or --query FILE, or --scene FILE "
+                     "(exactly one of them)\n";
+        return kExitUsage;
+      }
+      if (!files && (!view_command.pose_a.empty() || !view_command.pose_b.empty())) {
+        std::cerr << "proxima view: --pose-a and --pose-b go with two mesh files\n";
+        return kExitUsage;
+      }
+      view_command.options.algorithm = parse_algorithm(view_algorithm);
+      view_command.quaternion_order = parse_order(view_order);
+      return proxima::cli::run_view(view_command, std::cout, std::cerr);
+    }
   } catch (const std::exception& e) {
     std::cerr << "proxima: " << e.what() << "\n";
     return kExitFailure;

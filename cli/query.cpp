@@ -96,6 +96,8 @@ Pose read_pose(const Json& object, const std::string& path, QuaternionOrder orde
   return Pose(rotation, translation);
 }
 
+}  // namespace
+
 // Reads body `name` ("a" or "b") of `query` into vertices, pose, radius and
 // motion (time of impact, proxima/time_of_impact.h: "pose_end", or
 // "linear_velocity" and "angular_velocity" per unit t; none: no motion),
@@ -172,6 +174,8 @@ void read_body(const Json& query, const std::string& name, QuaternionOrder order
     motion = Motion::from_velocity(pose, v, w, 1.0);
   }
 }
+
+namespace {
 
 // A query-level number that must be finite and >= 0: absent or null gives
 // `otherwise`.
@@ -366,6 +370,18 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   out += '}';
   return true;
 }
+
+}  // namespace
+
+std::string answer_query_line(const std::string& line, const DistanceOptions& options,
+                              QuaternionOrder order) {
+  Workspace work;
+  std::string out;
+  answer_line(line, 1, options, order, work, out);
+  return out;
+}
+
+namespace {
 
 bool is_blank(std::string_view line) {
   return line.find_first_not_of(" \t\r\n\f\v") == std::string_view::npos;

@@ -8,8 +8,13 @@
 #pragma once
 
 #include <istream>
+#include <optional>
 #include <ostream>
+#include <string>
+#include <vector>
 
+#include "json_errors.h"
+#include "proxima/time_of_impact.h"
 #include "proxima/types.h"
 
 namespace proxima::cli {
@@ -36,5 +41,18 @@ struct QueryRunSummary {
 inline constexpr int kQueryBlockLines = 256;
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
                             int threads = 1, QuaternionOrder order = QuaternionOrder::wxyz);
+
+// One line's answer, as run_queries writes it (without the newline); the
+// error answer names line 1. `proxima view` answers the query it draws.
+std::string answer_query_line(const std::string& line, const DistanceOptions& options,
+                              QuaternionOrder order = QuaternionOrder::wxyz);
+
+// Reads body `name` ("a" or "b") of a parsed query line into its vertices,
+// pose, radius and motion (none: no motion), rotations in `order`: the
+// reader of run_queries, shared with `proxima view`. Throws QueryError with
+// the field named (`b.vertices[3][1] is not a finite number`).
+void read_body(const Json& query, const std::string& name, QuaternionOrder order,
+               std::vector<Vec3>& vertices, Pose& pose, double& radius,
+               std::optional<Motion>& motion);
 
 }  // namespace proxima::cli

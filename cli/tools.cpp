@@ -90,47 +90,6 @@ LoadedFile load_file(const std::string& path, std::uint64_t max_file_bytes) {
   }
 }
 
-double parse_number(const std::string& token, const std::string& option, int position,
-                    QuaternionOrder order) {
-  static constexpr std::array<const char*, 7> kScalarFirst = {"x",  "y",  "z", "qw",
-                                                              "qx", "qy", "qz"};
-  static constexpr std::array<const char*, 7> kScalarLast = {"x", "y", "z", "qx", "qy", "qz", "qw"};
-  const auto& kNames = order == QuaternionOrder::wxyz ? kScalarFirst : kScalarLast;
-  double value = 0.0;
-  const char* first = token.data();
-  const char* last = token.data() + token.size();
-  if (!token.empty() && token.front() == '+') ++first;  // from_chars takes no plus sign
-  const auto [end, ec] = std::from_chars(first, last, value);
-  const std::string where = option + " " + kNames[static_cast<std::size_t>(position)];
-  if (ec == std::errc::result_out_of_range)
-    throw BadArgument(where + ": '" + token + "' is out of the range of double");
-  if (ec != std::errc() || end != last || first == last)
-    throw BadArgument(where + ": '" + token + "' is not a number");
-  if (!std::isfinite(value)) throw BadArgument(where + ": '" + token + "' is not finite");
-  return value;
-}
-
-// x y z, then the quaternion in `order` (qw qx qy qz or qx qy qz qw); the
-// quaternion is normalized, so it only has to be non-zero (a zero
-// quaternion has no rotation to normalize to).
-Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option,
-                QuaternionOrder order) {
-  if (tokens.empty()) return Pose::identity();
-  std::array<double, 7> v{};
-  for (std::size_t i = 0; i < v.size(); ++i)
-    v[i] = parse_number(tokens[i], option, static_cast<int>(i), order);
-  // The pose contract's quaternion (proxima/pose.h): normalized at any
-  // magnitude, a zero one refused in the same words as everywhere.
-  try {
-    const char* words = order == QuaternionOrder::wxyz ? " (qw qx qy qz)" : " (qx qy qz qw)";
-    return Pose(
-        unit_quaternion(quaternion_in_order(&v[3], order), option + words).toRotationMatrix(),
-        Vec3(v[0], v[1], v[2]));
-  } catch (const InvalidInput& e) {
-    throw BadArgument(e.what());
-  }
-}
-
 std::vector<std::int32_t> hull_ids(const Feature& f) {
   std::vector<std::int32_t> ids;
   for (int i = 0; i < f.vertex_count(); ++i) ids.push_back(f.vertices[static_cast<std::size_t>(i)]);
@@ -279,6 +238,51 @@ ExportSummary write_hull(const ConvexPolytope& p, const std::string& path,
 }
 
 }  // namespace
+
+namespace {
+
+double parse_number(const std::string& token, const std::string& option, int position,
+                    QuaternionOrder order) {
+  static constexpr std::array<const char*, 7> kScalarFirst = {"x",  "y",  "z", "qw",
+                                                              "qx", "qy", "qz"};
+  static constexpr std::array<const char*, 7> kScalarLast = {"x", "y", "z", "qx", "qy", "qz", "qw"};
+  const auto& kNames = order == QuaternionOrder::wxyz ? kScalarFirst : kScalarLast;
+  double value = 0.0;
+  const char* first = token.data();
+  const char* last = token.data() + token.size();
+  if (!token.empty() && token.front() == '+') ++first;  // from_chars takes no plus sign
+  const auto [end, ec] = std::from_chars(first, last, value);
+  const std::string where = option + " " + kNames[static_cast<std::size_t>(position)];
+  if (ec == std::errc::result_out_of_range)
+    throw BadArgument(where + ": '" + token + "' is out of the range of double");
+  if (ec != std::errc() || end != last || first == last)
+    throw BadArgument(where + ": '" + token + "' is not a number");
+  if (!std::isfinite(value)) throw BadArgument(where + ": '" + token + "' is not finite");
+  return value;
+}
+
+}  // namespace
+
+// x y z, then the quaternion in `order` (qw qx qy qz or qx qy qz qw); the
+// quaternion is normalized, so it only has to be non-zero (a zero
+// quaternion has no rotation to normalize to).
+Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option,
+                QuaternionOrder order) {
+  if (tokens.empty()) return Pose::identity();
+  std::array<double, 7> v{};
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = parse_number(tokens[i], option, static_cast<int>(i), order);
+  // The pose contract's quaternion (proxima/pose.h): normalized at any
+  // magnitude, a zero one refused in the same words as everywhere.
+  try {
+    const char* words = order == QuaternionOrder::wxyz ? " (qw qx qy qz)" : " (qx qy qz qw)";
+    return Pose(
+        unit_quaternion(quaternion_in_order(&v[3], order), option + words).toRotationMatrix(),
+        Vec3(v[0], v[1], v[2]));
+  } catch (const InvalidInput& e) {
+    throw BadArgument(e.what());
+  }
+}
 
 std::string export_format(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();

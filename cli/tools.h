@@ -47,6 +47,13 @@ struct HullCommand {
 // OBJ or OFF. Returns 0 or 1 like run_distance.
 int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err);
 
+// A --pose-a/--pose-b value: seven tokens x y z and the quaternion in
+// `order`, normalized; no tokens is the identity. Throws std::runtime_error
+// naming the option and the number ("--pose-b qw: 'x' is not a number").
+// Shared by `proxima distance` and `proxima view`.
+Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option,
+                QuaternionOrder order);
+
 // "obj" or "off" for a path with that extension (any case), empty otherwise.
 std::string export_format(const std::string& path);
 

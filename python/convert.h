@@ -566,5 +566,7 @@ void bind_mesh(py::module_& m);
 Body to_body(py::handle obj, const char* name);
 // Motion, ImpactResult and time_of_impact (time_of_impact.cpp).
 void bind_time_of_impact(py::module_& m);
+// view and view_scene, the viewer's page (view.cpp).
+void bind_view(py::module_& m);
 
 }  // namespace proxima::python

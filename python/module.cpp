@@ -567,4 +567,5 @@ feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k],
   bind_bodies(m);
   bind_mesh(m);
   bind_time_of_impact(m);
+  bind_view(m);
 }
