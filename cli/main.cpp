@@ -176,6 +176,16 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
       ->capture_default_str();
   distance->add_flag("--json", distance_command.json, "One JSON object instead of the table");
+  std::string distance_as;
+  const auto kinds = CLI::IsMember({"mesh", "hull", "pieces"});
+  distance
+      ->add_option("--as", distance_as,
+                   "How both files become bodies: mesh (the surface as given), hull (the convex "
+                   "hull of every point) or pieces (one hull per OBJ group). Default: the hull "
+                   "of a convex file or a point cloud; a non-convex file with faces must be named")
+      ->check(kinds);
+  distance->add_option("--as-a", distance_command.as_a, "--as for file A only")->check(kinds);
+  distance->add_option("--as-b", distance_command.as_b, "--as for file B only")->check(kinds);
   distance
       ->add_option("--max-file-size", distance_command.max_file_bytes,
                    "Refuse an input file larger than this many bytes")
@@ -265,6 +275,8 @@ int main(int argc, char** argv) {
     if (*distance) {
       distance_command.options.algorithm = parse_algorithm(distance_algorithm);
       distance_command.quaternion_order = parse_order(distance_order);
+      if (distance_command.as_a.empty()) distance_command.as_a = distance_as;
+      if (distance_command.as_b.empty()) distance_command.as_b = distance_as;
       return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
     }
     if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);

@@ -21,6 +21,7 @@
 #include <fstream>
 #include <iomanip>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 #include <sstream>
 #include <stdexcept>
@@ -29,6 +30,7 @@
 #include <utility>
 #include <vector>
 
+#include "proxima/body.h"
 #include "proxima/distance.h"
 #include "proxima/io.h"
 #include "proxima/polytope.h"
@@ -129,24 +131,27 @@ std::string feature_text(const Feature& f, const ConvexPolytope& p) {
   return s;
 }
 
-Json body_json(const std::string& path, const LoadedFile& body) {
+// A file read as its hull: what was read and how convex it was.
+Json hull_report_json(const std::string& path, MeshFormat format, int input_points,
+                      const ConvexPolytope& hull, bool convex) {
   Json j;
   j["file"] = path;
-  j["format"] = to_string(body.format);
-  j["input_points"] = body.input_points;
-  j["hull_vertices"] = body.polytope.vertex_count();
-  j["dimension"] = body.polytope.dimension();
-  j["points_inside"] = body.polytope.interior_point_count();
-  j["convex"] = body.convex;
+  j["format"] = to_string(format);
+  j["input_points"] = input_points;
+  j["hull_vertices"] = hull.vertex_count();
+  j["dimension"] = hull.dimension();
+  j["points_inside"] = hull.interior_point_count();
+  j["convex"] = convex;
   return j;
 }
 
-std::string body_text(const std::string& path, const LoadedFile& body) {
+std::string hull_report_text(const std::string& path, MeshFormat format, int input_points,
+                             const ConvexPolytope& hull, bool convex) {
   std::ostringstream s;
-  s << path << " (" << to_string(body.format) << "): " << body.input_points << " points, "
-    << body.polytope.vertex_count() << " hull vertices, dimension " << body.polytope.dimension();
-  const int inside = body.polytope.interior_point_count();
-  if (!body.convex) {
+  s << path << " (" << to_string(format) << "): " << input_points << " points, "
+    << hull.vertex_count() << " hull vertices, dimension " << hull.dimension();
+  const int inside = hull.interior_point_count();
+  if (!convex) {
     s << "; not convex: ";
     if (inside > 0)
       s << inside << (inside == 1 ? " point is" : " points are")
@@ -156,6 +161,145 @@ std::string body_text(const std::string& path, const LoadedFile& body) {
     s << "the hull of all points is used";
   }
   return s.str();
+}
+
+Json body_json(const std::string& path, const LoadedFile& body) {
+  return hull_report_json(path, body.format, body.input_points, body.polytope, body.convex);
+}
+
+std::string body_text(const std::string& path, const LoadedFile& body) {
+  return hull_report_text(path, body.format, body.input_points, body.polytope, body.convex);
+}
+
+// A file read as the kind of body the command names (DistanceCommand::as_a).
+struct LoadedBody {
+  std::optional<Body> body;
+  std::string as;  // "mesh", "hull" or "pieces"
+  MeshFormat format = MeshFormat::unknown;
+  int input_points = 0;
+  int triangles = 0;  // the file's (fan-triangulated) faces
+  bool convex = true;
+  std::optional<ConvexPolytope> hull;  // as "hull": the polytope (for the hull-only answer)
+  int degenerate_triangles = 0;        // as "mesh"
+  bool closed = false;                 // as "mesh"
+  int pieces = 0;                      // as "pieces"
+};
+
+LoadedBody load_body_as(const std::string& path, const std::string& as,
+                        std::uint64_t max_file_bytes) {
+  ReadOptions options;
+  options.max_file_bytes = max_file_bytes;
+  const PointCloud cloud = read_points(path, options);
+  LoadedBody out;
+  out.format = cloud.format;
+  out.input_points = static_cast<int>(cloud.points.size());
+  out.triangles = static_cast<int>(cloud.triangles.size());
+  try {
+    std::string kind = as;
+    if (kind.empty() || kind == "hull") {
+      ConvexPolytope polytope(cloud.points);
+      out.convex = surface_is_convex(polytope, cloud.points, cloud.triangles);
+      if (kind.empty() && !out.convex && !cloud.triangles.empty()) {
+        throw FileError::in_file(
+            path,
+            "not convex (its surface is not its hull's boundary): say how to read it: --as mesh "
+            "(the surface as given), --as hull (its convex hull) or --as pieces (one hull per "
+            "group); --as-a / --as-b for one file");
+      }
+      kind = "hull";
+      out.hull.emplace(polytope);
+      out.body.emplace(std::make_shared<const ConvexPolytope>(std::move(polytope)));
+    } else if (kind == "mesh") {
+      LoadedMesh m = mesh_from_cloud(cloud);
+      out.degenerate_triangles = m.degenerate_triangles;
+      out.closed = m.closed;
+      out.body.emplace(std::make_shared<const TriangleMesh>(std::move(m.mesh)));
+    } else {  // "pieces" (main.cpp checks the names)
+      LoadedCompound c = compound_from_cloud(cloud);
+      out.pieces = c.body.piece_count();
+      out.body.emplace(std::make_shared<const CompoundBody>(std::move(c.body)));
+    }
+    out.as = kind;
+  } catch (const FileError&) {
+    throw;
+  } catch (const InvalidInput& e) {
+    throw FileError::in_file(path, e.what());
+  }
+  return out;
+}
+
+Json loaded_json(const std::string& path, const LoadedBody& body) {
+  Json j;
+  j["file"] = path;
+  j["format"] = to_string(body.format);
+  j["as"] = body.as;
+  j["input_points"] = body.input_points;
+  if (body.as == "hull") {
+    j["hull_vertices"] = body.hull->vertex_count();
+    j["dimension"] = body.hull->dimension();
+    j["convex"] = body.convex;
+  } else if (body.as == "mesh") {
+    j["triangles"] = body.triangles;
+    j["degenerate_triangles"] = body.degenerate_triangles;
+    j["closed"] = body.closed;
+  } else {
+    j["pieces"] = body.pieces;
+  }
+  return j;
+}
+
+std::string loaded_text(const std::string& path, const LoadedBody& body) {
+  std::ostringstream s;
+  s << path << " (" << to_string(body.format) << ") as " << body.as << ": " << body.input_points
+    << " points";
+  if (body.as == "hull") {
+    s << ", " << body.hull->vertex_count() << " hull vertices, dimension " << body.hull->dimension()
+      << (body.convex ? "" : "; not convex, its hull is used (--as hull)");
+  } else if (body.as == "mesh") {
+    s << ", " << body.triangles << " triangles, " << (body.closed ? "closed" : "open");
+    if (body.degenerate_triangles > 0)
+      s << ", " << body.degenerate_triangles << " degenerate (measured as segments or points)";
+  } else {
+    s << ", " << body.pieces << " pieces";
+  }
+  return s.str();
+}
+
+// `proxima distance` between two hulls keeps its hull report (input
+// indices of the features), with how the file was read.
+Json hull_json(const std::string& path, const LoadedBody& body) {
+  Json j = hull_report_json(path, body.format, body.input_points, *body.hull, body.convex);
+  j["as"] = body.as;
+  return j;
+}
+
+std::string hull_text(const std::string& path, const LoadedBody& body) {
+  return hull_report_text(path, body.format, body.input_points, *body.hull, body.convex);
+}
+
+// A feature of a body's core: vertex ids in the core's terms (hull ids for
+// a hull or a piece, the file's vertex ids for a mesh), the face (hull face,
+// or the triangle for a mesh), the piece or triangle it is on.
+Json body_feature_json(const Feature& f, std::int32_t piece, std::int32_t triangle) {
+  Json j;
+  j["type"] = to_string(f.type);
+  j["vertices"] = hull_ids(f);
+  j["face"] = f.face >= 0 ? Json(f.face) : Json(nullptr);
+  if (piece >= 0) j["piece"] = piece;
+  if (triangle >= 0) j["triangle"] = triangle;
+  return j;
+}
+
+std::string body_feature_text(const Feature& f, std::int32_t piece, std::int32_t triangle) {
+  std::string s = to_string(f.type);
+  if (triangle >= 0) {
+    s += " of triangle " + std::to_string(triangle);
+  } else if (f.face >= 0) {
+    s += " " + std::to_string(f.face);
+  }
+  if (piece >= 0) s += " of piece " + std::to_string(piece);
+  s += ": vertices " + id_list(hull_ids(f));
+  return s;
 }
 
 // One line of JSON. File names are bytes, not necessarily UTF-8, and
@@ -293,6 +437,58 @@ std::string export_format(const std::string& path) {
   return {};
 }
 
+// `proxima distance` when a file is read as a mesh or as pieces: the one
+// call for any two bodies (body.h), its signed distance and the triangles
+// or pieces of the answer.
+int print_body_distance(const DistanceCommand& command, const LoadedBody& a, const LoadedBody& b,
+                        const Pose& pose_a, const Pose& pose_b, std::ostream& out,
+                        std::ostream& err) {
+  const BodyDistance r = distance(*a.body, pose_a, *b.body, pose_b, command.options, nullptr);
+  if (!std::isfinite(r.distance) || !r.point_a.allFinite() || !r.point_b.allFinite()) {
+    err << "proxima distance: the result is not finite: the coordinates are too large for double "
+           "arithmetic\n";
+    return kExitFailure;
+  }
+  const auto bound = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
+  if (command.json) {
+    Json j;
+    j["a"] = loaded_json(command.file_a, a);
+    j["b"] = loaded_json(command.file_b, b);
+    j["status"] = to_string(r.status);
+    j["distance"] = r.distance;
+    j["lower_bound"] = r.lower_bound;
+    j["signed_distance"] = r.signed_distance();
+    j["signed_lower_bound"] = bound(r.signed_lower_bound());
+    j["signed_upper_bound"] = bound(r.signed_upper_bound());
+    j["point_a"] = point_json(r.point_a);
+    j["point_b"] = point_json(r.point_b);
+    j["normal"] = point_json(r.normal);
+    j["feature_a"] = body_feature_json(r.feature_a, r.piece_a, r.triangle_a);
+    j["feature_b"] = body_feature_json(r.feature_b, r.piece_b, r.triangle_b);
+    out << json_line(j);
+  } else {
+    row(out, "A", loaded_text(command.file_a, a));
+    row(out, "B", loaded_text(command.file_b, b));
+    row(out, "status", to_string(r.status));
+    row(out, "distance", number(r.distance));
+    row(out, "lower bound", number(r.lower_bound));
+    row(out, "signed",
+        number(r.signed_distance()) + "  (certified in [" + number(r.signed_lower_bound()) + ", " +
+            number(r.signed_upper_bound()) + "])");
+    row(out, "point on A", point_text(r.point_a));
+    row(out, "point on B", point_text(r.point_b));
+    row(out, "normal", point_text(r.normal) + "  (from A towards B)");
+    row(out, "feature A", body_feature_text(r.feature_a, r.piece_a, r.triangle_a));
+    row(out, "feature B", body_feature_text(r.feature_b, r.piece_b, r.triangle_b));
+  }
+  out.flush();
+  if (!out) {
+    err << "proxima distance: writing the answer failed\n";
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
 int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream& err) {
   Pose pose_a;
   Pose pose_b;
@@ -303,18 +499,21 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
     err << "proxima distance: " << e.what() << "\n";
     return kExitFailure;
   }
-  std::optional<LoadedFile> a;
-  std::optional<LoadedFile> b;
+  std::optional<LoadedBody> a;
+  std::optional<LoadedBody> b;
   try {
-    a.emplace(load_file(command.file_a, command.max_file_bytes));
-    b.emplace(load_file(command.file_b, command.max_file_bytes));
+    a.emplace(load_body_as(command.file_a, command.as_a, command.max_file_bytes));
+    b.emplace(load_body_as(command.file_b, command.as_b, command.max_file_bytes));
   } catch (const InvalidInput& e) {
     err << "proxima distance: " << e.what() << "\n";
     return kExitFailure;
   }
+  if (a->as != "hull" || b->as != "hull")
+    return print_body_distance(command, *a, *b, pose_a, pose_b, out, err);
 
-  const DistanceResult r =
-      distance(a->polytope, pose_a, b->polytope, pose_b, command.options, nullptr);
+  const ConvexPolytope& hull_a = *a->hull;
+  const ConvexPolytope& hull_b = *b->hull;
+  const DistanceResult r = distance(hull_a, pose_a, hull_b, pose_b, command.options, nullptr);
   // Finite inputs whose products overflow (coordinates near 1e308) are the
   // only way to a non-finite answer; JSON cannot carry it and a table of
   // "inf" would look like an answer.
@@ -326,8 +525,8 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
 
   if (command.json) {
     Json j;
-    j["a"] = body_json(command.file_a, *a);
-    j["b"] = body_json(command.file_b, *b);
+    j["a"] = hull_json(command.file_a, *a);
+    j["b"] = hull_json(command.file_b, *b);
     j["algorithm"] = to_string(command.options.algorithm);
     j["status"] = to_string(r.status);
     j["distance"] = r.distance;
@@ -336,12 +535,12 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
     j["point_a"] = point_json(r.point_a);
     j["point_b"] = point_json(r.point_b);
     j["normal"] = point_json(r.normal);
-    j["feature_a"] = feature_json(r.feature_a, a->polytope);
-    j["feature_b"] = feature_json(r.feature_b, b->polytope);
+    j["feature_a"] = feature_json(r.feature_a, hull_a);
+    j["feature_b"] = feature_json(r.feature_b, hull_b);
     out << json_line(j);
   } else {
-    row(out, "A", body_text(command.file_a, *a));
-    row(out, "B", body_text(command.file_b, *b));
+    row(out, "A", hull_text(command.file_a, *a));
+    row(out, "B", hull_text(command.file_b, *b));
     row(out, "algorithm", to_string(command.options.algorithm));
     row(out, "status", to_string(r.status));
     row(out, "distance", number(r.distance));
@@ -350,8 +549,8 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
     row(out, "point on A", point_text(r.point_a));
     row(out, "point on B", point_text(r.point_b));
     row(out, "normal", point_text(r.normal) + "  (from A towards B)");
-    row(out, "feature A", feature_text(r.feature_a, a->polytope));
-    row(out, "feature B", feature_text(r.feature_b, b->polytope));
+    row(out, "feature A", feature_text(r.feature_a, hull_a));
+    row(out, "feature B", feature_text(r.feature_b, hull_b));
   }
   out.flush();
   if (!out) {

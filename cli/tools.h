@@ -29,6 +29,11 @@ struct DistanceCommand {
   DistanceOptions options;
   bool json = false;
   std::uint64_t max_file_bytes = kDefaultMaxFileBytes;  // per input file (ReadOptions)
+  // How each file becomes a body: "mesh", "hull", "pieces", or "" for the
+  // default: the hull of a convex file or of a point cloud (no faces); a
+  // non-convex file with faces must be named (an error says so).
+  std::string as_a;
+  std::string as_b;
 };
 
 // Loads both files, runs one cold query, prints a table or one JSON object

@@ -303,14 +303,38 @@ TEST(CliDistance, FoldedMeshIsReportedNotConvex) {
            "f 2 4 8\nf 2 8 6\nf 1 4 6\n";
   }
   write_obj(other.path(), box(Vec3(5, 0, 0), Vec3(6, 1, 1)));
-  const CliRun json = run_cli("distance " + folded.quoted() + " " + other.quoted() + " --json");
+  // Issue 12: a non-convex file is not silently replaced by its hull: the
+  // caller names how to read it.
+  const CliRun unsaid = run_cli("distance " + folded.quoted() + " " + other.quoted(), true);
+  EXPECT_EQ(unsaid.exit_code, 1);
+  EXPECT_NE(unsaid.out.find("not convex (its surface is not its hull's boundary): say how to read "
+                            "it: --as mesh"),
+            std::string::npos)
+      << unsaid.out;
+  const CliRun json =
+      run_cli("distance " + folded.quoted() + " " + other.quoted() + " --as-a hull --json");
   ASSERT_EQ(json.exit_code, 0);
   const Json j = parse_json(json);
   EXPECT_EQ(j.at("a").at("points_inside"), 0);
   EXPECT_EQ(j.at("a").at("convex"), false);
+  EXPECT_EQ(j.at("a").at("as"), "hull");
   EXPECT_EQ(j.at("b").at("convex"), true);
-  const CliRun table = run_cli("distance " + folded.quoted() + " " + other.quoted());
+  const CliRun table = run_cli("distance " + folded.quoted() + " " + other.quoted() + " --as hull");
   EXPECT_NE(table.out.find("not convex: the surface folds inward"), std::string::npos) << table.out;
+  // As a mesh: the surface as given (the inner triangle is part of it), 4
+  // from the box at x = 5; closed? No: the inner triangle's edges are used
+  // three times.
+  const CliRun mesh =
+      run_cli("distance " + folded.quoted() + " " + other.quoted() + " --as-a mesh --json");
+  ASSERT_EQ(mesh.exit_code, 0);
+  const Json m = parse_json(mesh);
+  EXPECT_EQ(m.at("a").at("as"), "mesh");
+  EXPECT_EQ(m.at("a").at("triangles"), 13);
+  EXPECT_EQ(m.at("a").at("closed"), false);
+  EXPECT_EQ(m.at("b").at("as"), "hull");
+  EXPECT_DOUBLE_EQ(m.at("distance").get<double>(), 4.0);
+  EXPECT_DOUBLE_EQ(m.at("signed_distance").get<double>(), 4.0);
+  EXPECT_GE(m.at("feature_a").at("triangle").get<int>(), 0);
   const CliRun hull = run_cli("hull " + folded.quoted() + " --json");
   EXPECT_EQ(parse_json(hull).at("convex"), false);
 }
