@@ -329,7 +329,7 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
     zero += d == 0.0 ? 1 : 0;
     degenerate += (!a.planar || !b.planar) ? 1 : 0;
   }
-  EXPECT_GT(zero, 100);        // touching and crossing pairs are in the set
+  EXPECT_GT(zero, 100);       // touching and crossing pairs are in the set
   EXPECT_GT(degenerate, 40);  // and degenerate triangles
 }
 
@@ -450,6 +450,80 @@ TEST(MeshStatus, ContainsAgreesWithTheBoxOnRaysThroughEdges) {
     const bool inside = (p.cwiseAbs().array() < 1.0).all();
     EXPECT_EQ(box.contains(p), inside) << p.transpose();
   }
+}
+
+// --- 6. mesh against a convex polytope ---------------------------------------------
+
+std::vector<Vec3> random_cloud(Rng& rng, int n, double size) {
+  std::vector<Vec3> p;
+  for (int k = 0; k < n; ++k)
+    p.emplace_back(test::uniform(rng, -size, size), test::uniform(rng, -size, size),
+                   test::uniform(rng, -size, size));
+  return p;
+}
+
+TEST(MeshConvex, MatchesEveryTriangleAndTheMeshOfTheSameSolid) {
+  Rng rng(41);
+  for (int trial = 0; trial < 30; ++trial) {
+    const MeshData soup = random_soup(rng, test::uniform_int(rng, 1, 80), 4.0, 0.6);
+    const TriangleMesh mesh = soup.build();
+    const ConvexPolytope hull(random_cloud(rng, 12, 1.0));
+    const Pose pa = random_pose(rng, 1), pb = random_pose(rng, 6);
+    MeshCache cache;
+    const MeshResult r = distance(mesh, pa, hull, pb, {}, &cache);
+    const MeshResult brute = distance_all_pairs(mesh, pa, hull, pb);
+    EXPECT_EQ(r.status, brute.status) << trial;
+    if (brute.status != Status::intersecting) {
+      EXPECT_EQ(r.distance, brute.distance) << trial;
+      EXPECT_LE(r.pairs_tested, brute.pairs_tested);
+      // Tracked from the cache at the same pose: the same answer.
+      const MeshResult again = distance(mesh, pa, hull, pb, {}, &cache);
+      EXPECT_EQ(again.distance, r.distance);
+    }
+  }
+  // Outside a solid, its surface is as far as the solid: a tetrahedron as a
+  // closed mesh and as a polytope give the same distance to a soup.
+  const MeshData tet = tetrahedron(Vec3::Zero(), 1.0);
+  const TriangleMesh tet_mesh = tet.build();
+  const ConvexPolytope tet_hull(tet.vertices);
+  int compared = 0;
+  for (int k = 0; k < 20; ++k) {
+    const MeshData soup = random_soup(rng, 30, 4.0, 0.6);
+    const TriangleMesh mesh = soup.build();
+    const Pose pb = random_pose(rng, 8);
+    const MeshResult as_mesh = distance(mesh, Pose(), tet_mesh, pb);
+    const MeshResult as_hull = distance(mesh, Pose(), tet_hull, pb);
+    if (as_mesh.status == Status::separated && as_hull.status == Status::separated) {
+      ++compared;
+      EXPECT_NEAR(as_mesh.distance, as_hull.distance, 1e-12 * as_mesh.distance + 64 * kU * 20);
+    }
+  }
+  EXPECT_GT(compared, 5);
+}
+
+TEST(MeshConvex, InsideEitherIsIntersecting) {
+  const MeshData cube = box_mesh(Vec3(-2, -2, -2), Vec3(2, 2, 2));
+  const TriangleMesh box = cube.build();
+  const MeshData tet = tetrahedron(Vec3::Zero(), 0.5);
+  const ConvexPolytope tet_hull(tet.vertices);
+  // A polytope inside the closed box mesh.
+  EXPECT_EQ(distance(box, Pose(), tet_hull, Pose()).status, Status::intersecting);
+  // ... inside an open box: the surfaces are 1.5 apart.
+  MeshData open = cube;
+  open.triangles.resize(10);
+  const MeshResult in_open = distance(open.build(), Pose(), tet_hull, Pose());
+  EXPECT_EQ(in_open.status, Status::separated);
+  EXPECT_NEAR(in_open.distance, 1.5, 1e-12);
+  // A mesh inside the polytope (a solid).
+  const ConvexPolytope big(cube.vertices);
+  EXPECT_EQ(distance(tet.build(), Pose(), big, Pose()).status, Status::intersecting);
+  // Apart.
+  const MeshResult apart = distance(box, Pose(), tet_hull, Pose::from_translation(Vec3(5, 0, 0)));
+  EXPECT_EQ(apart.status, Status::separated);
+  EXPECT_NEAR(apart.distance, 2.5, 1e-12);
+  EXPECT_GE(apart.triangle_a, 0);
+  EXPECT_EQ(apart.triangle_b, -1);
+  EXPECT_NEAR(apart.point_a.x(), 2.0, 1e-12);  // on the box's face x = 2
 }
 
 }  // namespace

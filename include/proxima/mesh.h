@@ -27,6 +27,7 @@
 #include <span>
 #include <vector>
 
+#include "proxima/polytope.h"
 #include "proxima/types.h"
 
 namespace proxima {
@@ -211,6 +212,30 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
 // The slow, obvious twin: every triangle pair, the same kernel and the same
 // status rules. For tests and benchmarks.
 MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
+                              const Pose& pose_b, const DistanceOptions& options = {});
+
+// Minimum distance between a mesh and a convex polytope (a solid), each at
+// its pose: the mesh's hierarchy against the polytope's box in the mesh's
+// frame, the convex query (distance.h) between each near triangle (as a
+// polytope of its three vertices) and the polytope at the leaves.
+// triangle_b is -1; feature_b is the polytope's (hull vertex ids, as
+// DistanceResult gives them); feature_a the triangle's, with mesh vertex
+// ids. Status: intersecting when a triangle overlaps the polytope (deeper
+// than the contact band, as the convex query decides: a mesh inside the
+// polytope is intersecting) or when the polytope lies inside the mesh, if
+// the mesh is closed; touching and separated as in the convex query. The
+// depth is not computed (distance 0, depth_upper_bound +infinity). A
+// rounded body (core plus radius r, body.h) is the core's answer offset by
+// r along the normal: the closest triangle is the same.
+//
+// The cache keeps the last closest triangle (triangle_a), whose distance is
+// the first upper bound; any cache is range-checked (never wrong).
+MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
+                    const Pose& pose_b, const DistanceOptions& options = {},
+                    MeshCache* cache = nullptr);
+
+// Its slow twin: the convex query against every triangle.
+MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
                               const Pose& pose_b, const DistanceOptions& options = {});
 
 }  // namespace proxima
