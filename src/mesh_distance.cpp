@@ -331,16 +331,16 @@ double motion_bound(const TriangleMesh& b, const Mat3& r0, const Vec3& t0, const
   Vec3 lo, hi;
   b.box(0, lo, hi);
   const Vec3 c = 0.5 * (lo + hi);
-  const double h = (0.5 * (hi - lo)).norm();
+  const double h = (0.5 * (hi - lo)).stableNorm();
   const Mat3 dr = r1 - r0;
-  const double m = dr.norm() * h + (dr * c + (t1 - t0)).norm();
+  const double m = dr.norm() * h + (dr * c + (t1 - t0)).stableNorm();
   return m * (1.0 + 64.0 * kUnitRoundoff);
 }
 
 double b_radius(const TriangleMesh& b) {
   Vec3 lo, hi;
   b.box(0, lo, hi);
-  return (0.5 * (hi - lo)).norm();
+  return (0.5 * (hi - lo)).stableNorm();
 }
 
 }  // namespace

@@ -375,6 +375,30 @@ TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
   }
   EXPECT_GT(separated, 250);  // apart, close (gaps of a fraction of a triangle)
   EXPECT_GT(tracked, 200);
+  // The same motion near the largest accepted coordinates. Regression: the
+  // motion bound took plain norms of 1e300-sized vectors, whose squares
+  // overflowed to infinity, so no step was ever tracked at that scale (0 of
+  // 40; answers stayed right, every query went cold). Now stable norms.
+  {
+    MeshData big_a = a, big_b = b;
+    for (Vec3& v : big_a.vertices) v *= 0x1p990;
+    for (Vec3& v : big_b.vertices) v *= 0x1p990;
+    const TriangleMesh ba = big_a.build(), bb = big_b.build();
+    MeshCache big_cache;
+    int big_tracked = 0;
+    for (int step = 0; step < 40; ++step) {
+      const double s = 0.01 * step;
+      const Pose pb(Quat(Eigen::AngleAxisd(0.3 * s, Vec3(0, 0, 1))) * q0,
+                    0x1p990 * Vec3(2.0 * std::sin(s), 9.2 - 0.3 * s, 0.2));
+      const MeshResult warm = distance(ba, Pose(), bb, pb, {}, &big_cache);
+      const MeshResult cold = distance(ba, Pose(), bb, pb);
+      ASSERT_EQ(warm.status, cold.status) << step;
+      ASSERT_EQ(warm.distance, cold.distance) << step;
+      ASSERT_TRUE(std::isfinite(warm.distance));
+      big_tracked += warm.tracked ? 1 : 0;
+    }
+    EXPECT_GT(big_tracked, 20);
+  }
   // A cache of another pair, or of unrelated poses, is never wrong.
   const MeshData c = random_soup(rng, 200, 2.0, 0.5);
   const TriangleMesh mc = c.build();
