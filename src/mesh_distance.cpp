@@ -389,7 +389,8 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
         motion_bound(b, cache->rotation, cache->translation, q.rotation, q.translation);
     if (moved + unscaled_slack <= cache->margin) {
       for (const auto& pair : cache->near) {
-        test_pair(q, a_triangle(q, pair[0]), b_triangle(q, pair[1]), best, tested);
+        test_pair(q, a_triangle(q, pair[0]), b_triangle(q, pair[1]), best, tested,
+                  std::sqrt(best.d2) + slack_s);
         if (best.crossing) break;
       }
       bool inside = false;
@@ -444,7 +445,33 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   };
   double prune2 = threshold2();
   stack.push_back({0, 0, 0.0});
-  std::array<Triangles, TriangleMesh::kLeafSize> leaf_a, leaf_b;
+  // Prepared leaves, direct-mapped by node id: a depth-first traversal
+  // meets the same leaf against many leaves of the other mesh in a row.
+  // Per thread (the query is reentrant), stamped with this query so that no
+  // leaf placed at another query's pose is used.
+  struct LeafSlot {
+    std::uint64_t stamp = 0;
+    std::int32_t node = -1;
+    std::array<Triangles, TriangleMesh::kLeafSize> t;
+  };
+  constexpr std::size_t kSlots = 32;
+  thread_local std::array<LeafSlot, kSlots> slots_a, slots_b;
+  thread_local std::uint64_t query_stamp = 0;
+  const std::uint64_t stamp = ++query_stamp;
+  const auto leaf = [&](std::array<LeafSlot, kSlots> & slots, std::int32_t node,
+                        const TriangleMesh::Node& n, bool side_a) -> const auto& {
+    LeafSlot& slot = slots[static_cast<std::size_t>(node) % kSlots];
+    if (slot.stamp != stamp || slot.node != node) {
+      slot.stamp = stamp;
+      slot.node = node;
+      for (std::int32_t i = 0; i < n.count; ++i) {
+        const auto k = static_cast<std::size_t>(n.first_or_right + i);
+        slot.t[static_cast<std::size_t>(i)] =
+            side_a ? a_triangle(q, order_a[k]) : b_triangle(q, order_b[k]);
+      }
+    }
+    return slot.t;
+  };
   while (!stack.empty() && !best.crossing) {
     const Entry e = stack.back();
     stack.pop_back();
@@ -452,12 +479,8 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.na)];
     const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.nb)];
     if (na.is_leaf() && nb.is_leaf()) {
-      for (std::int32_t i = 0; i < na.count; ++i)
-        leaf_a[static_cast<std::size_t>(i)] =
-            a_triangle(q, order_a[static_cast<std::size_t>(na.first_or_right + i)]);
-      for (std::int32_t j = 0; j < nb.count; ++j)
-        leaf_b[static_cast<std::size_t>(j)] =
-            b_triangle(q, order_b[static_cast<std::size_t>(nb.first_or_right + j)]);
+      const auto& leaf_a = leaf(slots_a, e.na, na, true);
+      const auto& leaf_b = leaf(slots_b, e.nb, nb, false);
       for (std::int32_t i = 0; i < na.count && !best.crossing; ++i) {
         for (std::int32_t j = 0; j < nb.count; ++j) {
           const Triangles& ti = leaf_a[static_cast<std::size_t>(i)];
@@ -525,6 +548,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
       // pair left out is farther than best + 2 margin (pruned by its
       // node pair's bound, or by its own distance here).
       const double keep = std::sqrt(best.d2) + 2.0 * margin + slack_s;
+      // Closest first: a tracked query then finds its best early and skips
+      // the rest by their boxes.
+      std::sort(candidates.begin(), candidates.end(),
+                [](const Candidate& x, const Candidate& y) { return x.d2 < y.d2; });
       for (const Candidate& c : candidates)
         if (c.d2 <= keep * keep) cache->near.push_back({c.ta, c.tb});
       if (cache->near.size() <= kNearCapacity) {
