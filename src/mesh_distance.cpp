@@ -109,23 +109,38 @@ Box node_box(const TriangleMesh::Node& n, double unit) {
 // squared gaps along A's three axes, and likewise along B's: the larger of
 // the two sums. Exact for aligned boxes (R = I), never above the true
 // distance.
-double box_lower_bound_squared(const Query& q, const Box& a, const Box& b) {
-  const Vec3 cb = q.rotation * b.center + q.translation_s;
-  const Vec3 d = a.center - cb;
-  const Vec3 extent_b = q.abs_rotation * b.half;
-  double sa = 0.0;
+//
+// Both orders below compute the same two sums; each starts with the axes
+// whose other box is already placed (shared by the two children of a split)
+// and stops when that sum alone prunes.
+double sum_of_squared_gaps(const Vec3& d, const Vec3& half, const Vec3& extent) {
+  double sum = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const double g = std::abs(d[i]) - a.half[i] - extent_b[i];
-    if (g > 0.0) sa += g * g;
+    const double g = std::abs(d[i]) - half[i] - extent[i];
+    if (g > 0.0) sum += g * g;
   }
+  return sum;
+}
+
+// a: A's child box; b: B's box, whose center and extents in A's frame are
+// cb and extent_b.
+double lower_bound_on_a_axes(const Query& q, const Box& a, const Box& b, const Vec3& cb,
+                             const Vec3& extent_b, double prune2) {
+  const Vec3 d = a.center - cb;
+  const double sa = sum_of_squared_gaps(d, a.half, extent_b);
+  if (sa > prune2) return sa;
   const Vec3 db = q.rotation.transpose() * d;
-  const Vec3 extent_a = q.abs_rotation.transpose() * a.half;
-  double sb = 0.0;
-  for (int j = 0; j < 3; ++j) {
-    const double g = std::abs(db[j]) - b.half[j] - extent_a[j];
-    if (g > 0.0) sb += g * g;
-  }
-  return std::max(sa, sb);
+  return std::max(sa, sum_of_squared_gaps(db, b.half, q.abs_rotation.transpose() * a.half));
+}
+
+// b: B's child box; a: A's box, whose center and extents in B's frame are
+// ca and extent_a.
+double lower_bound_on_b_axes(const Query& q, const Box& a, const Box& b, const Vec3& ca,
+                             const Vec3& extent_a, double prune2) {
+  const double sb = sum_of_squared_gaps(b.center - ca, b.half, extent_a);
+  if (sb > prune2) return sb;
+  const Vec3 d = a.center - (q.rotation * b.center + q.translation_s);
+  return std::max(sb, sum_of_squared_gaps(d, a.half, q.abs_rotation * b.half));
 }
 
 // Whether an edge of one triangle passes through the interior of the other
@@ -506,21 +521,29 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
     Entry c0, c1;
     if (split_a) {
+      // B's box in A's frame, shared by both children.
+      const Vec3 cb = q.rotation * bb.center + q.translation_s;
+      const Vec3 extent_b = q.abs_rotation * bb.half;
       const std::int32_t l = e.na + 1, r = na.first_or_right;
       c0 = {l, e.nb,
-            box_lower_bound_squared(q, node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a),
-                                    bb)};
+            lower_bound_on_a_axes(q, node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a),
+                                  bb, cb, extent_b, prune2)};
       c1 = {r, e.nb,
-            box_lower_bound_squared(q, node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a),
-                                    bb)};
+            lower_bound_on_a_axes(q, node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a),
+                                  bb, cb, extent_b, prune2)};
     } else {
+      // A's box in B's frame, shared by both children.
+      const Vec3 ca = q.rotation.transpose() * (ba.center - q.translation_s);
+      const Vec3 extent_a = q.abs_rotation.transpose() * ba.half;
       const std::int32_t l = e.nb + 1, r = nb.first_or_right;
-      c0 = {e.na, l,
-            box_lower_bound_squared(q, ba,
-                                    node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b))};
-      c1 = {e.na, r,
-            box_lower_bound_squared(q, ba,
-                                    node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b))};
+      c0 = {
+          e.na, l,
+          lower_bound_on_b_axes(q, ba, node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b),
+                                ca, extent_a, prune2)};
+      c1 = {
+          e.na, r,
+          lower_bound_on_b_axes(q, ba, node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b),
+                                ca, extent_a, prune2)};
     }
     nodes_tested += 2;
     if (c0.lb2 > c1.lb2) std::swap(c0, c1);
