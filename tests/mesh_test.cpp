@@ -19,6 +19,7 @@
 #include <boost/multiprecision/gmp.hpp>
 #include <cmath>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "../src/triangle_distance.h"
@@ -411,6 +412,30 @@ TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
       EXPECT_EQ(warm.distance, cold.distance);
     }
   }
+}
+
+// Meshes are shared between threads (immutable), and a query keeps its
+// scratch per thread: two threads querying the same meshes at different
+// poses get the serial answers.
+TEST(MeshDistanceTraversal, SharedBetweenThreads) {
+  Rng rng(23);
+  const TriangleMesh ma = random_soup(rng, 300, 5.0, 0.5).build();
+  const TriangleMesh mb = random_soup(rng, 100, 2.0, 0.5).build();
+  std::vector<Pose> poses;
+  for (int k = 0; k < 200; ++k) poses.push_back(random_pose(rng, 9));
+  std::vector<double> serial;
+  for (const Pose& p : poses) serial.push_back(distance(ma, Pose(), mb, p).distance);
+  std::vector<double> results[2];
+  std::thread threads[2];
+  for (int t = 0; t < 2; ++t) {
+    threads[t] = std::thread([&, t] {
+      MeshCache cache;
+      for (std::size_t k = static_cast<std::size_t>(t); k < poses.size(); k += 2)
+        results[t].push_back(distance(ma, Pose(), mb, poses[k], {}, &cache).distance);
+    });
+  }
+  for (auto& th : threads) th.join();
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(results[k % 2][k / 2], serial[k]) << k;
 }
 
 // --- 5. status -----------------------------------------------------------------

@@ -152,9 +152,12 @@ struct MeshCache {
   std::uint64_t mesh_b = 0;
   std::int32_t triangle_a = -1;  // closest pair of the last answer
   std::int32_t triangle_b = -1;
-  // The candidate pairs: every triangle pair whose distance could be within
-  // `margin` of `base_distance` when the pose was (rotation, translation)
-  // (B's pose in A's frame, scaled units of the query are not used here).
+  // The candidate pairs, closest first: every triangle pair whose distance
+  // was within 2 margin of base_distance (the best then) when B's pose in
+  // A's frame was (rotation, translation). While B has moved less than
+  // `margin` from there, every other pair is farther than the best of
+  // these, so a query tests only them. Empty: no list (the next query
+  // searches, from the last closest pair).
   std::vector<std::array<std::int32_t, 2>> near;
   double base_distance = 0.0;
   double margin = 0.0;
