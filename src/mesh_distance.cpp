@@ -463,13 +463,14 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   // Prepared leaves, direct-mapped by node id: a depth-first traversal
   // meets the same leaf against many leaves of the other mesh in a row.
   // Per thread (the query is reentrant), stamped with this query so that no
-  // leaf placed at another query's pose is used.
+  // leaf placed at another query's pose is used. 128 slots a side (about
+  // 340 KB per thread): env/rob cold 130 -> 121 us against 32 slots.
   struct LeafSlot {
     std::uint64_t stamp = 0;
     std::int32_t node = -1;
     std::array<Triangles, TriangleMesh::kLeafSize> t;
   };
-  constexpr std::size_t kSlots = 32;
+  constexpr std::size_t kSlots = 128;
   thread_local std::array<LeafSlot, kSlots> slots_a, slots_b;
   thread_local std::uint64_t query_stamp = 0;
   const std::uint64_t stamp = ++query_stamp;
