@@ -23,11 +23,14 @@
 // 3 repetitions of the sequence), median triangle pairs tested (proxima),
 // and the largest disagreement with the referee, distance_all_pairs (every
 // triangle pair with the closed-form kernel), on K poses of each kind.
-// Then: the triangle-triangle kernel's time, and the build of a ~10^6
-// triangle mesh (time, bytes against the raw vertices + triangles).
+// Then: mesh against convex (env against the hull of rob along the motion,
+// cold and tracked; the same hull as a closed mesh, mesh against mesh; FCL
+// BVHModel<OBBRSS> against fcl::Convexd of the same hull), the exact triangle-triangle kernel's time, and the build of a
+// ~10^6-triangle mesh (time, bytes against the raw vertices + triangles).
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/distance.h>
 #include <proxima/closest_point.h>
+#include <proxima/distance.h>
 #include <proxima/io.h>
 #include <proxima/mesh.h>
 
@@ -40,6 +43,9 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "../src/triangle_distance.h"
+#include "peers/fcl_convex.h"
 
 namespace {
 
@@ -232,6 +238,72 @@ int main(int argc, char** argv) {
   }
   run("smooth motion", env, rob, motion, *env_obbrss, *rob_obbrss, *env_rss, *rob_rss, referee);
 
+  // Mesh against convex: env against the hull of rob (a solid), along the
+  // motion; FCL: BVHModel<OBBRSS> against fcl::Convexd of the same hull
+  // (GST_LIBCCD, its default solver).
+  {
+    const proxima::ConvexPolytope hull(rob_file.vertices);
+    const auto fcl_hull = proxima::bench::fcl_convex(hull, "rob hull");
+    // The same hull as a closed triangle mesh (its faces fanned), queried
+    // mesh against mesh: the other way to put a convex body against a mesh.
+    std::vector<proxima::TriangleMesh::Triangle> hull_triangles;
+    for (int f = 0; f < hull.face_count(); ++f) {
+      const auto face = hull.face(f);
+      for (std::size_t k = 1; k + 1 < face.size(); ++k)
+        hull_triangles.push_back({static_cast<std::uint32_t>(face[0]),
+                                  static_cast<std::uint32_t>(face[k]),
+                                  static_cast<std::uint32_t>(face[k + 1])});
+    }
+    const TriangleMesh hull_mesh(hull.vertices(), hull_triangles);
+    std::vector<double> as_mesh_cold, as_mesh_tracked;
+    int status_differs = 0;
+    std::vector<double> cold, tracked, fcl_times, pairs;
+    double worst = 0.0;
+    int intersecting = 0;
+    for (int rep = 0; rep < 3; ++rep) {
+      proxima::MeshCache cache, mesh_cache;
+      for (std::size_t i = 0; i < motion.size(); ++i) {
+        proxima::MeshResult r, w, m, mt;
+        as_mesh_cold.push_back(
+            time_us([&] { m = proxima::distance(env, Pose(), hull_mesh, motion[i]); }));
+        as_mesh_tracked.push_back(time_us(
+            [&] { mt = proxima::distance(env, Pose(), hull_mesh, motion[i], {}, &mesh_cache); }));
+        cold.push_back(time_us([&] { r = proxima::distance(env, Pose(), hull, motion[i]); }));
+        tracked.push_back(
+            time_us([&] { w = proxima::distance(env, Pose(), hull, motion[i], {}, &cache); }));
+        fcl::DistanceRequestd request(true, false, 0.0, 0.0);
+        fcl::DistanceResultd res;
+        fcl_times.push_back(time_us([&] {
+          fcl::distance(env_obbrss.get(), fcl::Transform3d::Identity(), fcl_hull.get(),
+                        to_fcl(motion[i]), request, res);
+        }));
+        if (rep == 0) {
+          pairs.push_back(r.pairs_tested);
+          intersecting += r.status == proxima::Status::intersecting ? 1 : 0;
+          worst = std::max(worst, std::abs(r.distance - w.distance));
+          if (m.status != r.status) ++status_differs;
+          if (r.status == proxima::Status::separated && m.status == r.status)
+            worst = std::max(worst, std::abs(r.distance - m.distance));
+          if (r.status == proxima::Status::separated)
+            worst = std::max(worst, std::abs(r.distance - res.min_distance));
+        }
+      }
+    }
+    std::printf("mesh vs convex (env vs hull of rob), smooth motion: %zu poses (%d intersecting)\n",
+                motion.size(), intersecting);
+    std::printf("  proxima cold       %10.2f us  %8.0f triangles\n", median(cold), median(pairs));
+    std::printf("  proxima tracked    %10.2f us\n", median(tracked));
+    std::printf(
+        "  hull as a closed mesh (closed %d), mesh-mesh: cold %.2f us, tracked %.2f us, "
+        "status differs on %d poses\n",
+        hull_mesh.is_closed() ? 1 : 0, median(as_mesh_cold), median(as_mesh_tracked),
+        status_differs);
+    std::printf(
+        "  FCL OBBRSS-Convex  %10.2f us  (largest |proxima - FCL| where separated, and "
+        "|cold - tracked|, |convex - closed mesh|: %.3g)\n",
+        median(fcl_times), worst);
+  }
+
   // The triangle-triangle kernel alone, on rob's triangles against env's.
   {
     std::vector<double> times;
@@ -250,8 +322,29 @@ int main(int argc, char** argv) {
       }
     }
     const double ns = std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / n;
-    std::printf("triangle-triangle kernel: %.0f ns per pair (%d pairs, checksum %g)\n", ns, n,
-                sink);
+    // The traversal's fast kernel on the same pairs (triangles prepared
+    // once, as the traversal's leaf cache does).
+    const auto tol = proxima::kernel_tolerance(std::max(env.scale(), rob.scale()));
+    std::vector<proxima::detail::FastTriangle> fa, fb;
+    for (int i = 0; i < env.triangle_count(); i += 7) {
+      const auto& t = env.triangle(i);
+      fa.emplace_back(env.vertex(static_cast<int>(t[0])), env.vertex(static_cast<int>(t[1])),
+                      env.vertex(static_cast<int>(t[2])), tol.min_sin_squared);
+    }
+    for (int j = 0; j < rob.triangle_count(); ++j) {
+      const auto& t = rob.triangle(j);
+      fb.emplace_back(rob.vertex(static_cast<int>(t[0])), rob.vertex(static_cast<int>(t[1])),
+                      rob.vertex(static_cast<int>(t[2])), tol.min_sin_squared);
+    }
+    double fast_sink = 0.0;
+    const auto t1 = Clock::now();
+    for (const auto& x : fa)
+      for (const auto& y : fb) fast_sink += proxima::detail::triangle_distance_squared(x, y, tol);
+    const double fast_ns = std::chrono::duration<double, std::nano>(Clock::now() - t1).count() / n;
+    std::printf(
+        "triangle-triangle kernel: exact twin %.0f ns, fast %.0f ns per pair (%d pairs, "
+        "checksums %g %g)\n",
+        ns, fast_ns, n, sink, fast_sink);
   }
 
   // Build of a ~10^6-triangle mesh: a wavy height field of 708 x 708 cells.

@@ -109,23 +109,38 @@ Box node_box(const TriangleMesh::Node& n, double unit) {
 // squared gaps along A's three axes, and likewise along B's: the larger of
 // the two sums. Exact for aligned boxes (R = I), never above the true
 // distance.
-double box_lower_bound_squared(const Query& q, const Box& a, const Box& b) {
-  const Vec3 cb = q.rotation * b.center + q.translation_s;
-  const Vec3 d = a.center - cb;
-  const Vec3 extent_b = q.abs_rotation * b.half;
-  double sa = 0.0;
+//
+// Both orders below compute the same two sums; each starts with the axes
+// whose other box is already placed (shared by the two children of a split)
+// and stops when that sum alone prunes.
+double sum_of_squared_gaps(const Vec3& d, const Vec3& half, const Vec3& extent) {
+  double sum = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const double g = std::abs(d[i]) - a.half[i] - extent_b[i];
-    if (g > 0.0) sa += g * g;
+    const double g = std::abs(d[i]) - half[i] - extent[i];
+    if (g > 0.0) sum += g * g;
   }
+  return sum;
+}
+
+// a: A's child box; b: B's box, whose center and extents in A's frame are
+// cb and extent_b.
+double lower_bound_on_a_axes(const Query& q, const Box& a, const Box& b, const Vec3& cb,
+                             const Vec3& extent_b, double prune2) {
+  const Vec3 d = a.center - cb;
+  const double sa = sum_of_squared_gaps(d, a.half, extent_b);
+  if (sa > prune2) return sa;
   const Vec3 db = q.rotation.transpose() * d;
-  const Vec3 extent_a = q.abs_rotation.transpose() * a.half;
-  double sb = 0.0;
-  for (int j = 0; j < 3; ++j) {
-    const double g = std::abs(db[j]) - b.half[j] - extent_a[j];
-    if (g > 0.0) sb += g * g;
-  }
-  return std::max(sa, sb);
+  return std::max(sa, sum_of_squared_gaps(db, b.half, q.abs_rotation.transpose() * a.half));
+}
+
+// b: B's child box; a: A's box, whose center and extents in B's frame are
+// ca and extent_a.
+double lower_bound_on_b_axes(const Query& q, const Box& a, const Box& b, const Vec3& ca,
+                             const Vec3& extent_a, double prune2) {
+  const double sb = sum_of_squared_gaps(b.center - ca, b.half, extent_a);
+  if (sb > prune2) return sb;
+  const Vec3 d = a.center - (q.rotation * b.center + q.translation_s);
+  return std::max(sb, sum_of_squared_gaps(d, a.half, q.abs_rotation * b.half));
 }
 
 // Whether an edge of one triangle passes through the interior of the other
@@ -331,16 +346,16 @@ double motion_bound(const TriangleMesh& b, const Mat3& r0, const Vec3& t0, const
   Vec3 lo, hi;
   b.box(0, lo, hi);
   const Vec3 c = 0.5 * (lo + hi);
-  const double h = (0.5 * (hi - lo)).norm();
+  const double h = (0.5 * (hi - lo)).stableNorm();
   const Mat3 dr = r1 - r0;
-  const double m = dr.norm() * h + (dr * c + (t1 - t0)).norm();
+  const double m = dr.norm() * h + (dr * c + (t1 - t0)).stableNorm();
   return m * (1.0 + 64.0 * kUnitRoundoff);
 }
 
 double b_radius(const TriangleMesh& b) {
   Vec3 lo, hi;
   b.box(0, lo, hi);
-  return (0.5 * (hi - lo)).norm();
+  return (0.5 * (hi - lo)).stableNorm();
 }
 
 }  // namespace
@@ -389,7 +404,8 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
         motion_bound(b, cache->rotation, cache->translation, q.rotation, q.translation);
     if (moved + unscaled_slack <= cache->margin) {
       for (const auto& pair : cache->near) {
-        test_pair(q, a_triangle(q, pair[0]), b_triangle(q, pair[1]), best, tested);
+        test_pair(q, a_triangle(q, pair[0]), b_triangle(q, pair[1]), best, tested,
+                  std::sqrt(best.d2) + slack_s);
         if (best.crossing) break;
       }
       bool inside = false;
@@ -444,7 +460,34 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   };
   double prune2 = threshold2();
   stack.push_back({0, 0, 0.0});
-  std::array<Triangles, TriangleMesh::kLeafSize> leaf_a, leaf_b;
+  // Prepared leaves, direct-mapped by node id: a depth-first traversal
+  // meets the same leaf against many leaves of the other mesh in a row.
+  // Per thread (the query is reentrant), stamped with this query so that no
+  // leaf placed at another query's pose is used. 128 slots a side (about
+  // 340 KB per thread): env/rob cold 130 -> 121 us against 32 slots.
+  struct LeafSlot {
+    std::uint64_t stamp = 0;
+    std::int32_t node = -1;
+    std::array<Triangles, TriangleMesh::kLeafSize> t;
+  };
+  constexpr std::size_t kSlots = 128;
+  thread_local std::array<LeafSlot, kSlots> slots_a, slots_b;
+  thread_local std::uint64_t query_stamp = 0;
+  const std::uint64_t stamp = ++query_stamp;
+  const auto leaf = [&](std::array<LeafSlot, kSlots> & slots, std::int32_t node,
+                        const TriangleMesh::Node& n, bool side_a) -> const auto& {
+    LeafSlot& slot = slots[static_cast<std::size_t>(node) % kSlots];
+    if (slot.stamp != stamp || slot.node != node) {
+      slot.stamp = stamp;
+      slot.node = node;
+      for (std::int32_t i = 0; i < n.count; ++i) {
+        const auto k = static_cast<std::size_t>(n.first_or_right + i);
+        slot.t[static_cast<std::size_t>(i)] =
+            side_a ? a_triangle(q, order_a[k]) : b_triangle(q, order_b[k]);
+      }
+    }
+    return slot.t;
+  };
   while (!stack.empty() && !best.crossing) {
     const Entry e = stack.back();
     stack.pop_back();
@@ -452,12 +495,8 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.na)];
     const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.nb)];
     if (na.is_leaf() && nb.is_leaf()) {
-      for (std::int32_t i = 0; i < na.count; ++i)
-        leaf_a[static_cast<std::size_t>(i)] =
-            a_triangle(q, order_a[static_cast<std::size_t>(na.first_or_right + i)]);
-      for (std::int32_t j = 0; j < nb.count; ++j)
-        leaf_b[static_cast<std::size_t>(j)] =
-            b_triangle(q, order_b[static_cast<std::size_t>(nb.first_or_right + j)]);
+      const auto& leaf_a = leaf(slots_a, e.na, na, true);
+      const auto& leaf_b = leaf(slots_b, e.nb, nb, false);
       for (std::int32_t i = 0; i < na.count && !best.crossing; ++i) {
         for (std::int32_t j = 0; j < nb.count; ++j) {
           const Triangles& ti = leaf_a[static_cast<std::size_t>(i)];
@@ -483,21 +522,29 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
     Entry c0, c1;
     if (split_a) {
+      // B's box in A's frame, shared by both children.
+      const Vec3 cb = q.rotation * bb.center + q.translation_s;
+      const Vec3 extent_b = q.abs_rotation * bb.half;
       const std::int32_t l = e.na + 1, r = na.first_or_right;
       c0 = {l, e.nb,
-            box_lower_bound_squared(q, node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a),
-                                    bb)};
+            lower_bound_on_a_axes(q, node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a),
+                                  bb, cb, extent_b, prune2)};
       c1 = {r, e.nb,
-            box_lower_bound_squared(q, node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a),
-                                    bb)};
+            lower_bound_on_a_axes(q, node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a),
+                                  bb, cb, extent_b, prune2)};
     } else {
+      // A's box in B's frame, shared by both children.
+      const Vec3 ca = q.rotation.transpose() * (ba.center - q.translation_s);
+      const Vec3 extent_a = q.abs_rotation.transpose() * ba.half;
       const std::int32_t l = e.nb + 1, r = nb.first_or_right;
-      c0 = {e.na, l,
-            box_lower_bound_squared(q, ba,
-                                    node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b))};
-      c1 = {e.na, r,
-            box_lower_bound_squared(q, ba,
-                                    node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b))};
+      c0 = {
+          e.na, l,
+          lower_bound_on_b_axes(q, ba, node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b),
+                                ca, extent_a, prune2)};
+      c1 = {
+          e.na, r,
+          lower_bound_on_b_axes(q, ba, node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b),
+                                ca, extent_a, prune2)};
     }
     nodes_tested += 2;
     if (c0.lb2 > c1.lb2) std::swap(c0, c1);
@@ -525,6 +572,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
       // pair left out is farther than best + 2 margin (pruned by its
       // node pair's bound, or by its own distance here).
       const double keep = std::sqrt(best.d2) + 2.0 * margin + slack_s;
+      // Closest first: a tracked query then finds its best early and skips
+      // the rest by their boxes.
+      std::sort(candidates.begin(), candidates.end(),
+                [](const Candidate& x, const Candidate& y) { return x.d2 < y.d2; });
       for (const Candidate& c : candidates)
         if (c.d2 <= keep * keep) cache->near.push_back({c.ta, c.tb});
       if (cache->near.size() <= kNearCapacity) {

@@ -19,6 +19,7 @@
 #include <boost/multiprecision/gmp.hpp>
 #include <cmath>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "../src/triangle_distance.h"
@@ -329,7 +330,7 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
     zero += d == 0.0 ? 1 : 0;
     degenerate += (!a.planar || !b.planar) ? 1 : 0;
   }
-  EXPECT_GT(zero, 100);        // touching and crossing pairs are in the set
+  EXPECT_GT(zero, 100);       // touching and crossing pairs are in the set
   EXPECT_GT(degenerate, 40);  // and degenerate triangles
 }
 
@@ -375,6 +376,30 @@ TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
   }
   EXPECT_GT(separated, 250);  // apart, close (gaps of a fraction of a triangle)
   EXPECT_GT(tracked, 200);
+  // The same motion near the largest accepted coordinates. Regression: the
+  // motion bound took plain norms of 1e300-sized vectors, whose squares
+  // overflowed to infinity, so no step was ever tracked at that scale (0 of
+  // 40; answers stayed right, every query went cold). Now stable norms.
+  {
+    MeshData big_a = a, big_b = b;
+    for (Vec3& v : big_a.vertices) v *= 0x1p990;
+    for (Vec3& v : big_b.vertices) v *= 0x1p990;
+    const TriangleMesh ba = big_a.build(), bb = big_b.build();
+    MeshCache big_cache;
+    int big_tracked = 0;
+    for (int step = 0; step < 40; ++step) {
+      const double s = 0.01 * step;
+      const Pose pb(Quat(Eigen::AngleAxisd(0.3 * s, Vec3(0, 0, 1))) * q0,
+                    0x1p990 * Vec3(2.0 * std::sin(s), 9.2 - 0.3 * s, 0.2));
+      const MeshResult warm = distance(ba, Pose(), bb, pb, {}, &big_cache);
+      const MeshResult cold = distance(ba, Pose(), bb, pb);
+      ASSERT_EQ(warm.status, cold.status) << step;
+      ASSERT_EQ(warm.distance, cold.distance) << step;
+      ASSERT_TRUE(std::isfinite(warm.distance));
+      big_tracked += warm.tracked ? 1 : 0;
+    }
+    EXPECT_GT(big_tracked, 20);
+  }
   // A cache of another pair, or of unrelated poses, is never wrong.
   const MeshData c = random_soup(rng, 200, 2.0, 0.5);
   const TriangleMesh mc = c.build();
@@ -387,6 +412,30 @@ TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
       EXPECT_EQ(warm.distance, cold.distance);
     }
   }
+}
+
+// Meshes are shared between threads (immutable), and a query keeps its
+// scratch per thread: two threads querying the same meshes at different
+// poses get the serial answers.
+TEST(MeshDistanceTraversal, SharedBetweenThreads) {
+  Rng rng(23);
+  const TriangleMesh ma = random_soup(rng, 300, 5.0, 0.5).build();
+  const TriangleMesh mb = random_soup(rng, 100, 2.0, 0.5).build();
+  std::vector<Pose> poses;
+  for (int k = 0; k < 200; ++k) poses.push_back(random_pose(rng, 9));
+  std::vector<double> serial;
+  for (const Pose& p : poses) serial.push_back(distance(ma, Pose(), mb, p).distance);
+  std::vector<double> results[2];
+  std::thread threads[2];
+  for (int t = 0; t < 2; ++t) {
+    threads[t] = std::thread([&, t] {
+      MeshCache cache;
+      for (std::size_t k = static_cast<std::size_t>(t); k < poses.size(); k += 2)
+        results[t].push_back(distance(ma, Pose(), mb, poses[k], {}, &cache).distance);
+    });
+  }
+  for (auto& th : threads) th.join();
+  for (std::size_t k = 0; k < poses.size(); ++k) EXPECT_EQ(results[k % 2][k / 2], serial[k]) << k;
 }
 
 // --- 5. status -----------------------------------------------------------------
@@ -450,6 +499,80 @@ TEST(MeshStatus, ContainsAgreesWithTheBoxOnRaysThroughEdges) {
     const bool inside = (p.cwiseAbs().array() < 1.0).all();
     EXPECT_EQ(box.contains(p), inside) << p.transpose();
   }
+}
+
+// --- 6. mesh against a convex polytope ---------------------------------------------
+
+std::vector<Vec3> random_cloud(Rng& rng, int n, double size) {
+  std::vector<Vec3> p;
+  for (int k = 0; k < n; ++k)
+    p.emplace_back(test::uniform(rng, -size, size), test::uniform(rng, -size, size),
+                   test::uniform(rng, -size, size));
+  return p;
+}
+
+TEST(MeshConvex, MatchesEveryTriangleAndTheMeshOfTheSameSolid) {
+  Rng rng(41);
+  for (int trial = 0; trial < 30; ++trial) {
+    const MeshData soup = random_soup(rng, test::uniform_int(rng, 1, 80), 4.0, 0.6);
+    const TriangleMesh mesh = soup.build();
+    const ConvexPolytope hull(random_cloud(rng, 12, 1.0));
+    const Pose pa = random_pose(rng, 1), pb = random_pose(rng, 6);
+    MeshCache cache;
+    const MeshResult r = distance(mesh, pa, hull, pb, {}, &cache);
+    const MeshResult brute = distance_all_pairs(mesh, pa, hull, pb);
+    EXPECT_EQ(r.status, brute.status) << trial;
+    if (brute.status != Status::intersecting) {
+      EXPECT_EQ(r.distance, brute.distance) << trial;
+      EXPECT_LE(r.pairs_tested, brute.pairs_tested);
+      // Tracked from the cache at the same pose: the same answer.
+      const MeshResult again = distance(mesh, pa, hull, pb, {}, &cache);
+      EXPECT_EQ(again.distance, r.distance);
+    }
+  }
+  // Outside a solid, its surface is as far as the solid: a tetrahedron as a
+  // closed mesh and as a polytope give the same distance to a soup.
+  const MeshData tet = tetrahedron(Vec3::Zero(), 1.0);
+  const TriangleMesh tet_mesh = tet.build();
+  const ConvexPolytope tet_hull(tet.vertices);
+  int compared = 0;
+  for (int k = 0; k < 20; ++k) {
+    const MeshData soup = random_soup(rng, 30, 4.0, 0.6);
+    const TriangleMesh mesh = soup.build();
+    const Pose pb = random_pose(rng, 8);
+    const MeshResult as_mesh = distance(mesh, Pose(), tet_mesh, pb);
+    const MeshResult as_hull = distance(mesh, Pose(), tet_hull, pb);
+    if (as_mesh.status == Status::separated && as_hull.status == Status::separated) {
+      ++compared;
+      EXPECT_NEAR(as_mesh.distance, as_hull.distance, 1e-12 * as_mesh.distance + 64 * kU * 20);
+    }
+  }
+  EXPECT_GT(compared, 5);
+}
+
+TEST(MeshConvex, InsideEitherIsIntersecting) {
+  const MeshData cube = box_mesh(Vec3(-2, -2, -2), Vec3(2, 2, 2));
+  const TriangleMesh box = cube.build();
+  const MeshData tet = tetrahedron(Vec3::Zero(), 0.5);
+  const ConvexPolytope tet_hull(tet.vertices);
+  // A polytope inside the closed box mesh.
+  EXPECT_EQ(distance(box, Pose(), tet_hull, Pose()).status, Status::intersecting);
+  // ... inside an open box: the surfaces are 1.5 apart.
+  MeshData open = cube;
+  open.triangles.resize(10);
+  const MeshResult in_open = distance(open.build(), Pose(), tet_hull, Pose());
+  EXPECT_EQ(in_open.status, Status::separated);
+  EXPECT_NEAR(in_open.distance, 1.5, 1e-12);
+  // A mesh inside the polytope (a solid).
+  const ConvexPolytope big(cube.vertices);
+  EXPECT_EQ(distance(tet.build(), Pose(), big, Pose()).status, Status::intersecting);
+  // Apart.
+  const MeshResult apart = distance(box, Pose(), tet_hull, Pose::from_translation(Vec3(5, 0, 0)));
+  EXPECT_EQ(apart.status, Status::separated);
+  EXPECT_NEAR(apart.distance, 2.5, 1e-12);
+  EXPECT_GE(apart.triangle_a, 0);
+  EXPECT_EQ(apart.triangle_b, -1);
+  EXPECT_NEAR(apart.point_a.x(), 2.0, 1e-12);  // on the box's face x = 2
 }
 
 }  // namespace

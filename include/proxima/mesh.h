@@ -27,6 +27,7 @@
 #include <span>
 #include <vector>
 
+#include "proxima/polytope.h"
 #include "proxima/types.h"
 
 namespace proxima {
@@ -151,9 +152,12 @@ struct MeshCache {
   std::uint64_t mesh_b = 0;
   std::int32_t triangle_a = -1;  // closest pair of the last answer
   std::int32_t triangle_b = -1;
-  // The candidate pairs: every triangle pair whose distance could be within
-  // `margin` of `base_distance` when the pose was (rotation, translation)
-  // (B's pose in A's frame, scaled units of the query are not used here).
+  // The candidate pairs, closest first: every triangle pair whose distance
+  // was within 2 margin of base_distance (the best then) when B's pose in
+  // A's frame was (rotation, translation). While B has moved less than
+  // `margin` from there, every other pair is farther than the best of
+  // these, so a query tests only them. Empty: no list (the next query
+  // searches, from the last closest pair).
   std::vector<std::array<std::int32_t, 2>> near;
   double base_distance = 0.0;
   double margin = 0.0;
@@ -211,6 +215,30 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
 // The slow, obvious twin: every triangle pair, the same kernel and the same
 // status rules. For tests and benchmarks.
 MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
+                              const Pose& pose_b, const DistanceOptions& options = {});
+
+// Minimum distance between a mesh and a convex polytope (a solid), each at
+// its pose: the mesh's hierarchy against the polytope's box in the mesh's
+// frame, the convex query (distance.h) between each near triangle (as a
+// polytope of its three vertices) and the polytope at the leaves.
+// triangle_b is -1; feature_b is the polytope's (hull vertex ids, as
+// DistanceResult gives them); feature_a the triangle's, with mesh vertex
+// ids. Status: intersecting when a triangle overlaps the polytope (deeper
+// than the contact band, as the convex query decides: a mesh inside the
+// polytope is intersecting) or when the polytope lies inside the mesh, if
+// the mesh is closed; touching and separated as in the convex query. The
+// depth is not computed (distance 0, depth_upper_bound +infinity). A
+// rounded body (core plus radius r, body.h) is the core's answer offset by
+// r along the normal: the closest triangle is the same.
+//
+// The cache keeps the last closest triangle (triangle_a), whose distance is
+// the first upper bound; any cache is range-checked (never wrong).
+MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
+                    const Pose& pose_b, const DistanceOptions& options = {},
+                    MeshCache* cache = nullptr);
+
+// Its slow twin: the convex query against every triangle.
+MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
                               const Pose& pose_b, const DistanceOptions& options = {});
 
 }  // namespace proxima
