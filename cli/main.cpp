@@ -230,6 +230,10 @@ int main(int argc, char** argv) {
   view->add_option("--pose-b", view_command.pose_b, "Pose of B, as for `proxima distance`")
       ->expected(7)
       ->type_name("x y z qw qx qy qz");
+  view->add_option("--as", view_command.as,
+                   "How A and B become bodies: mesh (the surface as given), hull or pieces (one "
+                   "hull per OBJ group); default: the groups as pieces")
+      ->check(kinds);
   view->add_option("--query", view_command.query_file,
                    "A file ('-': standard input) holding one `proxima query` line, then "
                    "optionally its answer line; without one the query is answered here");

@@ -15,6 +15,7 @@
 #include "query.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -23,6 +24,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -103,8 +105,8 @@ Pose read_pose(const Json& object, const std::string& path, QuaternionOrder orde
 // "linear_velocity" and "angular_velocity" per unit t; none: no motion),
 // its rotations' four numbers in `order`.
 void read_body(const Json& query, const std::string& name, QuaternionOrder order,
-               std::vector<Vec3>& vertices, Pose& pose, double& radius,
-               std::optional<Motion>& motion) {
+               std::vector<Vec3>& vertices, std::vector<std::array<std::int32_t, 3>>& triangles,
+               Pose& pose, double& radius, std::optional<Motion>& motion) {
   const auto body = query.find(name);
   if (body == query.end()) fail("missing \"" + name + "\"");
   if (!body->is_object()) fail(name + " is not an object (it is " + kind(*body) + ")");
@@ -132,6 +134,41 @@ void read_body(const Json& query, const std::string& name, QuaternionOrder order
     }
     read_numbers(p, indexed(vertices_path, i), 3, "3 numbers [x, y, z]", xyz);
     vertices.emplace_back(xyz[0], xyz[1], xyz[2]);
+  }
+
+  // "triangles": a mesh body (proxima/mesh.h) of the vertices as given;
+  // absent or null, the hull of the vertices. Indices are checked here so
+  // that the message names the JSON path.
+  triangles.clear();
+  const auto faces = body->find("triangles");
+  if (faces != body->end() && !faces->is_null()) {
+    const std::string path = name + ".triangles";
+    if (!faces->is_array())
+      fail(path + " is not an array of triangles (it is " + kind(*faces) + ")");
+    if (faces->empty()) fail(path + " is empty: a mesh needs at least one triangle");
+    triangles.reserve(faces->size());
+    for (std::size_t i = 0; i < faces->size(); ++i) {
+      const Json& t = (*faces)[i];
+      const std::string at = indexed(path, i);
+      if (!t.is_array()) {
+        fail(at + " is not an array of 3 vertex indices [i, j, k] (it is " + kind(t) + ")");
+      }
+      if (t.size() != 3) {
+        fail(at + " is not an array of 3 vertex indices [i, j, k] (it has " +
+             std::to_string(t.size()) + " elements)");
+      }
+      std::array<std::int32_t, 3> tri{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Json& v = t[k];
+        if (!v.is_number_integer() || v.get<std::int64_t>() < 0 ||
+            v.get<std::int64_t>() >= static_cast<std::int64_t>(vertices.size())) {
+          fail(indexed(at, k) + " is not a vertex index: expected an integer in [0, " +
+               std::to_string(vertices.size()) + ")");
+        }
+        tri[k] = static_cast<std::int32_t>(v.get<std::int64_t>());
+      }
+      triangles.push_back(tri);
+    }
   }
 
   // Absent and null both mean identity, so that writers with optional
@@ -217,7 +254,29 @@ double world_scale(const ConvexPolytope& p, const Pose& pose) {
 struct Workspace {
   std::vector<Vec3> vertices_a;
   std::vector<Vec3> vertices_b;
+  std::vector<std::array<std::int32_t, 3>> triangles_a;
+  std::vector<std::array<std::int32_t, 3>> triangles_b;
 };
+
+}  // namespace
+
+Body query_body(const std::vector<Vec3>& vertices,
+                const std::vector<std::array<std::int32_t, 3>>& triangles, double radius,
+                const std::string& name) {
+  try {
+    if (!triangles.empty()) {
+      return Body(std::make_shared<const TriangleMesh>(
+                      std::span<const Vec3>(vertices),
+                      std::span<const std::array<std::int32_t, 3>>(triangles)),
+                  radius);
+    }
+    return Body(std::make_shared<const ConvexPolytope>(vertices), radius);
+  } catch (const InvalidInput& e) {
+    fail(name + ": " + e.what());
+  }
+}
+
+namespace {
 
 ConvexPolytope build_hull(const std::vector<Vec3>& vertices, const std::string& name) {
   try {
@@ -253,6 +312,7 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   const Json* id = id_it != query.end() ? &*id_it : nullptr;
 
   DistanceResult r;
+  std::optional<BodyDistance> mesh_answer;  // a query with a mesh body
   bool capped = false;
   double contact_band = 0.0;
   try {
@@ -262,63 +322,75 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
     double radius_b = 0.0;
     std::optional<Motion> motion_a;
     std::optional<Motion> motion_b;
-    read_body(query, "a", order, work.vertices_a, pose_a, radius_a, motion_a);
-    read_body(query, "b", order, work.vertices_b, pose_b, radius_b, motion_b);
-    const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
-    const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
-    if (motion_a || motion_b) {
-      // A time-of-impact query: its own answer line.
-      ImpactOptions impact;
-      impact.distance = options;
-      impact.target_separation = read_nonnegative(query, "target_separation", 0.0);
-      impact.tolerance = read_nonnegative(query, "tolerance", 0.0);
-      const ImpactResult hit =
-          time_of_impact(Body(a, radius_a), motion_a.value_or(Motion::fixed(pose_a)),
-                         Body(b, radius_b), motion_b.value_or(Motion::fixed(pose_b)), impact);
-      const DistanceResult& at = hit.at_t;
-      if (!std::isfinite(at.distance) || !std::isfinite(at.signed_distance()) ||
-          !at.point_a.allFinite() || !at.point_b.allFinite()) {
-        fail("the result is not finite: the coordinates are too large for double arithmetic");
+    read_body(query, "a", order, work.vertices_a, work.triangles_a, pose_a, radius_a, motion_a);
+    read_body(query, "b", order, work.vertices_b, work.triangles_b, pose_b, radius_b, motion_b);
+    if (!work.triangles_a.empty() || !work.triangles_b.empty()) {
+      if (motion_a || motion_b) {
+        fail("a time-of-impact query takes convex bodies (\"vertices\" without \"triangles\")");
       }
-      out += "{\"id\":";
-      append_id(out, id);
-      out += ",\"status\":\"";
-      out += to_string(hit.status);
-      out += "\",\"t\":";
-      append_number(out, hit.t);
-      out += ",\"distance\":";
-      append_number(out, at.distance);
-      out += ",\"signed_distance\":";
-      append_number(out, at.signed_distance());
-      out += ",\"point_a\":";
-      append_point(out, at.point_a);
-      out += ",\"point_b\":";
-      append_point(out, at.point_b);
-      out += ",\"normal\":";
-      append_point(out, at.normal);
-      out += ",\"pose_a\":";
-      append_pose(out, hit.pose_a, order);
-      out += ",\"pose_b\":";
-      append_pose(out, hit.pose_b, order);
-      out += ",\"iterations\":";
-      out += std::to_string(hit.iterations);
-      out += '}';
-      return true;
-    }
-    if (radius_a > 0.0 || radius_b > 0.0) {
-      // Rounded bodies: the cores' answer offset by the radii, points on
-      // the rounded surfaces.
-      r = distance(Body(a, radius_a), pose_a, Body(b, radius_b), pose_b, options, nullptr);
+      // A mesh on either side: the one call for any two bodies.
+      const BodyDistance m = distance(
+          query_body(work.vertices_a, work.triangles_a, radius_a, "a"), pose_a,
+          query_body(work.vertices_b, work.triangles_b, radius_b, "b"), pose_b, options, nullptr);
+      mesh_answer = m;
+      r = m;
     } else {
-      r = distance(*a, pose_a, *b, pose_b, options, nullptr);
-    }
-    capped = r.status == Status::iteration_cap;
-    if (capped) {
-      // The same band the library uses for touching: 64 u R plus Ae, R of
-      // the rounded bodies.
-      const double scale =
-          std::max(world_scale(*a, pose_a) + radius_a, world_scale(*b, pose_b) + radius_b);
-      contact_band = proxima::contact_band(scale, options.absolute_tolerance);
+      const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
+      const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
+      if (motion_a || motion_b) {
+        // A time-of-impact query: its own answer line.
+        ImpactOptions impact;
+        impact.distance = options;
+        impact.target_separation = read_nonnegative(query, "target_separation", 0.0);
+        impact.tolerance = read_nonnegative(query, "tolerance", 0.0);
+        const ImpactResult hit =
+            time_of_impact(Body(a, radius_a), motion_a.value_or(Motion::fixed(pose_a)),
+                           Body(b, radius_b), motion_b.value_or(Motion::fixed(pose_b)), impact);
+        const DistanceResult& at = hit.at_t;
+        if (!std::isfinite(at.distance) || !std::isfinite(at.signed_distance()) ||
+            !at.point_a.allFinite() || !at.point_b.allFinite()) {
+          fail("the result is not finite: the coordinates are too large for double arithmetic");
+        }
+        out += "{\"id\":";
+        append_id(out, id);
+        out += ",\"status\":\"";
+        out += to_string(hit.status);
+        out += "\",\"t\":";
+        append_number(out, hit.t);
+        out += ",\"distance\":";
+        append_number(out, at.distance);
+        out += ",\"signed_distance\":";
+        append_number(out, at.signed_distance());
+        out += ",\"point_a\":";
+        append_point(out, at.point_a);
+        out += ",\"point_b\":";
+        append_point(out, at.point_b);
+        out += ",\"normal\":";
+        append_point(out, at.normal);
+        out += ",\"pose_a\":";
+        append_pose(out, hit.pose_a, order);
+        out += ",\"pose_b\":";
+        append_pose(out, hit.pose_b, order);
+        out += ",\"iterations\":";
+        out += std::to_string(hit.iterations);
+        out += '}';
+        return true;
+      }
+      if (radius_a > 0.0 || radius_b > 0.0) {
+        // Rounded bodies: the cores' answer offset by the radii, points on
+        // the rounded surfaces.
+        r = distance(Body(a, radius_a), pose_a, Body(b, radius_b), pose_b, options, nullptr);
+      } else {
+        r = distance(*a, pose_a, *b, pose_b, options, nullptr);
+      }
+      capped = r.status == Status::iteration_cap;
+      if (capped) {
+        // The same band the library uses for touching: 64 u R plus Ae, R of
+        // the rounded bodies.
+        const double scale =
+            std::max(world_scale(*a, pose_a) + radius_a, world_scale(*b, pose_b) + radius_b);
+        contact_band = proxima::contact_band(scale, options.absolute_tolerance);
+      }
     }
   } catch (const QueryError& e) {
     append_error_answer(out, id, line_number, e.what());
@@ -334,9 +406,13 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   // A JSON line can carry no NaN or infinity. Finite inputs whose products
   // overflow (coordinates near 1e308) are the only way to get one; say so
   // rather than print an invalid line.
+  // An overlap with a mesh has no depth: its signed lower bound is
+  // -infinity, written as null.
+  const bool no_depth = mesh_answer && mesh_answer->cores_overlap;
   if (!std::isfinite(r.distance) || !std::isfinite(r.signed_distance()) ||
-      !std::isfinite(r.signed_lower_bound()) || !std::isfinite(r.signed_upper_bound()) ||
-      !r.point_a.allFinite() || !r.point_b.allFinite() || !r.normal.allFinite()) {
+      (!std::isfinite(r.signed_lower_bound()) && !no_depth) ||
+      !std::isfinite(r.signed_upper_bound()) || !r.point_a.allFinite() || !r.point_b.allFinite() ||
+      !r.normal.allFinite()) {
     append_error_answer(out, id, line_number,
                         "the result is not finite: the coordinates are too large for double "
                         "arithmetic");
@@ -355,7 +431,11 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   out += ",\"signed_distance\":";
   append_number(out, r.signed_distance());
   out += ",\"signed_lower_bound\":";
-  append_number(out, r.signed_lower_bound());
+  if (std::isfinite(r.signed_lower_bound())) {
+    append_number(out, r.signed_lower_bound());
+  } else {
+    out += "null";
+  }
   out += ",\"signed_upper_bound\":";
   append_number(out, r.signed_upper_bound());
   out += ",\"point_a\":";
@@ -366,6 +446,11 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   append_point(out, r.normal);
   out += ",\"iterations\":";
   out += std::to_string(r.iterations);
+  if (mesh_answer) {
+    // The closest triangles of mesh bodies (-1 for a hull).
+    out += ",\"triangle_a\":" + std::to_string(mesh_answer->triangle_a);
+    out += ",\"triangle_b\":" + std::to_string(mesh_answer->triangle_b);
+  }
   if (capped) out += ",\"iteration_cap\":true";
   out += '}';
   return true;

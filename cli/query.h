@@ -7,6 +7,8 @@
 // parsing (main.cpp) and the stream loop (query.cpp).
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <istream>
 #include <optional>
 #include <ostream>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "json_errors.h"
+#include "proxima/body.h"
 #include "proxima/time_of_impact.h"
 #include "proxima/types.h"
 
@@ -48,11 +51,18 @@ std::string answer_query_line(const std::string& line, const DistanceOptions& op
                               QuaternionOrder order = QuaternionOrder::wxyz);
 
 // Reads body `name` ("a" or "b") of a parsed query line into its vertices,
-// pose, radius and motion (none: no motion), rotations in `order`: the
-// reader of run_queries, shared with `proxima view`. Throws QueryError with
-// the field named (`b.vertices[3][1] is not a finite number`).
+// triangles (empty: no "triangles", the hull of the vertices), pose, radius
+// and motion (none: no motion), rotations in `order`: the reader of
+// run_queries, shared with `proxima view`. Throws QueryError with the field
+// named (`b.vertices[3][1] is not a finite number`).
 void read_body(const Json& query, const std::string& name, QuaternionOrder order,
-               std::vector<Vec3>& vertices, Pose& pose, double& radius,
-               std::optional<Motion>& motion);
+               std::vector<Vec3>& vertices, std::vector<std::array<std::int32_t, 3>>& triangles,
+               Pose& pose, double& radius, std::optional<Motion>& motion);
+
+// The body a query line describes: its mesh when it has triangles, else the
+// hull of its vertices, with its radius. Throws QueryError naming `name`.
+Body query_body(const std::vector<Vec3>& vertices,
+                const std::vector<std::array<std::int32_t, 3>>& triangles, double radius,
+                const std::string& name);
 
 }  // namespace proxima::cli

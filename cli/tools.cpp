@@ -163,13 +163,6 @@ std::string hull_report_text(const std::string& path, MeshFormat format, int inp
   return s.str();
 }
 
-Json body_json(const std::string& path, const LoadedFile& body) {
-  return hull_report_json(path, body.format, body.input_points, body.polytope, body.convex);
-}
-
-std::string body_text(const std::string& path, const LoadedFile& body) {
-  return hull_report_text(path, body.format, body.input_points, body.polytope, body.convex);
-}
 
 // A file read as the kind of body the command names (DistanceCommand::as_a).
 struct LoadedBody {

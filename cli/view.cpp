@@ -91,11 +91,12 @@ Json parse_object(const std::string& line, const std::string& where) {
   return j;
 }
 
-// A mesh file as a body: its OBJ groups are the pieces of a compound; a
-// file of one piece is a convex body.
-Body load_body(const std::string& path, std::uint64_t max_bytes) {
+// A mesh file as a body: as the command names it (--as), or by default its
+// OBJ groups as the pieces of a compound, a file of one piece a convex body.
+Body load_body(const std::string& path, const std::string& as, std::uint64_t max_bytes) {
   ReadOptions read;
   read.max_file_bytes = max_bytes;
+  if (!as.empty()) return proxima::load_body(path, load_as_from_string(as), read);
   LoadedCompound loaded = load_compound(path, read);
   if (loaded.body.piece_count() == 1 && loaded.body.piece(0).pose.rotation.isIdentity() &&
       loaded.body.piece(0).pose.translation.isZero()) {
@@ -125,9 +126,9 @@ std::string view_files(const ViewCommand& command) {
   const Pose pose_a = parse_pose(command.pose_a, "--pose-a", command.quaternion_order);
   const Pose pose_b = parse_pose(command.pose_b, "--pose-b", command.quaternion_order);
   const viewer::ShownBody a{file_name(command.file_a),
-                            load_body(command.file_a, command.max_file_bytes), pose_a};
+                            load_body(command.file_a, command.as, command.max_file_bytes), pose_a};
   const viewer::ShownBody b{file_name(command.file_b),
-                            load_body(command.file_b, command.max_file_bytes), pose_b};
+                            load_body(command.file_b, command.as, command.max_file_bytes), pose_b};
   const BodyDistance r = distance(a.body, a.pose, b.body, b.pose, command.options);
   return viewer::pair_page(a, b, r, viewer::answer_of(r), a.name + " and " + b.name);
 }
@@ -200,12 +201,15 @@ std::string view_query(const ViewCommand& command) {
 
   // The bodies, read as `proxima query` reads them.
   std::vector<Vec3> vertices_a, vertices_b;
+  std::vector<std::array<std::int32_t, 3>> triangles_a, triangles_b;
   Pose pose_a, pose_b;
   double radius_a = 0.0, radius_b = 0.0;
   std::optional<Motion> motion_a, motion_b;
   try {
-    read_body(query, "a", command.quaternion_order, vertices_a, pose_a, radius_a, motion_a);
-    read_body(query, "b", command.quaternion_order, vertices_b, pose_b, radius_b, motion_b);
+    read_body(query, "a", command.quaternion_order, vertices_a, triangles_a, pose_a, radius_a,
+              motion_a);
+    read_body(query, "b", command.quaternion_order, vertices_b, triangles_b, pose_b, radius_b,
+              motion_b);
   } catch (const QueryError& e) {
     throw ViewError(query_where + ": " + e.what());
   }
@@ -222,11 +226,13 @@ std::string view_query(const ViewCommand& command) {
         if (p->contains(key)) wrapped["a"][key] = (*p)[key];
       }
       std::vector<Vec3> unused;
+      std::vector<std::array<std::int32_t, 3>> no_triangles;
       Pose pose;
       double radius = 0.0;
       std::optional<Motion> motion;
       try {
-        read_body(wrapped, "a", command.quaternion_order, unused, pose, radius, motion);
+        read_body(wrapped, "a", command.quaternion_order, unused, no_triangles, pose, radius,
+                  motion);
       } catch (const QueryError& e) {
         throw ViewError(answer_where + ": " + field + ": " + e.what());
       }
@@ -247,15 +253,17 @@ std::string view_query(const ViewCommand& command) {
   shown.normal = answer_point(answer, "normal", answer_where);
   if (impact) shown.status += ", t = " + answer["t"].dump();
 
-  const auto build = [&](const std::vector<Vec3>& vertices, double radius, const char* side) {
+  const auto build = [&](const std::vector<Vec3>& vertices,
+                         const std::vector<std::array<std::int32_t, 3>>& triangles, double radius,
+                         const char* side) {
     try {
-      return Body(std::make_shared<const ConvexPolytope>(vertices), radius);
-    } catch (const InvalidInput& e) {
-      throw ViewError(query_where + ": " + side + ": " + e.what());
+      return query_body(vertices, triangles, radius, side);
+    } catch (const QueryError& e) {
+      throw ViewError(query_where + ": " + e.what());
     }
   };
-  const viewer::ShownBody a{"a", build(vertices_a, radius_a, "a"), pose_a};
-  const viewer::ShownBody b{"b", build(vertices_b, radius_b, "b"), pose_b};
+  const viewer::ShownBody a{"a", build(vertices_a, triangles_a, radius_a, "a"), pose_a};
+  const viewer::ShownBody b{"b", build(vertices_b, triangles_b, radius_b, "b"), pose_b};
   const BodyDistance witness = distance(a.body, a.pose, b.body, b.pose, command.options);
   return viewer::pair_page(a, b, witness, shown, "query " + id.dump());
 }
@@ -277,15 +285,19 @@ std::string view_scene(const ViewCommand& command) {
     Json wrapped = Json::object();
     wrapped["body"] = parse_object(line, where);
     std::vector<Vec3> vertices;
+    std::vector<std::array<std::int32_t, 3>> triangles;
     Pose pose;
     double radius = 0.0;
     std::optional<Motion> motion;
     try {
-      read_body(wrapped, "body", command.quaternion_order, vertices, pose, radius, motion);
+      read_body(wrapped, "body", command.quaternion_order, vertices, triangles, pose, radius,
+                motion);
     } catch (const QueryError& e) {
       throw ViewError(where + ": " + e.what());
     }
     if (radius != 0.0) throw ViewError(where + ": a scene's body has no radius");
+    if (!triangles.empty())
+      throw ViewError(where + ": a scene's body is convex (no \"triangles\")");
     if (motion) throw ViewError(where + ": a scene's body has no motion (one step is drawn)");
     std::shared_ptr<const ConvexPolytope> hull;
     try {

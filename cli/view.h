@@ -24,6 +24,9 @@ struct ViewCommand {
   std::string file_b;
   std::vector<std::string> pose_a;  // seven tokens, as `proxima distance` takes them
   std::vector<std::string> pose_b;
+  // How the files become bodies: "mesh", "hull" or "pieces" (proxima::LoadAs);
+  // "" draws each OBJ group as a piece (one group: a convex body).
+  std::string as;
   // ... or a file of JSON Lines: a query line (docs/query-format.md), then
   // optionally its answer line; without one, the query is answered here ...
   std::string query_file;

@@ -7,6 +7,7 @@
 // does no pose arithmetic of its own: what it draws is what was queried.
 #include "viewer.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -64,13 +65,32 @@ Json piece_json(const ConvexPolytope& hull, const Pose& to_world) {
   return piece_json(hull.vertices(), hull.triangles(), hull.edges(), to_world);
 }
 
-// The pieces of a body and where each sits in the body's frame. Mesh bodies
-// (issue 15's third kind, added beside this viewer) join here: a new
-// Body::Kind makes this switch warn (-Wswitch) until it has its case, which
-// gives the mesh's triangles to piece_json (vertices, triangles, edges) and
-// its closest triangle to feature_json as the witness.
+// The mesh's triangles and their distinct edges, as piece_json takes them.
+Json mesh_json(const TriangleMesh& mesh, const Pose& to_world) {
+  std::vector<std::array<std::int32_t, 3>> surface;
+  std::vector<std::array<std::int32_t, 2>> edges;
+  surface.reserve(mesh.triangles().size());
+  for (const TriangleMesh::Triangle& t : mesh.triangles()) {
+    const std::array<std::int32_t, 3> s{static_cast<std::int32_t>(t[0]),
+                                        static_cast<std::int32_t>(t[1]),
+                                        static_cast<std::int32_t>(t[2])};
+    surface.push_back(s);
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t u = s[static_cast<std::size_t>(k)];
+      const std::int32_t v = s[static_cast<std::size_t>((k + 1) % 3)];
+      if (u != v) edges.push_back({std::min(u, v), std::max(u, v)});
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return piece_json(mesh.vertices(), surface, edges, to_world);
+}
+
+// The pieces of a body and where each sits in the body's frame: a hull per
+// convex piece, or the body's one mesh.
 struct PlacedPiece {
   const ConvexPolytope* hull = nullptr;
+  const TriangleMesh* mesh = nullptr;
   Pose pose;  // piece frame -> body frame
 };
 
@@ -78,11 +98,14 @@ std::vector<PlacedPiece> pieces_of(const Body& body) {
   std::vector<PlacedPiece> pieces;
   switch (body.kind()) {
     case Body::Kind::convex:
-      pieces.push_back({body.convex().get(), Pose::identity()});
+      pieces.push_back({body.convex().get(), nullptr, Pose::identity()});
       return pieces;
     case Body::Kind::compound:
       for (const CompoundPiece& p : body.compound()->pieces())
-        pieces.push_back({p.polytope.get(), p.pose});
+        pieces.push_back({p.polytope.get(), nullptr, p.pose});
+      return pieces;
+    case Body::Kind::mesh:
+      pieces.push_back({nullptr, body.mesh().get(), Pose::identity()});
       return pieces;
   }
   throw InvalidInput("the viewer does not know this kind of body");
@@ -90,8 +113,10 @@ std::vector<PlacedPiece> pieces_of(const Body& body) {
 
 Json body_json(const ShownBody& shown) {
   Json pieces = Json::array();
-  for (const PlacedPiece& p : pieces_of(shown.body))
-    pieces.push_back(piece_json(*p.hull, shown.pose * p.pose));
+  for (const PlacedPiece& p : pieces_of(shown.body)) {
+    pieces.push_back(p.mesh != nullptr ? mesh_json(*p.mesh, shown.pose * p.pose)
+                                       : piece_json(*p.hull, shown.pose * p.pose));
+  }
   return Json{{"name", shown.name}, {"radius", shown.body.radius()}, {"pieces", std::move(pieces)}};
 }
 
@@ -106,8 +131,30 @@ Json feature_json(const ShownBody& shown, std::int32_t piece, const Feature& fea
     throw InvalidInput(std::string("viewer: the witness piece of ") + side + " (" +
                        std::to_string(piece) + ") is not a piece of the body");
   }
-  const ConvexPolytope& hull = *pieces[index].hull;
   const Pose to_world = shown.pose * pieces[index].pose;
+  if (const TriangleMesh* mesh = pieces[index].mesh; mesh != nullptr) {
+    // A mesh's feature: mesh vertex ids; a face feature is its triangle.
+    Json points = Json::array();
+    for (int k = 0; k < feature.vertex_count(); ++k) {
+      const std::int32_t v = feature.vertices[static_cast<std::size_t>(k)];
+      if (v < 0 || v >= mesh->vertex_count()) {
+        throw InvalidInput(std::string("viewer: witness vertex ") + std::to_string(v) + " of " +
+                           side + " is not a vertex of its mesh");
+      }
+      points.push_back(point_json(to_world.apply(mesh->vertex(v))));
+    }
+    Json face = Json::array();
+    if (feature.type == FeatureType::face && feature.face >= 0 &&
+        feature.face < mesh->triangle_count()) {
+      for (const std::uint32_t v : mesh->triangle(feature.face))
+        face.push_back(point_json(to_world.apply(mesh->vertex(static_cast<int>(v)))));
+    }
+    return Json{{"type", to_string(feature.type)},
+                {"piece", piece},
+                {"points", std::move(points)},
+                {"face", std::move(face)}};
+  }
+  const ConvexPolytope& hull = *pieces[index].hull;
   Json points = Json::array();
   for (int k = 0; k < feature.vertex_count(); ++k) {
     const std::int32_t v = feature.vertices[static_cast<std::size_t>(k)];
