@@ -66,20 +66,6 @@ class Sweep {
   Vec3 axis_ = Vec3::UnitX();
 };
 
-void check_options(const ImpactOptions& options) {
-  const double target = options.target_separation;
-  if (!std::isfinite(target) || target < 0.0) {
-    throw InvalidInput("time_of_impact: options.target_separation must be finite and >= 0, not " +
-                       std::to_string(target));
-  }
-  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
-    throw InvalidInput("time_of_impact: options.tolerance must be finite and >= 0 (0: default)");
-  }
-  if (options.max_iterations < 1) {
-    throw InvalidInput("time_of_impact: options.max_iterations must be at least 1");
-  }
-}
-
 // Bound on the distance of any point of the body (its rounded surface
 // included) from its reference point.
 double body_reach(const Body& body) {
@@ -94,6 +80,26 @@ double body_size(const Body& body) {
 }
 
 }  // namespace
+
+namespace detail {
+
+void check_impact_options(const ImpactOptions& options, const char* who) {
+  const double target = options.target_separation;
+  if (!std::isfinite(target) || target < 0.0) {
+    throw InvalidInput(std::string(who) +
+                       ": options.target_separation must be finite and >= 0, not " +
+                       std::to_string(target));
+  }
+  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
+    throw InvalidInput(std::string(who) +
+                       ": options.tolerance must be finite and >= 0 (0: default)");
+  }
+  if (options.max_iterations < 1) {
+    throw InvalidInput(std::string(who) + ": options.max_iterations must be at least 1");
+  }
+}
+
+}  // namespace detail
 
 Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& angular,
                              double duration) {
@@ -202,7 +208,7 @@ SafeStep lower_bound_step(double lower, double target, double speed) {
 ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
                             const ImpactOptions& options, DistanceCache* cache) {
-  check_options(options);
+  detail::check_impact_options(options, "time_of_impact");
   const double target = options.target_separation;
   const Sweep ma =
       checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
@@ -249,7 +255,7 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
                             const Motion& motion_b, const ImpactOptions& options,
                             BodyCache* cache) {
-  check_options(options);
+  detail::check_impact_options(options, "time_of_impact");
   BodyCache local;
   BodyCache& c = cache != nullptr ? *cache : local;
   const double ra = a.radius();

@@ -137,4 +137,11 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
                             const Motion& motion_b, const ImpactOptions& options = {},
                             BodyCache* cache = nullptr);
 
+namespace detail {
+// The checks of `options` that time_of_impact makes (InvalidInput naming
+// `who` and the field), for callers that validate once before many calls
+// (Scene::sweep).
+void check_impact_options(const ImpactOptions& options, const char* who);
+}  // namespace detail
+
 }  // namespace proxima
