@@ -693,6 +693,20 @@ std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   return s.impacts;
 }
 
+namespace {
+ImpactOptions scene_impact_options(const SceneOptions& scene) {
+  ImpactOptions options;
+  options.distance = scene.distance;
+  return options;
+}
+}  // namespace
+
+std::span<const ImpactPair> Scene::sweep() { return sweep(scene_impact_options(impl_->options)); }
+
+std::vector<ImpactPair> Scene::impact_pairs_all_pairs() const {
+  return impact_pairs_all_pairs(scene_impact_options(impl_->options));
+}
+
 const SweepStats& Scene::sweep_stats() const { return impl_->sweep_stats; }
 
 std::vector<ImpactPair> Scene::impact_pairs_all_pairs(const ImpactOptions& options) const {

@@ -423,6 +423,7 @@ TEST(SceneSweep, RandomScenesMissNoPairOfTheTwinAndAgreeBitForBitAcrossThreadsAn
     }
     ImpactOptions options;
     options.target_separation = round % 3 == 2 ? 0.05 : 0.0;
+    options.distance.penetration = round % 2 == 0;  // the depth of pairs overlapping at t = 0
     const std::span<const ImpactPair> got = first.sweep(options);
     const std::vector<ImpactPair> hits(got.begin(), got.end());
     for (std::size_t k = 1; k < lock.scenes.size(); ++k) {
