@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "proxima/compound.h"
 #include "proxima/support.h"
@@ -25,17 +26,23 @@ bool finite(const Vec3& v) { return v.allFinite(); }
 // and 1e300 are valid.
 double reach(const ConvexPolytope& p) { return p.centroid().stableNorm() + p.bounding_radius(); }
 
-// The gap between the support planes of the two placed hulls along the unit
-// direction n (world frame): min over B of n.y minus max over A of n.x, a
-// lower bound on their distance whatever n is. Hill climbing from the
-// cache's hints (exact maximizers).
-double support_gap(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                   const Pose& pose_b, const Vec3& n, const DistanceCache& cache) {
+// How far the hull of A reaches along the unit direction n (world frame),
+// and how far B's hull starts, at the placed poses: max over A of n.x and
+// min over B of n.y, found by hill climbing from the cache's hints (exact
+// maximizers). B's minus A's is the gap between the support planes, a lower
+// bound on the distance whatever n is.
+struct SupportPlanes {
+  double top_a = 0.0;
+  double bottom_b = 0.0;
+};
+
+SupportPlanes support_planes(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                             const Pose& pose_b, const Vec3& n, const DistanceCache& cache) {
   const Vec3 na = pose_a.rotation.transpose() * n;
   const Vec3 nb = pose_b.rotation.transpose() * n;
   const int ia = support_hill_climb(a, na, cache.hint_a);
   const int ib = support_hill_climb(b, -nb, cache.hint_b);
-  return n.dot(pose_b.apply(b.vertex(ib))) - n.dot(pose_a.apply(a.vertex(ia)));
+  return {n.dot(pose_a.apply(a.vertex(ia))), n.dot(pose_b.apply(b.vertex(ib)))};
 }
 
 // A motion with its turn precomputed (Motion::at converts the rotation to
@@ -230,22 +237,45 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   const auto query = [&](const Pose& pa, const Pose& pb) {
     return distance(a, pa, b, pb, options.distance, &c);
   };
-  // Two safe steps; the longer is taken. Along the normal: the support gap
-  // closes no faster than mu_n. In any direction: the certified lower bound
-  // closes no faster than any_speed. Both keep off the contact band of the
-  // accuracy standard at these poses (the rounding of the query's
-  // coordinates).
+  // Safe steps; the longest is taken. Along the normal n: the gap between
+  // a plane that bounds A from above along n and one that bounds B from
+  // below. For each body two such planes: its hull's support plane, which
+  // moves along n no faster than the body's speed along n plus the turn's
+  // |w x n| times the reach (a point r from the reference point moves along
+  // n at (w x r).n = (r x n).w, at most |w x n| |r|: a spin about the
+  // normal does not approach), and the support plane of its bounding ball
+  // (the hull stays inside the ball as it turns), whose lever is only the
+  // distance of the ball's center from the reference point: a round body
+  // turning about its middle approaches at its linear speed only, so far
+  // from contact the ball's planes give the longer step, near contact the
+  // hull's. Each of the four pairs of planes is a certified lower bound on
+  // the distance until it closes to the target. In any direction: the
+  // certified lower bound closes no faster than any_speed. All keep off
+  // the contact band of the accuracy standard at these poses (the rounding
+  // of the query's coordinates).
+  const double lever_a = a.centroid().stableNorm();
+  const double lever_b = b.centroid().stableNorm();
   const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
     const double band =
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
     const Vec3& n = r.normal;
-    const double gap = support_gap(a, pa, b, pb, n, c) - band;
-    // A point r from a reference point moves along n at (w x r).n =
-    // (r x n).w, at most |w x n| |r|: a spin about the normal does not
-    // approach.
-    const double mu_n =
-        (va - vb).dot(n) + wa.cross(n).norm() * reach_a + wb.cross(n).norm() * reach_b;
-    const SafeStep along = lower_bound_step(gap, target, mu_n);
+    const SupportPlanes hull = support_planes(a, pa, b, pb, n, c);
+    const double ball_top_a = n.dot(pa.apply(a.centroid())) + a.bounding_radius();
+    const double ball_bottom_b = n.dot(pb.apply(b.centroid())) - b.bounding_radius();
+    const double turn_a = wa.cross(n).norm();
+    const double turn_b = wb.cross(n).norm();
+    const double closing = (va - vb).dot(n);
+    SafeStep along;
+    for (const auto& [top, lever_top] :
+         {std::pair{hull.top_a, reach_a}, std::pair{ball_top_a, lever_a}}) {
+      for (const auto& [bottom, lever_bottom] :
+           {std::pair{hull.bottom_b, reach_b}, std::pair{ball_bottom_b, lever_b}}) {
+        const SafeStep s = lower_bound_step(bottom - top - band, target,
+                                            closing + turn_a * lever_top + turn_b * lever_bottom);
+        along.step = std::max(along.step, s.step);
+        along.never = along.never || s.never;
+      }
+    }
     const SafeStep any = lower_bound_step(r.lower_bound - band, target, any_speed);
     return SafeStep{std::max(along.step, any.step), along.never || any.never};
   };
