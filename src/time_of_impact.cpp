@@ -9,7 +9,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <utility>
 
 #include "proxima/compound.h"
 #include "proxima/support.h"
@@ -34,6 +33,10 @@ double reach(const ConvexPolytope& p) { return p.centroid().stableNorm() + p.bou
 struct SupportPlanes {
   double top_a = 0.0;
   double bottom_b = 0.0;
+  int vertex_a = 0;  // the support vertices
+  int vertex_b = 0;
+  Vec3 direction_a = Vec3::Zero();  // n seen from each body
+  Vec3 direction_b = Vec3::Zero();
 };
 
 SupportPlanes support_planes(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
@@ -42,7 +45,86 @@ SupportPlanes support_planes(const ConvexPolytope& a, const Pose& pose_a, const 
   const Vec3 nb = pose_b.rotation.transpose() * n;
   const int ia = support_hill_climb(a, na, cache.hint_a);
   const int ib = support_hill_climb(b, -nb, cache.hint_b);
-  return {n.dot(pose_a.apply(a.vertex(ia))), n.dot(pose_b.apply(b.vertex(ib)))};
+  return {n.dot(pose_a.apply(a.vertex(ia))), n.dot(pose_b.apply(b.vertex(ib))), ia, ib, na, nb};
+}
+
+// A bound on how a body's support plane along a fixed unit n moves while
+// the body turns by w about its reference point, good for a time span:
+// from `value`, at `rate` (per unit t, towards +n) at first, with a
+// magnitude of acceleration at most `acceleration`, for `span`.
+//
+// Why. Let q be the support vertex (maximizing along +sign n) and r = R q
+// its offset from the reference point. The point q moves along n at exactly
+// sign n.(v + w x r) now, and its rotation part accelerates by at most
+// |w|^2 |r| (the centripetal term; the translation is linear). The plane
+// stays q's while the body's turn keeps the direction, seen from the body,
+// inside q's normal cone: for each neighbour y of q the cone's wall is at
+// an angle whose sine is margin_y = sign n.(q - y) / |q - y| (world frame,
+// >= 0); the direction seen from the body moves by at most |w x n| per unit
+// t, so no neighbour overtakes q (and, the hull being convex, no other
+// vertex either) for margin / |w x n|. A round body touching at a vertex
+// then closes at second order in its turn, where the bound |w x n| reach
+// charged it first order; a face-on body has margin 0 and keeps the
+// first-order bound.
+struct PlaneBound {
+  double value = 0.0;
+  double rate = 0.0;
+  double acceleration = 0.0;
+  double span = 0.0;
+};
+
+// Cone margins a hair inside the computed ones, for their rounding.
+constexpr double kConeMarginShrink = 1.0 - 1e-9;
+
+// |x| from its square where that neither overflows nor underflows (the
+// common case, one sqrt), else the stable norm.
+double fast_norm(const Vec3& x) {
+  const double squared = x.squaredNorm();
+  if (squared >= std::numeric_limits<double>::min() && squared < 0x1p1000)
+    return std::sqrt(squared);
+  return x.stableNorm();
+}
+
+// `direction` is n seen from the body (pose.rotation^T n), `turn` |w x n|.
+PlaneBound vertex_plane(const ConvexPolytope& body, const Pose& pose, int q, const Vec3& n,
+                        const Vec3& direction, double sign, const Vec3& v, const Vec3& w,
+                        double turn) {
+  const Vec3 r = pose.rotation * body.vertex(q);
+  PlaneBound out;
+  out.value = sign * n.dot(pose.translation + r);
+  out.rate = sign * n.dot(v + w.cross(r));
+  out.acceleration = w.squaredNorm() * fast_norm(r);
+  if (!(turn > 0.0)) {
+    out.span = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  double margin = 1.0;
+  const Vec3& apex = body.vertex(q);
+  for (const std::int32_t y : body.neighbors(q)) {
+    const Vec3 edge = apex - body.vertex(y);
+    const double length = fast_norm(edge);
+    const double rise = sign * direction.dot(edge);
+    if (length > 0.0 && rise < margin * length) margin = rise / length;
+  }
+  margin = std::max(0.0, margin * kConeMarginShrink);
+  out.span = margin / turn;
+  return out;
+}
+
+// The first time in [0, span] at which a gap gap0 closing at `rate` with
+// acceleration at most `acceleration` can reach 0 (gap0 > 0): the smaller
+// root of gap0 - rate t - acceleration t^2 / 2, capped at span; infinity
+// when it never closes and span is unbounded.
+double first_closing(double gap0, double rate, double acceleration, double span) {
+  double t = std::numeric_limits<double>::infinity();
+  if (acceleration > 0.0) {
+    // Written without cancellation: 2 gap0 / (rate + sqrt(rate^2 + 2 a gap0)).
+    const double root = std::sqrt(rate * rate + 2.0 * acceleration * gap0);
+    t = rate + root > 0.0 ? 2.0 * gap0 / (rate + root) : std::numeric_limits<double>::infinity();
+  } else if (rate > 0.0) {
+    t = gap0 / rate;
+  }
+  return std::min(t, span);
 }
 
 // A motion with its turn precomputed (Motion::at converts the rotation to
@@ -239,20 +321,22 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   };
   // Safe steps; the longest is taken. Along the normal n: the gap between
   // a plane that bounds A from above along n and one that bounds B from
-  // below. For each body two such planes: its hull's support plane, which
+  // below, each moving no faster than a bound (PlaneBound), so that the gap
+  // is a certified lower bound on the distance until it closes to the
+  // target. Three such planes per body: its hull's support plane, which
   // moves along n no faster than the body's speed along n plus the turn's
   // |w x n| times the reach (a point r from the reference point moves along
   // n at (w x r).n = (r x n).w, at most |w x n| |r|: a spin about the
-  // normal does not approach), and the support plane of its bounding ball
-  // (the hull stays inside the ball as it turns), whose lever is only the
+  // normal does not approach); the support plane of its bounding ball (the
+  // hull stays inside the ball as it turns), whose lever is only the
   // distance of the ball's center from the reference point: a round body
   // turning about its middle approaches at its linear speed only, so far
-  // from contact the ball's planes give the longer step, near contact the
-  // hull's. Each of the four pairs of planes is a certified lower bound on
-  // the distance until it closes to the target. In any direction: the
-  // certified lower bound closes no faster than any_speed. All keep off
-  // the contact band of the accuracy standard at these poses (the rounding
-  // of the query's coordinates).
+  // from contact the ball's planes give the longer step; and the support
+  // vertex's own plane (vertex_plane: second order in the turn while the
+  // vertex stays the support), which gives the longer step near a contact
+  // at a vertex. In any direction: the certified lower bound closes no
+  // faster than any_speed. All keep off the contact band of the accuracy
+  // standard at these poses (the rounding of the query's coordinates).
   const double lever_a = a.centroid().stableNorm();
   const double lever_b = b.centroid().stableNorm();
   const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
@@ -260,20 +344,33 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
     const Vec3& n = r.normal;
     const SupportPlanes hull = support_planes(a, pa, b, pb, n, c);
-    const double ball_top_a = n.dot(pa.apply(a.centroid())) + a.bounding_radius();
-    const double ball_bottom_b = n.dot(pb.apply(b.centroid())) - b.bounding_radius();
-    const double turn_a = wa.cross(n).norm();
-    const double turn_b = wb.cross(n).norm();
-    const double closing = (va - vb).dot(n);
+    const double turn_a = fast_norm(wa.cross(n));
+    const double turn_b = fast_norm(wb.cross(n));
+    const double inf = std::numeric_limits<double>::infinity();
+    // A's top along n, and B's bottom as -(min along n): both rising at
+    // `rate` at most bring them closer.
+    const PlaneBound top_a[3] = {
+        {hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
+        {n.dot(pa.apply(a.centroid())) + a.bounding_radius(), va.dot(n) + turn_a * lever_a, 0.0,
+         inf},
+        vertex_plane(a, pa, hull.vertex_a, n, hull.direction_a, 1.0, va, wa, turn_a)};
+    const PlaneBound bottom_b[3] = {
+        {-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
+        {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()), -vb.dot(n) + turn_b * lever_b, 0.0,
+         inf},
+        vertex_plane(b, pb, hull.vertex_b, n, hull.direction_b, -1.0, vb, wb, turn_b)};
     SafeStep along;
-    for (const auto& [top, lever_top] :
-         {std::pair{hull.top_a, reach_a}, std::pair{ball_top_a, lever_a}}) {
-      for (const auto& [bottom, lever_bottom] :
-           {std::pair{hull.bottom_b, reach_b}, std::pair{ball_bottom_b, lever_b}}) {
-        const SafeStep s = lower_bound_step(bottom - top - band, target,
-                                            closing + turn_a * lever_top + turn_b * lever_bottom);
-        along.step = std::max(along.step, s.step);
-        along.never = along.never || s.never;
+    for (const PlaneBound& x : top_a) {
+      for (const PlaneBound& y : bottom_b) {
+        const double gap = -y.value - x.value - band - target;
+        if (!(gap > 0.0)) continue;
+        const double step = first_closing(gap, x.rate + y.rate, x.acceleration + y.acceleration,
+                                          std::min(x.span, y.span));
+        if (step == inf) {
+          along.never = true;
+        } else {
+          along.step = std::max(along.step, step);
+        }
       }
     }
     const SafeStep any = lower_bound_step(r.lower_bound - band, target, any_speed);
