@@ -25,11 +25,16 @@
 // query. At time t the query's normal n (unit, A towards B) and the support
 // planes of the two hulls along n bound the distance from below by their
 // gap s; no point of B approaches A's plane along n faster than
-//   mu = (v_a - v_b).n + |w_a| rho_a + |w_b| rho_b,
+//   mu = (v_a - v_b).n + |w_a x n| rho_a + |w_b x n| rho_b,
 // rho being the farthest hull vertex from the body's reference point, so
 // the distance stays above the target until t + (s - target) / mu, and the
-// time advances there. The cache carried from step to step makes each
-// step a tracked query (a few hundred nanoseconds).
+// time advances there. Two more planes per body bound longer steps where
+// they can (src/time_of_impact.cpp says why each is safe): its bounding
+// ball's, whose lever under the turn is the ball center's distance from
+// the reference point, and its support vertex's own, which closes at
+// second order in the turn while the vertex stays the support. The cache
+// carried from step to step makes each step a tracked query (a few
+// hundred nanoseconds).
 //
 // Thread safety: as distance(); the cache belongs to one pair.
 #pragma once
