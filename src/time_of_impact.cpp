@@ -6,6 +6,7 @@
 #include "proxima/time_of_impact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -53,19 +54,24 @@ SupportPlanes support_planes(const ConvexPolytope& a, const Pose& pose_a, const 
 // from `value`, at `rate` (per unit t, towards +n) at first, with a
 // magnitude of acceleration at most `acceleration`, for `span`.
 //
-// Why. Let q be the support vertex (maximizing along +sign n) and r = R q
-// its offset from the reference point. The point q moves along n at exactly
+// Why. Take a set S of vertices that holds the support vertex along
+// +sign n (the witness feature: a vertex, an edge, a face's vertices, and
+// the support vertex found by hill climbing); the support plane is S's
+// highest vertex as long as that is a local maximum of the hull's vertex
+// graph (the hull being convex, then a global one). A vertex q of S, r = R q
+// its offset from the reference point, moves along n at exactly
 // sign n.(v + w x r) now, and its rotation part accelerates by at most
-// |w|^2 |r| (the centripetal term; the translation is linear). The plane
-// stays q's while the body's turn keeps the direction, seen from the body,
-// inside q's normal cone: for each neighbour y of q the cone's wall is at
-// an angle whose sine is margin_y = sign n.(q - y) / |q - y| (world frame,
-// >= 0); the direction seen from the body moves by at most |w x n| per unit
-// t, so no neighbour overtakes q (and, the hull being convex, no other
-// vertex either) for margin / |w x n|. A round body touching at a vertex
-// then closes at second order in its turn, where the bound |w x n| reach
-// charged it first order; a face-on body has margin 0 and keeps the
-// first-order bound.
+// |w|^2 |r| (the centripetal term; the translation is linear): the highest
+// of S rises at most at the largest rate with the largest acceleration.
+// It stays the highest vertex while no neighbour y outside S overtakes any
+// q of S: the direction seen from the body moves by at most |w x n| per
+// unit t, and y stays below q while that is less than margin_y = sign n.(q
+// - y) / |q - y| (world frame). So the bound holds for the smallest margin
+// over |w x n| (none when a margin is negative: S does not hold the
+// support). A contact at a vertex then closes at second order in the turn
+// (the vertex's rate along the normal is about 0), a face-on contact at the
+// true rates of the face's corners, where the bound |w x n| reach charged
+// both first order at the full reach.
 struct PlaneBound {
   double value = 0.0;
   double rate = 0.0;
@@ -76,6 +82,11 @@ struct PlaneBound {
 // Cone margins a hair inside the computed ones, for their rounding.
 constexpr double kConeMarginShrink = 1.0 - 1e-9;
 
+// The largest face taken whole into S (bigger faces: S is the witness
+// feature's vertices and the support vertex only). The margin loop costs
+// |S| times the degree times |S|.
+constexpr std::size_t kMaxFeatureVertices = 16;
+
 // |x| from its square where that neither overflows nor underflows (the
 // common case, one sqrt), else the stable norm.
 double fast_norm(const Vec3& x) {
@@ -85,26 +96,66 @@ double fast_norm(const Vec3& x) {
   return x.stableNorm();
 }
 
+// S: the witness feature's vertices (a face's whole polygon when it is
+// small) and the support vertex, without repeats.
+struct VertexSet {
+  std::array<std::int32_t, kMaxFeatureVertices + 4> ids{};
+  std::size_t size = 0;
+  void add(std::int32_t v) {
+    if (v < 0 || std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
+                     ids.begin() + static_cast<std::ptrdiff_t>(size))
+      return;
+    ids[size++] = v;
+  }
+  bool has(std::int32_t v) const {
+    return std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
+           ids.begin() + static_cast<std::ptrdiff_t>(size);
+  }
+};
+
+VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int support) {
+  VertexSet set;
+  if (feature.type == FeatureType::face && feature.face >= 0 && feature.face < body.face_count() &&
+      body.face(feature.face).size() <= kMaxFeatureVertices) {
+    for (const std::int32_t v : body.face(feature.face)) set.add(v);
+  } else {
+    for (const std::int32_t v : feature.vertices) {
+      if (v < body.vertex_count()) set.add(v);
+    }
+  }
+  set.add(support);
+  return set;
+}
+
 // `direction` is n seen from the body (pose.rotation^T n), `turn` |w x n|.
-PlaneBound vertex_plane(const ConvexPolytope& body, const Pose& pose, int q, const Vec3& n,
-                        const Vec3& direction, double sign, const Vec3& v, const Vec3& w,
-                        double turn) {
-  const Vec3 r = pose.rotation * body.vertex(q);
+PlaneBound feature_plane(const ConvexPolytope& body, const Pose& pose, const VertexSet& set,
+                         const Vec3& n, const Vec3& direction, double sign, const Vec3& v,
+                         const Vec3& w, double turn) {
   PlaneBound out;
-  out.value = sign * n.dot(pose.translation + r);
-  out.rate = sign * n.dot(v + w.cross(r));
-  out.acceleration = w.squaredNorm() * fast_norm(r);
+  out.value = -std::numeric_limits<double>::infinity();
+  out.rate = -std::numeric_limits<double>::infinity();
+  double arm = 0.0;
+  for (std::size_t k = 0; k < set.size; ++k) {
+    const Vec3 r = pose.rotation * body.vertex(set.ids[k]);
+    out.value = std::max(out.value, sign * n.dot(pose.translation + r));
+    out.rate = std::max(out.rate, sign * n.dot(v + w.cross(r)));
+    arm = std::max(arm, fast_norm(r));
+  }
+  out.acceleration = w.squaredNorm() * arm;
   if (!(turn > 0.0)) {
     out.span = std::numeric_limits<double>::infinity();
     return out;
   }
   double margin = 1.0;
-  const Vec3& apex = body.vertex(q);
-  for (const std::int32_t y : body.neighbors(q)) {
-    const Vec3 edge = apex - body.vertex(y);
-    const double length = fast_norm(edge);
-    const double rise = sign * direction.dot(edge);
-    if (length > 0.0 && rise < margin * length) margin = rise / length;
+  for (std::size_t k = 0; k < set.size; ++k) {
+    const Vec3& q = body.vertex(set.ids[k]);
+    for (const std::int32_t y : body.neighbors(set.ids[k])) {
+      if (set.has(y)) continue;
+      const Vec3 edge = q - body.vertex(y);
+      const double length = fast_norm(edge);
+      const double rise = sign * direction.dot(edge);
+      if (length > 0.0 && rise < margin * length) margin = rise / length;
+    }
   }
   margin = std::max(0.0, margin * kConeMarginShrink);
   out.span = margin / turn;
@@ -332,9 +383,9 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   // distance of the ball's center from the reference point: a round body
   // turning about its middle approaches at its linear speed only, so far
   // from contact the ball's planes give the longer step; and the support
-  // vertex's own plane (vertex_plane: second order in the turn while the
-  // vertex stays the support), which gives the longer step near a contact
-  // at a vertex. In any direction: the certified lower bound closes no
+  // feature's own plane (feature_plane: the true rates of its vertices
+  // while they hold the support), which gives the longer step near a
+  // contact. In any direction: the certified lower bound closes no
   // faster than any_speed. All keep off the contact band of the accuracy
   // standard at these poses (the rounding of the query's coordinates).
   const double lever_a = a.centroid().stableNorm();
@@ -349,16 +400,16 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     const double inf = std::numeric_limits<double>::infinity();
     // A's top along n, and B's bottom as -(min along n): both rising at
     // `rate` at most bring them closer.
-    const PlaneBound top_a[3] = {
-        {hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
-        {n.dot(pa.apply(a.centroid())) + a.bounding_radius(), va.dot(n) + turn_a * lever_a, 0.0,
-         inf},
-        vertex_plane(a, pa, hull.vertex_a, n, hull.direction_a, 1.0, va, wa, turn_a)};
-    const PlaneBound bottom_b[3] = {
-        {-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
-        {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()), -vb.dot(n) + turn_b * lever_b, 0.0,
-         inf},
-        vertex_plane(b, pb, hull.vertex_b, n, hull.direction_b, -1.0, vb, wb, turn_b)};
+    const PlaneBound top_a[3] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
+                                 {n.dot(pa.apply(a.centroid())) + a.bounding_radius(),
+                                  va.dot(n) + turn_a * lever_a, 0.0, inf},
+                                 feature_plane(a, pa, feature_set(a, r.feature_a, hull.vertex_a), n,
+                                               hull.direction_a, 1.0, va, wa, turn_a)};
+    const PlaneBound bottom_b[3] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
+                                    {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()),
+                                     -vb.dot(n) + turn_b * lever_b, 0.0, inf},
+                                    feature_plane(b, pb, feature_set(b, r.feature_b, hull.vertex_b),
+                                                  n, hull.direction_b, -1.0, vb, wb, turn_b)};
     SafeStep along;
     for (const PlaneBound& x : top_a) {
       for (const PlaneBound& y : bottom_b) {

@@ -218,8 +218,8 @@ TEST(TimeOfImpact, AVertexSwingingDownAboutAFarPivotIsCaughtAtSecondOrder) {
 }
 
 // Fast turns, slow approach, hulls of few vertices (wide normal cones: the
-// support vertex's own plane bounds long steps, src/time_of_impact.cpp
-// vertex_plane), some off their reference point: a step that overshot
+// witness feature's own plane bounds long steps, src/time_of_impact.cpp
+// feature_plane), some off their reference point: a step that overshot
 // would leave the bodies overlapping at the reported t (the signed
 // distance below the target) or skip a sampled contact.
 TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {

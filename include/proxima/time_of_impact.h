@@ -31,8 +31,9 @@
 // time advances there. Two more planes per body bound longer steps where
 // they can (src/time_of_impact.cpp says why each is safe): its bounding
 // ball's, whose lever under the turn is the ball center's distance from
-// the reference point, and its support vertex's own, which closes at
-// second order in the turn while the vertex stays the support. The cache
+// the reference point, and its witness feature's own, which moves at the
+// true rates of the feature's vertices while they hold the support (at
+// second order in the turn for a vertex). The cache
 // carried from step to step makes each step a tracked query (a few
 // hundred nanoseconds).
 //
