@@ -204,6 +204,9 @@ TEST(SceneSweep, TargetSeparationReachesPairsThatNeverTouch) {
 }
 
 TEST(SceneSweep, BadInputIsNamed) {
+  Scene empty;
+  EXPECT_TRUE(empty.sweep().empty());
+  EXPECT_EQ(empty.sweep_stats().candidate_pairs, 0);
   Scene scene;
   const BodyId a = scene.add(box(Vec3::Constant(0.5)), at(Vec3::Zero()));
   const auto message = [](auto&& call) {
