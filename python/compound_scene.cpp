@@ -3,7 +3,7 @@
 //
 // Layer 7: the Python side of compound bodies and scenes (CompoundBody,
 // CompoundCache, CompoundResult, load_compound, distance over compounds,
-// Scene, ClosePair, SceneStats). Same conventions as module.cpp: names one
+// Scene, ClosePair, SceneStats, ImpactPair, SweepStats). Same conventions as module.cpp: names one
 // for one with C++, arrays are numpy copies, enums are strings, the long
 // calls release the GIL.
 //
@@ -36,7 +36,7 @@ using PyScene = Guarded<Scene>;
 
 // Body ids from Python: integers only (forcecast would truncate 1.5 to 1),
 // within BodyId's range.
-std::vector<BodyId> to_body_ids(py::handle obj) {
+std::vector<BodyId> to_body_ids(py::handle obj, const char* what) {
   const py::array any = py::array::ensure(obj);
   if (!any || any.ndim() != 1) value_error("ids: expected a 1-D array of body ids");
   const char kind = any.dtype().kind();
@@ -51,7 +51,8 @@ std::vector<BodyId> to_body_ids(py::handle obj) {
   for (py::ssize_t k = 0; k < wide.shape(0); ++k) {
     const std::int64_t id = wide.at(k);
     if (id < std::numeric_limits<BodyId>::min() || id > std::numeric_limits<BodyId>::max()) {
-      throw InvalidInput("Scene.set_poses: ids[" + std::to_string(k) + "] = " + std::to_string(id) +
+      throw InvalidInput(std::string("Scene.") + what + ": ids[" + std::to_string(k) +
+                         "] = " + std::to_string(id) +
                          " is not in the scene (never added, or removed); no body was moved");
     }
     ids[static_cast<std::size_t>(k)] = static_cast<BodyId>(id);
@@ -90,6 +91,45 @@ py::list close_pair_list(std::span<const ClosePair> pairs) {
   py::list out;
   for (const ClosePair& p : pairs) out.append(py::cast(p));
   return out;
+}
+
+py::list impact_pair_list(std::span<const ImpactPair> pairs) {
+  py::list out;
+  for (const ImpactPair& p : pairs) out.append(py::cast(p));
+  return out;
+}
+
+// Scene.set_poses and Scene.set_end_poses: every id and pose checked before
+// the first body is touched, then `set(id, pose)` for each.
+template <class Set>
+void set_many(PyScene& s, py::object ids, py::object poses, const char* what, const Set& set) {
+  const std::vector<BodyId> id_list = to_body_ids(ids, what);
+  std::vector<Pose> list = to_poses(poses, static_cast<py::ssize_t>(id_list.size()), "poses");
+  const InUse in_use(s, "Scene");
+  for (std::size_t k = 0; k < id_list.size(); ++k) {
+    if (!s.contains(id_list[k])) {
+      throw InvalidInput(std::string("Scene.") + what + ": ids[" + std::to_string(k) +
+                         "] = " + std::to_string(id_list[k]) +
+                         " is not in the scene (never added, or removed); no body was moved");
+    }
+    list[k] = checked_pose(list[k], [&] {
+      return std::string("Scene.") + what + ": poses[" + std::to_string(k) +
+             "] (no body was moved)";
+    });
+  }
+  for (std::size_t k = 0; k < id_list.size(); ++k) set(id_list[k], list[k]);
+}
+
+// The sweep's options from Python's keywords, with the scene's distance
+// options.
+ImpactOptions sweep_options(const Scene& s, double target_separation, double tolerance,
+                            int max_iterations) {
+  ImpactOptions options;
+  options.target_separation = target_separation;
+  options.tolerance = tolerance;
+  options.max_iterations = max_iterations;
+  options.distance = s.options().distance;
+  return options;
 }
 
 }  // namespace
@@ -287,6 +327,34 @@ void bind_compound_and_scene(py::module_& m) {
                ", distance=" + py::repr(py::float_(p.result.distance)).cast<std::string>() + ")";
       });
 
+  py::class_<ImpactPair>(m, "ImpactPair",
+                         "A pair of bodies that meet during a sweep (a < b), and when.")
+      .def_readonly("a", &ImpactPair::a, "Body id.")
+      .def_readonly("b", &ImpactPair::b, "Body id.")
+      .def_readonly("result", &ImpactPair::result,
+                    "The ImpactResult of the pair (status, t, poses and distance at t).")
+      .def("__repr__", [](const ImpactPair& p) {
+        return "proxima.ImpactPair(" + std::to_string(p.a) + ", " + std::to_string(p.b) +
+               ", status='" + to_string(p.result.status) +
+               "', t=" + py::repr(py::float_(p.result.t)).cast<std::string>() + ")";
+      });
+
+  py::class_<SweepStats>(m, "SweepStats", "What the last sweep did.")
+      .def_readonly("bodies", &SweepStats::bodies, "Bodies in the scene.")
+      .def_readonly("moving_bodies", &SweepStats::moving_bodies,
+                    "Bodies whose end pose differs from their pose.")
+      .def_readonly("candidate_pairs", &SweepStats::candidate_pairs,
+                    "Pairs whose swept boxes overlap, after the filters (each one a "
+                    "time_of_impact).")
+      .def_readonly("impact_pairs", &SweepStats::impact_pairs,
+                    "Of those, the pairs not separated over the motion (reported).")
+      .def_readonly("distance_queries", &SweepStats::distance_queries,
+                    "Advancement steps (distance queries) of all candidate pairs.")
+      .def_readonly("warm_pairs", &SweepStats::warm_pairs,
+                    "Candidate pairs that started from a cache (the last sweep's or step's).")
+      .def_readonly("filtered_pairs", &SweepStats::filtered_pairs,
+                    "Pairs whose swept boxes overlapped but that the pair filters dropped.");
+
   py::class_<SceneStats>(m, "SceneStats", "What the last step did.")
       .def_readonly("bodies", &SceneStats::bodies, "Bodies in the scene.")
       .def_readonly("candidate_pairs", &SceneStats::candidate_pairs,
@@ -357,24 +425,10 @@ void bind_compound_and_scene(py::module_& m) {
       .def(
           "set_poses",
           [](PyScene& s, py::object ids, py::object poses) {
-            const std::vector<BodyId> id_list = to_body_ids(ids);
-            std::vector<Pose> list =
-                to_poses(poses, static_cast<py::ssize_t>(id_list.size()), "poses");
-            const InUse in_use(s, "Scene");
             // All or nothing: every id and every pose is checked before the
             // first body moves (a proxima.Pose object is checked here too).
-            for (std::size_t k = 0; k < id_list.size(); ++k) {
-              if (!s.contains(id_list[k])) {
-                throw InvalidInput("Scene.set_poses: ids[" + std::to_string(k) +
-                                   "] = " + std::to_string(id_list[k]) +
-                                   " is not in the scene (never added, or removed); no body was "
-                                   "moved");
-              }
-              list[k] = checked_pose(list[k], [&] {
-                return "Scene.set_poses: poses[" + std::to_string(k) + "] (no body was moved)";
-              });
-            }
-            for (std::size_t k = 0; k < id_list.size(); ++k) s.set_pose(id_list[k], list[k]);
+            set_many(s, ids, poses, "set_poses",
+                     [&s](BodyId id, const Pose& p) { s.set_pose(id, p); });
           },
           py::arg("ids"), py::arg("poses"),
           "Moves many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing: an unknown "
@@ -522,6 +576,79 @@ void bind_compound_and_scene(py::module_& m) {
           py::arg("id"), py::arg("margin"),
           "Every body within margin of body id (touching and intersecting included), as "
           "ClosePair (min id, max id), by increasing other id.")
+      .def(
+          "set_end_pose",
+          [](PyScene& s, BodyId id, py::object pose) {
+            const Pose p = to_pose(pose, "pose");
+            const InUse in_use(s, "Scene");
+            s.set_end_pose(id, p);
+          },
+          py::arg("id"), py::arg("pose"),
+          "Where body id moves to over the next sweep() (its motion: constant linear velocity of "
+          "its frame's origin and constant angular velocity about it, the shorter way round). "
+          "set_pose ends the motion (the end pose becomes the new pose).")
+      .def(
+          "set_end_poses",
+          [](PyScene& s, py::object ids, py::object poses) {
+            set_many(s, ids, poses, "set_end_poses",
+                     [&s](BodyId id, const Pose& p) { s.set_end_pose(id, p); });
+          },
+          py::arg("ids"), py::arg("poses"),
+          "set_end_pose for many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing.")
+      .def(
+          "end_pose",
+          [](const PyScene& s, BodyId id) {
+            const InUse in_use(s, "Scene");
+            return Pose(s.end_pose(id));
+          },
+          py::arg("id"), "The end pose of body id (its pose when it does not move).")
+      .def(
+          "sweep",
+          [](PyScene& s, double target_separation, double tolerance, int max_iterations) {
+            const InUse in_use(s, "Scene");
+            const ImpactOptions options =
+                sweep_options(s, target_separation, tolerance, max_iterations);
+            std::span<const ImpactPair> pairs;
+            {
+              py::gil_scoped_release release;
+              pairs = s.sweep(options);
+            }
+            return impact_pair_list(pairs);
+          },
+          py::arg("target_separation") = ImpactOptions{}.target_separation,
+          py::arg("tolerance") = ImpactOptions{}.tolerance,
+          py::arg("max_iterations") = ImpactOptions{}.max_iterations,
+          "Continuous collision: every body moves from its pose to its end pose over t in [0, "
+          "1]; returns the ImpactPair of every pair that comes within target_separation on the "
+          "way (status 'contact' at t, 'overlapping' at t = 0, or 'iteration_cap'), sorted by "
+          "(a, b). No pair is missed, however fast or thin the bodies (the broad phase boxes the "
+          "whole motion) and no t is after the true first contact; the filters apply. Poses are "
+          "not changed. tolerance: as time_of_impact (0: 1e-6 of the bodies' size). The scene's "
+          "distance options apply (penetration off by default).")
+      .def_property_readonly(
+          "sweep_stats",
+          [](const PyScene& s) {
+            const InUse in_use(s, "Scene");
+            return s.sweep_stats();
+          },
+          "SweepStats of the last sweep.")
+      .def(
+          "impact_pairs_all_pairs",
+          [](const PyScene& s, double target_separation, double tolerance, int max_iterations) {
+            const InUse in_use(s, "Scene");
+            const ImpactOptions options =
+                sweep_options(s, target_separation, tolerance, max_iterations);
+            std::vector<ImpactPair> pairs;
+            {
+              py::gil_scoped_release release;
+              pairs = s.impact_pairs_all_pairs(options);
+            }
+            return impact_pair_list(pairs);
+          },
+          py::arg("target_separation") = ImpactOptions{}.target_separation,
+          py::arg("tolerance") = ImpactOptions{}.tolerance,
+          py::arg("max_iterations") = ImpactOptions{}.max_iterations,
+          "The slow twin of sweep(): cold time_of_impact on every pair. For checks.")
       .def(
           "close_pairs_all_pairs",
           [](const PyScene& s) {

@@ -562,10 +562,12 @@ signed_lower_bound, signed_upper_bound, point_a (K, 3),
 point_b (K, 3), normal (K, 3), feature_a_type (str), feature_a_vertices (K, 3; -1 unused),
 feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k], b, poses_b[k]).)doc");
 
+  // Before the scene: Scene.sweep's ImpactPair holds an ImpactResult, whose
+  // type must be known when its property is bound (for its signature).
+  bind_time_of_impact(m);
   bind_compound_and_scene(m);
   bind_pair_batch(m);
   bind_bodies(m);
   bind_mesh(m);
-  bind_time_of_impact(m);
   bind_view(m);
 }

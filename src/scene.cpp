@@ -14,6 +14,12 @@
 // Each candidate owns its cache and its result slot, and the bodies are only
 // read, so the narrow phase runs over index ranges on any number of threads
 // and gives bit-identical answers whatever that number is.
+//
+// A sweep (continuous collision) is the same pipeline on other boxes and
+// another query: each body's box holds its whole swept volume (swept_box
+// below), its own pair finder and pair list keep the sweep's coherence
+// apart from the step's, and each candidate pair runs time_of_impact from
+// its cache.
 #include "proxima/scene.h"
 
 #include <algorithm>
@@ -25,6 +31,7 @@
 
 #include "broad_phase.h"
 #include "parallel_ranges.h"
+#include "proxima/body.h"
 #include "proxima/distance.h"
 
 namespace proxima {
@@ -50,6 +57,16 @@ constexpr std::size_t kCloseChunk = 1024;
 // operations on numbers of magnitude R).
 constexpr double kBoxSlackUlps = 128.0;
 
+// A swept box adds up a few more numbers of magnitude R (the boxes shifted
+// by the other end's translation, the turn's sag) and numbers of the size of
+// the target and the turn's sag: a few more units of rounding on each.
+constexpr double kSweptBoxSlackUlps = kBoxSlackUlps + 32.0;
+constexpr double kSweptPadSlackUlps = 8.0;
+
+// time_of_impact's default tolerance, relative to the bodies' size
+// (src/time_of_impact.cpp): 1e-6 of the sum of their bounding radii.
+constexpr double kDefaultImpactTolerance = 1e-6;
+
 std::size_t slot(BodyId id) { return static_cast<std::size_t>(id); }
 
 std::string name(BodyId id) { return "body " + std::to_string(id); }
@@ -72,6 +89,7 @@ struct Scene::Impl {
     // through the compound query).
     std::shared_ptr<const CompoundBody> compound;
     Pose pose;
+    Pose end;                                                      // the end pose of the next sweep
     std::array<std::int32_t, 6> hints = {-1, -1, -1, -1, -1, -1};  // support_box
     CollisionFilter filter;
     bool live = false;
@@ -104,6 +122,17 @@ struct Scene::Impl {
   std::vector<ClosePair> close;
   SceneStats stats;
 
+  // The sweep's own broad phase and coherence, made by the first sweep.
+  std::unique_ptr<detail::PairFinder> sweep_finder;
+  std::vector<Aabb> swept_boxes;
+  std::vector<std::uint64_t> sweep_candidates;
+  std::vector<PairState> sweep_pairs;  // sorted by key: the last sweep's candidates
+  std::vector<BodyId> removed_since_sweep;
+  std::vector<int> sweep_queries;  // parallel to sweep_pairs
+  std::vector<std::vector<ImpactPair>> impact_chunks;
+  std::vector<ImpactPair> impacts;
+  SweepStats sweep_stats;
+
   const Body& live_body(BodyId id, const char* what) const {
     if (id < 0 || slot(id) >= bodies.size() || !bodies[slot(id)].live) {
       throw InvalidInput(std::string("Scene::") + what + ": " + name(id) +
@@ -132,6 +161,7 @@ struct Scene::Impl {
     body.live = true;
     bodies[slot(id)] = std::move(body);
     finder->add(id);
+    if (sweep_finder) sweep_finder->add(id);
     ++live_count;
     return id;
   }
@@ -188,20 +218,20 @@ struct Scene::Impl {
 
   // Drops the candidates the filters reject: one merge with the sorted
   // exclusions (both lists increase). Returns how many were dropped.
-  int filter_candidates() {
+  int filter_candidates(std::vector<std::uint64_t>& keys) const {
     const bool any_groups = std::any_of(bodies.begin(), bodies.end(), [](const Body& b) {
       return b.live && (b.filter.group != 1 || b.filter.mask != 0xffffffffu);
     });
     if (!any_groups && excluded.empty()) return 0;
     std::size_t e = 0;
-    const std::size_t before = candidates.size();
-    std::erase_if(candidates, [&](std::uint64_t key) {
+    const std::size_t before = keys.size();
+    std::erase_if(keys, [&](std::uint64_t key) {
       while (e < excluded.size() && excluded[e] < key) ++e;
       if (e < excluded.size() && excluded[e] == key) return true;
       return !groups_meet(bodies[slot(detail::pair_first(key))],
                           bodies[slot(detail::pair_second(key))]);
     });
-    return static_cast<int>(before - candidates.size());
+    return static_cast<int>(before - keys.size());
   }
 
   // The state of pair `key` for a query outside step(): the pair's own
@@ -222,39 +252,143 @@ struct Scene::Impl {
                      query(state_of(key, scratch))};
   }
 
-  // Carries the cache of every pair that stays a candidate over to this
-  // step's pair list; new candidates start cold. Returns how many are warm.
-  int carry_caches() {
-    if (!removed_since_step.empty()) {
-      // A removed body's id may already belong to a new body: its pairs'
-      // caches describe other bodies and go (a stale cache is only slower,
-      // but it would also make the warm count lie).
-      removed_flag.assign(bodies.size(), 0);
-      for (const BodyId id : removed_since_step) removed_flag[slot(id)] = 1;
-      std::erase_if(pairs, [&](const PairState& p) {
-        return removed_flag[slot(detail::pair_first(p.key))] != 0 ||
-               removed_flag[slot(detail::pair_second(p.key))] != 0;
-      });
-      removed_since_step.clear();
-    }
-    next_pairs.resize(candidates.size());
+  // A removed body's id may already belong to a new body: its pairs'
+  // caches describe other bodies and go (a stale cache is only slower, but
+  // it would also make the warm count lie).
+  void drop_removed(std::vector<PairState>& list, std::vector<BodyId>& removed) {
+    if (removed.empty()) return;
+    removed_flag.assign(bodies.size(), 0);
+    for (const BodyId id : removed) removed_flag[slot(id)] = 1;
+    std::erase_if(list, [&](const PairState& p) {
+      return removed_flag[slot(detail::pair_first(p.key))] != 0 ||
+             removed_flag[slot(detail::pair_second(p.key))] != 0;
+    });
+    removed.clear();
+  }
+
+  // Makes `list` (sorted by key, the states of the last call's candidates)
+  // the states of `keys` (sorted): a pair that stays keeps its state, a new
+  // one starts from its state in `donor` (sorted too; may be null) when it
+  // has one there, else cold. Returns how many are warm.
+  int carry_caches(const std::vector<std::uint64_t>& keys, std::vector<PairState>& list,
+                   const std::vector<PairState>* donor) {
+    next_pairs.resize(keys.size());
     int warm = 0;
     std::size_t old = 0;
-    for (std::size_t k = 0; k < candidates.size(); ++k) {
-      const std::uint64_t key = candidates[k];
-      while (old < pairs.size() && pairs[old].key < key) ++old;
+    std::size_t given = 0;
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+      const std::uint64_t key = keys[k];
+      while (old < list.size() && list[old].key < key) ++old;
       PairState& next = next_pairs[k];
-      if (old < pairs.size() && pairs[old].key == key) {
-        next = std::move(pairs[old]);
+      if (old < list.size() && list[old].key == key) {
+        next = std::move(list[old]);
         ++warm;
-      } else {
-        next.convex.reset();
-        next.compound.reset();
-        next.key = key;
+        continue;
       }
+      if (donor != nullptr) {
+        while (given < donor->size() && (*donor)[given].key < key) ++given;
+        if (given < donor->size() && (*donor)[given].key == key) {
+          next = (*donor)[given];
+          ++warm;
+          continue;
+        }
+      }
+      next.convex.reset();
+      next.compound.reset();
+      next.key = key;
     }
-    pairs.swap(next_pairs);
+    list.swap(next_pairs);
     return warm;
+  }
+
+  // The box of everything body b covers on its way from its pose to its end
+  // pose, grown by `pad` (plus `size_pad` times the body's size, for a
+  // tolerance relative to the bodies' sizes).
+  //
+  // Why it holds the swept volume. A point x of the body (x' = R0 x, from
+  // the reference point c0) is at p(t) = c0 + t v + E(t) x', E(t) the turn
+  // by t theta about the axis (theta <= pi). On the plane across the axis,
+  // E(t) x' runs along an arc of angle theta <= pi, which stays within the
+  // sag s = rho (1 - cos(theta / 2)) of its chord [x', E(1) x'] (rho <= |x'|
+  // its distance from the axis), with the foot of the perpendicular on the
+  // chord. So E(t) x' = x' + sigma (E(1) x' - x') + e with sigma in [0, 1],
+  // |e| <= s, and p(t) - e is a convex combination of c0 + x' (the body at
+  // its pose), c0 + v + E(1) x' (at its end pose), c0 + v + x' (the pose
+  // moved by v) and c0 + E(1) x' (the end pose moved back by v). The box of
+  // the body at those four poses is the box at each end and that box shifted
+  // by the other end's v; grown by s for the farthest point, it holds the
+  // swept volume. The union of the two end boxes alone is not enough: a bar
+  // turning a quarter turn about its middle sweeps a disc that neither end
+  // touches. s = 2 rho sin^2(theta / 4), second order in theta: a small turn
+  // barely grows the box.
+  //
+  // A compound's box is its bounding sphere's: the sphere's center moves as
+  // a point of the body, and the ball around it turns onto itself.
+  Aabb swept_box(Body& b, double pad, double size_pad) const {
+    Aabb start, end;
+    double scale = 0.0;
+    double arm = 0.0;   // bound on rho over the points (or the sphere's center) boxed
+    double size = 0.0;  // bound on the body's size in any query's default tolerance
+    const bool moving =
+        !(b.end.translation == b.pose.translation && b.end.rotation == b.pose.rotation);
+    if (b.convex) {
+      start = detail::support_box(*b.convex, b.pose, b.hints);
+      end = moving ? detail::support_box(*b.convex, b.end, b.hints) : start;
+      scale = b.convex->scale();
+      arm = b.convex->centroid().stableNorm() + b.convex->bounding_radius();
+      size = arm;
+      if (b.compound)
+        size = std::max(size, b.compound->center().stableNorm() + b.compound->bounding_radius());
+    } else {
+      const double r = b.compound->bounding_radius();
+      const auto sphere = [&](const Pose& p) {
+        const Vec3 center = p.apply(b.compound->center());
+        return Aabb{(center.array() - r).matrix(), (center.array() + r).matrix()};
+      };
+      start = sphere(b.pose);
+      end = moving ? sphere(b.end) : start;
+      scale = b.compound->scale();
+      arm = b.compound->center().stableNorm();
+      size = arm + r;
+    }
+    Aabb box = start;
+    double sag = 0.0;
+    if (moving) {
+      const Vec3 v = b.end.translation - b.pose.translation;
+      box.lo = start.lo.cwiseMin(end.lo).cwiseMin(start.lo + v).cwiseMin(end.lo - v);
+      box.hi = start.hi.cwiseMax(end.hi).cwiseMax(start.hi + v).cwiseMax(end.hi - v);
+      // The turn as time_of_impact's motion takes it (Eigen's angle in [0, pi]).
+      const double theta =
+          Eigen::AngleAxisd(Mat3(b.end.rotation * b.pose.rotation.transpose())).angle();
+      const double q = std::sin(0.25 * theta);
+      sag = 2.0 * arm * q * q;
+    }
+    const double grow = pad + size_pad * size + sag;
+    const double magnitude =
+        std::max(magnitude_bound(b.pose, scale), magnitude_bound(b.end, scale));
+    const double slack =
+        kSweptBoxSlackUlps * kUnitRoundoff * magnitude + kSweptPadSlackUlps * kUnitRoundoff * grow;
+    return inflated(box, grow + slack);
+  }
+
+  // time_of_impact of bodies a and b moving from their poses to their end
+  // poses: the convex query for two convex bodies, the Body query when
+  // either is a compound; from and into `state`'s cache when given.
+  static ImpactResult impact(const Body& a, const Body& b, const ImpactOptions& impact_options,
+                             PairState* state) {
+    const Motion ma{a.pose, a.end};
+    const Motion mb{b.pose, b.end};
+    if (a.convex && b.convex) {
+      return time_of_impact(*a.convex, ma, *b.convex, mb, impact_options,
+                            state != nullptr ? &state->convex : nullptr);
+    }
+    const proxima::Body ba(a.compound);
+    const proxima::Body bb(b.compound);
+    BodyCache cache;
+    if (state != nullptr) cache.compound = std::move(state->compound);
+    ImpactResult r = time_of_impact(ba, ma, bb, mb, impact_options, &cache);
+    if (state != nullptr) state->compound = std::move(cache.compound);
+    return r;
   }
 };
 
@@ -289,6 +423,7 @@ BodyId Scene::add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose) 
   if (!body) throw InvalidInput("Scene::add: the convex body is null");
   Impl::Body b;
   b.pose = checked_pose(pose, "Scene::add: pose of the new convex body");
+  b.end = b.pose;
   if (impl_->compound_count > 0) b.compound = Impl::wrap(body);
   b.convex = std::move(body);
   return impl_->insert(std::move(b));
@@ -306,6 +441,7 @@ BodyId Scene::add(std::shared_ptr<const CompoundBody> body, const Pose& pose) {
   Impl::Body b;
   b.compound = std::move(body);
   b.pose = checked;
+  b.end = checked;
   const BodyId id = impl_->insert(std::move(b));
   ++impl_->compound_count;
   return id;
@@ -313,9 +449,18 @@ BodyId Scene::add(std::shared_ptr<const CompoundBody> body, const Pose& pose) {
 
 void Scene::set_pose(BodyId id, const Pose& pose) {
   impl_->live_body(id, "set_pose");
-  impl_->bodies[slot(id)].pose =
-      checked_pose(pose, [&] { return "Scene::set_pose: pose of " + name(id); });
+  Impl::Body& b = impl_->bodies[slot(id)];
+  b.pose = checked_pose(pose, [&] { return "Scene::set_pose: pose of " + name(id); });
+  b.end = b.pose;
 }
+
+void Scene::set_end_pose(BodyId id, const Pose& end) {
+  impl_->live_body(id, "set_end_pose");
+  impl_->bodies[slot(id)].end =
+      checked_pose(end, [&] { return "Scene::set_end_pose: end pose of " + name(id); });
+}
+
+const Pose& Scene::end_pose(BodyId id) const { return impl_->live_body(id, "end_pose").end; }
 
 void Scene::remove(BodyId id) {
   impl_->live_body(id, "remove");
@@ -329,6 +474,10 @@ void Scene::remove(BodyId id) {
   impl_->finder->remove(id);
   impl_->free_ids.push_back(id);
   impl_->removed_since_step.push_back(id);
+  if (impl_->sweep_finder) {
+    impl_->sweep_finder->remove(id);
+    impl_->removed_since_sweep.push_back(id);
+  }
   --impl_->live_count;
 }
 
@@ -412,8 +561,9 @@ std::span<const ClosePair> Scene::step() {
                             }
                           });
   s.finder->find_pairs(s.boxes, s.candidates, threads);
-  const int filtered = s.filter_candidates();
-  const int warm = s.carry_caches();
+  const int filtered = s.filter_candidates(s.candidates);
+  s.drop_removed(s.pairs, s.removed_since_step);
+  const int warm = s.carry_caches(s.candidates, s.pairs, nullptr);
 
   const std::size_t n = s.pairs.size();
   s.results.resize(n);
@@ -479,6 +629,101 @@ std::span<const ClosePair> Scene::step() {
 }
 
 const SceneStats& Scene::stats() const { return impl_->stats; }
+
+std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
+  detail::check_impact_options(options, "Scene::sweep");
+  Impl& s = *impl_;
+  if (!s.sweep_finder) {
+    s.sweep_finder = detail::make_pair_finder(s.options.broad_phase);
+    for (std::size_t k = 0; k < s.bodies.size(); ++k) {
+      if (s.bodies[k].live) s.sweep_finder->add(static_cast<BodyId>(k));
+    }
+  }
+  const int threads = s.options.threads;
+  // Each box takes half of what the pair may close to and still count as a
+  // contact: the target, the tolerance (time_of_impact's default: relative
+  // to each body's size) and the touching tolerance Ae.
+  const double explicit_tolerance = options.tolerance;
+  const double pad =
+      0.5 * (options.target_separation + explicit_tolerance + options.distance.absolute_tolerance);
+  const double size_pad = explicit_tolerance > 0.0 ? 0.0 : kDefaultImpactTolerance;
+  s.swept_boxes.resize(s.bodies.size());
+  detail::parallel_chunks(s.bodies.size(), kBoxChunk, threads,
+                          [&](std::size_t, std::size_t begin, std::size_t end) {
+                            for (std::size_t k = begin; k < end; ++k) {
+                              if (s.bodies[k].live)
+                                s.swept_boxes[k] = s.swept_box(s.bodies[k], pad, size_pad);
+                            }
+                          });
+  s.sweep_finder->find_pairs(s.swept_boxes, s.sweep_candidates, threads);
+  const int filtered = s.filter_candidates(s.sweep_candidates);
+  s.drop_removed(s.sweep_pairs, s.removed_since_sweep);
+  s.drop_removed(s.pairs, s.removed_since_step);
+  const int warm = s.carry_caches(s.sweep_candidates, s.sweep_pairs, &s.pairs);
+
+  // The time of impact of each candidate, the pairs not separated gathered
+  // in pair order (each chunk into its own list, joined in chunk order).
+  const std::size_t n = s.sweep_pairs.size();
+  s.sweep_queries.assign(n, 0);
+  detail::parallel_gather(
+      n, kGrainSize, threads, s.impact_chunks, s.impacts,
+      [&s, &options](std::size_t begin, std::size_t end, std::vector<ImpactPair>& out) {
+        for (std::size_t k = begin; k < end; ++k) {
+          Impl::PairState& state = s.sweep_pairs[k];
+          const BodyId a = detail::pair_first(state.key);
+          const BodyId b = detail::pair_second(state.key);
+          ImpactResult r = s.impact(s.bodies[slot(a)], s.bodies[slot(b)], options, &state);
+          s.sweep_queries[k] = r.iterations;
+          if (r.status != ImpactStatus::separated) out.push_back(ImpactPair{a, b, std::move(r)});
+        }
+      });
+
+  SweepStats& stats = s.sweep_stats;
+  stats = SweepStats{};
+  stats.bodies = s.live_count;
+  for (const Impl::Body& b : s.bodies) {
+    if (b.live && !(b.end.translation == b.pose.translation && b.end.rotation == b.pose.rotation))
+      ++stats.moving_bodies;
+  }
+  stats.candidate_pairs = static_cast<int>(n);
+  stats.impact_pairs = static_cast<int>(s.impacts.size());
+  for (const int q : s.sweep_queries) stats.distance_queries += q;
+  stats.warm_pairs = warm;
+  stats.filtered_pairs = filtered;
+  return s.impacts;
+}
+
+namespace {
+ImpactOptions scene_impact_options(const SceneOptions& scene) {
+  ImpactOptions options;
+  options.distance = scene.distance;
+  return options;
+}
+}  // namespace
+
+std::span<const ImpactPair> Scene::sweep() { return sweep(scene_impact_options(impl_->options)); }
+
+std::vector<ImpactPair> Scene::impact_pairs_all_pairs() const {
+  return impact_pairs_all_pairs(scene_impact_options(impl_->options));
+}
+
+const SweepStats& Scene::sweep_stats() const { return impl_->sweep_stats; }
+
+std::vector<ImpactPair> Scene::impact_pairs_all_pairs(const ImpactOptions& options) const {
+  detail::check_impact_options(options, "Scene::impact_pairs_all_pairs");
+  const Impl& s = *impl_;
+  std::vector<ImpactPair> out;
+  const std::vector<BodyId> ids = body_ids();
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    for (std::size_t j = i + 1; j < ids.size(); ++j) {
+      if (!tests_pair(ids[i], ids[j])) continue;
+      ImpactResult r = s.impact(s.bodies[slot(ids[i])], s.bodies[slot(ids[j])], options, nullptr);
+      if (r.status != ImpactStatus::separated)
+        out.push_back(ImpactPair{ids[i], ids[j], std::move(r)});
+    }
+  }
+  return out;
+}
 
 std::optional<ClosePair> Scene::nearest_pair() {
   Impl& s = *impl_;

@@ -6,6 +6,7 @@
 #include "proxima/time_of_impact.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -25,17 +26,156 @@ bool finite(const Vec3& v) { return v.allFinite(); }
 // and 1e300 are valid.
 double reach(const ConvexPolytope& p) { return p.centroid().stableNorm() + p.bounding_radius(); }
 
-// The gap between the support planes of the two placed hulls along the unit
-// direction n (world frame): min over B of n.y minus max over A of n.x, a
-// lower bound on their distance whatever n is. Hill climbing from the
-// cache's hints (exact maximizers).
-double support_gap(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                   const Pose& pose_b, const Vec3& n, const DistanceCache& cache) {
+// How far the hull of A reaches along the unit direction n (world frame),
+// and how far B's hull starts, at the placed poses: max over A of n.x and
+// min over B of n.y, found by hill climbing from the cache's hints (exact
+// maximizers). B's minus A's is the gap between the support planes, a lower
+// bound on the distance whatever n is.
+struct SupportPlanes {
+  double top_a = 0.0;
+  double bottom_b = 0.0;
+  int vertex_a = 0;  // the support vertices
+  int vertex_b = 0;
+  Vec3 direction_a = Vec3::Zero();  // n seen from each body
+  Vec3 direction_b = Vec3::Zero();
+};
+
+SupportPlanes support_planes(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                             const Pose& pose_b, const Vec3& n, const DistanceCache& cache) {
   const Vec3 na = pose_a.rotation.transpose() * n;
   const Vec3 nb = pose_b.rotation.transpose() * n;
   const int ia = support_hill_climb(a, na, cache.hint_a);
   const int ib = support_hill_climb(b, -nb, cache.hint_b);
-  return n.dot(pose_b.apply(b.vertex(ib))) - n.dot(pose_a.apply(a.vertex(ia)));
+  return {n.dot(pose_a.apply(a.vertex(ia))), n.dot(pose_b.apply(b.vertex(ib))), ia, ib, na, nb};
+}
+
+// A bound on how a body's support plane along a fixed unit n moves while
+// the body turns by w about its reference point, good for a time span:
+// from `value`, at `rate` (per unit t, towards +n) at first, with a
+// magnitude of acceleration at most `acceleration`, for `span`.
+//
+// Why. Take a set S of vertices that holds the support vertex along
+// +sign n (the witness feature: a vertex, an edge, a face's vertices, and
+// the support vertex found by hill climbing); the support plane is S's
+// highest vertex as long as that is a local maximum of the hull's vertex
+// graph (the hull being convex, then a global one). A vertex q of S, r = R q
+// its offset from the reference point, moves along n at exactly
+// sign n.(v + w x r) now, and its rotation part accelerates by at most
+// |w|^2 |r| (the centripetal term; the translation is linear): the highest
+// of S rises at most at the largest rate with the largest acceleration.
+// It stays the highest vertex while no neighbour y outside S overtakes any
+// q of S: the direction seen from the body moves by at most |w x n| per
+// unit t, and y stays below q while that is less than margin_y = sign n.(q
+// - y) / |q - y| (world frame). So the bound holds for the smallest margin
+// over |w x n| (none when a margin is negative: S does not hold the
+// support). A contact at a vertex then closes at second order in the turn
+// (the vertex's rate along the normal is about 0), a face-on contact at the
+// true rates of the face's corners, where the bound |w x n| reach charged
+// both first order at the full reach.
+struct PlaneBound {
+  double value = 0.0;
+  double rate = 0.0;
+  double acceleration = 0.0;
+  double span = 0.0;
+};
+
+// Cone margins a hair inside the computed ones, for their rounding.
+constexpr double kConeMarginShrink = 1.0 - 1e-9;
+
+// The largest face taken whole into S (bigger faces: S is the witness
+// feature's vertices and the support vertex only). The margin loop costs
+// |S| times the degree times |S|.
+constexpr std::size_t kMaxFeatureVertices = 16;
+
+// |x| from its square where that neither overflows nor underflows (the
+// common case, one sqrt), else the stable norm.
+double fast_norm(const Vec3& x) {
+  const double squared = x.squaredNorm();
+  if (squared >= std::numeric_limits<double>::min() && squared < 0x1p1000)
+    return std::sqrt(squared);
+  return x.stableNorm();
+}
+
+// S: the witness feature's vertices (a face's whole polygon when it is
+// small) and the support vertex, without repeats.
+struct VertexSet {
+  std::array<std::int32_t, kMaxFeatureVertices + 4> ids{};
+  std::size_t size = 0;
+  void add(std::int32_t v) {
+    if (v < 0 || std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
+                     ids.begin() + static_cast<std::ptrdiff_t>(size))
+      return;
+    ids[size++] = v;
+  }
+  bool has(std::int32_t v) const {
+    return std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
+           ids.begin() + static_cast<std::ptrdiff_t>(size);
+  }
+};
+
+VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int support) {
+  VertexSet set;
+  if (feature.type == FeatureType::face && feature.face >= 0 && feature.face < body.face_count() &&
+      body.face(feature.face).size() <= kMaxFeatureVertices) {
+    for (const std::int32_t v : body.face(feature.face)) set.add(v);
+  } else {
+    for (const std::int32_t v : feature.vertices) {
+      if (v < body.vertex_count()) set.add(v);
+    }
+  }
+  set.add(support);
+  return set;
+}
+
+// `direction` is n seen from the body (pose.rotation^T n), `turn` |w x n|.
+PlaneBound feature_plane(const ConvexPolytope& body, const Pose& pose, const VertexSet& set,
+                         const Vec3& n, const Vec3& direction, double sign, const Vec3& v,
+                         const Vec3& w, double turn) {
+  PlaneBound out;
+  out.value = -std::numeric_limits<double>::infinity();
+  out.rate = -std::numeric_limits<double>::infinity();
+  double arm = 0.0;
+  for (std::size_t k = 0; k < set.size; ++k) {
+    const Vec3 r = pose.rotation * body.vertex(set.ids[k]);
+    out.value = std::max(out.value, sign * n.dot(pose.translation + r));
+    out.rate = std::max(out.rate, sign * n.dot(v + w.cross(r)));
+    arm = std::max(arm, fast_norm(r));
+  }
+  out.acceleration = w.squaredNorm() * arm;
+  if (!(turn > 0.0)) {
+    out.span = std::numeric_limits<double>::infinity();
+    return out;
+  }
+  double margin = 1.0;
+  for (std::size_t k = 0; k < set.size; ++k) {
+    const Vec3& q = body.vertex(set.ids[k]);
+    for (const std::int32_t y : body.neighbors(set.ids[k])) {
+      if (set.has(y)) continue;
+      const Vec3 edge = q - body.vertex(y);
+      const double length = fast_norm(edge);
+      const double rise = sign * direction.dot(edge);
+      if (length > 0.0 && rise < margin * length) margin = rise / length;
+    }
+  }
+  margin = std::max(0.0, margin * kConeMarginShrink);
+  out.span = margin / turn;
+  return out;
+}
+
+// The first time in [0, span] at which a gap gap0 closing at `rate` with
+// acceleration at most `acceleration` can reach 0 (gap0 > 0): the smaller
+// root of gap0 - rate t - acceleration t^2 / 2, capped at span; infinity
+// when it never closes and span is unbounded.
+double first_closing(double gap0, double rate, double acceleration, double span) {
+  double t = std::numeric_limits<double>::infinity();
+  if (acceleration > 0.0) {
+    // Written without cancellation: 2 gap0 / (rate + sqrt(rate^2 + 2 a gap0)).
+    const double root = std::sqrt(rate * rate + 2.0 * acceleration * gap0);
+    t = rate + root > 0.0 ? 2.0 * gap0 / (rate + root) : std::numeric_limits<double>::infinity();
+  } else if (rate > 0.0) {
+    t = gap0 / rate;
+  }
+  return std::min(t, span);
 }
 
 // A motion with its turn precomputed (Motion::at converts the rotation to
@@ -66,20 +206,6 @@ class Sweep {
   Vec3 axis_ = Vec3::UnitX();
 };
 
-void check_options(const ImpactOptions& options) {
-  const double target = options.target_separation;
-  if (!std::isfinite(target) || target < 0.0) {
-    throw InvalidInput("time_of_impact: options.target_separation must be finite and >= 0, not " +
-                       std::to_string(target));
-  }
-  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
-    throw InvalidInput("time_of_impact: options.tolerance must be finite and >= 0 (0: default)");
-  }
-  if (options.max_iterations < 1) {
-    throw InvalidInput("time_of_impact: options.max_iterations must be at least 1");
-  }
-}
-
 // Bound on the distance of any point of the body (its rounded surface
 // included) from its reference point.
 double body_reach(const Body& body) {
@@ -94,6 +220,26 @@ double body_size(const Body& body) {
 }
 
 }  // namespace
+
+namespace detail {
+
+void check_impact_options(const ImpactOptions& options, const char* who) {
+  const double target = options.target_separation;
+  if (!std::isfinite(target) || target < 0.0) {
+    throw InvalidInput(std::string(who) +
+                       ": options.target_separation must be finite and >= 0, not " +
+                       std::to_string(target));
+  }
+  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
+    throw InvalidInput(std::string(who) +
+                       ": options.tolerance must be finite and >= 0 (0: default)");
+  }
+  if (options.max_iterations < 1) {
+    throw InvalidInput(std::string(who) + ": options.max_iterations must be at least 1");
+  }
+}
+
+}  // namespace detail
 
 Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& angular,
                              double duration) {
@@ -202,7 +348,7 @@ SafeStep lower_bound_step(double lower, double target, double speed) {
 ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
                             const ImpactOptions& options, DistanceCache* cache) {
-  check_options(options);
+  detail::check_impact_options(options, "time_of_impact");
   const double target = options.target_separation;
   const Sweep ma =
       checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
@@ -224,22 +370,60 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   const auto query = [&](const Pose& pa, const Pose& pb) {
     return distance(a, pa, b, pb, options.distance, &c);
   };
-  // Two safe steps; the longer is taken. Along the normal: the support gap
-  // closes no faster than mu_n. In any direction: the certified lower bound
-  // closes no faster than any_speed. Both keep off the contact band of the
-  // accuracy standard at these poses (the rounding of the query's
-  // coordinates).
+  // Safe steps; the longest is taken. Along the normal n: the gap between
+  // a plane that bounds A from above along n and one that bounds B from
+  // below, each moving no faster than a bound (PlaneBound), so that the gap
+  // is a certified lower bound on the distance until it closes to the
+  // target. Three such planes per body: its hull's support plane, which
+  // moves along n no faster than the body's speed along n plus the turn's
+  // |w x n| times the reach (a point r from the reference point moves along
+  // n at (w x r).n = (r x n).w, at most |w x n| |r|: a spin about the
+  // normal does not approach); the support plane of its bounding ball (the
+  // hull stays inside the ball as it turns), whose lever is only the
+  // distance of the ball's center from the reference point: a round body
+  // turning about its middle approaches at its linear speed only, so far
+  // from contact the ball's planes give the longer step; and the support
+  // feature's own plane (feature_plane: the true rates of its vertices
+  // while they hold the support), which gives the longer step near a
+  // contact. In any direction: the certified lower bound closes no
+  // faster than any_speed. All keep off the contact band of the accuracy
+  // standard at these poses (the rounding of the query's coordinates).
+  const double lever_a = a.centroid().stableNorm();
+  const double lever_b = b.centroid().stableNorm();
   const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
     const double band =
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
     const Vec3& n = r.normal;
-    const double gap = support_gap(a, pa, b, pb, n, c) - band;
-    // A point r from a reference point moves along n at (w x r).n =
-    // (r x n).w, at most |w x n| |r|: a spin about the normal does not
-    // approach.
-    const double mu_n =
-        (va - vb).dot(n) + wa.cross(n).norm() * reach_a + wb.cross(n).norm() * reach_b;
-    const SafeStep along = lower_bound_step(gap, target, mu_n);
+    const SupportPlanes hull = support_planes(a, pa, b, pb, n, c);
+    const double turn_a = fast_norm(wa.cross(n));
+    const double turn_b = fast_norm(wb.cross(n));
+    const double inf = std::numeric_limits<double>::infinity();
+    // A's top along n, and B's bottom as -(min along n): both rising at
+    // `rate` at most bring them closer.
+    const PlaneBound top_a[3] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
+                                 {n.dot(pa.apply(a.centroid())) + a.bounding_radius(),
+                                  va.dot(n) + turn_a * lever_a, 0.0, inf},
+                                 feature_plane(a, pa, feature_set(a, r.feature_a, hull.vertex_a), n,
+                                               hull.direction_a, 1.0, va, wa, turn_a)};
+    const PlaneBound bottom_b[3] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
+                                    {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()),
+                                     -vb.dot(n) + turn_b * lever_b, 0.0, inf},
+                                    feature_plane(b, pb, feature_set(b, r.feature_b, hull.vertex_b),
+                                                  n, hull.direction_b, -1.0, vb, wb, turn_b)};
+    SafeStep along;
+    for (const PlaneBound& x : top_a) {
+      for (const PlaneBound& y : bottom_b) {
+        const double gap = -y.value - x.value - band - target;
+        if (!(gap > 0.0)) continue;
+        const double step = first_closing(gap, x.rate + y.rate, x.acceleration + y.acceleration,
+                                          std::min(x.span, y.span));
+        if (step == inf) {
+          along.never = true;
+        } else {
+          along.step = std::max(along.step, step);
+        }
+      }
+    }
     const SafeStep any = lower_bound_step(r.lower_bound - band, target, any_speed);
     return SafeStep{std::max(along.step, any.step), along.never || any.never};
   };
@@ -249,7 +433,7 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
                             const Motion& motion_b, const ImpactOptions& options,
                             BodyCache* cache) {
-  check_options(options);
+  detail::check_impact_options(options, "time_of_impact");
   BodyCache local;
   BodyCache& c = cache != nullptr ? *cache : local;
   const double ra = a.radius();

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <random>
@@ -188,6 +189,86 @@ TEST(TimeOfImpact, RandomMotionsNeverReportContactLate) {
     check_against_sampling(a, ma, b, mb, options, r, 1000);
   }
   EXPECT_GT(contacts, 20);  // the motions cross: most trials meet
+}
+
+// An octahedron 10 above its reference point swings down about it (a
+// quarter turn about z) onto a slab: its lowest vertex starts moving
+// sideways, with no speed along the normal at all, and comes down only by
+// its centripetal acceleration, 9.5 cos(theta): it meets the slab's top
+// (0.5) at theta = acos(8.5 / 9.5), t* = theta / (pi / 2) = 0.2952. A bound
+// on that vertex's plane without the acceleration term would step over the
+// contact in one go (the vertex stays lowest until the turn reaches its
+// normal cone's wall, past t*).
+TEST(TimeOfImpact, AVertexSwingingDownAboutAFarPivotIsCaughtAtSecondOrder) {
+  const ConvexPolytope slab(box(Vec3(5, 0.5, 5)));
+  const ConvexPolytope octahedron({Vec3(0, 9.5, 0), Vec3(0, 10.5, 0), Vec3(0.5, 10, 0),
+                                   Vec3(-0.5, 10, 0), Vec3(0, 10, 0.5), Vec3(0, 10, -0.5)});
+  const Motion still = Motion::fixed(Pose::identity());
+  const Motion swing = Motion::from_velocity(Pose::from_translation(Vec3(0, -8, 0)), Vec3::Zero(),
+                                             Vec3(0, 0, M_PI / 2));
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult r = time_of_impact(slab, still, octahedron, swing, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  const double t_star = std::acos(8.5 / 9.5) / (M_PI / 2);
+  EXPECT_LE(r.t, t_star + 1e-12);
+  EXPECT_GE(r.t, t_star - 1e-6);
+  EXPECT_GE(distance(slab, r.pose_a, octahedron, r.pose_b).signed_distance(), -1e-12);
+  check_against_sampling(slab, still, octahedron, swing, options, r, 2000);
+}
+
+// Fast turns, slow approach, hulls of few vertices (wide normal cones: the
+// witness feature's own plane bounds long steps, src/time_of_impact.cpp
+// feature_plane), some off their reference point: a step that overshot
+// would leave the bodies overlapping at the reported t (the signed
+// distance below the target) or skip a sampled contact.
+TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {
+  std::mt19937 rng(1313);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int contacts = 0, capped = 0;
+  long steps = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    const auto hull = [&](int n, double radius, double off) {
+      std::vector<Vec3> pts;
+      const Vec3 shift = off * Vec3(g(rng), g(rng), g(rng)).normalized();
+      for (int i = 0; i < n; ++i) {
+        pts.push_back(radius * Vec3(g(rng), g(rng), g(rng)).normalized() + shift);
+      }
+      return ConvexPolytope(pts);
+    };
+    const ConvexPolytope a = hull(4 + trial % 7, 0.5 + u(rng), trial % 3 == 0 ? u(rng) : 0.0);
+    const ConvexPolytope b = hull(4 + trial % 5, 0.3 + u(rng), trial % 4 == 0 ? u(rng) : 0.0);
+    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
+    const Pose a0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3::Zero());
+    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), (2.5 + u(rng)) * dir);
+    const Motion ma =
+        Motion::from_velocity(a0, 0.3 * Vec3(g(rng), g(rng), g(rng)),
+                              M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+    const Motion mb = Motion::from_velocity(
+        b0, -(1.0 + 2.0 * u(rng)) * dir, M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+    ImpactOptions options;
+    options.target_separation = trial % 5 == 0 ? 0.1 * u(rng) : 0.0;
+    options.tolerance = 1e-9;
+    const ImpactResult r = time_of_impact(a, ma, b, mb, options);
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    if (r.status == ImpactStatus::overlapping) continue;
+    // A near miss while turning fast can stall the advancement (steps
+    // shrink with the gap, which stays): the cap, with t still safe.
+    capped += r.status == ImpactStatus::iteration_cap ? 1 : 0;
+    if (r.status == ImpactStatus::contact) {
+      ++contacts;
+      steps += r.iterations;
+      const DistanceResult at = distance(a, r.pose_a, b, r.pose_b);
+      EXPECT_GE(at.signed_distance(), options.target_separation - 1e-9);
+      EXPECT_LE(at.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+    }
+    check_against_sampling(a, ma, b, mb, options, r, 2000);
+  }
+  EXPECT_GT(contacts, 60);
+  EXPECT_LE(capped, 2);
+  std::printf("%d contacts, %.2f steps each, %d capped\n", contacts,
+              static_cast<double>(steps) / contacts, capped);
 }
 
 TEST(TimeOfImpact, TheCacheTracksAlongTheSteps) {

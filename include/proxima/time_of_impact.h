@@ -25,11 +25,17 @@
 // query. At time t the query's normal n (unit, A towards B) and the support
 // planes of the two hulls along n bound the distance from below by their
 // gap s; no point of B approaches A's plane along n faster than
-//   mu = (v_a - v_b).n + |w_a| rho_a + |w_b| rho_b,
+//   mu = (v_a - v_b).n + |w_a x n| rho_a + |w_b x n| rho_b,
 // rho being the farthest hull vertex from the body's reference point, so
 // the distance stays above the target until t + (s - target) / mu, and the
-// time advances there. The cache carried from step to step makes each
-// step a tracked query (a few hundred nanoseconds).
+// time advances there. Two more planes per body bound longer steps where
+// they can (src/time_of_impact.cpp says why each is safe): its bounding
+// ball's, whose lever under the turn is the ball center's distance from
+// the reference point, and its witness feature's own, which moves at the
+// true rates of the feature's vertices while they hold the support (at
+// second order in the turn for a vertex). The cache
+// carried from step to step makes each step a tracked query (a few
+// hundred nanoseconds).
 //
 // Thread safety: as distance(); the cache belongs to one pair.
 #pragma once
@@ -136,5 +142,12 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
                             const Motion& motion_b, const ImpactOptions& options = {},
                             BodyCache* cache = nullptr);
+
+namespace detail {
+// The checks of `options` that time_of_impact makes (InvalidInput naming
+// `who` and the field), for callers that validate once before many calls
+// (Scene::sweep).
+void check_impact_options(const ImpactOptions& options, const char* who);
+}  // namespace detail
 
 }  // namespace proxima

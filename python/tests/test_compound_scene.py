@@ -327,3 +327,63 @@ def test_compound_and_scene_results_carry_the_signed_distance():
     scene.add(hull, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
     pairs = scene.step()
     assert len(pairs) == 1 and abs(pairs[0].result.signed_distance + 0.25) <= 1e-15
+
+
+# --- Scene.sweep (continuous collision) ------------------------------------------
+
+
+def box(hx, hy, hz):
+    return proxima.ConvexPolytope(
+        np.array([[x, y, z] for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)]))
+
+
+def test_scene_sweep_catches_the_cube_that_tunnels_through_a_plate():
+    scene = proxima.Scene()
+    T = proxima.Pose.from_translation
+    plate = scene.add(box(2, 2, 0.01), T((0, 0, 0)))
+    cube = scene.add(box(0.05, 0.05, 0.05), T((0.3, -0.2, 1.0)))
+    scene.set_end_pose(cube, T((0.3, -0.2, -1.0)))
+    np.testing.assert_allclose(scene.end_pose(cube).translation, [0.3, -0.2, -1.0])
+    assert scene.step() == []
+    hits = scene.sweep()
+    assert len(hits) == 1
+    hit = hits[0]
+    assert isinstance(hit, proxima.ImpactPair)
+    assert (hit.a, hit.b) == (plate, cube)
+    assert hit.result.status == "contact"
+    assert 0.47 - 1e-5 <= hit.result.t <= 0.47
+    assert "contact" in repr(hit)
+    stats = scene.sweep_stats
+    assert (stats.bodies, stats.moving_bodies, stats.candidate_pairs, stats.impact_pairs) == (2, 1, 1, 1)
+    assert stats.distance_queries == hit.result.iterations
+    twin = scene.impact_pairs_all_pairs()
+    assert [(p.a, p.b, p.result.t) for p in twin] == [(plate, cube, hit.result.t)]
+    # A contact offset: met earlier.
+    early = scene.sweep(target_separation=0.2)
+    assert early[0].result.t < hit.result.t
+    # set_pose ends the motion.
+    scene.set_pose(cube, T((0.3, -0.2, -1.0)))
+    assert scene.sweep() == []
+
+
+def test_scene_set_end_poses_is_all_or_nothing_and_errors_are_named():
+    rng = np.random.default_rng(3)
+    scene = proxima.Scene()
+    ids = [scene.add(proxima.ConvexPolytope(rng.normal(size=(12, 3))), np.eye(4)) for _ in range(3)]
+    poses = np.tile(np.eye(4), (3, 1, 1))
+    poses[:, 0, 3] = [1.0, 2.0, 3.0]
+    scene.set_end_poses(np.array(ids), poses)
+    np.testing.assert_allclose([scene.end_pose(i).translation[0] for i in ids], [1.0, 2.0, 3.0])
+    bad = poses.copy()
+    bad[2, 0, 3] = np.nan
+    with pytest.raises(proxima.InvalidInput, match=r"poses\[2\] is not finite"):
+        scene.set_end_poses(np.array(ids), bad)
+    np.testing.assert_allclose([scene.end_pose(i).translation[0] for i in ids], [1.0, 2.0, 3.0])
+    with pytest.raises(proxima.InvalidInput, match=r"set_end_poses: ids\[1\] = 9"):
+        scene.set_end_poses(np.array([0, 9]), poses[:2])
+    with pytest.raises(proxima.InvalidInput, match="body 9"):
+        scene.set_end_pose(9, np.eye(4))
+    with pytest.raises(proxima.InvalidInput, match="Scene::sweep: options.tolerance"):
+        scene.sweep(tolerance=-1.0)
+    with pytest.raises(proxima.InvalidInput, match="max_iterations"):
+        scene.sweep(max_iterations=0)
