@@ -29,7 +29,11 @@
 //                    (what Bullet's convex-convex collision uses), margin 0;
 //   Bullet SD        btGjkEpaSolver2::SignedDistance (GJK, then EPA), margin 0.
 // FCL's GST_INDEP is not run: with enable_signed_distance FCL 0.7 aborts on
-// an internal assert for Convex pairs. None of the peers tracks a
+// an internal assert for overlapping Convex pairs (checked on two unit cubes
+// as fcl::Convexd, B shifted by (0.75, 0.1, 0.2): "distance-inl.h:177 ...
+// Assertion `index != static_cast<std::size_t>(-1)' failed", also with
+// NDEBUG: the assert is compiled into libfcl; its fallback collide() finds
+// no contact for the pair). None of the peers tracks a
 // penetration query from one call to the next (FCL's libccd solver takes no
 // guess; Bullet resets its cached axis on every call), so their one mode is
 // compared with both of proxima's.
