@@ -324,10 +324,7 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
     std::optional<Motion> motion_b;
     read_body(query, "a", order, work.vertices_a, work.triangles_a, pose_a, radius_a, motion_a);
     read_body(query, "b", order, work.vertices_b, work.triangles_b, pose_b, radius_b, motion_b);
-    if (!work.triangles_a.empty() || !work.triangles_b.empty()) {
-      if (motion_a || motion_b) {
-        fail("a time-of-impact query takes convex bodies (\"vertices\" without \"triangles\")");
-      }
+    if ((!work.triangles_a.empty() || !work.triangles_b.empty()) && !motion_a && !motion_b) {
       // A mesh on either side: the one call for any two bodies.
       const BodyDistance m = distance(
           query_body(work.vertices_a, work.triangles_a, radius_a, "a"), pose_a,
@@ -335,8 +332,6 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
       mesh_answer = m;
       r = m;
     } else {
-      const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
-      const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
       if (motion_a || motion_b) {
         // A time-of-impact query: its own answer line.
         ImpactOptions impact;
@@ -344,8 +339,10 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
         impact.target_separation = read_nonnegative(query, "target_separation", 0.0);
         impact.tolerance = read_nonnegative(query, "tolerance", 0.0);
         const ImpactResult hit =
-            time_of_impact(Body(a, radius_a), motion_a.value_or(Motion::fixed(pose_a)),
-                           Body(b, radius_b), motion_b.value_or(Motion::fixed(pose_b)), impact);
+            time_of_impact(query_body(work.vertices_a, work.triangles_a, radius_a, "a"),
+                           motion_a.value_or(Motion::fixed(pose_a)),
+                           query_body(work.vertices_b, work.triangles_b, radius_b, "b"),
+                           motion_b.value_or(Motion::fixed(pose_b)), impact);
         const DistanceResult& at = hit.at_t;
         if (!std::isfinite(at.distance) || !std::isfinite(at.signed_distance()) ||
             !at.point_a.allFinite() || !at.point_b.allFinite()) {
@@ -376,6 +373,8 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
         out += '}';
         return true;
       }
+      const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
+      const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
       if (radius_a > 0.0 || radius_b > 0.0) {
         // Rounded bodies: the cores' answer offset by the radii, points on
         // the rounded surfaces.

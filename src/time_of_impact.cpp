@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "proxima/compound.h"
 #include "proxima/support.h"
@@ -208,15 +209,39 @@ class Sweep {
 
 // Bound on the distance of any point of the body (its rounded surface
 // included) from its reference point.
+// A mesh's root box (its frame): center and half diagonal.
+std::pair<Vec3, double> mesh_ball(const TriangleMesh& mesh) {
+  Vec3 lo, hi;
+  mesh.box(0, lo, hi);
+  return {0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()};
+}
+
 double body_reach(const Body& body) {
-  if (body.kind() == Body::Kind::convex) return reach(*body.convex()) + body.radius();
-  const CompoundBody& c = *body.compound();
-  return c.center().stableNorm() + c.bounding_radius() + body.radius();
+  switch (body.kind()) {
+    case Body::Kind::convex:
+      return reach(*body.convex()) + body.radius();
+    case Body::Kind::compound: {
+      const CompoundBody& c = *body.compound();
+      return c.center().stableNorm() + c.bounding_radius() + body.radius();
+    }
+    case Body::Kind::mesh: {
+      const auto [center, radius] = mesh_ball(*body.mesh());
+      return center.stableNorm() + radius + body.radius();
+    }
+  }
+  return 0.0;
 }
 
 double body_size(const Body& body) {
-  if (body.kind() == Body::Kind::convex) return body.convex()->bounding_radius() + body.radius();
-  return body.compound()->bounding_radius() + body.radius();
+  switch (body.kind()) {
+    case Body::Kind::convex:
+      return body.convex()->bounding_radius() + body.radius();
+    case Body::Kind::compound:
+      return body.compound()->bounding_radius() + body.radius();
+    case Body::Kind::mesh:
+      return mesh_ball(*body.mesh()).second + body.radius();
+  }
+  return 0.0;
 }
 
 }  // namespace
@@ -450,8 +475,9 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
     return r;
   }
 
-  // A compound on either side: advancement by the certified lower bound of
-  // the Bodies' signed distance over the fastest point speed.
+  // A compound or a mesh on either side: advancement by the certified lower
+  // bound of the Bodies' signed distance over the fastest point speed (an
+  // overlap with a mesh has lower bound -infinity: contact at once).
   const Sweep ma =
       checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
   const Sweep mb =

@@ -7,6 +7,7 @@
 // sample before t is in contact, and at t the distance is within the
 // tolerance of the target.
 #include "proxima/time_of_impact.h"
+#include "proxima/mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -483,6 +484,49 @@ TEST(TimeOfImpact, RoundedAndCompoundBodies) {
   sampled(pair, still, cube, through, comp);
   const ImpactResult flipped = time_of_impact(cube, through, pair, still, options);
   EXPECT_NEAR(flipped.t, comp.t, 1e-6);
+}
+
+// Issue 13 with issue 12's meshes: a triangle mesh moving into a box and a
+// closed mesh sweeping over a ball. Before mesh bodies were handled here a
+// mesh Body was read as a compound (a null one): a crash.
+TEST(TimeOfImpact, MeshBodies) {
+  // The cube [-0.5, 0.5]^3 as 12 triangles (closed), and the same cube as a
+  // polytope: the two must hit at the same time.
+  const std::vector<Vec3> corners = box(Vec3(0.5, 0.5, 0.5));
+  std::vector<TriangleMesh::Triangle> faces;
+  const ConvexPolytope hull(corners);
+  for (int f = 0; f < hull.face_count(); ++f) {
+    const auto face = hull.face(f);
+    for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+      const auto v = [&](std::size_t i) {
+        return static_cast<std::uint32_t>(hull.input_index()[static_cast<std::size_t>(face[i])]);
+      };
+      faces.push_back({v(0), v(k), v(k + 1)});
+    }
+  }
+  const Body mesh(std::make_shared<const TriangleMesh>(corners, faces));
+  ASSERT_TRUE(mesh.mesh()->is_closed());
+  const Body convex(hull);
+  const Body ball = make_sphere(0.2);
+  const Motion still = Motion::fixed(Pose::identity());
+  const Motion spin_in{Pose::from_translation(Vec3(4, 0.1, 0)),
+                       Pose(Quat(Eigen::AngleAxisd(1.0, Vec3(0, 0, 1))), Vec3(-2, 0.1, 0))};
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult want = time_of_impact(convex, spin_in, ball, still, options);
+  const ImpactResult got = time_of_impact(mesh, spin_in, ball, still, options);
+  ASSERT_EQ(want.status, ImpactStatus::contact);
+  ASSERT_EQ(got.status, ImpactStatus::contact);
+  // Both never pass the true time, and both stop within the tolerance of
+  // contact: they agree to the distance covered at the fastest speed.
+  EXPECT_NEAR(got.t, want.t, 1e-6);
+  EXPECT_LE(got.at_t.distance, 1e-8);
+  // Mesh against mesh, and a mesh that starts around the ball (inside a
+  // closed mesh: overlapping at t = 0).
+  const ImpactResult both = time_of_impact(mesh, spin_in, mesh, still, options);
+  EXPECT_EQ(both.status, ImpactStatus::contact);
+  const ImpactResult around = time_of_impact(mesh, still, ball, still, options);
+  EXPECT_EQ(around.status, ImpactStatus::overlapping);
 }
 
 TEST(TimeOfImpact, BadInputIsRefusedByName) {
