@@ -116,9 +116,10 @@ void bind_view(py::module_& m) {
           const std::string name = "bodies[" + std::to_string(i) + "]";
           shown.push_back({"body " + std::to_string(i), to_body(bodies[i], name.c_str()),
                            to_pose(poses[i], "poses[" + std::to_string(i) + "]")});
-          if (shown.back().body.radius() != 0.0)
+          if (shown.back().body.radius() != 0.0 || shown.back().body.kind() == Body::Kind::mesh)
             throw InvalidInput(name +
-                               ": a Scene takes no radius (a ConvexPolytope or a CompoundBody)");
+                               ": the scene view takes a ConvexPolytope or a CompoundBody (no "
+                               "radius, no mesh)");
         }
         std::string page;
         {
