@@ -4,7 +4,8 @@
 #
 # The viewer in a real browser (issue 15, "Look"): `proxima view` writes its
 # pages (a convex pair from a query line, an intersecting pair from a query
-# and its answer line, two compound bodies from OBJ files, one scene step),
+# and its answer line, two compound bodies from OBJ files, two triangle
+# meshes, one scene step),
 # headless Chromium opens each from a file with the network off, and the test
 # checks that the page rendered:
 #   - the page says so (<body data-rendered="yes">, set after the first
@@ -245,7 +246,33 @@ def main():
     assert abs(data["pair"]["distance"] - expected) <= 1e-12, (data["pair"]["distance"], expected)
     pages.append(("compound", w("compound.html"), data["pair"]["distance"]))
 
-    # 4. One scene step: a 4 x 4 grid of turned cubes, some close.
+    # 4. Two triangle meshes (--as mesh): an L-shaped prism (non-convex,
+    # closed, 20 triangles) and a small cube mesh in its notch, 0.3 from both
+    # inner walls (x = 1 and y = 1) while inside the L's hull.
+    outline = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+    l_faces = [(1, 3, 2), (1, 4, 3), (1, 6, 4), (4, 6, 5), (7, 8, 9), (7, 9, 10), (7, 10, 12),
+               (10, 11, 12)]
+    for i in range(6):
+        j = (i + 1) % 6
+        l_faces += [(i + 1, j + 1, j + 7), (i + 1, j + 7, i + 7)]
+    with open(w("l.obj"), "w") as f:
+        f.writelines(f"v {x} {y} {z}\n" for z in (0, 1) for x, y in outline)
+        f.writelines(f"f {a} {b} {c}\n" for a, b, c in l_faces)
+    cube = box_points([-0.2, -0.2, -0.2], [0.2, 0.2, 0.2])  # corner i: bits (x, y, z) = (i>>2, i>>1, i) & 1
+    cube_faces = [(1, 2, 4), (1, 4, 3), (5, 7, 8), (5, 8, 6), (1, 5, 6), (1, 6, 2), (3, 4, 8),
+                  (3, 8, 7), (1, 3, 7), (1, 7, 5), (2, 6, 8), (2, 8, 4)]
+    with open(w("cube.obj"), "w") as f:
+        f.writelines("v %r %r %r\n" % tuple(p) for p in cube)
+        f.writelines(f"f {a} {b} {c}\n" for a, b, c in cube_faces)
+    run([proxima, "view", w("l.obj"), w("cube.obj"), "--as", "mesh", "--pose-b", "1.5", "1.5", "0.5",
+         "1", "0", "0", "0", "--out", w("mesh.html")])
+    data = page_data(w("mesh.html"))
+    assert [len(b["pieces"][0]["triangles"]) // 3 for b in data["bodies"]] == [20, 12], "the meshes lost triangles"
+    assert data["pair"]["status"] == "separated", data["pair"]
+    assert abs(data["pair"]["distance"] - 0.3) <= 1e-12, data["pair"]["distance"]
+    pages.append(("mesh", w("mesh.html"), data["pair"]["distance"]))
+
+    # 5. One scene step: a 4 x 4 grid of turned cubes, some close.
     with open(w("scene.jsonl"), "w") as f:
         for i in range(16):
             x, y = i % 4, i // 4
@@ -319,7 +346,7 @@ def main():
     if failures:
         sys.exit("FAILED:\n" + "\n".join(failures))
     if opt.screenshots:
-        for name in ("pair", "compound", "scene"):
+        for name in ("pair", "compound", "mesh", "scene"):
             shutil.copy(shots[name], os.path.join(opt.screenshots, f"viewer-{name}.png"))
     print("viewer pages rendered in Chromium")
     return 0
