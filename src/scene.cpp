@@ -564,15 +564,13 @@ BodyId Scene::add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose) 
 
 BodyId Scene::add(const proxima::Body& body, const Pose& pose, double padding) {
   checked_padding(padding, "Scene::add");
-  switch (body.kind()) {
-    case proxima::Body::Kind::convex:
-      if (body.radius() == 0.0 && padding == 0.0) return add(body.convex(), pose);
-      break;
-    case proxima::Body::Kind::compound:
-      if (body.radius() == 0.0 && padding == 0.0) return add(body.compound(), pose);
-      break;
-    case proxima::Body::Kind::mesh:
-      break;
+  if (body.kind() != proxima::Body::Kind::mesh && body.radius() == 0.0 && padding == 0.0) {
+    // A plain body: the adds above, keeping the Body as given (its
+    // approximation error, for body()).
+    const BodyId id = body.kind() == proxima::Body::Kind::convex ? add(body.convex(), pose)
+                                                                 : add(body.compound(), pose);
+    impl_->bodies[slot(id)].shape = std::make_unique<Impl::Shape>(Impl::Shape{body, body});
+    return id;
   }
   Impl::Body b;
   b.pose = checked_pose(pose, "Scene::add: pose of the new body");

@@ -542,5 +542,22 @@ TEST(SceneBodies, BadPaddingIsRefusedByName) {
   EXPECT_THROW(scene.body(7), InvalidInput);
 }
 
+// body(id) is the Body as given, even for a plain one (radius and padding
+// 0), which takes the convex fast path: a cylinder keeps its approximation
+// error.
+TEST(SceneBodies, BodyIsTheBodyAsGiven) {
+  Scene scene;
+  const Body cylinder = make_cylinder(0.5, 1.0, 1e-3);
+  ASSERT_GT(cylinder.approximation_error(), 0.0);
+  const BodyId plain = scene.add(cylinder, Pose::identity());
+  const BodyId padded = scene.add(cylinder, Pose{Mat3::Identity(), Vec3(5, 0, 0)}, 0.25);
+  for (const BodyId id : {plain, padded}) {
+    EXPECT_EQ(scene.body(id).approximation_error(), cylinder.approximation_error());
+    EXPECT_EQ(scene.body(id).radius(), 0.0);
+    EXPECT_EQ(scene.body(id).convex(), cylinder.convex());
+  }
+  EXPECT_EQ(scene.padding(padded), 0.25);
+}
+
 }  // namespace
 }  // namespace proxima
