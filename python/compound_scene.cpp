@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "convert.h"
+#include "proxima/body.h"
 #include "proxima/compound.h"
 #include "proxima/io.h"
 #include "proxima/scene.h"
@@ -322,6 +323,10 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("a", &ClosePair::a, "Body id.")
       .def_readonly("b", &ClosePair::b, "Body id.")
       .def_readonly("result", &ClosePair::result, "The CompoundResult of the pair.")
+      .def_readonly("triangle_a", &ClosePair::triangle_a,
+                    "The closest triangle of body a when it is a mesh, else -1.")
+      .def_readonly("triangle_b", &ClosePair::triangle_b,
+                    "The closest triangle of body b when it is a mesh, else -1.")
       .def("__repr__", [](const ClosePair& p) {
         return "proxima.ClosePair(" + std::to_string(p.a) + ", " + std::to_string(p.b) +
                ", distance=" + py::repr(py::float_(p.result.distance)).cast<std::string>() + ")";
@@ -399,20 +404,41 @@ void bind_compound_and_scene(py::module_& m) {
            "default in a scene, where it costs 5 to 60 us per overlapping pair and step.")
       .def(
           "add",
-          [](PyScene& s, std::shared_ptr<ConvexPolytope> body, py::object pose) {
+          [](PyScene& s, py::handle body, py::object pose, double padding) {
+            const Body b = to_body(body, "body");
             const Pose p = to_pose(pose, "pose");
             const InUse in_use(s, "Scene");
-            return s.add(std::shared_ptr<const ConvexPolytope>(std::move(body)), p);
+            return s.add(b, p, padding);
           },
-          py::arg("body"), py::arg("pose") = py::none(), "Adds a ConvexPolytope; returns its id.")
+          py::arg("body"), py::arg("pose") = py::none(), py::arg("padding") = 0.0,
+          "Adds a body and returns its id. body: a ConvexPolytope, a CompoundBody, a "
+          "TriangleMesh or a Body (rounded). padding >= 0: the scene's safety distance around "
+          "the body, added to its radius in the broad and the narrow phase (so every distance "
+          "reported is the padded bodies'). A pair with a rounded, padded or mesh body is "
+          "answered as distance(Body, Body); sweep() refuses a scene holding a mesh.")
       .def(
-          "add",
-          [](PyScene& s, std::shared_ptr<CompoundBody> body, py::object pose) {
-            const Pose p = to_pose(pose, "pose");
+          "set_padding",
+          [](PyScene& s, BodyId id, double padding) {
             const InUse in_use(s, "Scene");
-            return s.add(std::shared_ptr<const CompoundBody>(std::move(body)), p);
+            s.set_padding(id, padding);
           },
-          py::arg("body"), py::arg("pose") = py::none(), "Adds a CompoundBody; returns its id.")
+          py::arg("id"), py::arg("padding"), "Changes body id's padding (>= 0).")
+      .def(
+          "padding",
+          [](const PyScene& s, BodyId id) {
+            const InUse in_use(s, "Scene");
+            return s.padding(id);
+          },
+          py::arg("id"), "Body id's padding.")
+      .def(
+          "body",
+          // py::object: Body is bound after Scene (module.cpp), and a typed
+          // return would name the C++ type in the signature (and the stubs).
+          [](const PyScene& s, BodyId id) -> py::object {
+            const InUse in_use(s, "Scene");
+            return py::cast(s.body(id));
+          },
+          py::arg("id"), "Body id as added (a Body: its core and radius, without the padding).")
       .def(
           "set_pose",
           [](PyScene& s, BodyId id, py::object pose) {

@@ -79,15 +79,66 @@ bool is_close(const DistanceResult& r, double margin) {
   return r.status == Status::touching || r.status == Status::intersecting || r.distance <= margin;
 }
 
+// A pair's BodyCache (pairs with a rounded, padded or mesh body), on the
+// heap so that the states of the plain pairs, which are moved about by every
+// step's merge, stay small. Copies are deep (a sweep's pair may start from
+// a copy of the step's cache).
+class BodyCacheSlot {
+ public:
+  BodyCacheSlot() = default;
+  BodyCacheSlot(const BodyCacheSlot& other)
+      : cache_(other.cache_ ? std::make_unique<BodyCache>(*other.cache_) : nullptr) {}
+  BodyCacheSlot& operator=(const BodyCacheSlot& other) {
+    if (this != &other)
+      cache_ = other.cache_ ? std::make_unique<BodyCache>(*other.cache_) : nullptr;
+    return *this;
+  }
+  BodyCacheSlot(BodyCacheSlot&&) noexcept = default;
+  BodyCacheSlot& operator=(BodyCacheSlot&&) noexcept = default;
+  ~BodyCacheSlot() = default;
+
+  BodyCache& get() {
+    if (!cache_) cache_ = std::make_unique<BodyCache>();
+    return *cache_;
+  }
+  void reset() {
+    if (cache_) cache_->reset();
+  }
+
+ private:
+  std::unique_ptr<BodyCache> cache_;
+};
+
+double checked_padding(double padding, const std::string& who) {
+  if (!std::isfinite(padding) || padding < 0.0) {
+    throw InvalidInput(who + ": padding must be finite and >= 0, got " + std::to_string(padding));
+  }
+  return padding;
+}
+
 }  // namespace
 
 struct Scene::Impl {
+  struct Shape {
+    proxima::Body given;  // as added
+    // `given` with its radius plus the padding: what the narrow phase of a
+    // general pair measures.
+    proxima::Body padded;
+    double padding = 0.0;
+  };
+
   struct Body {
-    std::shared_ptr<const ConvexPolytope> convex;  // null for a compound body
+    std::shared_ptr<const ConvexPolytope> convex;  // the core of a convex body, else null
     // The compound body; for a convex body, the body as a one-piece compound,
-    // made when the scene first holds a compound (convex-compound pairs go
-    // through the compound query).
+    // made when the scene first holds a compound (plain convex-compound
+    // pairs go through the compound query). Null for a mesh.
     std::shared_ptr<const CompoundBody> compound;
+    // The body as a proxima::Body, on the heap: the step's loops read the
+    // fields around it for every pair, and scene_bench measured a step 4 to
+    // 8% slower at 10,000 bodies with the two Bodies held here.
+    std::unique_ptr<Shape> shape;
+    double reach = 0.0;    // shape->padded.radius(): how far the body reaches beyond its core
+    bool general = false;  // rounded, padded or a mesh: its pairs take the Body query
     Pose pose;
     Pose end;                                                      // the end pose of the next sweep
     std::array<std::int32_t, 6> hints = {-1, -1, -1, -1, -1, -1};  // support_box
@@ -96,11 +147,18 @@ struct Scene::Impl {
   };
 
   // The coherence of one candidate pair: the convex cache for a pair of
-  // convex bodies, the compound cache otherwise.
+  // plain convex bodies, the Body cache for a pair with a general body, the
+  // compound cache otherwise.
   struct PairState {
     std::uint64_t key = 0;
     DistanceCache convex;
     CompoundCache compound;
+    BodyCacheSlot body;
+    void reset() {
+      convex.reset();
+      compound.reset();
+      body.reset();
+    }
   };
 
   SceneOptions options;
@@ -116,7 +174,7 @@ struct Scene::Impl {
   std::vector<std::uint64_t> excluded;  // pair keys, increasing
   std::vector<BodyId> removed_since_step;
   std::vector<std::uint8_t> removed_flag;  // by id, scratch
-  std::vector<CompoundResult> results;     // parallel to pairs
+  std::vector<ClosePair> results;          // parallel to pairs
   std::vector<std::size_t> chunk_close;    // close pairs per chunk of pairs, then their offsets
   std::vector<int> chunk_queries;          // convex queries per chunk of pairs
   std::vector<ClosePair> close;
@@ -156,6 +214,24 @@ struct Scene::Impl {
     return std::make_shared<const CompoundBody>(std::move(pieces));
   }
 
+  // From now on plain convex bodies may meet a compound: give each its
+  // wrapper.
+  void wrap_convex_bodies() {
+    for (Body& other : bodies) {
+      if (other.live && other.convex && !other.compound) other.compound = wrap(other.convex);
+    }
+  }
+
+  // The padded body, reach and kind of pairs of body b after its padding
+  // was set.
+  static void pad(Body& b) {
+    Shape& shape = *b.shape;
+    const double radius = shape.given.radius() + shape.padding;
+    shape.padded = shape.given.with_radius(radius);
+    b.reach = radius;
+    b.general = radius > 0.0 || shape.given.kind() == proxima::Body::Kind::mesh;
+  }
+
   BodyId insert(Body body) {
     const BodyId id = take_id();
     body.live = true;
@@ -173,6 +249,11 @@ struct Scene::Impl {
   // measured 37% fewer candidate pairs and a 3 to 6% faster Scene::step at
   // 1,000 and 10,000 bodies (the hill climbs cost less than the tracked
   // queries they save).
+  //
+  // A mesh's box is its hierarchy's root box, placed (the box of the
+  // turned box); a general body's box grows by its reach (radius plus
+  // padding): the box of the core grown by r holds the core plus a ball of
+  // radius r.
   Aabb world_box(Body& b) const { return world_box(b, options.margin); }
   Aabb world_box(Body& b, double margin) const {
     Aabb box;
@@ -180,6 +261,10 @@ struct Scene::Impl {
     if (b.convex) {
       box = detail::support_box(*b.convex, b.pose, b.hints);
       scale = b.convex->scale();
+    } else if (!b.compound) {
+      const TriangleMesh& mesh = *b.shape->given.mesh();
+      box = placed_root_box(mesh, b.pose);
+      scale = mesh.scale();
     } else {
       // Compounds: the box of the root's bounding sphere.
       const Vec3 center = b.pose.apply(b.compound->center());
@@ -187,25 +272,69 @@ struct Scene::Impl {
       box = {(center.array() - r).matrix(), (center.array() + r).matrix()};
       scale = b.compound->scale();
     }
-    const double slack = kBoxSlackUlps * kUnitRoundoff * magnitude_bound(b.pose, scale);
-    return inflated(box, 0.5 * (margin + options.distance.absolute_tolerance) + slack);
+    const double slack = kBoxSlackUlps * kUnitRoundoff * magnitude_bound(b.pose, scale + b.reach);
+    return inflated(box, 0.5 * (margin + options.distance.absolute_tolerance) + b.reach + slack);
   }
 
-  CompoundResult query(PairState& state) const {
-    const Body& a = bodies[slot(detail::pair_first(state.key))];
-    const Body& b = bodies[slot(detail::pair_second(state.key))];
+  // The root box of a mesh's hierarchy at `pose`: center placed, half
+  // extents through |R|. Its rounding (a few operations on numbers below
+  // the mesh's magnitude bound) is inside the callers' slack.
+  static Aabb placed_root_box(const TriangleMesh& mesh, const Pose& pose) {
+    Vec3 lo, hi;
+    mesh.box(0, lo, hi);
+    const Vec3 center = pose.apply(0.5 * (lo + hi));
+    const Vec3 half = Mat3(pose.rotation).cwiseAbs() * (0.5 * (hi - lo));
+    return {center - half, center + half};
+  }
+
+  // The answer of distance(Body, Body) on two padded bodies in the scene's
+  // terms (ClosePair): pieces 0 for a convex body, one query.
+  static ClosePair body_answer(BodyId ia, const Body& a, BodyId ib, const Body& b,
+                               const BodyDistance& d) {
+    ClosePair p{ia, ib, {}, d.triangle_a, d.triangle_b};
+    static_cast<DistanceResult&>(p.result) = d;
+    p.result.piece_a = a.convex ? 0 : d.piece_a;
+    p.result.piece_b = b.convex ? 0 : d.piece_b;
+    p.result.pairs_tested = 1;
+    return p;
+  }
+
+  ClosePair query(PairState& state) const {
+    const BodyId ia = detail::pair_first(state.key);
+    const BodyId ib = detail::pair_second(state.key);
+    const Body& a = bodies[slot(ia)];
+    const Body& b = bodies[slot(ib)];
+    if (a.general || b.general) {
+      return body_answer(ia, a, ib, b,
+                         distance(a.shape->padded, a.pose, b.shape->padded, b.pose,
+                                  options.distance, &state.body.get()));
+    }
+    ClosePair p{ia, ib, {}};
     if (a.convex && b.convex) {
-      CompoundResult r;
-      static_cast<DistanceResult&>(r) =
+      static_cast<DistanceResult&>(p.result) =
           // The stored poses were checked by add and set_pose.
           detail::distance_of_rigid_poses(*a.convex, a.pose, *b.convex, b.pose, options.distance,
                                           &state.convex);
-      r.piece_a = 0;
-      r.piece_b = 0;
-      r.pairs_tested = 1;
-      return r;
+      p.result.piece_a = 0;
+      p.result.piece_b = 0;
+      p.result.pairs_tested = 1;
+      return p;
     }
-    return distance(*a.compound, a.pose, *b.compound, b.pose, options.distance, &state.compound);
+    p.result =
+        distance(*a.compound, a.pose, *b.compound, b.pose, options.distance, &state.compound);
+    return p;
+  }
+
+  // sweep() refuses meshes (time_of_impact does not take them): throws
+  // InvalidInput naming the first live mesh body.
+  void refuse_meshes(const char* who) const {
+    for (std::size_t k = 0; k < bodies.size(); ++k) {
+      if (bodies[k].live && !bodies[k].convex && !bodies[k].compound) {
+        throw InvalidInput(std::string(who) + ": " + name(static_cast<BodyId>(k)) +
+                           " is a mesh, and time_of_impact does not take meshes (remove it, or "
+                           "sweep a scene without it)");
+      }
+    }
   }
 
   bool groups_meet(const Body& a, const Body& b) const {
@@ -242,15 +371,11 @@ struct Scene::Impl {
                                      [](const PairState& p, std::uint64_t k) { return p.key < k; });
     if (at != pairs.end() && at->key == key) return *at;
     scratch.key = key;
-    scratch.convex.reset();
-    scratch.compound.reset();
+    scratch.reset();
     return scratch;
   }
 
-  ClosePair answer(std::uint64_t key, PairState& scratch) {
-    return ClosePair{detail::pair_first(key), detail::pair_second(key),
-                     query(state_of(key, scratch))};
-  }
+  ClosePair answer(std::uint64_t key, PairState& scratch) { return query(state_of(key, scratch)); }
 
   // A removed body's id may already belong to a new body: its pairs'
   // caches describe other bodies and go (a stale cache is only slower, but
@@ -293,8 +418,7 @@ struct Scene::Impl {
           continue;
         }
       }
-      next.convex.reset();
-      next.compound.reset();
+      next.reset();
       next.key = key;
     }
     list.swap(next_pairs);
@@ -323,7 +447,9 @@ struct Scene::Impl {
   // barely grows the box.
   //
   // A compound's box is its bounding sphere's: the sphere's center moves as
-  // a point of the body, and the ball around it turns onto itself.
+  // a point of the body, and the ball around it turns onto itself. A
+  // general body's box grows by its reach: the swept volume of the core
+  // plus a ball of radius r is the core's swept volume grown by r.
   Aabb swept_box(Body& b, double pad, double size_pad) const {
     Aabb start, end;
     double scale = 0.0;
@@ -351,6 +477,7 @@ struct Scene::Impl {
       arm = b.compound->center().stableNorm();
       size = arm + r;
     }
+    size += b.reach;
     Aabb box = start;
     double sag = 0.0;
     if (moving) {
@@ -363,7 +490,7 @@ struct Scene::Impl {
       const double q = std::sin(0.25 * theta);
       sag = 2.0 * arm * q * q;
     }
-    const double grow = pad + size_pad * size + sag;
+    const double grow = pad + size_pad * size + sag + b.reach;
     const double magnitude =
         std::max(magnitude_bound(b.pose, scale), magnitude_bound(b.end, scale));
     const double slack =
@@ -372,12 +499,17 @@ struct Scene::Impl {
   }
 
   // time_of_impact of bodies a and b moving from their poses to their end
-  // poses: the convex query for two convex bodies, the Body query when
-  // either is a compound; from and into `state`'s cache when given.
+  // poses: the convex query for two plain convex bodies, the Body query
+  // otherwise (on the padded bodies when either is general); from and into
+  // `state`'s cache when given.
   static ImpactResult impact(const Body& a, const Body& b, const ImpactOptions& impact_options,
                              PairState* state) {
     const Motion ma{a.pose, a.end};
     const Motion mb{b.pose, b.end};
+    if (a.general || b.general) {
+      return time_of_impact(a.shape->padded, ma, b.shape->padded, mb, impact_options,
+                            state != nullptr ? &state->body.get() : nullptr);
+    }
     if (a.convex && b.convex) {
       return time_of_impact(*a.convex, ma, *b.convex, mb, impact_options,
                             state != nullptr ? &state->convex : nullptr);
@@ -425,20 +557,59 @@ BodyId Scene::add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose) 
   b.pose = checked_pose(pose, "Scene::add: pose of the new convex body");
   b.end = b.pose;
   if (impl_->compound_count > 0) b.compound = Impl::wrap(body);
+  b.shape = std::make_unique<Impl::Shape>(Impl::Shape{proxima::Body(body), proxima::Body(body)});
   b.convex = std::move(body);
   return impl_->insert(std::move(b));
+}
+
+BodyId Scene::add(const proxima::Body& body, const Pose& pose, double padding) {
+  checked_padding(padding, "Scene::add");
+  if (body.kind() != proxima::Body::Kind::mesh && body.radius() == 0.0 && padding == 0.0) {
+    // A plain body: the adds above, keeping the Body as given (its
+    // approximation error, for body()).
+    const BodyId id = body.kind() == proxima::Body::Kind::convex ? add(body.convex(), pose)
+                                                                 : add(body.compound(), pose);
+    impl_->bodies[slot(id)].shape = std::make_unique<Impl::Shape>(Impl::Shape{body, body});
+    return id;
+  }
+  Impl::Body b;
+  b.pose = checked_pose(pose, "Scene::add: pose of the new body");
+  b.end = b.pose;
+  if (body.kind() == proxima::Body::Kind::convex) {
+    b.convex = body.convex();
+    if (impl_->compound_count > 0) b.compound = Impl::wrap(b.convex);
+  } else if (body.kind() == proxima::Body::Kind::compound) {
+    b.compound = body.compound();
+  }
+  b.shape = std::make_unique<Impl::Shape>(Impl::Shape{body, body, padding});
+  Impl::pad(b);
+  const bool compound = body.kind() == proxima::Body::Kind::compound;
+  if (compound && impl_->compound_count == 0) impl_->wrap_convex_bodies();
+  const BodyId id = impl_->insert(std::move(b));
+  if (compound) ++impl_->compound_count;
+  return id;
+}
+
+void Scene::set_padding(BodyId id, double padding) {
+  impl_->live_body(id, "set_padding");
+  checked_padding(padding, "Scene::set_padding: " + name(id));
+  Impl::Body& b = impl_->bodies[slot(id)];
+  b.shape->padding = padding;
+  Impl::pad(b);
+}
+
+double Scene::padding(BodyId id) const { return impl_->live_body(id, "padding").shape->padding; }
+
+const proxima::Body& Scene::body(BodyId id) const {
+  return impl_->live_body(id, "body").shape->given;
 }
 
 BodyId Scene::add(std::shared_ptr<const CompoundBody> body, const Pose& pose) {
   if (!body) throw InvalidInput("Scene::add: the compound body is null");
   const Pose checked = checked_pose(pose, "Scene::add: pose of the new compound body");
-  if (impl_->compound_count == 0) {
-    // From now on convex bodies may meet a compound: give each its wrapper.
-    for (Impl::Body& other : impl_->bodies) {
-      if (other.live && other.convex && !other.compound) other.compound = Impl::wrap(other.convex);
-    }
-  }
+  if (impl_->compound_count == 0) impl_->wrap_convex_bodies();
   Impl::Body b;
+  b.shape = std::make_unique<Impl::Shape>(Impl::Shape{proxima::Body(body), proxima::Body(body)});
   b.compound = std::move(body);
   b.pose = checked;
   b.end = checked;
@@ -465,7 +636,7 @@ const Pose& Scene::end_pose(BodyId id) const { return impl_->live_body(id, "end_
 void Scene::remove(BodyId id) {
   impl_->live_body(id, "remove");
   Impl::Body& b = impl_->bodies[slot(id)];
-  if (!b.convex) --impl_->compound_count;
+  if (b.shape->given.kind() == proxima::Body::Kind::compound) --impl_->compound_count;
   b = Impl::Body{};
   // Its exclusions go with it: the id may be reused by a new body.
   std::erase_if(impl_->excluded, [id](std::uint64_t key) {
@@ -584,10 +755,8 @@ std::span<const ClosePair> Scene::step() {
   if (threads == 1 || chunks < 2) {
     s.close.clear();
     for (std::size_t k = 0; k < n; ++k) {
-      convex_queries += s.results[k].pairs_tested;
-      if (!is_close(s.results[k], margin)) continue;
-      s.close.push_back(ClosePair{detail::pair_first(s.pairs[k].key),
-                                  detail::pair_second(s.pairs[k].key), s.results[k]});
+      convex_queries += s.results[k].result.pairs_tested;
+      if (is_close(s.results[k].result, margin)) s.close.push_back(s.results[k]);
     }
   } else {
     s.chunk_close.assign(chunks, 0);
@@ -597,8 +766,8 @@ std::span<const ClosePair> Scene::step() {
                               std::size_t count = 0;
                               int queries = 0;
                               for (std::size_t k = begin; k < end; ++k) {
-                                count += is_close(s.results[k], margin) ? 1 : 0;
-                                queries += s.results[k].pairs_tested;
+                                count += is_close(s.results[k].result, margin) ? 1 : 0;
+                                queries += s.results[k].result.pairs_tested;
                               }
                               s.chunk_close[c] = count;
                               s.chunk_queries[c] = queries;
@@ -610,11 +779,8 @@ std::span<const ClosePair> Scene::step() {
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t at = s.chunk_close[c];
                               for (std::size_t k = begin; k < end; ++k) {
-                                if (!is_close(s.results[k], margin)) continue;
-                                ClosePair& out = s.close[at++];
-                                out.a = detail::pair_first(s.pairs[k].key);
-                                out.b = detail::pair_second(s.pairs[k].key);
-                                out.result = s.results[k];
+                                if (is_close(s.results[k].result, margin))
+                                  s.close[at++] = s.results[k];
                               }
                             });
     for (const int q : s.chunk_queries) convex_queries += q;
@@ -633,6 +799,7 @@ const SceneStats& Scene::stats() const { return impl_->stats; }
 std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   detail::check_impact_options(options, "Scene::sweep");
   Impl& s = *impl_;
+  s.refuse_meshes("Scene::sweep");
   if (!s.sweep_finder) {
     s.sweep_finder = detail::make_pair_finder(s.options.broad_phase);
     for (std::size_t k = 0; k < s.bodies.size(); ++k) {
@@ -712,6 +879,7 @@ const SweepStats& Scene::sweep_stats() const { return impl_->sweep_stats; }
 std::vector<ImpactPair> Scene::impact_pairs_all_pairs(const ImpactOptions& options) const {
   detail::check_impact_options(options, "Scene::impact_pairs_all_pairs");
   const Impl& s = *impl_;
+  s.refuse_meshes("Scene::impact_pairs_all_pairs");
   std::vector<ImpactPair> out;
   const std::vector<BodyId> ids = body_ids();
   for (std::size_t i = 0; i < ids.size(); ++i) {
@@ -812,6 +980,13 @@ std::vector<ClosePair> Scene::close_pairs_all_pairs() const {
     for (std::size_t j = i + 1; j < ids.size(); ++j) {
       if (!tests_pair(ids[i], ids[j])) continue;
       const Impl::Body& b = s.bodies[slot(ids[j])];
+      if (a.general || b.general) {
+        ClosePair p = Impl::body_answer(
+            ids[i], a, ids[j], b,
+            distance(a.shape->padded, a.pose, b.shape->padded, b.pose, s.options.distance));
+        if (is_close(p.result, s.options.margin)) out.push_back(std::move(p));
+        continue;
+      }
       CompoundResult r;
       if (a.convex && b.convex) {
         static_cast<DistanceResult&>(r) =

@@ -32,6 +32,7 @@
 #include <span>
 #include <vector>
 
+#include "proxima/body.h"
 #include "proxima/compound.h"
 #include "proxima/polytope.h"
 #include "proxima/time_of_impact.h"
@@ -98,10 +99,24 @@ struct CollisionFilter {
 // with its signed distance (negative for an overlap: minus the depth, as
 // distance() and the compound query define it) when
 // SceneOptions::distance.penetration is set (not by default).
+//
+// A pair with a rounded or padded body or a mesh (Scene::add of a Body) is
+// answered by distance(Body, Body) (proxima/body.h) on the padded bodies:
+// `result` is that BodyDistance's DistanceResult part (distance, signed
+// distance and bounds, points on the padded surfaces, normal, features),
+// piece_a/piece_b its pieces (0 for a convex body, -1 for a mesh),
+// pairs_tested 1, and triangle_a/triangle_b its closest triangles of mesh
+// bodies (-1 for other kinds and for every other pair). The Body query
+// takes the depth of overlapping convex or compound cores whatever
+// SceneOptions::distance.penetration says (signed distance minus the depth
+// minus the radii; 5 to 60 us per such pair and step, as penetration costs
+// plain pairs); an overlap with a mesh has no depth (cores' signed value 0).
 struct ClosePair {
   BodyId a = -1;
   BodyId b = -1;
   CompoundResult result;
+  std::int32_t triangle_a = -1;
+  std::int32_t triangle_b = -1;
 };
 
 // One pair of a sweep (Scene::sweep): a < b, and the time of impact of
@@ -129,7 +144,8 @@ struct SceneStats {
   int bodies = 0;
   int candidate_pairs = 0;  // pairs the broad phase passed to the narrow phase
   int close_pairs = 0;      // of those, at distance <= margin
-  int convex_queries = 0;   // convex distance queries run (compounds run several per pair)
+  int convex_queries = 0;   // convex distance queries run (compounds run several per pair; a
+                            // pair through the Body query counts one)
   int warm_pairs = 0;       // candidate pairs that started from the previous step's cache
   int filtered_pairs = 0;   // pairs whose boxes overlap but that the filters dropped
 };
@@ -148,6 +164,25 @@ class Scene {
   // reused). Throws InvalidInput for a null body or a non-finite pose.
   BodyId add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose);
   BodyId add(std::shared_ptr<const CompoundBody> body, const Pose& pose);
+  // Any body of proxima/body.h: convex, compound or TriangleMesh, with its
+  // radius, plus a `padding` >= 0 of the scene's own (a robot planner's
+  // safety distance): the scene treats the body as body.with_radius(
+  // body.radius() + padding) everywhere, in the broad phase (its box holds
+  // the padded body) and in the narrow phase, so a padding p changes which
+  // pairs are reported exactly as a radius larger by p would, and every
+  // distance, signed distance and closest point reported is the padded
+  // bodies'. A plain convex or compound body (radius and padding 0) is the
+  // same as the two calls above (their fast paths); a pair where either
+  // body is rounded, padded or a mesh is answered by distance(Body, Body)
+  // with a BodyCache kept per pair (see ClosePair). Throws InvalidInput for
+  // a padding that is negative, NaN or infinite, or a non-finite pose.
+  BodyId add(const Body& body, const Pose& pose, double padding = 0.0);
+  // Changes a body's padding (same rules; the pair caches stay valid: the
+  // padding is outside the cores). Throws InvalidInput naming the id.
+  void set_padding(BodyId id, double padding);
+  double padding(BodyId id) const;
+  // The body as added (its radius without the padding).
+  const Body& body(BodyId id) const;
   // Throws InvalidInput naming the id for an unknown id or a non-finite pose.
   void set_pose(BodyId id, const Pose& pose);
   void remove(BodyId id);
@@ -207,7 +242,11 @@ class Scene {
   // iteration_cap), sorted by (a, b); valid until the next call of a
   // non-const method. Poses are not changed. The same answers bit for bit
   // whatever options.threads (the scene's). Throws InvalidInput for bad
-  // options (as time_of_impact).
+  // options (as time_of_impact). Rounded and padded bodies sweep as their
+  // padded bodies (the Body query; the padding adds to the target
+  // separation as a radius does). time_of_impact does not take meshes:
+  // sweep() throws InvalidInput naming the first mesh body while the scene
+  // holds one.
   std::span<const ImpactPair> sweep(const ImpactOptions& options);
   // The same with ImpactOptions{} but the scene's distance options
   // (options().distance): by default no penetration depth for pairs that
@@ -237,8 +276,9 @@ class Scene {
   std::vector<ClosePair> pairs_within(BodyId id, double margin);
 
   // The slow, obvious twin of step(): the cold distance query on every pair
-  // of bodies that tests_pair, no broad phase, no caches; same output order.
-  // For tests.
+  // of bodies that tests_pair (distance(Body, Body) on the padded bodies
+  // for a pair with a general body, as step()), no broad phase, no caches;
+  // same output order. For tests.
   std::vector<ClosePair> close_pairs_all_pairs() const;
 
  private:

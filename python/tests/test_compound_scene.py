@@ -387,3 +387,90 @@ def test_scene_set_end_poses_is_all_or_nothing_and_errors_are_named():
         scene.sweep(tolerance=-1.0)
     with pytest.raises(proxima.InvalidInput, match="max_iterations"):
         scene.sweep(max_iterations=0)
+
+
+# --- Scenes of any body: rounded, padded, meshes -------------------------------
+
+
+def box_mesh(lo, hi):
+    """The closed surface of the box [lo, hi] (outward triangles)."""
+    v = np.array([[hi[0] if k & 1 else lo[0], hi[1] if k & 2 else lo[1],
+                   hi[2] if k & 4 else lo[2]] for k in range(8)], dtype=float)
+    f = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4],
+                  [2, 6, 3], [3, 6, 7], [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+    return proxima.TriangleMesh(v, f)
+
+
+def test_scene_takes_bodies_meshes_and_padding_as_distance_of_bodies():
+    rng = np.random.default_rng(40)
+    hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)) * 0.4)
+    kinds = [hull, proxima.sphere(0.3), proxima.capsule(0.3, 0.2), box_mesh((-.4,) * 3, (.4,) * 3),
+             random_compound(rng, 2, spread=0.3), proxima.Body(hull, 0.1)]
+    scene = proxima.Scene(margin=0.2)
+    entries = []
+    for i in range(30):
+        body = kinds[i % len(kinds)]
+        pose = (quaternion(rng), rng.uniform(0, 4, 3))
+        padding = 0.1 if i % 4 == 0 else 0.0
+        assert scene.add(body, pose, padding=padding) == i
+        entries.append((proxima.Body(body) if not isinstance(body, proxima.Body) else body,
+                        pose, padding))
+    assert scene.padding(0) == 0.1 and scene.padding(1) == 0.0
+    assert scene.body(3).kind == "mesh" and scene.body(5).radius == 0.1
+    pairs = scene.step()
+    twin = scene.close_pairs_all_pairs()
+    assert [(p.a, p.b) for p in pairs] == [(p.a, p.b) for p in twin]
+    assert len(pairs) >= 10
+    seen_mesh = False
+    for p in pairs:
+        (ba, pa, da), (bb, pb, db) = entries[p.a], entries[p.b]
+        # The first step is cold: bit for bit the twin and, for a pair with a
+        # rounded, padded or mesh body, distance(Body, Body) of the padded bodies.
+        twin_pair = twin[[(q.a, q.b) for q in twin].index((p.a, p.b))]
+        assert p.result.distance == twin_pair.result.distance
+        if ba.kind == "mesh" or bb.kind == "mesh":
+            seen_mesh = True
+            assert p.triangle_a >= 0 or p.triangle_b >= 0
+        else:
+            assert p.triangle_a == -1 and p.triangle_b == -1
+        if ba.radius + da > 0 or bb.radius + db > 0 or "mesh" in (ba.kind, bb.kind):
+            d = proxima.distance(ba.with_radius(ba.radius + da), pa,
+                                 bb.with_radius(bb.radius + db), pb, penetration=False)
+            assert p.result.distance == d.distance
+            assert p.result.signed_distance == d.signed_distance
+            assert p.result.status == d.status
+    assert seen_mesh
+
+
+def test_scene_padding_acts_as_a_radius_and_is_checked():
+    ball = proxima.sphere(0.5)
+    scene = proxima.Scene()
+    a = scene.add(ball, ((1, 0, 0, 0), (0, 0, 0)))
+    b = scene.add(ball, ((1, 0, 0, 0), (1.5, 0, 0)))  # 0.5 apart
+    assert scene.step() == []
+    scene.set_padding(a, 0.3)
+    assert scene.step() == []  # 0.2 apart
+    scene.set_padding(b, 0.3)  # overlap 0.1
+    (pair,) = scene.step()
+    assert pair.result.status == "intersecting"
+    assert abs(pair.result.signed_distance - -0.1) <= 1e-12
+    for bad in (-1.0, float("nan"), float("inf")):
+        with pytest.raises(proxima.InvalidInput, match="padding"):
+            scene.set_padding(a, bad)
+        with pytest.raises(proxima.InvalidInput, match="padding"):
+            scene.add(ball, None, padding=bad)
+    with pytest.raises(proxima.InvalidInput, match="body 9"):
+        scene.set_padding(9, 0.1)
+    with pytest.raises(TypeError, match="body"):
+        scene.add("a sphere")
+
+
+def test_scene_bodies_inside_a_closed_room_mesh_intersect_it_and_sweep_refuses_it():
+    scene = proxima.Scene()
+    room = scene.add(box_mesh((-10, -10, 0), (10, 10, 10)))
+    inside = scene.add(proxima.sphere(0.5), ((1, 0, 0, 0), (0, 0, 5)), padding=0.2)
+    scene.add(proxima.sphere(0.5), ((1, 0, 0, 0), (30, 0, 5)))
+    (pair,) = scene.step()
+    assert (pair.a, pair.b) == (room, inside) and pair.result.status == "intersecting"
+    with pytest.raises(proxima.InvalidInput, match="body 0 is a mesh"):
+        scene.sweep()
