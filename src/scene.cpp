@@ -325,18 +325,6 @@ struct Scene::Impl {
     return p;
   }
 
-  // sweep() refuses meshes (time_of_impact does not take them): throws
-  // InvalidInput naming the first live mesh body.
-  void refuse_meshes(const char* who) const {
-    for (std::size_t k = 0; k < bodies.size(); ++k) {
-      if (bodies[k].live && !bodies[k].convex && !bodies[k].compound) {
-        throw InvalidInput(std::string(who) + ": " + name(static_cast<BodyId>(k)) +
-                           " is a mesh, and time_of_impact does not take meshes (remove it, or "
-                           "sweep a scene without it)");
-      }
-    }
-  }
-
   bool groups_meet(const Body& a, const Body& b) const {
     return (a.filter.group & b.filter.mask) != 0 && (b.filter.group & a.filter.mask) != 0;
   }
@@ -466,15 +454,29 @@ struct Scene::Impl {
       if (b.compound)
         size = std::max(size, b.compound->center().stableNorm() + b.compound->bounding_radius());
     } else {
-      const double r = b.compound->bounding_radius();
+      // A compound's bounding sphere, or a mesh's: its root box's center and
+      // half diagonal (the box holds every vertex).
+      Vec3 center_local;
+      double r = 0.0;
+      if (b.compound) {
+        center_local = b.compound->center();
+        r = b.compound->bounding_radius();
+        scale = b.compound->scale();
+      } else {
+        const TriangleMesh& mesh = *b.shape->given.mesh();
+        Vec3 lo, hi;
+        mesh.box(0, lo, hi);
+        center_local = 0.5 * (lo + hi);
+        r = 0.5 * (hi - lo).stableNorm();
+        scale = mesh.scale();
+      }
       const auto sphere = [&](const Pose& p) {
-        const Vec3 center = p.apply(b.compound->center());
+        const Vec3 center = p.apply(center_local);
         return Aabb{(center.array() - r).matrix(), (center.array() + r).matrix()};
       };
       start = sphere(b.pose);
       end = moving ? sphere(b.end) : start;
-      scale = b.compound->scale();
-      arm = b.compound->center().stableNorm();
+      arm = center_local.stableNorm();
       size = arm + r;
     }
     size += b.reach;
@@ -799,7 +801,6 @@ const SceneStats& Scene::stats() const { return impl_->stats; }
 std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   detail::check_impact_options(options, "Scene::sweep");
   Impl& s = *impl_;
-  s.refuse_meshes("Scene::sweep");
   if (!s.sweep_finder) {
     s.sweep_finder = detail::make_pair_finder(s.options.broad_phase);
     for (std::size_t k = 0; k < s.bodies.size(); ++k) {
@@ -879,7 +880,6 @@ const SweepStats& Scene::sweep_stats() const { return impl_->sweep_stats; }
 std::vector<ImpactPair> Scene::impact_pairs_all_pairs(const ImpactOptions& options) const {
   detail::check_impact_options(options, "Scene::impact_pairs_all_pairs");
   const Impl& s = *impl_;
-  s.refuse_meshes("Scene::impact_pairs_all_pairs");
   std::vector<ImpactPair> out;
   const std::vector<BodyId> ids = body_ids();
   for (std::size_t i = 0; i < ids.size(); ++i) {

@@ -383,17 +383,28 @@ TEST(SceneBodies, BodiesInsideAClosedRoomMeshIntersectIt) {
   EXPECT_NEAR(near_outside[0].result.distance, 19.5, 1e-12);
   EXPECT_GE(near_outside[0].triangle_a, 0);
 
-  // time_of_impact does not take meshes: sweep() says which body.
-  try {
-    scene.sweep();
-    ADD_FAILURE() << "sweep() took a mesh";
-  } catch (const InvalidInput& e) {
-    EXPECT_NE(std::string(e.what()).find("body 0 is a mesh"), std::string::npos) << e.what();
+  // Meshes sweep too (time_of_impact takes them): the bodies inside the
+  // closed room overlap it at t = 0; the outside ball flying to x = 8 turns
+  // while it goes, crosses the wall at x = 10 and meets the crate mesh
+  // nowhere. The sweep equals its all-pairs twin.
+  scene.set_end_pose(outside, Pose{Mat3(Eigen::AngleAxisd(2.0, Vec3(0, 0, 1))), Vec3(8, 0, 5)});
+  scene.set_end_pose(crate, Pose{Mat3(Eigen::AngleAxisd(1.0, Vec3(1, 0, 0))), Vec3(-5, 4, 3.5)});
+  const std::span<const ImpactPair> hits = scene.sweep();
+  const std::vector<ImpactPair> twin = scene.impact_pairs_all_pairs();
+  ASSERT_EQ(hits.size(), twin.size());
+  ASSERT_EQ(hits.size(), 4u);  // the three inside at t = 0, the outside ball at the wall
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    EXPECT_EQ(hits[i].a, twin[i].a);
+    EXPECT_EQ(hits[i].b, twin[i].b);
+    EXPECT_EQ(hits[i].result.status, twin[i].result.status);
+    EXPECT_NEAR(hits[i].result.t, twin[i].result.t, 1e-6);
   }
-  EXPECT_THROW(scene.impact_pairs_all_pairs(), InvalidInput);
-  scene.remove(room);
-  scene.remove(crate);
-  EXPECT_NO_THROW(scene.sweep());
+  const ImpactPair& wall = hits.back();
+  EXPECT_EQ(wall.b, outside);
+  EXPECT_EQ(wall.result.status, ImpactStatus::contact);
+  // The ball's surface reaches x = 10 when its center is at 10.5: t = 19.5 / 22.
+  EXPECT_LE(wall.result.t, 19.5 / 22.0);
+  EXPECT_NEAR(wall.result.t, 19.5 / 22.0, 1e-5);
 }
 
 TEST(SceneBodies, FiltersDropGeneralPairsBeforeTheNarrowPhase) {

@@ -244,9 +244,8 @@ class Scene {
   // whatever options.threads (the scene's). Throws InvalidInput for bad
   // options (as time_of_impact). Rounded and padded bodies sweep as their
   // padded bodies (the Body query; the padding adds to the target
-  // separation as a radius does). time_of_impact does not take meshes:
-  // sweep() throws InvalidInput naming the first mesh body while the scene
-  // holds one.
+  // separation as a radius does). A mesh's swept box is its root box's
+  // bounding sphere swept like a compound's.
   std::span<const ImpactPair> sweep(const ImpactOptions& options);
   // The same with ImpactOptions{} but the scene's distance options
   // (options().distance): by default no penetration depth for pairs that
