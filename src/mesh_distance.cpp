@@ -447,9 +447,23 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   struct Entry {
     std::int32_t na, nb;
     double lb2;
+    double center2;  // squared distance of the boxes' centers: ties of lb2
   };
-  std::vector<Entry> stack;
-  stack.reserve(128);
+  // Best first (a binary heap of node pairs, the smallest lower bound on
+  // top, ties to the nearer centers), each pop followed by a dive to a leaf
+  // pair along the nearer child: the first leaves reached are near the
+  // closest pair, so the upper bound is tight early and prunes most of the
+  // rest. Measured (bench/mesh_bench, env/rob, medians, cold) against the
+  // depth-first stack it replaces: random poses 120 -> 51 us, 262 -> 54
+  // triangle pairs; smooth motion 82 -> 28 us. A plain heap without the
+  // dive tested about as few pairs but paid ~100 ns of heap work per node
+  // pair (slower when apart); a depth-first stack with the same tie rule
+  // reached 68 us.
+  const auto later = [](const Entry& x, const Entry& y) {
+    return x.lb2 > y.lb2 || (x.lb2 == y.lb2 && x.center2 > y.center2);
+  };
+  std::vector<Entry> heap;
+  heap.reserve(256);
   const auto nodes_a = a.nodes();
   const auto nodes_b = b.nodes();
   const auto order_a = a.triangle_order();
@@ -459,9 +473,9 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     return t * t;
   };
   double prune2 = threshold2();
-  stack.push_back({0, 0, 0.0});
-  // Prepared leaves, direct-mapped by node id: a depth-first traversal
-  // meets the same leaf against many leaves of the other mesh in a row.
+  heap.push_back({0, 0, 0.0, 0.0});
+  // Prepared leaves, direct-mapped by node id: a dive meets the same leaf
+  // against several leaves of the other mesh in a row.
   // Per thread (the query is reentrant), stamped with this query so that no
   // leaf placed at another query's pose is used. 128 slots a side (about
   // 340 KB per thread): env/rob cold 130 -> 121 us against 32 slots.
@@ -488,68 +502,75 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     }
     return slot.t;
   };
-  while (!stack.empty() && !best.crossing) {
-    const Entry e = stack.back();
-    stack.pop_back();
-    if (e.lb2 > prune2) continue;
-    const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.na)];
-    const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.nb)];
-    if (na.is_leaf() && nb.is_leaf()) {
-      const auto& leaf_a = leaf(slots_a, e.na, na, true);
-      const auto& leaf_b = leaf(slots_b, e.nb, nb, false);
-      for (std::int32_t i = 0; i < na.count && !best.crossing; ++i) {
-        for (std::int32_t j = 0; j < nb.count; ++j) {
-          const Triangles& ti = leaf_a[static_cast<std::size_t>(i)];
-          const Triangles& tj = leaf_b[static_cast<std::size_t>(j)];
-          const double before = best.d2;
-          const double d2 = test_pair(q, ti, tj, best, tested, std::sqrt(prune2));
-          if (best.d2 < before) prune2 = threshold2();
-          if (best.crossing) break;
-          if (margin > 0.0 && !overflow && d2 <= prune2) {
-            // Every tested pair that may end within the margin; filtered
-            // against the final best at the end.
-            candidates.push_back({ti.id, tj.id, d2});
-            overflow = candidates.size() > 4 * kNearCapacity;
+  while (!heap.empty() && !best.crossing) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    Entry e = heap.back();
+    heap.pop_back();
+    if (e.lb2 > prune2) break;  // every other pair's bound is as large
+    // Dive: follow the nearer child down to a leaf pair, the other child
+    // waits in the heap.
+    while (true) {
+      const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.na)];
+      const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.nb)];
+      if (na.is_leaf() && nb.is_leaf()) {
+        const auto& leaf_a = leaf(slots_a, e.na, na, true);
+        const auto& leaf_b = leaf(slots_b, e.nb, nb, false);
+        for (std::int32_t i = 0; i < na.count && !best.crossing; ++i) {
+          for (std::int32_t j = 0; j < nb.count; ++j) {
+            const Triangles& ti = leaf_a[static_cast<std::size_t>(i)];
+            const Triangles& tj = leaf_b[static_cast<std::size_t>(j)];
+            const double before = best.d2;
+            const double d2 = test_pair(q, ti, tj, best, tested, std::sqrt(prune2));
+            if (best.d2 < before) prune2 = threshold2();
+            if (best.crossing) break;
+            if (margin > 0.0 && !overflow && d2 <= prune2) {
+              // Every tested pair that may end within the margin; filtered
+              // against the final best at the end.
+              candidates.push_back({ti.id, tj.id, d2});
+              overflow = candidates.size() > 4 * kNearCapacity;
+            }
           }
         }
+        prune2 = threshold2();
+        break;
       }
-      prune2 = threshold2();
-      continue;
+      // Split the larger node (an inner node against a leaf: the inner one).
+      const Box ba = node_box(na, q.box_unit_a);
+      const Box bb = node_box(nb, q.box_unit_b);
+      const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
+      Entry c0, c1;
+      if (split_a) {
+        // B's box in A's frame, shared by both children.
+        const Vec3 cb = q.rotation * bb.center + q.translation_s;
+        const Vec3 extent_b = q.abs_rotation * bb.half;
+        const std::int32_t l = e.na + 1, r = na.first_or_right;
+        const Box b0 = node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a);
+        const Box b1 = node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a);
+        c0 = {l, e.nb, lower_bound_on_a_axes(q, b0, bb, cb, extent_b, prune2),
+              (b0.center - cb).squaredNorm()};
+        c1 = {r, e.nb, lower_bound_on_a_axes(q, b1, bb, cb, extent_b, prune2),
+              (b1.center - cb).squaredNorm()};
+      } else {
+        // A's box in B's frame, shared by both children.
+        const Vec3 ca = q.rotation.transpose() * (ba.center - q.translation_s);
+        const Vec3 extent_a = q.abs_rotation.transpose() * ba.half;
+        const std::int32_t l = e.nb + 1, r = nb.first_or_right;
+        const Box b0 = node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b);
+        const Box b1 = node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b);
+        c0 = {e.na, l, lower_bound_on_b_axes(q, ba, b0, ca, extent_a, prune2),
+              (b0.center - ca).squaredNorm()};
+        c1 = {e.na, r, lower_bound_on_b_axes(q, ba, b1, ca, extent_a, prune2),
+              (b1.center - ca).squaredNorm()};
+      }
+      nodes_tested += 2;
+      if (later(c0, c1)) std::swap(c0, c1);
+      if (c1.lb2 <= prune2) {
+        heap.push_back(c1);
+        std::push_heap(heap.begin(), heap.end(), later);
+      }
+      if (c0.lb2 > prune2) break;
+      e = c0;
     }
-    // Split the larger node (an inner node against a leaf: the inner one).
-    const Box ba = node_box(na, q.box_unit_a);
-    const Box bb = node_box(nb, q.box_unit_b);
-    const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
-    Entry c0, c1;
-    if (split_a) {
-      // B's box in A's frame, shared by both children.
-      const Vec3 cb = q.rotation * bb.center + q.translation_s;
-      const Vec3 extent_b = q.abs_rotation * bb.half;
-      const std::int32_t l = e.na + 1, r = na.first_or_right;
-      c0 = {l, e.nb,
-            lower_bound_on_a_axes(q, node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a),
-                                  bb, cb, extent_b, prune2)};
-      c1 = {r, e.nb,
-            lower_bound_on_a_axes(q, node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a),
-                                  bb, cb, extent_b, prune2)};
-    } else {
-      // A's box in B's frame, shared by both children.
-      const Vec3 ca = q.rotation.transpose() * (ba.center - q.translation_s);
-      const Vec3 extent_a = q.abs_rotation.transpose() * ba.half;
-      const std::int32_t l = e.nb + 1, r = nb.first_or_right;
-      c0 = {
-          e.na, l,
-          lower_bound_on_b_axes(q, ba, node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b),
-                                ca, extent_a, prune2)};
-      c1 = {
-          e.na, r,
-          lower_bound_on_b_axes(q, ba, node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b),
-                                ca, extent_a, prune2)};
-    }
-    nodes_tested += 2;
-    if (c0.lb2 > c1.lb2) std::swap(c0, c1);
-    if (c1.lb2 <= prune2) stack.push_back(c1);
-    if (c0.lb2 <= prune2) stack.push_back(c0);
   }
 
   const bool inside = !best.crossing && contained(q);
