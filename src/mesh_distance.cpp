@@ -218,6 +218,20 @@ Triangles prepared(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::int32_t 
   return t;
 }
 
+// Slack of a box gap against a limit (scaled units, magnitudes about 1):
+// each coordinate difference rounds once, the squares and sum a few times.
+constexpr double kBoxSlackUlps = 16.0;
+
+// Squared gap between two axis-aligned boxes of the query frame.
+double box_gap_squared(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
+  double gap2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    const double g = std::max(alo[k] - bhi[k], blo[k] - ahi[k]);
+    if (g > 0.0) gap2 += g * g;
+  }
+  return gap2;
+}
+
 // One triangle pair: skipped when its spheres are farther apart than
 // `limit` (scaled; the caller needs only pairs within it), else the fast
 // kernel, and the crossing test when in the band. Returns the pair's squared
@@ -226,12 +240,8 @@ double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& b
                  double limit = std::numeric_limits<double>::infinity()) {
   // The boxes' gap (exact differences of stored coordinates, rounded once
   // each; the slack below covers them).
-  double gap2 = 0.0;
-  for (int k = 0; k < 3; ++k) {
-    const double g = std::max(a.lo[k] - b.hi[k], b.lo[k] - a.hi[k]);
-    if (g > 0.0) gap2 += g * g;
-  }
-  const double box_limit = limit + 16.0 * kUnitRoundoff;
+  const double gap2 = box_gap_squared(a.lo, a.hi, b.lo, b.hi);
+  const double box_limit = limit + kBoxSlackUlps * kUnitRoundoff;
   if (gap2 > box_limit * box_limit) return std::numeric_limits<double>::infinity();
   // The planes' bound, with the slack of its rounding (a few u of the
   // scaled magnitudes, about 1).
@@ -483,6 +493,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     std::uint64_t stamp = 0;
     std::int32_t node = -1;
     std::array<Triangles, TriangleMesh::kLeafSize> t;
+    Vec3 lo, hi;  // the union of the triangles' boxes (query frame)
   };
   constexpr std::size_t kSlots = 128;
   thread_local std::array<LeafSlot, kSlots> slots_a, slots_b;
@@ -494,13 +505,17 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     if (slot.stamp != stamp || slot.node != node) {
       slot.stamp = stamp;
       slot.node = node;
+      slot.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+      slot.hi = -slot.lo;
       for (std::int32_t i = 0; i < n.count; ++i) {
         const auto k = static_cast<std::size_t>(n.first_or_right + i);
-        slot.t[static_cast<std::size_t>(i)] =
-            side_a ? a_triangle(q, order_a[k]) : b_triangle(q, order_b[k]);
+        Triangles& t = slot.t[static_cast<std::size_t>(i)];
+        t = side_a ? a_triangle(q, order_a[k]) : b_triangle(q, order_b[k]);
+        slot.lo = slot.lo.cwiseMin(t.lo);
+        slot.hi = slot.hi.cwiseMax(t.hi);
       }
     }
-    return slot.t;
+    return slot;
   };
   while (!heap.empty() && !best.crossing) {
     std::pop_heap(heap.begin(), heap.end(), later);
@@ -513,12 +528,24 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
       const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.na)];
       const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.nb)];
       if (na.is_leaf() && nb.is_leaf()) {
-        const auto& leaf_a = leaf(slots_a, e.na, na, true);
-        const auto& leaf_b = leaf(slots_b, e.nb, nb, false);
-        for (std::int32_t i = 0; i < na.count && !best.crossing; ++i) {
+        const LeafSlot& leaf_a = leaf(slots_a, e.na, na, true);
+        const LeafSlot& leaf_b = leaf(slots_b, e.nb, nb, false);
+        // Each triangle against the other leaf's box first (both in the
+        // query frame): a triangle farther than the limit from every
+        // triangle of the other leaf skips its row or column of pairs.
+        const double box_limit = std::sqrt(prune2) + kBoxSlackUlps * kUnitRoundoff;
+        unsigned columns = 0;
+        for (std::int32_t j = 0; j < nb.count; ++j) {
+          const Triangles& tj = leaf_b.t[static_cast<std::size_t>(j)];
+          if (box_gap_squared(tj.lo, tj.hi, leaf_a.lo, leaf_a.hi) <= box_limit * box_limit)
+            columns |= 1u << j;
+        }
+        for (std::int32_t i = 0; i < na.count && columns != 0 && !best.crossing; ++i) {
+          const Triangles& ti = leaf_a.t[static_cast<std::size_t>(i)];
+          if (box_gap_squared(ti.lo, ti.hi, leaf_b.lo, leaf_b.hi) > box_limit * box_limit) continue;
           for (std::int32_t j = 0; j < nb.count; ++j) {
-            const Triangles& ti = leaf_a[static_cast<std::size_t>(i)];
-            const Triangles& tj = leaf_b[static_cast<std::size_t>(j)];
+            if ((columns >> j & 1u) == 0) continue;
+            const Triangles& tj = leaf_b.t[static_cast<std::size_t>(j)];
             const double before = best.d2;
             const double d2 = test_pair(q, ti, tj, best, tested, std::sqrt(prune2));
             if (best.d2 < before) prune2 = threshold2();
