@@ -249,7 +249,11 @@ double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& b
   if (plane_separates(a, b, plane_limit) || plane_separates(b, a, plane_limit))
     return std::numeric_limits<double>::infinity();
   ++tested;
-  const double d2 = detail::triangle_distance_squared(a.fast, b.fast, q.tol);
+  // The kernel needs no answer beyond the limit (plus its slack): a result
+  // at or above that bound is a pair farther than the limit.
+  const double bound = plane_limit * plane_limit;
+  const double d2 = detail::triangle_distance_squared(a.fast, b.fast, q.tol, bound);
+  if (d2 >= bound) return std::numeric_limits<double>::infinity();
   if (d2 <= q.band_s * q.band_s && !best.crossing && triangles_cross(a.v, b.v, q.band_s)) {
     best.d2 = d2;
     best.ta = a.id;

@@ -327,6 +327,20 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
     const double d = exact_sqrt(exact.distance_squared, 0);
     ASSERT_LE(std::abs(fast - d), 1e-12 * d + 64 * kU * 2.0)
         << "trial " << trial << ": fast " << fast << " exact " << d;
+    // With a bound (the traversal passes its running limit): below the
+    // bound the answer is the distance; at or above it, the pair is at
+    // least that far. Bounds below, near and above the distance.
+    for (const double factor : {0.25, 0.999, 1.001, 4.0}) {
+      const double bound = factor * d * d;
+      const double bounded = detail::triangle_distance_squared(a, b, tol, bound);
+      if (bounded < bound) {
+        ASSERT_LE(std::abs(std::sqrt(bounded) - d), 1e-12 * d + 64 * kU * 2.0)
+            << "trial " << trial << " bound " << factor << ": " << std::sqrt(bounded);
+      } else {
+        ASSERT_GE(d, std::sqrt(bound) - (1e-12 * d + 64 * kU * 2.0))
+            << "trial " << trial << " bound " << factor << ": reported beyond the bound";
+      }
+    }
     zero += d == 0.0 ? 1 : 0;
     degenerate += (!a.planar || !b.planar) ? 1 : 0;
   }
