@@ -44,10 +44,13 @@ float float_up(double x) {
   return f;
 }
 
+// Floats: they only order the triangles and rank the splits (the node boxes
+// are computed from the vertices in doubles); half the bytes of doubles for
+// nth_element to move (10^6-triangle build 1.23 -> 1.07 s, one run each).
 struct BuildItem {
-  Vec3 centroid;  // in units of the mesh's unit (|.| <= 1)
+  Eigen::Vector3f centroid;  // in units of the mesh's unit (|.| <= 1)
   std::int32_t triangle;
-  Vec3 lo, hi;  // the triangle's box, same units
+  Eigen::Vector3f lo, hi;  // the triangle's box, same units
 };
 
 struct Builder {
@@ -92,12 +95,12 @@ struct Builder {
                        });
     };
     const auto extent = [&](std::int32_t from, std::int32_t to) {
-      Vec3 blo = items[from].lo, bhi = items[from].hi;
+      Eigen::Vector3f blo = items[from].lo, bhi = items[from].hi;
       for (std::int32_t k = from + 1; k < to; ++k) {
         blo = blo.cwiseMin(items[k].lo);
         bhi = bhi.cwiseMax(items[k].hi);
       }
-      return (bhi - blo).sum();
+      return static_cast<double>((bhi - blo).sum());
     };
     int axis = 0;
     double best_cost = std::numeric_limits<double>::infinity();
@@ -297,8 +300,9 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
     const Triangle& tri = triangles_[t];
     const Vec3 p0 = vertices_[tri[0]] * inv_unit, p1 = vertices_[tri[1]] * inv_unit,
                p2 = vertices_[tri[2]] * inv_unit;
-    builder.items[t] = {(p0 + p1 + p2) / 3.0, static_cast<std::int32_t>(t),
-                        p0.cwiseMin(p1).cwiseMin(p2), p0.cwiseMax(p1).cwiseMax(p2)};
+    builder.items[t] = {((p0 + p1 + p2) / 3.0).cast<float>(), static_cast<std::int32_t>(t),
+                        p0.cwiseMin(p1).cwiseMin(p2).cast<float>(),
+                        p0.cwiseMax(p1).cwiseMax(p2).cast<float>()};
   }
   nodes_.reserve(2 * (triangles_.size() + TriangleMesh::kLeafSize - 1) / TriangleMesh::kLeafSize *
                  2);
