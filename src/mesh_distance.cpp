@@ -189,6 +189,7 @@ struct Triangles {
   // of its distance to the plane.
   Vec3 unit_normal = Vec3::Zero();
   double offset = 0.0;
+  Vec3 centroid;  // the mean of the vertices, an axis's anchor
   std::int32_t id = -1;
 };
 
@@ -214,6 +215,7 @@ Triangles prepared(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::int32_t 
     t.unit_normal = n / n.norm();
     t.offset = t.unit_normal.dot(p0);
   }
+  t.centroid = (p0 + p1 + p2) / 3.0;
   t.id = id;
   return t;
 }
@@ -248,6 +250,24 @@ double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& b
   const double plane_limit = limit + 16.0 * kUnitRoundoff;
   if (plane_separates(a, b, plane_limit) || plane_separates(b, a, plane_limit))
     return std::numeric_limits<double>::infinity();
+  // A separating axis through the centroids: along any direction w, the
+  // gap between the triangles' projections over |w| is a lower bound on
+  // their distance. Catches the pairs of large slanted triangles whose
+  // boxes overlap and whose planes cut each other (env/rob, cold random
+  // poses: kernel calls 47.5 -> 39.3 per query, and on the slowest poses
+  // 394 -> 200, 60 -> 45 us; medians unchanged). Rounding: scaled
+  // coordinates are at most 1 and |w| at most 2, so each projection is
+  // within 3u|w| and the gap within 6u|w|; the slack covers that and the
+  // squares.
+  {
+    const Vec3 w = b.centroid - a.centroid;
+    const double a_max = std::max({w.dot(a.v[0]), w.dot(a.v[1]), w.dot(a.v[2])});
+    const double b_min = std::min({w.dot(b.v[0]), w.dot(b.v[1]), w.dot(b.v[2])});
+    const double gap = b_min - a_max;
+    const double reach = limit + kBoxSlackUlps * 2.0 * kUnitRoundoff;
+    if (gap > 0.0 && gap * gap > w.squaredNorm() * reach * reach)
+      return std::numeric_limits<double>::infinity();
+  }
   ++tested;
   // The kernel needs no answer beyond the limit (plus its slack): a result
   // at or above that bound is a pair farther than the limit.
