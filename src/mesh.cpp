@@ -58,6 +58,9 @@ struct Builder {
   std::span<const TriangleMesh::Triangle> triangles;
   std::vector<BuildItem> items;
   std::vector<TriangleMesh::Node>& nodes;
+  // Sample size of the split search in large ranges, and its buffer.
+  static constexpr std::size_t kSplitSample = 4096;
+  std::vector<BuildItem> sample;
   double inv_unit;
 
   // Builds the subtree over items[first, last), returns its box (units).
@@ -85,31 +88,45 @@ struct Builder {
     // axis of the centroids' box (bench/mesh_bench, env/rob, cold, medians):
     // random poses 42 -> 16 us, node pairs 453 -> 221, triangle pairs 74 ->
     // 48 per query; env's large slanted triangles are what the longest axis
-    // split badly. The 10^6-triangle build takes about 2.5x as long (three
-    // trial partitions per node; 1.2 s on a loaded machine).
+    // split badly.
     const std::int32_t mid = first + (last - first) / 2;
-    const auto split = [&](int axis) {
-      std::nth_element(items.begin() + first, items.begin() + mid, items.begin() + last,
-                       [axis](const BuildItem& x, const BuildItem& y) {
-                         return x.centroid[axis] < y.centroid[axis];
-                       });
+    const auto by_axis = [](int axis) {
+      return [axis](const BuildItem& x, const BuildItem& y) {
+        return x.centroid[axis] < y.centroid[axis];
+      };
     };
-    const auto extent = [&](std::int32_t from, std::int32_t to) {
-      Eigen::Vector3f blo = items[from].lo, bhi = items[from].hi;
-      for (std::int32_t k = from + 1; k < to; ++k) {
-        blo = blo.cwiseMin(items[k].lo);
-        bhi = bhi.cwiseMax(items[k].hi);
+    // The axis is chosen on the range itself, or on an even sample of it
+    // when large (the top levels of a big mesh: the choice needs only the
+    // halves' rough boxes, and three trial partitions of the whole range
+    // made the 10^6-triangle build take ~3x as long).
+    std::span<BuildItem> trial(items.data() + first, static_cast<std::size_t>(last - first));
+    if (trial.size() > kSplitSample) {
+      sample.clear();
+      const std::size_t stride = trial.size() / kSplitSample;
+      for (std::size_t k = 0; k < trial.size(); k += stride) sample.push_back(trial[k]);
+      trial = sample;
+    }
+    const auto extent = [](std::span<const BuildItem> part) {
+      Eigen::Vector3f blo = part[0].lo, bhi = part[0].hi;
+      for (const BuildItem& item : part) {
+        blo = blo.cwiseMin(item.lo);
+        bhi = bhi.cwiseMax(item.hi);
       }
       return static_cast<double>((bhi - blo).sum());
     };
+    const std::size_t half = trial.size() / 2;
     int axis = 0;
     double best_cost = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 3; ++k) {
-      split(k);
-      const double cost = extent(first, mid) + extent(mid, last);
+      std::nth_element(trial.begin(), trial.begin() + static_cast<std::ptrdiff_t>(half),
+                       trial.end(), by_axis(k));
+      const double cost = extent(trial.first(half)) + extent(trial.subspan(half));
       if (cost < best_cost) best_cost = cost, axis = k;
     }
-    if (axis != 2) split(axis);
+    if (trial.data() != items.data() + first || axis != 2) {
+      std::nth_element(items.begin() + first, items.begin() + mid, items.begin() + last,
+                       by_axis(axis));
+    }
     Vec3 llo, lhi, rlo, rhi;
     build(first, mid, llo, lhi);
     nodes[id].first_or_right = static_cast<std::int32_t>(nodes.size());
@@ -298,7 +315,7 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
 
   // The hierarchy.
   const double inv_unit = 1.0 / unit_;
-  Builder builder{vertices_, triangles_, {}, nodes_, inv_unit};
+  Builder builder{vertices_, triangles_, {}, nodes_, {}, inv_unit};
   builder.items.resize(triangles_.size());
   for (std::size_t t = 0; t < triangles_.size(); ++t) {
     const Triangle& tri = triangles_[t];
