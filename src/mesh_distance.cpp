@@ -512,7 +512,9 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   // against several leaves of the other mesh in a row.
   // Per thread (the query is reentrant), stamped with this query so that no
   // leaf placed at another query's pose is used. 128 slots a side (about
-  // 340 KB per thread): env/rob cold 130 -> 121 us against 32 slots.
+  // 340 KB per thread): env/rob cold 130 -> 121 us against 32 slots with the
+  // depth-first traversal; with the best-first one 32, 128 and 512 slots
+  // measure the same (16.2 us, three alternating runs).
   struct LeafSlot {
     std::uint64_t stamp = 0;
     std::int32_t node = -1;
