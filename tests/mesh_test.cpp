@@ -18,6 +18,7 @@
 #include <boost/multiprecision/eigen.hpp>
 #include <boost/multiprecision/gmp.hpp>
 #include <cmath>
+#include <functional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -219,6 +220,55 @@ TEST(MeshBuild, HierarchyHoldsEveryTriangle) {
   EXPECT_EQ(m.component_vertices().size(), 500u);
 }
 
+// The split search (mesh.cpp: median along the axis of the smallest halves)
+// at any scale: every leaf box holds its triangles' vertices, every inner
+// box its children's boxes (boxes are floats in units of unit(), rounded
+// outwards), and the halves are equal, so every leaf but a few is full (the
+// node count, hence the memory, is that of equal halves). Large
+// slanted triangles like those of FCL's env.obj.
+TEST(MeshBuild, HierarchyHoldsItsTrianglesAtAnyScale) {
+  Rng rng(8);
+  for (const int k : {-996, -500, -60, 0, 60, 500, 990}) {
+    // 5000 triangles: the split search samples ranges above 4096.
+    const int count = k == 0 || k == 990 ? 5000 : 300;
+    MeshData soup = random_soup(rng, count, 10, 4.0);
+    for (Vec3& v : soup.vertices)
+      v = Vec3(std::ldexp(v.x(), k), std::ldexp(v.y(), k), std::ldexp(v.z(), k));
+    const TriangleMesh m = soup.build();
+    const auto nodes = m.nodes();
+    int leaves = 0;
+    for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
+      Vec3 lo, hi;
+      m.box(i, lo, hi);
+      const auto inside = [&](const Vec3& p) {
+        return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+      };
+      const auto& n = nodes[static_cast<std::size_t>(i)];
+      if (n.is_leaf()) {
+        ++leaves;
+        for (int t = 0; t < n.count; ++t) {
+          const Tri& tri =
+              m.triangle(m.triangle_order()[static_cast<std::size_t>(n.first_or_right + t)]);
+          for (const auto v : tri)
+            ASSERT_TRUE(inside(m.vertex(static_cast<int>(v)))) << "scale 2^" << k << " leaf " << i;
+        }
+      } else {
+        for (const int c : {i + 1, static_cast<int>(n.first_or_right)}) {
+          Vec3 clo, chi;
+          m.box(c, clo, chi);
+          ASSERT_TRUE(inside(clo) && inside(chi)) << "scale 2^" << k << " node " << i;
+        }
+      }
+    }
+    // Equal halves (the larger on the right) down to at most kLeafSize.
+    const std::function<int(int)> leaf_count = [&](int n) {
+      return n <= TriangleMesh::kLeafSize ? 1 : leaf_count(n / 2) + leaf_count(n - n / 2);
+    };
+    EXPECT_EQ(leaves, leaf_count(count)) << "scale 2^" << k;
+    EXPECT_EQ(nodes.size(), static_cast<std::size_t>(2 * leaf_count(count) - 1)) << "scale 2^" << k;
+  }
+}
+
 // --- 3. brute force against the exact referee ----------------------------------
 
 TEST(MeshDistanceExact, BruteForceMatchesRationalReferee) {
@@ -327,6 +377,20 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
     const double d = exact_sqrt(exact.distance_squared, 0);
     ASSERT_LE(std::abs(fast - d), 1e-12 * d + 64 * kU * 2.0)
         << "trial " << trial << ": fast " << fast << " exact " << d;
+    // With a bound (the traversal passes its running limit): below the
+    // bound the answer is the distance; at or above it, the pair is at
+    // least that far. Bounds below, near and above the distance.
+    for (const double factor : {0.25, 0.999, 1.001, 4.0}) {
+      const double bound = factor * d * d;
+      const double bounded = detail::triangle_distance_squared(a, b, tol, bound);
+      if (bounded < bound) {
+        ASSERT_LE(std::abs(std::sqrt(bounded) - d), 1e-12 * d + 64 * kU * 2.0)
+            << "trial " << trial << " bound " << factor << ": " << std::sqrt(bounded);
+      } else {
+        ASSERT_GE(d, std::sqrt(bound) - (1e-12 * d + 64 * kU * 2.0))
+            << "trial " << trial << " bound " << factor << ": reported beyond the bound";
+      }
+    }
     zero += d == 0.0 ? 1 : 0;
     degenerate += (!a.planar || !b.planar) ? 1 : 0;
   }
@@ -351,6 +415,44 @@ TEST(MeshDistanceTraversal, MatchesBruteForceOnRandomSoupsAndPoses) {
     }
     EXPECT_LE(r.pairs_tested, brute.pairs_tested);
   }
+}
+
+// The best-first traversal with its leaf-box culling and bounded kernel at
+// any scale, on soups of large slanted triangles (many overlapping boxes,
+// where pruning is hardest): the same distance as every pair, a lower bound
+// below the exact distance, within the standard of the rational referee.
+TEST(MeshDistanceTraversal, MatchesBruteForceAtAnyScale) {
+  Rng rng(23);
+  int separated = 0, intersecting = 0;
+  for (const int k : {-996, -500, -60, 0, 60, 500, 990}) {
+    for (int trial = 0; trial < 6; ++trial) {
+      MeshData a = random_soup(rng, 30, 6.0, 2.5);
+      MeshData b = random_soup(rng, 14, 3.0, 2.0);
+      const Pose pb = random_pose(rng, 12);
+      for (Vec3& v : b.vertices) v = pb.apply(v);  // B placed in the world as given
+      for (MeshData* m : {&a, &b})
+        for (Vec3& v : m->vertices)
+          v = Vec3(std::ldexp(v.x(), k), std::ldexp(v.y(), k), std::ldexp(v.z(), k));
+      const TriangleMesh ma = a.build(), mb = b.build();
+      const MeshResult r = distance(ma, Pose(), mb, Pose());
+      const MeshResult brute = distance_all_pairs(ma, Pose(), mb, Pose());
+      const std::string where = "scale 2^" + std::to_string(k) + " trial " + std::to_string(trial);
+      ASSERT_EQ(r.status, brute.status) << where;
+      ASSERT_TRUE(std::isfinite(r.distance)) << where;
+      if (brute.status == Status::intersecting) {
+        ++intersecting;
+        continue;
+      }
+      ++separated;
+      EXPECT_EQ(r.distance, brute.distance) << where;
+      if (separated > 4) continue;  // the rational referee on the first ones (its time)
+      const double exact = exact_sqrt(exact_distance_squared(a, b), k);
+      expect_standard(r.distance, exact, std::max(max_coordinate(a), max_coordinate(b)), where);
+      EXPECT_LE(r.lower_bound, exact) << where;
+    }
+  }
+  EXPECT_GT(separated, 10);  // both kinds are in the set
+  EXPECT_GT(intersecting, 3);
 }
 
 TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
