@@ -430,10 +430,18 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
 
   // Tracked: the candidate pairs are enough while B moved less than the
   // margin since they were collected (see MeshCache).
+  // A list that did not pay delays the next collections (MeshCache).
+  const auto list_failed = [&] {
+    cache->list_backoff = static_cast<std::uint8_t>(std::min(2 * cache->list_backoff + 1, 32));
+    cache->list_wait = cache->list_backoff;
+  };
   if (same_pair && !cache->near.empty()) {
     const double moved =
         motion_bound(b, cache->rotation, cache->translation, q.rotation, q.translation);
+    if (!(moved + unscaled_slack <= cache->margin) && cache->list_uses == 0) list_failed();
     if (moved + unscaled_slack <= cache->margin) {
+      cache->list_uses = static_cast<std::uint16_t>(std::min(cache->list_uses + 1, 0xffff));
+      cache->list_backoff = 0;
       for (const auto& pair : cache->near) {
         test_pair(q, a_triangle(q, pair[0]), b_triangle(q, pair[1]), best, tested,
                   std::sqrt(best.d2) + slack_s);
@@ -464,8 +472,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
 
   // The margin of a new candidate list (scaled), 0 for none.
   double margin = 0.0;
-  if (cache != nullptr && same_pair && std::isfinite(last_step) &&
-      kMarginSteps * last_step <= kMarginRadiusFraction * b_radius(b)) {
+  if (cache != nullptr && same_pair && cache->list_wait > 0) {
+    --cache->list_wait;
+  } else if (cache != nullptr && same_pair && std::isfinite(last_step) &&
+             kMarginSteps * last_step <= kMarginRadiusFraction * b_radius(b)) {
     margin = std::max(kMarginSteps * last_step, 4.0 * unscaled_slack) * q.factor;
   }
   struct Candidate {
@@ -650,6 +660,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
       for (const Candidate& c : candidates)
         if (c.d2 <= keep * keep) cache->near.push_back({c.ta, c.tb});
       if (cache->near.size() <= kNearCapacity) {
+        cache->list_uses = 0;
         cache->base_distance = std::ldexp(std::sqrt(best.d2), q.exponent);
         cache->margin = std::ldexp(margin, q.exponent);
         cache->rotation = q.rotation;
@@ -657,7 +668,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
         cache->inside = inside ? 1 : 0;
       } else {
         cache->near.clear();
+        list_failed();
       }
+    } else if (margin > 0.0 && overflow) {
+      list_failed();
     }
   }
   return r;

@@ -172,6 +172,13 @@ struct MeshCache {
   // a surface inside the other's closed mesh); valid while the motion is
   // below base_distance.
   std::int8_t inside = -1;
+  // Collecting a list costs a wider search; when lists do not pay (too many
+  // pairs within the margin, or the motion outran the margin before the
+  // list was used once), the next collections wait `list_wait` queries, a
+  // wait that doubles with each failure (up to 32) and ends with a use.
+  std::uint16_t list_uses = 0;  // queries the current list has answered
+  std::uint8_t list_backoff = 0;
+  std::uint8_t list_wait = 0;
 
   bool is_cold() const { return triangle_a < 0; }
   void reset() { *this = MeshCache{}; }
