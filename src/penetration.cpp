@@ -50,6 +50,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 
 #include "power_of_two.h"
@@ -80,9 +81,9 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 constexpr double kTieUlps = 64.0;
 
 struct Arc {
-  Vec3 p, q;               // unit endpoints
-  Vec3 k;                  // axis: p x q along +k
-  double tolerance = 0.0;  // kArcTolerance |k|
+  Vec3 p, q;         // unit endpoints
+  Vec3 k;            // axis: p x q along +k
+  double tolerance;  // kArcTolerance |k| (no initializer: see add_edge_candidates_walk)
 };
 
 bool arcs_may_cross(const Arc& x, const Arc& y) {
@@ -105,9 +106,9 @@ struct Query {
   Vec3 translation;  // scaled
   double inverse = 1.0;
   double unit = 1.0;
-  double magnitude = 0.0;       // R, unscaled
-  std::vector<Vec3> normals_a;  // outward unit face normals of A
-  std::vector<Vec3> normals_b;  // of -B in A's frame: -(rotation n)
+  double magnitude = 0.0;           // R, unscaled
+  std::span<const Vec3> normals_a;  // outward unit face normals of A (the shapes')
+  std::vector<Vec3> normals_b;      // of -B in A's frame: -(rotation n)
   // Pruning (cold fast path only): the centroids (scaled, A's frame) and
   // the radii of balls about them inside the hulls (0 for flat hulls), so
   // that h_X(n) >= n.centroid_X + inradius_X for every unit n.
@@ -143,7 +144,7 @@ struct Query {
       shapes.inradius_a = inradius(a, shapes.normals_a);
       shapes.inradius_b = inradius(b, shapes.normals_b);
     }
-    normals_a = shapes.normals_a;
+    normals_a = shapes.normals_a;  // a view: the shapes outlive the query
     normals_b.resize(shapes.normals_b.size());
     for (std::size_t g = 0; g < normals_b.size(); ++g)
       normals_b[g] = -(rotation * shapes.normals_b[g]);
@@ -426,8 +427,12 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   // (an arc read backwards is the same arc for the crossing test).
   const bool memo = q.b.dimension() == 3;
   const auto offsets = q.b.adjacency_offsets();
-  std::vector<Arc> slot_arc(memo ? q.b.adjacency().size() : 0);
-  std::vector<char> slot_ready(slot_arc.size(), 0);
+  // Storage only (not value-initialized): with pruning a query reads a
+  // few of B's slots, and writing all of them (80 bytes each) was a tenth
+  // of a cold query at N = 4096 (page faults of the fresh allocation).
+  const std::size_t slots = memo ? q.b.adjacency().size() : 0;
+  const std::unique_ptr<Arc[]> slot_arc = std::make_unique_for_overwrite<Arc[]>(slots);
+  std::vector<char> slot_ready(slots, 0);
   for (const auto& e : q.a.edges()) {
     const int nx = arcs_of_a(q, e[0], e[1], xs);
     if (q.prune && nx > 0) {
