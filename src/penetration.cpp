@@ -654,11 +654,9 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
           static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
 }
 
-// Builds the tree over cache.facets[begin, end) (PenetrationCache::Node),
-// its node at `at` (already allocated): split at the median of the normals'
-// coordinate of largest spread. Depth O(log entries), O(entries log
-// entries) work.
-void build_node(PenetrationCache& cache, int at, int begin, int end) {
+// Fills node `at` (already allocated) over cache.facets[begin, end): the
+// ball around their normals and their least offset; not split.
+void make_node(PenetrationCache& cache, int at, int begin, int end) {
   const auto first = cache.facets.begin() + begin;
   const auto last = cache.facets.begin() + end;
   Vec3 lo = first->normal, hi = first->normal;
@@ -674,19 +672,30 @@ void build_node(PenetrationCache& cache, int at, int begin, int end) {
   // Rounded up: the norm is within a few u of the exact one (normals are
   // unit, so |n - c| <= 2), and the query adds its own slack.
   radius = radius * (1.0 + 0x1p-48) + 0x1p-48;
-  {
-    PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
-    node.center = center;
-    node.radius = radius;
-    node.least_offset = least;
-    node.begin = begin;
-    node.end = end;
-    node.left = -1;
+  PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
+  node.center = center;
+  node.radius = radius;
+  node.least_offset = least;
+  node.begin = begin;
+  node.end = end;
+  node.left = -1;
+}
+
+// Splits node `at` (more than kLeaf faces, no children yet) at the median
+// of its normals' coordinate of largest spread: O(its faces). Children
+// come after their parent in nodes.
+void split_node(PenetrationCache& cache, int at) {
+  const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+  const auto first = cache.facets.begin() + node.begin;
+  const auto last = cache.facets.begin() + node.end;
+  Vec3 lo = first->normal, hi = first->normal;
+  for (auto f = first; f != last; ++f) {
+    lo = lo.cwiseMin(f->normal);
+    hi = hi.cwiseMax(f->normal);
   }
-  if (end - begin <= PenetrationCache::kLeaf) return;
   int axis = 0;
   (hi - lo).maxCoeff(&axis);
-  const int middle = begin + (end - begin) / 2;
+  const int middle = node.begin + (node.end - node.begin) / 2;
   std::nth_element(first, cache.facets.begin() + middle, last,
                    [axis](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
                      return x.normal[axis] < y.normal[axis];
@@ -694,24 +703,17 @@ void build_node(PenetrationCache& cache, int at, int begin, int end) {
   const int left = static_cast<int>(cache.nodes.size());
   cache.nodes.resize(cache.nodes.size() + 2);
   cache.nodes[static_cast<std::size_t>(at)].left = left;
-  build_node(cache, left, begin, middle);
-  build_node(cache, left + 1, middle, end);
+  make_node(cache, left, node.begin, middle);
+  make_node(cache, left + 1, middle, node.end);
 }
 
-// The tree over all cached faces (reordering them), and `last` the least
-// offset's face (the enumeration's answer: the offsets are still the
-// enumeration's).
+// The tree's root over all cached faces (the searches split it).
 void build_tree(PenetrationCache& cache) {
   cache.nodes.clear();
-  cache.last = -1;
   if (cache.facets.empty()) return;
   cache.nodes.reserve(4 * cache.facets.size() / PenetrationCache::kLeaf + 2);
   cache.nodes.resize(1);
-  build_node(cache, 0, 0, static_cast<int>(cache.facets.size()));
-  cache.last = 0;
-  for (std::size_t i = 1; i < cache.facets.size(); ++i)
-    if (cache.facets[i].offset < cache.facets[static_cast<std::size_t>(cache.last)].offset)
-      cache.last = static_cast<std::int32_t>(i);
+  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()));
 }
 
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
@@ -775,7 +777,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     // enumerates every query, never pays for it); until then `last` is the
     // answer's face.
     cache->nodes.clear();
-    cache->last = static_cast<std::int32_t>(best - candidates.begin());
+    cache->last = cache->facets[static_cast<std::size_t>(best - candidates.begin())];
   }
   return r;
 }
@@ -806,22 +808,23 @@ void re_anchor(PenetrationCache& cache, const Vec3& t) {
 }
 
 // A translation-only tracked query: the least of the cached faces' offsets
-// moved by -n.delta (delta = B's translation since the enumeration, |delta|
-// = `moved`), by branch and bound on the tree (PenetrationCache::Node),
-// starting from the last answer's face. A node is skipped when its bound
-// (least offset less the most any of its normals can gain, c.delta + rho
-// |delta| and at most |delta|, rounded up) is at least the best value
-// found: every face skipped has a value at least the best (up to the
-// rounding of the values themselves, which the certificate's slack
-// covers). Returns the best face's index, its value in `best` and the
-// faces and nodes visited in `work`.
-int search_tree(const PenetrationCache& cache, const Vec3& delta, double moved, double& best,
-                int& work) {
+// moved by -n.delta (delta = B's translation since the anchor, |delta| =
+// `moved`), by branch and bound on the tree (PenetrationCache::Node),
+// starting from the last answer's face (its value from the enumeration's
+// offset: `enumerated_delta` = B's translation since the enumeration). A
+// node is skipped when its bound (least offset less the most any of its
+// normals can gain, c.delta + rho |delta| and at most |delta|, rounded up)
+// is at least the best value found: every face skipped has a value at
+// least the best (up to the rounding of the values themselves, which the
+// certificate's slack covers). A node not split yet is split when the
+// search descends into it. Returns the best face, its value in `best` and
+// the faces and nodes visited in `work`.
+PenetrationCache::Facet search_tree(PenetrationCache& cache, const Vec3& delta, double moved,
+                                    const Vec3& enumerated_delta, double& best, int& work) {
   // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
   const double gain_slack = 0x1p-44 * moved;
-  int arg = cache.last;
-  const PenetrationCache::Facet& start = cache.facets[static_cast<std::size_t>(arg)];
-  best = start.offset - start.normal.dot(delta);
+  PenetrationCache::Facet winner = cache.last;
+  best = winner.enumerated_offset - winner.normal.dot(enumerated_delta);
   work = 1;
   const auto bound = [&](const PenetrationCache::Node& node) {
     const double gain = std::min(moved, node.center.dot(delta) + node.radius * moved);
@@ -833,10 +836,17 @@ int search_tree(const PenetrationCache& cache, const Vec3& delta, double moved, 
   int top = 0;
   stack[static_cast<std::size_t>(top++)] = 0;
   while (top > 0) {
-    const PenetrationCache::Node& node =
-        cache.nodes[static_cast<std::size_t>(stack[static_cast<std::size_t>(--top)])];
+    const int at = stack[static_cast<std::size_t>(--top)];
+    // A copy: splitting appends to nodes.
+    PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
     ++work;
     if (!(bound(node) < best)) continue;
+    if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf) {
+      // Not counted in `work`: a split is done once per enumeration (a
+      // re-anchor keeps it), and counting it would re-anchor sooner.
+      split_node(cache, at);
+      node = cache.nodes[static_cast<std::size_t>(at)];
+    }
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
@@ -844,7 +854,7 @@ int search_tree(const PenetrationCache& cache, const Vec3& delta, double moved, 
         ++work;
         if (value < best) {
           best = value;
-          arg = i;
+          winner = f;
         }
       }
       continue;
@@ -861,7 +871,7 @@ int search_tree(const PenetrationCache& cache, const Vec3& delta, double moved, 
       if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
     }
   }
-  return arg;
+  return winner;
 }
 
 }  // namespace
@@ -892,10 +902,11 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     const double pruned_cut = cache.pruned - moved;
     double best = 0.0;
     int work = 0;
-    const int arg = search_tree(cache, b_in_a.translation - cache.translation,
-                                distance(cache.translation), best, work);
+    const PenetrationCache::Facet f =
+        search_tree(cache, b_in_a.translation - cache.translation, distance(cache.translation),
+                    b_in_a.translation - cache.enumerated_translation, best, work);
     if (best <= pruned_cut) {
-      cache.last = arg;
+      cache.last = f;
       cache.search_work += work;
       if (cache.search_work > static_cast<std::int64_t>(cache.facets.size())) {
         // Certified, but the searches since the anchor cost as much as
@@ -903,7 +914,6 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
         re_anchor(cache, b_in_a.translation);
         work += static_cast<int>(cache.facets.size() + cache.nodes.size());
       }
-      const PenetrationCache::Facet f = cache.facets[static_cast<std::size_t>(arg)];
       // The winner evaluated with true supports (they do not move under a
       // translation: the cached ones are checked by one hill-climbing step).
       Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
@@ -915,16 +925,14 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     // bodies' radii: a B that jumps keeps pruning.
     cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved),
                                   0.5 * (a.bounding_radius() + b.bounding_radius()));
-    cache.last = arg;
+    cache.last = f;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
   // the fewer faces kept, the faster).
   const bool has_start = same_polytopes && !cache.facets.empty();
   if (has_start && cache.rotation != b_in_a.rotation) cache.prune_margin *= 0.5;
-  const PenetrationCache::Facet start =
-      has_start ? cache.facets[static_cast<std::size_t>(std::max(cache.last, 0))]
-                : PenetrationCache::Facet{};
+  const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
   return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr);
 }
 

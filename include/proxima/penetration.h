@@ -167,8 +167,10 @@ struct PenetrationCache {
   };
   // A node of the tree over facets[begin, end): the ball |n - center| <=
   // radius holds their normals (radius rounded up), least_offset the least
-  // of their offsets; children (two, at `left` and `left` + 1) or a leaf
-  // (left = -1). nodes[0] is the root.
+  // of their offsets; children (two, at `left` and `left` + 1) or none yet
+  // (left = -1: a leaf of at most kLeaf faces, or a node not split yet:
+  // a search splits the nodes it descends into, so the tree is only as
+  // deep as the searches went). nodes[0] is the root.
   struct Node {
     Vec3 center = Vec3::Zero();
     double radius = 0.0;
@@ -191,8 +193,9 @@ struct PenetrationCache {
   // All faces of A - B found, in tree order, and the tree.
   std::vector<Facet> facets;
   std::vector<Node> nodes;
-  // The facet of the last answer (its index in facets), or -1.
-  std::int32_t last = -1;
+  // The facet of the last answer (a copy: the tree reorders facets while
+  // it is built, lazily, by the searches that descend into it).
+  Facet last;
   // Least lower bound of the faces the enumeration pruned (not in facets),
   // at the enumeration's translation; +infinity when none.
   double pruned = 0.0;
