@@ -27,7 +27,8 @@
 // so far are not evaluated, which leaves the faces near the answer.
 // Tracking (penetration_depth): under a translation of B the faces of M
 // only translate, so the cache keeps them with their offsets and a query
-// scans the nearest (scan); see PenetrationCache.
+// searches them by branch and bound on a tree over their normals
+// (search_tree); see PenetrationCache.
 //
 // Arcs. For a directed edge v -> w of a solid with the face L on its left
 // and R on its right (outward normals nL, nR), nL x nR points along +(w - v)
@@ -49,6 +50,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 
 #include "power_of_two.h"
@@ -79,9 +81,9 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 constexpr double kTieUlps = 64.0;
 
 struct Arc {
-  Vec3 p, q;               // unit endpoints
-  Vec3 k;                  // axis: p x q along +k
-  double tolerance = 0.0;  // kArcTolerance |k|
+  Vec3 p, q;         // unit endpoints
+  Vec3 k;            // axis: p x q along +k
+  double tolerance;  // kArcTolerance |k| (no initializer: see add_edge_candidates_walk)
 };
 
 bool arcs_may_cross(const Arc& x, const Arc& y) {
@@ -104,9 +106,9 @@ struct Query {
   Vec3 translation;  // scaled
   double inverse = 1.0;
   double unit = 1.0;
-  double magnitude = 0.0;       // R, unscaled
-  std::vector<Vec3> normals_a;  // outward unit face normals of A
-  std::vector<Vec3> normals_b;  // of -B in A's frame: -(rotation n)
+  double magnitude = 0.0;           // R, unscaled
+  std::span<const Vec3> normals_a;  // outward unit face normals of A (the shapes')
+  std::vector<Vec3> normals_b;      // of -B in A's frame: -(rotation n)
   // Pruning (cold fast path only): the centroids (scaled, A's frame) and
   // the radii of balls about them inside the hulls (0 for flat hulls), so
   // that h_X(n) >= n.centroid_X + inradius_X for every unit n.
@@ -142,7 +144,7 @@ struct Query {
       shapes.inradius_a = inradius(a, shapes.normals_a);
       shapes.inradius_b = inradius(b, shapes.normals_b);
     }
-    normals_a = shapes.normals_a;
+    normals_a = shapes.normals_a;  // a view: the shapes outlive the query
     normals_b.resize(shapes.normals_b.size());
     for (std::size_t g = 0; g < normals_b.size(); ++g)
       normals_b[g] = -(rotation * shapes.normals_b[g]);
@@ -425,8 +427,12 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   // (an arc read backwards is the same arc for the crossing test).
   const bool memo = q.b.dimension() == 3;
   const auto offsets = q.b.adjacency_offsets();
-  std::vector<Arc> slot_arc(memo ? q.b.adjacency().size() : 0);
-  std::vector<char> slot_ready(slot_arc.size(), 0);
+  // Storage only (not value-initialized): with pruning a query reads a
+  // few of B's slots, and writing all of them (80 bytes each) was a tenth
+  // of a cold query at N = 4096 (page faults of the fresh allocation).
+  const std::size_t slots = memo ? q.b.adjacency().size() : 0;
+  const std::unique_ptr<Arc[]> slot_arc = std::make_unique_for_overwrite<Arc[]>(slots);
+  std::vector<char> slot_ready(slots, 0);
   for (const auto& e : q.a.edges()) {
     const int nx = arcs_of_a(q, e[0], e[1], xs);
     if (q.prune && nx > 0) {
@@ -648,21 +654,66 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
           static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
 }
 
-// Sorts the kSorted nearest cached faces to the front.
-void sort_prefix(PenetrationCache& cache) {
-  const auto by_offset = [](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
-    return x.offset < y.offset;
-  };
-  const std::size_t k =
-      std::min(std::max<std::size_t>(PenetrationCache::kSorted, cache.facets.size() / 16),
-               cache.facets.size());
-  std::nth_element(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k),
-                   cache.facets.end(), by_offset);
-  std::sort(cache.facets.begin(), cache.facets.begin() + static_cast<std::ptrdiff_t>(k), by_offset);
-  cache.sorted = static_cast<int>(k);
-  cache.rest = std::numeric_limits<double>::infinity();
-  for (std::size_t i = k; i < cache.facets.size(); ++i)
-    cache.rest = std::min(cache.rest, cache.facets[i].offset);
+// Fills node `at` (already allocated) over cache.facets[begin, end): the
+// ball around their normals and their least offset; not split.
+void make_node(PenetrationCache& cache, int at, int begin, int end) {
+  const auto first = cache.facets.begin() + begin;
+  const auto last = cache.facets.begin() + end;
+  Vec3 lo = first->normal, hi = first->normal;
+  double least = first->offset;
+  for (auto f = first; f != last; ++f) {
+    lo = lo.cwiseMin(f->normal);
+    hi = hi.cwiseMax(f->normal);
+    least = std::min(least, f->offset);
+  }
+  const Vec3 center = 0.5 * (lo + hi);
+  double radius = 0.0;
+  for (auto f = first; f != last; ++f) radius = std::max(radius, (f->normal - center).norm());
+  // Rounded up: the norm is within a few u of the exact one (normals are
+  // unit, so |n - c| <= 2), and the query adds its own slack.
+  radius = radius * (1.0 + 0x1p-48) + 0x1p-48;
+  PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
+  node.center = center;
+  node.radius = radius;
+  node.least_offset = least;
+  node.begin = begin;
+  node.end = end;
+  node.left = -1;
+}
+
+// Splits node `at` (more than kLeaf faces, no children yet) at the median
+// of its normals' coordinate of largest spread: O(its faces). Children
+// come after their parent in nodes.
+void split_node(PenetrationCache& cache, int at) {
+  const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+  const auto first = cache.facets.begin() + node.begin;
+  const auto last = cache.facets.begin() + node.end;
+  Vec3 lo = first->normal, hi = first->normal;
+  for (auto f = first; f != last; ++f) {
+    lo = lo.cwiseMin(f->normal);
+    hi = hi.cwiseMax(f->normal);
+  }
+  int axis = 0;
+  (hi - lo).maxCoeff(&axis);
+  const int middle = node.begin + (node.end - node.begin) / 2;
+  std::nth_element(first, cache.facets.begin() + middle, last,
+                   [axis](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
+                     return x.normal[axis] < y.normal[axis];
+                   });
+  const int left = static_cast<int>(cache.nodes.size());
+  cache.nodes.resize(cache.nodes.size() + 2);
+  cache.nodes[static_cast<std::size_t>(at)].left = left;
+  make_node(cache, left, node.begin, middle);
+  make_node(cache, left + 1, middle, node.end);
+}
+
+// The tree's root over all cached faces (the searches split it).
+void build_tree(PenetrationCache& cache) {
+  cache.nodes.clear();
+  if (cache.facets.empty()) return;
+  cache.nodes.reserve(4 * cache.facets.size() / PenetrationCache::kLeaf + 2);
+  cache.nodes.resize(1);
+  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()));
 }
 
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
@@ -711,6 +762,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     cache->fingerprint = fingerprint(q.a, q.b);
     cache->rotation = b_in_a.rotation;
     cache->translation = b_in_a.translation;
+    cache->search_work = 0;
     cache->facets.resize(candidates.size());
     for (std::size_t i = 0; i < candidates.size(); ++i)
       cache->facets[i] = {candidates[i].id,
@@ -721,52 +773,105 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
                           candidates[i].support_b};
     cache->enumerated_translation = b_in_a.translation;
     cache->pruned = q.pruned * q.unit;
-    cache->scan_work = 0;
-    sort_prefix(*cache);
+    // The tree is built by the first tracked query (a rotating B, which
+    // enumerates every query, never pays for it); until then `last` is the
+    // answer's face.
+    cache->nodes.clear();
+    cache->last = cache->facets[static_cast<std::size_t>(best - candidates.begin())];
   }
   return r;
 }
 
-// Re-anchors the cache at translation t: every offset moves by -n.(t - t_ref)
-// (the facets of A - B translate with B), and the nearest are sorted again.
+// Moves the anchor to translation t: every offset moved by -n.(t -
+// t_enumeration) from the enumeration's (one rounding each, however many
+// re-anchors), and the nodes' least offsets again, children before parents
+// (they come after them in nodes).
 void re_anchor(PenetrationCache& cache, const Vec3& t) {
-  // From the enumeration's offsets, not the last reference's: one rounding
-  // per offset however many re-anchors.
   const Vec3 delta = t - cache.enumerated_translation;
   for (PenetrationCache::Facet& f : cache.facets)
     f.offset = f.enumerated_offset - f.normal.dot(delta);
-  cache.translation = t;
-  cache.scan_work = 0;
-  sort_prefix(cache);
-}
-
-// A translation-only tracked query: the cached facets at their offsets
-// moved by -n.delta, nearest first, until the next one cannot beat the best
-// found (its offset at the reference minus |delta| is a lower bound on its
-// offset now: |n.delta| <= |delta|), and the faces the enumeration pruned
-// at least `pruned_cut` (their least lower bound less the distance moved
-// since the enumeration). Returns the best cached facet, or -1 when that
-// does not certify it (re-anchor, or enumerate, then).
-int scan(const PenetrationCache& cache, const Vec3& delta, double moved, double pruned_cut,
-         double& best, double& cutoff, int& scanned) {
-  best = std::numeric_limits<double>::infinity();
-  int arg = -1;
-  scanned = 0;
-  for (int i = 0; i < cache.sorted; ++i) {
-    const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
-    if (f.offset - moved >= best) {
-      cutoff = std::min(f.offset - moved, pruned_cut);
-      return best <= cutoff ? arg : -1;
-    }
-    ++scanned;
-    const double value = f.offset - f.normal.dot(delta);
-    if (value < best) {
-      best = value;
-      arg = i;
+  for (std::size_t k = cache.nodes.size(); k-- > 0;) {
+    PenetrationCache::Node& node = cache.nodes[k];
+    if (node.left < 0) {
+      double least = std::numeric_limits<double>::infinity();
+      for (int i = node.begin; i < node.end; ++i)
+        least = std::min(least, cache.facets[static_cast<std::size_t>(i)].offset);
+      node.least_offset = least;
+    } else {
+      node.least_offset =
+          std::min(cache.nodes[static_cast<std::size_t>(node.left)].least_offset,
+                   cache.nodes[static_cast<std::size_t>(node.left) + 1].least_offset);
     }
   }
-  cutoff = std::min(cache.rest - moved, pruned_cut);
-  return best <= cutoff ? arg : -1;
+  cache.translation = t;
+  cache.search_work = 0;
+}
+
+// A translation-only tracked query: the least of the cached faces' offsets
+// moved by -n.delta (delta = B's translation since the anchor, |delta| =
+// `moved`), by branch and bound on the tree (PenetrationCache::Node),
+// starting from the last answer's face (its value from the enumeration's
+// offset: `enumerated_delta` = B's translation since the enumeration). A
+// node is skipped when its bound (least offset less the most any of its
+// normals can gain, c.delta + rho |delta| and at most |delta|, rounded up)
+// is at least the best value found: every face skipped has a value at
+// least the best (up to the rounding of the values themselves, which the
+// certificate's slack covers). A node not split yet is split when the
+// search descends into it. Returns the best face, its value in `best` and
+// the faces and nodes visited in `work`.
+PenetrationCache::Facet search_tree(PenetrationCache& cache, const Vec3& delta, double moved,
+                                    const Vec3& enumerated_delta, double& best, int& work) {
+  // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
+  const double gain_slack = 0x1p-44 * moved;
+  PenetrationCache::Facet winner = cache.last;
+  best = winner.enumerated_offset - winner.normal.dot(enumerated_delta);
+  work = 1;
+  const auto bound = [&](const PenetrationCache::Node& node) {
+    const double gain = std::min(moved, node.center.dot(delta) + node.radius * moved);
+    return node.least_offset - gain - gain_slack;
+  };
+  // Depth-first, nearer child first; the stack holds at most one sibling
+  // per level (depth <= 2 log2(entries)).
+  std::array<std::int32_t, 128> stack;
+  int top = 0;
+  stack[static_cast<std::size_t>(top++)] = 0;
+  while (top > 0) {
+    const int at = stack[static_cast<std::size_t>(--top)];
+    // A copy: splitting appends to nodes.
+    PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+    ++work;
+    if (!(bound(node) < best)) continue;
+    if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf) {
+      // Not counted in `work`: a split is done once per enumeration (a
+      // re-anchor keeps it), and counting it would re-anchor sooner.
+      split_node(cache, at);
+      node = cache.nodes[static_cast<std::size_t>(at)];
+    }
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i) {
+        const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
+        const double value = f.offset - f.normal.dot(delta);
+        ++work;
+        if (value < best) {
+          best = value;
+          winner = f;
+        }
+      }
+      continue;
+    }
+    const int l = node.left;
+    const double bl = bound(cache.nodes[static_cast<std::size_t>(l)]);
+    const double br = bound(cache.nodes[static_cast<std::size_t>(l) + 1]);
+    // Pushed far child first, so that the near one is searched first.
+    if (bl <= br) {
+      if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
+      if (bl < best) stack[static_cast<std::size_t>(top++)] = l;
+    } else {
+      if (bl < best) stack[static_cast<std::size_t>(top++)] = l;
+      if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
+    }
+  }
+  return winner;
 }
 
 }  // namespace
@@ -792,49 +897,42 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     const auto distance = [&](const Vec3& from) {
       return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
     };
-    const double pruned_cut = cache.pruned - distance(cache.enumerated_translation);
-    double best = 0.0, cutoff = 0.0;
-    int scanned = 0;
-    const Vec3 delta = b_in_a.translation - cache.translation;
-    int arg = scan(cache, delta, distance(cache.translation), pruned_cut, best, cutoff, scanned);
-    int work = scanned;
-    if (arg < 0 && best <= pruned_cut) {
-      re_anchor(cache, b_in_a.translation);
-      arg = scan(cache, Vec3::Zero(), 0.0, pruned_cut, best, cutoff, scanned);
-      work += static_cast<int>(cache.facets.size()) + scanned;
-    }
-    if (arg < 0 && best > pruned_cut) {
-      // The pruned faces may be nearer now: enumerate again, keeping more
-      // of them for the translations to come (twice the distance moved
-      // since the enumeration, and at least twice the last margin).
-      // Capped at half the bodies' radii: a B that jumps keeps pruning.
-      cache.prune_margin =
-          std::min(std::max(2.0 * cache.prune_margin, 2.0 * distance(cache.enumerated_translation)),
-                   0.5 * (a.bounding_radius() + b.bounding_radius()));
-    }
-    if (arg >= 0) {
-      const PenetrationCache::Facet f = cache.facets[static_cast<std::size_t>(arg)];
-      cache.scan_work += scanned;
-      if (cache.scan_work > static_cast<std::int64_t>(cache.facets.size())) {
-        // Certified, but the scans since the reference cost as much as a
-        // re-anchor: re-anchor for the next queries (amortized, at most
-        // doubling the work).
+    if (cache.nodes.empty()) build_tree(cache);
+    const double moved = distance(cache.enumerated_translation);
+    const double pruned_cut = cache.pruned - moved;
+    double best = 0.0;
+    int work = 0;
+    const PenetrationCache::Facet f =
+        search_tree(cache, b_in_a.translation - cache.translation, distance(cache.translation),
+                    b_in_a.translation - cache.enumerated_translation, best, work);
+    if (best <= pruned_cut) {
+      cache.last = f;
+      cache.search_work += work;
+      if (cache.search_work > static_cast<std::int64_t>(cache.facets.size())) {
+        // Certified, but the searches since the anchor cost as much as
+        // moving it: move it here for the queries to come.
         re_anchor(cache, b_in_a.translation);
-        work += static_cast<int>(cache.facets.size());
+        work += static_cast<int>(cache.facets.size() + cache.nodes.size());
       }
       // The winner evaluated with true supports (they do not move under a
       // translation: the cached ones are checked by one hill-climbing step).
       Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
-      return finish(q, c, (std::min(best, cutoff) - slack) * q.inverse, work, true);
+      return finish(q, c, (best - slack) * q.inverse, work, true);
     }
+    // The pruned faces may be nearer now: enumerate again, keeping more of
+    // them for the translations to come (twice the distance moved since the
+    // enumeration, and at least twice the last margin). Capped at half the
+    // bodies' radii: a B that jumps keeps pruning.
+    cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved),
+                                  0.5 * (a.bounding_radius() + b.bounding_radius()));
+    cache.last = f;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
   // the fewer faces kept, the faster).
   const bool has_start = same_polytopes && !cache.facets.empty();
   if (has_start && cache.rotation != b_in_a.rotation) cache.prune_margin *= 0.5;
-  const PenetrationCache::Facet start =
-      has_start ? cache.facets.front() : PenetrationCache::Facet{};
+  const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
   return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr);
 }
 

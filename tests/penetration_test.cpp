@@ -542,6 +542,39 @@ TEST(PenetrationTracking, SweepThroughAndBackIsContinuousAndMatchesCold) {
   EXPECT_GE(tracked, steps / 4);  // the cache certified a good part of the sweep
 }
 
+// The tracked query searches a tree over the cached faces' normals with
+// bounds that loosen with the distance from the anchor, and moves the
+// anchor after enough searching (PenetrationCache). A random walk of B
+// with steps from 1e-9 to 0.3 (small ones that stay near the anchor, large
+// ones that cross many faces and trigger re-anchors and re-enumerations),
+// on hulls large enough for a deep tree: every tracked answer equals the
+// slow twin's and its bounds bracket it.
+TEST(PenetrationTracking, RandomWalkMatchesBruteForceThroughReAnchors) {
+  Rng rng(23);
+  const Points a = points_on_sphere(rng, 400);
+  const Points b_local = points_in_cube(rng, 300, 0.6);
+  const ConvexPolytope pa(a), pb(b_local);
+  const Mat3 rotation = random_rotation(rng);
+  PenetrationCache cache;
+  Vec3 t = 0.2 * random_unit_vector(rng);
+  int tracked = 0;
+  const int steps = 600;
+  for (int i = 0; i < steps; ++i) {
+    t += log_uniform(rng, 1e-9, 0.3) * random_unit_vector(rng);
+    if (t.norm() > 1.2) t *= 0.5;  // stay mostly overlapping
+    const Pose pose(rotation, t);
+    const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult slow_twin = penetration_depth_brute_force(pa, pb, pose);
+    const double tol = kContactBandUlps * kUnitRoundoff * 2.0;
+    ASSERT_EQ(r.status, slow_twin.status) << i;
+    ASSERT_NEAR(r.depth, slow_twin.depth, kRel * slow_twin.depth + tol) << i;
+    ASSERT_LE(r.lower_bound, slow_twin.depth + tol) << i;
+    ASSERT_GE(r.upper_bound, slow_twin.depth - tol) << i;
+    tracked += r.tracked;
+  }
+  EXPECT_GE(tracked, steps / 2);
+}
+
 TEST(PenetrationTracking, RotationAndForeignCachesAreNeverWrong) {
   Rng rng(18);
   const Points a1 = points_on_sphere(rng, 60), b1 = points_on_sphere(rng, 40, 0.5);

@@ -126,8 +126,8 @@ struct PenetrationResult {
   Feature feature_a;
   Feature feature_b;
   // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
-  // crossing edge pairs) for a cold query; scanned, plus every cached one
-  // when it re-anchored, for a tracked one.
+  // crossing edge pairs) for a cold query; faces and tree nodes visited,
+  // plus every cached face when it re-anchored, for a tracked one.
   int candidates = 0;
   // True when the cache certified the answer (no enumeration of M).
   bool tracked = false;
@@ -136,46 +136,66 @@ struct PenetrationResult {
 // Coherence between queries of one pair, owned by the caller;
 // default-constructed means cold. It holds every Minkowski face of A - B
 // found by the last enumeration (O(F_A + F_B + crossing edge pairs)
-// entries: not small for large hulls), with their offsets at a reference
-// translation of B. A query reuses it when it comes from the same two
-// polytope objects (addresses, sizes and a few coordinates are checked: a
-// cache of another pair is ignored, at worst making a query cold) and B's
-// rotation is unchanged bit for bit: then the faces of A - B are the cached
-// ones translated, each offset moved by -n.(t - t_ref). The nearest
-// max(kSorted, entries / 16) are kept sorted; a query scans them until the next cannot beat
-// the best (offset at the reference minus |t - t_ref|), and when the
-// sorted prefix does not settle it, re-anchors: every offset is moved to
-// the new translation (O(entries) multiply-adds, no support or Gauss-map
-// work) and the prefix sorted again; so does a query after scans that
-// together cost as much as a re-anchor (amortized: at most twice the work).
-// Offsets are always moved from the enumeration's (one rounding each, however
-// many re-anchors). A rotated B enumerates again.
+// entries: not small for large hulls), with their offsets at the
+// enumeration's translation of B. A query reuses it when it comes from the
+// same two polytope objects (addresses, sizes and a few coordinates are
+// checked: a cache of another pair is ignored, at worst making a query
+// cold) and B's rotation is unchanged bit for bit: then the faces of A - B
+// are the cached ones translated, each offset moved by -n.delta (delta = t
+// - t_enumeration), and the depth is the least of them. The faces are kept
+// in a tree over their normals: each node holds a ball around its faces'
+// normals (centre c, radius rho) and their least offset o, so that every
+// face under it has an offset now of at least o - min(|delta|, c.delta +
+// rho |delta|). A query evaluates the last answer's face first, then
+// descends (nearer child first) into the nodes whose bound is below the
+// best value found: the faces whose normals point away from delta, or
+// whose offsets are far above the depth, are never touched. The bound
+// loosens with |delta|, so offsets are taken at an anchor (delta = t -
+// t_anchor) that moves to the query's translation once the searches since
+// the last move visited as many nodes and faces as there are faces: one
+// pass over the faces and the nodes (the tree over the normals does not
+// change; amortized, at most doubling the work; offsets always moved from
+// the enumeration's, one rounding each). A rotated B enumerates again.
 struct PenetrationCache {
-  // The sorted prefix: at least kSorted faces, and a sixteenth of them.
-  static constexpr int kSorted = 64;
-
   struct Facet {
     MinkowskiFaceId id;
     Vec3 normal = Vec3::UnitX();     // outward unit normal of the face of A - B
-    double offset = 0.0;             // h_A(n) + h_B(-n) at the reference, A's units
+    double offset = 0.0;             // h_A(n) + h_B(-n) at the anchor, A's units
     double enumerated_offset = 0.0;  // the same at the enumeration
     std::int32_t support_a = -1;     // supports along n and -n (they do not
     std::int32_t support_b = -1;     // change under a translation)
   };
+  // A node of the tree over facets[begin, end): the ball |n - center| <=
+  // radius holds their normals (radius rounded up), least_offset the least
+  // of their offsets; children (two, at `left` and `left` + 1) or none yet
+  // (left = -1: a leaf of at most kLeaf faces, or a node not split yet:
+  // a search splits the nodes it descends into, so the tree is only as
+  // deep as the searches went). nodes[0] is the root.
+  struct Node {
+    Vec3 center = Vec3::Zero();
+    double radius = 0.0;
+    double least_offset = 0.0;
+    std::int32_t begin = 0, end = 0;
+    std::int32_t left = -1;
+  };
+  // Faces at most this many to a leaf.
+  static constexpr int kLeaf = 8;
 
   // Identity of the pair the cache was filled for.
   const ConvexPolytope* a = nullptr;
   const ConvexPolytope* b = nullptr;
   std::array<double, 4> fingerprint = {0, 0, 0, 0};
-  // B's pose at the reference, and its translation at the enumeration.
+  // B's rotation, its translation at the anchor (where `offset` and the
+  // nodes' least offsets are taken) and at the enumeration.
   Mat3 rotation = Mat3::Zero();
   Vec3 translation = Vec3::Zero();
   Vec3 enumerated_translation = Vec3::Zero();
-  // All faces of A - B; [0, sorted) ascending by offset, every later one
-  // at least `rest`.
+  // All faces of A - B found, in tree order, and the tree.
   std::vector<Facet> facets;
-  int sorted = 0;
-  double rest = 0.0;
+  std::vector<Node> nodes;
+  // The facet of the last answer (a copy: the tree reorders facets while
+  // it is built, lazily, by the searches that descend into it).
+  Facet last;
   // Least lower bound of the faces the enumeration pruned (not in facets),
   // at the enumeration's translation; +infinity when none.
   double pruned = 0.0;
@@ -190,7 +210,7 @@ struct PenetrationCache {
     std::vector<Vec3> normals_a, normals_b;
     double inradius_a = 0.0, inradius_b = 0.0;
   } shapes;
-  std::int64_t scan_work = 0;  // faces scanned since the last re-anchor
+  std::int64_t search_work = 0;  // nodes and faces visited since the anchor
 
   bool is_cold() const { return a == nullptr; }
   void reset() { *this = PenetrationCache{}; }
@@ -204,7 +224,7 @@ struct PenetrationCache {
 // face of A - B (and every edge of A with all its edge pairs) whose lower
 // bound exceeds the best value found so far, so that only the faces near
 // the answer are evaluated; a tracked query (same pair, same rotation, see
-// PenetrationCache) scans the nearest cached faces. A rotated B enumerates
+// PenetrationCache) searches the cached faces' tree. A rotated B enumerates
 // again (with the cached face normals and the last answer as the first
 // bound). Not thread-safe on one cache; the polytopes may be shared.
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
