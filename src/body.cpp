@@ -392,10 +392,8 @@ BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const P
   // Each piece's placed bounding sphere: the root box's center and half
   // diagonal, placed.
   const auto sphere = [](const Body::MeshOfPiece& m, const Pose& pose) {
-    Vec3 lo, hi;
-    m.mesh->box(0, lo, hi);
-    const Pose placed = pose * m.pose;
-    return std::pair<Vec3, double>(placed.apply(0.5 * (lo + hi)), 0.5 * (hi - lo).norm());
+    return std::pair<Vec3, double>((pose * m.pose).apply(m.mesh->center()),
+                                   m.mesh->bounding_radius());
   };
   MeshResult best;
   bool have = false;

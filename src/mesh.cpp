@@ -334,6 +334,18 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
   for (std::size_t k = 0; k < order_.size(); ++k) order_[k] = builder.items[k].triangle;
 }
 
+Vec3 TriangleMesh::center() const {
+  Vec3 lo, hi;
+  box(0, lo, hi);
+  return 0.5 * (lo + hi);
+}
+
+double TriangleMesh::bounding_radius() const {
+  Vec3 lo, hi;
+  box(0, lo, hi);
+  return 0.5 * (hi - lo).stableNorm();
+}
+
 void TriangleMesh::box(int i, Vec3& lo, Vec3& hi) const {
   const Node& node = nodes_[static_cast<std::size_t>(i)];
   for (int k = 0; k < 3; ++k) {

@@ -464,10 +464,8 @@ struct Scene::Impl {
         scale = b.compound->scale();
       } else {
         const TriangleMesh& mesh = *b.shape->given.mesh();
-        Vec3 lo, hi;
-        mesh.box(0, lo, hi);
-        center_local = 0.5 * (lo + hi);
-        r = 0.5 * (hi - lo).stableNorm();
+        center_local = mesh.center();
+        r = mesh.bounding_radius();
         scale = mesh.scale();
       }
       const auto sphere = [&](const Pose& p) {

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <utility>
 
 #include "proxima/compound.h"
 #include "proxima/support.h"
@@ -209,13 +208,6 @@ class Sweep {
 
 // Bound on the distance of any point of the body (its rounded surface
 // included) from its reference point.
-// A mesh's root box (its frame): center and half diagonal.
-std::pair<Vec3, double> mesh_ball(const TriangleMesh& mesh) {
-  Vec3 lo, hi;
-  mesh.box(0, lo, hi);
-  return {0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()};
-}
-
 double body_reach(const Body& body) {
   switch (body.kind()) {
     case Body::Kind::convex:
@@ -224,10 +216,8 @@ double body_reach(const Body& body) {
       const CompoundBody& c = *body.compound();
       return c.center().stableNorm() + c.bounding_radius() + body.radius();
     }
-    case Body::Kind::mesh: {
-      const auto [center, radius] = mesh_ball(*body.mesh());
-      return center.stableNorm() + radius + body.radius();
-    }
+    case Body::Kind::mesh:
+      return body.mesh()->center().stableNorm() + body.mesh()->bounding_radius() + body.radius();
   }
   return 0.0;
 }
@@ -239,7 +229,7 @@ double body_size(const Body& body) {
     case Body::Kind::compound:
       return body.compound()->bounding_radius() + body.radius();
     case Body::Kind::mesh:
-      return mesh_ball(*body.mesh()).second + body.radius();
+      return body.mesh()->bounding_radius() + body.radius();
   }
   return 0.0;
 }

@@ -99,6 +99,12 @@ class TriangleMesh {
   // standard for the mesh in its own frame.
   double scale() const { return scale_; }
 
+  // A ball holding every vertex (mesh frame): the root box's center and
+  // half diagonal. What sweeps, time of impact and piece pruning bound the
+  // mesh by.
+  Vec3 center() const;
+  double bounding_radius() const;
+
   // The hierarchy: nodes()[0] is the root.
   std::span<const Node> nodes() const { return nodes_; }
   std::span<const std::int32_t> triangle_order() const { return order_; }
