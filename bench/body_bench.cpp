@@ -62,16 +62,19 @@ void BM_Convex(benchmark::State& state) {
   }
 }
 
-void run_body(benchmark::State& state, double radius, double center_distance, bool mixed) {
+void run_body(benchmark::State& state, double radius, double center_distance, bool mixed,
+              bool depth = true) {
   const int n = static_cast<int>(state.range(0));
   const Body a(std::make_shared<const ConvexPolytope>(sphere_points(n, 1)), radius);
   const Body convex_b(std::make_shared<const ConvexPolytope>(sphere_points(n, 2)), radius);
   const Body b = mixed ? Body(convex_b.compound(), radius) : convex_b;
   const std::vector<Pose> poses = sequence(center_distance);
+  DistanceOptions options;
+  options.penetration = depth;
   BodyCache cache;
   std::size_t i = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(distance(a, Pose::identity(), b, poses[i], {}, &cache));
+    benchmark::DoNotOptimize(distance(a, Pose::identity(), b, poses[i], options, &cache));
     i = (i + 1) % poses.size();
   }
 }
@@ -79,6 +82,10 @@ void run_body(benchmark::State& state, double radius, double center_distance, bo
 void BM_BodyConvex(benchmark::State& state) { run_body(state, 0.1, 2.5, false); }
 void BM_BodyOverlap(benchmark::State& state) { run_body(state, 0.8, 2.5, false); }
 void BM_BodyCoreOverlap(benchmark::State& state) { run_body(state, 0.1, 0.6, false); }
+// The cores overlap and the caller skips the depth (a Scene's default).
+void BM_BodyCoreOverlapStatusOnly(benchmark::State& state) {
+  run_body(state, 0.1, 0.6, false, false);
+}
 void BM_BodyMixed(benchmark::State& state) { run_body(state, 0.1, 2.5, true); }
 
 void BM_Capsules(benchmark::State& state) {
@@ -96,6 +103,7 @@ BENCHMARK(BM_Convex)->Arg(16)->Arg(256);
 BENCHMARK(BM_BodyConvex)->Arg(16)->Arg(256);
 BENCHMARK(BM_BodyOverlap)->Arg(16)->Arg(256);
 BENCHMARK(BM_BodyCoreOverlap)->Arg(16)->Arg(256);
+BENCHMARK(BM_BodyCoreOverlapStatusOnly)->Arg(16)->Arg(256);
 BENCHMARK(BM_BodyMixed)->Arg(16)->Arg(256);
 BENCHMARK(BM_Capsules);
 

@@ -222,8 +222,9 @@ void bind_bodies(py::module_& m) {
       "Any two bodies: a ConvexPolytope, a CompoundBody, a TriangleMesh or a Body on either side "
       "(two polytopes "
       "or two compounds take the overloads above). cache: a BodyCache or None. Returns a "
-      "BodyDistance (overlapping cores always get their depth: penetration=False has no effect "
-      "here). A ConvexPolytope met with a compound is wrapped on every call (O(N)): for "
+      "BodyDistance. penetration=False skips the depth of overlapping cores: their signed value "
+      "is then 0 with bounds [-inf, 0] (signed distance minus the radii). A ConvexPolytope met "
+      "with a compound is wrapped on every call (O(N)): for "
       "tracked queries, wrap it once as a Body.");
 }
 

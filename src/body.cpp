@@ -116,6 +116,17 @@ bool needs_depth(const CoreAnswer& c, double radii) {
   return c.status == Status::touching && radii > 0.0 && !(c.lower > 0.0);
 }
 
+// The answer for overlapping cores when the caller skipped the depth
+// (DistanceOptions::penetration false), as for a mesh overlap: signed value
+// 0 with the certificate [-infinity, 0]; points and normal stay the distance
+// query's.
+void without_depth(CoreAnswer& c) {
+  c.value = 0.0;
+  c.lower = -std::numeric_limits<double>::infinity();
+  c.upper = 0.0;
+  c.overlap = true;
+}
+
 // Replaces the answer's value, bounds, points, normal and features by the
 // penetration query's (in the frame `frame_a`), unless it found the cores
 // apart (a disagreement of the two queries at the band's edge): then the
@@ -225,13 +236,17 @@ BodyDistance offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedSt
   return r;
 }
 
+// `depth`: the caller's DistanceOptions::penetration (`options` are the
+// cores' options, without it).
 BodyDistance convex_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
-                         const DistanceOptions& options, BodyCache& cache) {
+                         const DistanceOptions& options, bool depth, BodyCache& cache) {
   const ConvexPolytope& ca = *a.convex();
   const ConvexPolytope& cb = *b.convex();
   CoreAnswer c = from_distance(
       detail::distance_of_rigid_poses(ca, pose_a, cb, pose_b, options, &cache.convex));
-  if (needs_depth(c, a.radius() + b.radius())) {
+  if (!depth) {
+    if (c.status == Status::intersecting) without_depth(c);
+  } else if (needs_depth(c, a.radius() + b.radius())) {
     take_depth(c, penetration_depth(ca, cb, relative(pose_a, pose_b), cache.penetration), pose_a);
   }
   return offset(c, a, b, [&](double value) {
@@ -335,7 +350,7 @@ class DeepestPair {
 };
 
 BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
-                           const DistanceOptions& options, BodyCache& cache) {
+                           const DistanceOptions& options, bool depth, BodyCache& cache) {
   const std::shared_ptr<const CompoundBody> hold_a = a.compound();
   const std::shared_ptr<const CompoundBody> hold_b = b.compound();
   const CompoundBody& ca = *hold_a;
@@ -344,10 +359,12 @@ BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, con
   CoreAnswer c = from_distance(cr);
   c.piece_a = cr.piece_a;
   c.piece_b = cr.piece_b;
-  if (c.status == Status::intersecting) {
+  if (c.status == Status::intersecting && !depth) {
+    without_depth(c);
+  } else if (c.status == Status::intersecting) {
     c.overlap = true;
     DeepestPair(ca, pose_a, cb, pose_b, options).run(c);
-  } else if (needs_depth(c, a.radius() + b.radius())) {
+  } else if (depth && needs_depth(c, a.radius() + b.radius())) {
     const CompoundPiece& piece_a = ca.piece(c.piece_a);
     const CompoundPiece& piece_b = cb.piece(c.piece_b);
     const Pose place_a = pose_a * piece_a.pose;
@@ -565,12 +582,12 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
   DistanceOptions cores = options;
   cores.penetration = false;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
-    return convex_pair(a, pa, b, pb, cores, c);
+    return convex_pair(a, pa, b, pb, cores, options.penetration, c);
   }
   if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
     return mesh_pair(a, pa, b, pb, cores, c);
   }
-  return compound_pair(a, pa, b, pb, cores, c);
+  return compound_pair(a, pa, b, pb, cores, options.penetration, c);
 }
 
 }  // namespace proxima

@@ -341,6 +341,50 @@ TEST(BodyCompound, OverlappingCompoundReportsItsDeepestPiecePair) {
   expect_consistent(r, 2.0);
 }
 
+TEST(BodyDepth, PenetrationOffSkipsTheDepthOfOverlappingCores) {
+  // DistanceOptions::penetration false is a caller's "status only": before,
+  // a Body pair computed the cores' depth whatever it said, so a Scene of
+  // padded bodies (penetration off by default) paid 5 to 60 us per
+  // overlapping pair and step for a depth it then reported. Now the cores'
+  // signed value is 0 with bounds [-inf, 0], as for a mesh overlap, and the
+  // penetration cache stays cold.
+  DistanceOptions status_only;
+  status_only.penetration = false;
+  const Body box = make_box(Vec3(1, 1, 1), 0.25);
+  const Body ball = make_sphere(0.5);
+  const Pose inside = Pose::from_translation(Vec3(0.7, 0.1, 0));
+  BodyCache cache;
+  const BodyDistance r = distance(box, Pose::identity(), ball, inside, status_only, &cache);
+  EXPECT_EQ(r.status, Status::intersecting);
+  EXPECT_TRUE(r.cores_overlap);
+  EXPECT_TRUE(cache.penetration.is_cold());
+  EXPECT_EQ(r.distance, 0.0);
+  EXPECT_DOUBLE_EQ(r.signed_upper_bound(), -0.75);
+  EXPECT_EQ(r.signed_lower_bound(), -std::numeric_limits<double>::infinity());
+  // The default takes the depth: the core point is 0.3 inside the box.
+  const BodyDistance deep = distance(box, Pose::identity(), ball, inside);
+  EXPECT_NEAR(deep.signed_distance(), -0.3 - 0.75, 1e-14);
+  EXPECT_GE(r.signed_upper_bound(), deep.signed_distance());
+
+  // A compound whose pieces overlap the ball's core: no deepest-pair search.
+  std::vector<CompoundPiece> pieces;
+  pieces.push_back({make_box(Vec3(1, 1, 1)).convex(), Pose::from_translation(Vec3(0.8, 0, 0))});
+  pieces.push_back({make_box(Vec3(1, 1, 1)).convex(), Pose::from_translation(Vec3(-0.6, 0, 0))});
+  const Body compound(std::make_shared<const CompoundBody>(std::move(pieces)), 0.1);
+  const BodyDistance c = distance(compound, Pose::identity(), ball, Pose::identity(), status_only);
+  EXPECT_EQ(c.status, Status::intersecting);
+  EXPECT_TRUE(c.cores_overlap);
+  EXPECT_DOUBLE_EQ(c.signed_upper_bound(), -0.6);
+  EXPECT_EQ(c.signed_lower_bound(), -std::numeric_limits<double>::infinity());
+
+  // Cores apart: the option changes nothing.
+  const Pose apart = Pose::from_translation(Vec3(2.0, 0, 0));
+  const BodyDistance far = distance(box, Pose::identity(), ball, apart, status_only);
+  EXPECT_EQ(far.status, Status::separated);  // cores 1 apart, radii 0.75
+  EXPECT_FALSE(far.cores_overlap);
+  EXPECT_NEAR(far.signed_distance(), 1.0 - 0.75, 1e-14);
+}
+
 TEST(BodyCompound, DeepestPairIsTheAllPairsTwins) {
   // Overlapping compounds of a few random pieces: the signed distance is the
   // smallest over every piece pair of the pair's own (minus its brute-force
@@ -405,7 +449,8 @@ TEST(BodyCompound, MixedKindsAgreeWithTheirOnePieceCompounds) {
     const BodyDistance convex = distance(convex_a, pa, convex_b, pb);
     const BodyDistance mixed = distance(convex_a, pa, compound_b, pb);
     EXPECT_EQ(convex.status, mixed.status) << i;
-    EXPECT_NEAR(convex.signed_distance(), mixed.signed_distance(), bound(convex.signed_distance(), 4.0))
+    EXPECT_NEAR(convex.signed_distance(), mixed.signed_distance(),
+                bound(convex.signed_distance(), 4.0))
         << i;
     EXPECT_EQ(mixed.piece_b, 0);
     EXPECT_EQ(mixed.piece_a, -1);

@@ -201,7 +201,11 @@ struct BodyDistance : DistanceResult {
 // the pair's signed distance (the deepest overlapping pair when cores
 // overlap: every piece pair whose bounding spheres meet is then tested,
 // cold). Convex cores that overlap cost a penetration query (tracked
-// through the cache) on top of the distance query.
+// through the cache) on top of the distance query. With
+// options.penetration false that depth is skipped: overlapping cores then
+// have the signed value 0 with certificate [-infinity, 0] (as a mesh
+// overlap), status intersecting, and the distance query's points and normal
+// (which do not separate them).
 BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options = {}, BodyCache* cache = nullptr);
 

@@ -106,11 +106,12 @@ struct CollisionFilter {
 // distance and bounds, points on the padded surfaces, normal, features),
 // piece_a/piece_b its pieces (0 for a convex body, -1 for a mesh),
 // pairs_tested 1, and triangle_a/triangle_b its closest triangles of mesh
-// bodies (-1 for other kinds and for every other pair). The Body query
-// takes the depth of overlapping convex or compound cores whatever
-// SceneOptions::distance.penetration says (signed distance minus the depth
-// minus the radii; 5 to 60 us per such pair and step, as penetration costs
-// plain pairs); an overlap with a mesh has no depth (cores' signed value 0).
+// bodies (-1 for other kinds and for every other pair). Overlapping convex
+// or compound cores get their depth when SceneOptions::distance.penetration
+// is set (signed distance minus the depth minus the radii; 5 to 60 us per
+// such pair and step, as for plain pairs); without it (the default), and
+// for an overlap with a mesh, the cores' signed value is 0 with bounds
+// [-inf, 0] (signed distance minus the radii).
 struct ClosePair {
   BodyId a = -1;
   BodyId b = -1;
