@@ -127,40 +127,82 @@ VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int su
   return set;
 }
 
-// `direction` is n seen from the body (pose.rotation^T n), `turn` |w x n|.
-PlaneBound feature_plane(const ConvexPolytope& body, const Pose& pose, const VertexSet& set,
-                         const Vec3& n, const Vec3& direction, double sign, const Vec3& v,
-                         const Vec3& w, double turn) {
-  PlaneBound out;
-  out.value = -std::numeric_limits<double>::infinity();
-  out.rate = -std::numeric_limits<double>::infinity();
-  double arm = 0.0;
-  for (std::size_t k = 0; k < set.size; ++k) {
-    const Vec3 r = pose.rotation * body.vertex(set.ids[k]);
-    out.value = std::max(out.value, sign * n.dot(pose.translation + r));
-    out.rate = std::max(out.rate, sign * n.dot(v + w.cross(r)));
-    arm = std::max(arm, fast_norm(r));
-  }
-  out.acceleration = w.squaredNorm() * arm;
-  if (!(turn > 0.0)) {
-    out.span = std::numeric_limits<double>::infinity();
-    return out;
-  }
-  double margin = 1.0;
-  for (std::size_t k = 0; k < set.size; ++k) {
-    const Vec3& q = body.vertex(set.ids[k]);
-    for (const std::int32_t y : body.neighbors(set.ids[k])) {
-      if (set.has(y)) continue;
-      const Vec3 edge = q - body.vertex(y);
-      const double length = fast_norm(edge);
-      const double rise = sign * direction.dot(edge);
-      if (length > 0.0 && rise < margin * length) margin = rise / length;
+// The witness feature's plane of one body at one step. Its value, rate and
+// acceleration cost O(|S|) and are computed at once; its span (the margin
+// loop, O(|S| degree |S|)) only when a pair of planes could take a longer
+// step with it than the best found so far (span(floor)), which far from
+// contact (the balls' planes win) is seldom. `direction` is n seen from
+// the body (pose.rotation^T n), `turn` |w x n|.
+class FeaturePlane {
+ public:
+  FeaturePlane(const ConvexPolytope& body, const Pose& pose, const VertexSet& set, const Vec3& n,
+               const Vec3& direction, double sign, const Vec3& v, const Vec3& w, double turn)
+      : body_(&body), set_(set), direction_(direction), sign_(sign), turn_(turn) {
+    // Vertex q at r = R q: n.(t + r) = n.t + (R^T n).q, and its rotation
+    // part moves along n at (w x r).n = r.(n x w) = (R^T (n x w)).q; |r| =
+    // |q|. Dot products with the body's own vertices, no rotation of each.
+    const Vec3 spin = pose.rotation.transpose() * n.cross(w);
+    double top = -std::numeric_limits<double>::infinity();
+    double rise = -std::numeric_limits<double>::infinity();
+    double arm = 0.0;
+    for (std::size_t k = 0; k < set.size; ++k) {
+      const Vec3& q = body.vertex(set.ids[k]);
+      top = std::max(top, sign * direction.dot(q));
+      rise = std::max(rise, sign * spin.dot(q));
+      arm = std::max(arm, fast_norm(q));
     }
+    bound_.value = sign * n.dot(pose.translation) + top;
+    bound_.rate = sign * n.dot(v) + rise;
+    bound_.acceleration = w.squaredNorm() * arm;
+    bound_.span = std::numeric_limits<double>::infinity();
+    if (turn > 0.0) span_ = -1.0;  // not computed yet
   }
-  margin = std::max(0.0, margin * kConeMarginShrink);
-  out.span = margin / turn;
-  return out;
-}
+
+  // value, rate and acceleration (span: see span()).
+  const PlaneBound& bound() const { return bound_; }
+
+  // The span, or 0 when it is at most `floor` (no step through this plane
+  // then beats floor). Computed once: calls come with floors that never
+  // decrease (the best step so far), so a 0 kept from a lower floor still
+  // holds.
+  double span(double floor) {
+    if (span_ >= 0.0) return span_;
+    double margin = 1.0;
+    span_ = kConeMarginShrink / turn_;  // margin <= 1 from here on
+    if (!(span_ > floor)) {
+      span_ = 0.0;
+      return span_;
+    }
+    for (std::size_t k = 0; k < set_.size; ++k) {
+      const Vec3& q = body_->vertex(set_.ids[k]);
+      for (const std::int32_t y : body_->neighbors(set_.ids[k])) {
+        if (set_.has(y)) continue;
+        const Vec3 edge = q - body_->vertex(y);
+        const double length = fast_norm(edge);
+        const double rise = sign_ * direction_.dot(edge);
+        if (length > 0.0 && rise < margin * length) {
+          margin = rise / length;
+          // The span only shrinks from here on.
+          span_ = std::max(0.0, margin * kConeMarginShrink) / turn_;
+          if (!(span_ > floor)) {
+            span_ = 0.0;
+            return span_;
+          }
+        }
+      }
+    }
+    return span_;
+  }
+
+ private:
+  const ConvexPolytope* body_;
+  VertexSet set_;
+  Vec3 direction_;
+  double sign_;
+  double turn_;
+  PlaneBound bound_;
+  double span_ = std::numeric_limits<double>::infinity();  // unbounded without a turn
+};
 
 // The first time in [0, span] at which a gap gap0 closing at `rate` with
 // acceleration at most `acceleration` can reach 0 (gap0 > 0): the smaller
@@ -178,21 +220,37 @@ double first_closing(double gap0, double rate, double acceleration, double span)
   return std::min(t, span);
 }
 
-// A motion with its turn precomputed (Motion::at converts the rotation to
-// an angle and an axis on every call; a time of impact takes poses at a
-// dozen times).
+// A motion with its turn precomputed (Motion::at would convert the rotation
+// to an angle and an axis on every call; a time of impact takes poses at a
+// dozen times). The turn by phi = t angle about the unit axis k is
+// Rodrigues' I + sin(phi) K + (1 - cos(phi)) K^2 (K the cross product
+// matrix of k), so the pose's rotation is R0 + sin(phi) (K R0) +
+// (1 - cos(phi)) (K^2 R0): the two products are made once, and each pose
+// costs one sincos (of phi / 2: sin(phi) = 2 s c and 1 - cos(phi) = 2 s^2,
+// without the cancellation of 1 - cos for small phi) and 18 multiply-adds.
 class Sweep {
  public:
   explicit Sweep(const Motion& m) : motion_(m) {
     const Eigen::AngleAxisd turn(Mat3(m.end.rotation * m.start.rotation.transpose()));
     angle_ = turn.angle();
     axis_ = turn.axis();
+    Mat3 k;
+    k << 0.0, -axis_.z(), axis_.y(), axis_.z(), 0.0, -axis_.x(), -axis_.y(), axis_.x(), 0.0;
+    k_r0_ = k * m.start.rotation;
+    kk_r0_ = k * k_r0_;
   }
   Pose at(double t) const {
     if (t <= 0.0) return motion_.start;
     if (t >= 1.0) return motion_.end;
     Pose p;
-    p.rotation = Eigen::AngleAxisd(t * angle_, axis_).toRotationMatrix() * motion_.start.rotation;
+    if (angle_ > 0.0) {
+      const double half = 0.5 * t * angle_;
+      const double s = std::sin(half);
+      const double c = std::cos(half);
+      p.rotation = motion_.start.rotation + (2.0 * s * c) * k_r0_ + (2.0 * s * s) * kk_r0_;
+    } else {
+      p.rotation = motion_.start.rotation;
+    }
     p.translation =
         motion_.start.translation + t * (motion_.end.translation - motion_.start.translation);
     return p;
@@ -204,6 +262,8 @@ class Sweep {
   Motion motion_;
   double angle_ = 0.0;
   Vec3 axis_ = Vec3::UnitX();
+  Mat3 k_r0_ = Mat3::Zero();
+  Mat3 kk_r0_ = Mat3::Zero();
 };
 
 // Bound on the distance of any point of the body (its rounded surface
@@ -312,22 +372,24 @@ ImpactResult advance(const Sweep& ma, const Sweep& mb, const ImpactOptions& opti
     const Pose pb = mb.at(t);
     const DistanceResult r = query(pa, pb);
     ++out.iterations;
-    out.t = t;
-    out.pose_a = pa;
-    out.pose_b = pb;
-    out.at_t = r;
+    // The answer at t (copied out only when the loop stops there).
+    const auto stop_here = [&](ImpactStatus status) {
+      out.status = status;
+      out.t = t;
+      out.pose_a = pa;
+      out.pose_b = pb;
+      out.at_t = r;
+      return out;
+    };
     if (in_contact(r)) {
       // At t = 0: overlapping when the bodies overlap or are strictly within
       // the offset; touching (or at the offset) is a contact at t = 0.
-      out.status = t == 0.0 && (r.status == Status::intersecting || r.signed_distance() < target)
-                       ? ImpactStatus::overlapping
-                       : ImpactStatus::contact;
-      return out;
+      return stop_here(t == 0.0 &&
+                               (r.status == Status::intersecting || r.signed_distance() < target)
+                           ? ImpactStatus::overlapping
+                           : ImpactStatus::contact);
     }
-    if (out.iterations >= options.max_iterations) {
-      out.status = ImpactStatus::iteration_cap;
-      return out;
-    }
+    if (out.iterations >= options.max_iterations) return stop_here(ImpactStatus::iteration_cap);
     const SafeStep s = safe_step(r, pa, pb);
     if (s.never || t + s.step >= 1.0) {
       // Safe up to the end: the answer at t = 1.
@@ -342,8 +404,7 @@ ImpactResult advance(const Sweep& ma, const Sweep& mb, const ImpactOptions& opti
     if (!(t + s.step > t)) {
       // No safe progress at this precision (bounds within rounding of the
       // target while the distance is not): stop, t is still safe.
-      out.status = ImpactStatus::iteration_cap;
-      return out;
+      return stop_here(ImpactStatus::iteration_cap);
     }
     t += s.step;
   }
@@ -398,7 +459,7 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   // distance of the ball's center from the reference point: a round body
   // turning about its middle approaches at its linear speed only, so far
   // from contact the ball's planes give the longer step; and the support
-  // feature's own plane (feature_plane: the true rates of its vertices
+  // feature's own plane (FeaturePlane: the true rates of its vertices
   // while they hold the support), which gives the longer step near a
   // contact. In any direction: the certified lower bound closes no
   // faster than any_speed. All keep off the contact band of the accuracy
@@ -414,33 +475,51 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     const double turn_b = fast_norm(wb.cross(n));
     const double inf = std::numeric_limits<double>::infinity();
     // A's top along n, and B's bottom as -(min along n): both rising at
-    // `rate` at most bring them closer.
-    const PlaneBound top_a[3] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
+    // `rate` at most bring them closer. The hull's and the ball's planes
+    // have no span limit and no acceleration.
+    const PlaneBound top_a[2] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
                                  {n.dot(pa.apply(a.centroid())) + a.bounding_radius(),
-                                  va.dot(n) + turn_a * lever_a, 0.0, inf},
-                                 feature_plane(a, pa, feature_set(a, r.feature_a, hull.vertex_a), n,
-                                               hull.direction_a, 1.0, va, wa, turn_a)};
-    const PlaneBound bottom_b[3] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
+                                  va.dot(n) + turn_a * lever_a, 0.0, inf}};
+    const PlaneBound bottom_b[2] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
                                     {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()),
-                                     -vb.dot(n) + turn_b * lever_b, 0.0, inf},
-                                    feature_plane(b, pb, feature_set(b, r.feature_b, hull.vertex_b),
-                                                  n, hull.direction_b, -1.0, vb, wb, turn_b)};
-    SafeStep along;
-    for (const PlaneBound& x : top_a) {
-      for (const PlaneBound& y : bottom_b) {
-        const double gap = -y.value - x.value - band - target;
-        if (!(gap > 0.0)) continue;
-        const double step = first_closing(gap, x.rate + y.rate, x.acceleration + y.acceleration,
-                                          std::min(x.span, y.span));
-        if (step == inf) {
-          along.never = true;
-        } else {
-          along.step = std::max(along.step, step);
-        }
+                                     -vb.dot(n) + turn_b * lever_b, 0.0, inf}};
+    SafeStep best = lower_bound_step(r.lower_bound - band, target, any_speed);
+    // The step of planes x and y without their span limit, or 0 when their
+    // gap is already closed.
+    const auto unlimited = [&](const PlaneBound& x, const PlaneBound& y) {
+      const double gap = -y.value - x.value - band - target;
+      if (!(gap > 0.0)) return 0.0;
+      return first_closing(gap, x.rate + y.rate, x.acceleration + y.acceleration, inf);
+    };
+    const auto take = [&](double step) {
+      if (step == inf) {
+        best.never = true;
+      } else {
+        best.step = std::max(best.step, step);
       }
+    };
+    for (const PlaneBound& x : top_a) {
+      for (const PlaneBound& y : bottom_b) take(unlimited(x, y));
     }
-    const SafeStep any = lower_bound_step(r.lower_bound - band, target, any_speed);
-    return SafeStep{std::max(along.step, any.step), along.never || any.never};
+    if (best.never) return best;
+    // The pairs with a feature's plane: its span (costly) only where the
+    // step before the span limit beats the best so far.
+    FeaturePlane feature_a(a, pa, feature_set(a, r.feature_a, hull.vertex_a), n, hull.direction_a,
+                           1.0, va, wa, turn_a);
+    FeaturePlane feature_b(b, pb, feature_set(b, r.feature_b, hull.vertex_b), n, hull.direction_b,
+                           -1.0, vb, wb, turn_b);
+    const PlaneBound& fa = feature_a.bound();
+    const PlaneBound& fb = feature_b.bound();
+    const auto with_span = [&](double step, FeaturePlane* x, FeaturePlane* y) {
+      if (!(step > best.step)) return;
+      if (x != nullptr) step = std::min(step, x->span(best.step));
+      if (y != nullptr) step = std::min(step, y->span(best.step));
+      take(step);
+    };
+    with_span(unlimited(fa, fb), &feature_a, &feature_b);
+    for (const PlaneBound& y : bottom_b) with_span(unlimited(fa, y), &feature_a, nullptr);
+    for (const PlaneBound& x : top_a) with_span(unlimited(x, fb), nullptr, &feature_b);
+    return best;
   };
   return advance(ma, mb, options, tolerance, query, safe_step);
 }

@@ -7,7 +7,6 @@
 // sample before t is in contact, and at t the distance is within the
 // tolerance of the target.
 #include "proxima/time_of_impact.h"
-#include "proxima/mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -21,6 +20,7 @@
 #include "proxima/body.h"
 #include "proxima/compound.h"
 #include "proxima/distance.h"
+#include "proxima/mesh.h"
 #include "proxima/primitives.h"
 #include "support/penetration_oracle.h"
 
@@ -297,6 +297,31 @@ TEST(TimeOfImpact, MotionFromVelocityMatchesItsEndPoses) {
   const Mat3 expected = Eigen::AngleAxisd(0.25, Vec3::UnitZ()).toRotationMatrix() * p.rotation;
   EXPECT_TRUE(half.rotation.isApprox(expected, 1e-14));
   EXPECT_TRUE(m.at(0.0).rotation == p.rotation);
+}
+
+// Motion::at turns by Rodrigues' formula from products made once
+// (src/time_of_impact.cpp Sweep): the same rotation as an angle-axis turn
+// of t times the angle, and rigid to machine precision (within the pose
+// contract's kOrthonormalUlps, so that no step's query re-orthonormalizes
+// it), for turns from 1e-9 rad to a half turn.
+TEST(TimeOfImpact, MotionAtIsTheAngleAxisTurnAndStaysRigid) {
+  std::mt19937 rng(77);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Pose p(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3(g(rng), g(rng), g(rng)));
+    const Vec3 axis = Vec3(g(rng), g(rng), g(rng)).normalized();
+    const double angle = trial % 4 == 0 ? 1e-9 * u(rng) : M_PI * u(rng);
+    const Motion m = Motion::from_velocity(p, Vec3(g(rng), g(rng), g(rng)), angle * axis);
+    for (int i = 1; i < 16; ++i) {
+      const double t = i / 16.0;
+      const Pose at = m.at(t);
+      EXPECT_TRUE(detail::is_rigid(at)) << "trial " << trial << ", t = " << t;
+      const Mat3 expected = Eigen::AngleAxisd(t * angle, axis).toRotationMatrix() * p.rotation;
+      EXPECT_LE((at.rotation - expected).cwiseAbs().maxCoeff(), 1e-14)
+          << "trial " << trial << ", t = " << t;
+    }
+  }
 }
 
 // The exact first time of contact of the hull of `a` (fixed) and the hull of
