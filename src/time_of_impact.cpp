@@ -8,8 +8,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <queue>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "proxima/compound.h"
 #include "proxima/support.h"
@@ -135,12 +140,15 @@ VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int su
 // the body (pose.rotation^T n), `turn` |w x n|.
 class FeaturePlane {
  public:
-  FeaturePlane(const ConvexPolytope& body, const Pose& pose, const VertexSet& set, const Vec3& n,
-               const Vec3& direction, double sign, const Vec3& v, const Vec3& w, double turn)
+  FeaturePlane(const ConvexPolytope& body, const Pose& pose, const Vec3& origin,
+               const VertexSet& set, const Vec3& n, const Vec3& direction, double sign,
+               const Vec3& v, const Vec3& w, double turn)
       : body_(&body), set_(set), direction_(direction), sign_(sign), turn_(turn) {
-    // Vertex q at r = R q: n.(t + r) = n.t + (R^T n).q, and its rotation
-    // part moves along n at (w x r).n = r.(n x w) = (R^T (n x w)).q; |r| =
-    // |q|. Dot products with the body's own vertices, no rotation of each.
+    // Vertex q at r = R (q - o) from the reference point (o, `origin`, the
+    // reference point in the hull's frame): n.(x) = n.t + (R^T n).q, and
+    // its rotation part moves along n at (w x r).n = r.(n x w) =
+    // (R^T (n x w)).(q - o); |r| = |q - o|. Dot products with the hull's
+    // own vertices, no rotation of each.
     const Vec3 spin = pose.rotation.transpose() * n.cross(w);
     double top = -std::numeric_limits<double>::infinity();
     double rise = -std::numeric_limits<double>::infinity();
@@ -149,10 +157,10 @@ class FeaturePlane {
       const Vec3& q = body.vertex(set.ids[k]);
       top = std::max(top, sign * direction.dot(q));
       rise = std::max(rise, sign * spin.dot(q));
-      arm = std::max(arm, fast_norm(q));
+      arm = std::max(arm, fast_norm(q - origin));
     }
     bound_.value = sign * n.dot(pose.translation) + top;
-    bound_.rate = sign * n.dot(v) + rise;
+    bound_.rate = sign * (n.dot(v) - spin.dot(origin)) + rise;
     bound_.acceleration = w.squaredNorm() * arm;
     bound_.span = std::numeric_limits<double>::infinity();
     if (turn > 0.0) span_ = -1.0;  // not computed yet
@@ -354,22 +362,25 @@ struct SafeStep {
   bool never = false;
 };
 
-// The advancement loop shared by every body kind: `query(pa, pb)` is the
-// distance query at the poses (its signed distance and status decide
-// contact), `safe_step(r, pa, pb)` how far time may advance after answer r.
-template <class Query, class Step>
-ImpactResult advance(const Sweep& ma, const Sweep& mb, const ImpactOptions& options,
-                     double tolerance, const Query& query, const Step& safe_step) {
+// The advancement loop shared by every body kind, over [t_begin, t_end]
+// (no contact before t_begin is known): `poses(t)` the two poses at t,
+// `query(pa, pb)` the distance query at them (its signed distance and
+// status decide contact), `safe_step(r, pa, pb)` how far time may advance
+// after answer r. Safe up to t_end < 1: status separated at t = t_end, no
+// query there (a caller that already has a contact at t_end).
+template <class Poses, class Query, class Step>
+ImpactResult advance(const Poses& poses, const ImpactOptions& options, double tolerance,
+                     const Query& query, const Step& safe_step, double t_begin = 0.0,
+                     double t_end = 1.0) {
   const double target = options.target_separation;
   const auto in_contact = [&](const DistanceResult& r) {
     return r.status == Status::intersecting || r.status == Status::touching ||
            r.signed_distance() <= target + tolerance;
   };
   ImpactResult out;
-  double t = 0.0;
+  double t = t_begin;
   for (;;) {
-    const Pose pa = ma.at(t);
-    const Pose pb = mb.at(t);
+    const auto [pa, pb] = poses(t);
     const DistanceResult r = query(pa, pb);
     ++out.iterations;
     // The answer at t (copied out only when the loop stops there).
@@ -391,10 +402,14 @@ ImpactResult advance(const Sweep& ma, const Sweep& mb, const ImpactOptions& opti
     }
     if (out.iterations >= options.max_iterations) return stop_here(ImpactStatus::iteration_cap);
     const SafeStep s = safe_step(r, pa, pb);
+    if (t_end < 1.0 && (s.never || t + s.step >= t_end)) {
+      out.status = ImpactStatus::separated;
+      out.t = t_end;
+      return out;
+    }
     if (s.never || t + s.step >= 1.0) {
       // Safe up to the end: the answer at t = 1.
-      out.pose_a = ma.at(1.0);
-      out.pose_b = mb.at(1.0);
+      std::tie(out.pose_a, out.pose_b) = poses(1.0);
       out.at_t = query(out.pose_a, out.pose_b);
       ++out.iterations;
       out.t = 1.0;
@@ -419,30 +434,49 @@ SafeStep lower_bound_step(double lower, double target, double speed) {
   return {(lower - target) / speed, false};
 }
 
-}  // namespace
+// A convex hull carried by a moving body: the hull placed in the body's
+// frame by `local` (a compound's piece; the identity for a convex body),
+// the body moving by `sweep`. The bounds below need the body's reference
+// point in the hull's frame (`origin`, local^-1 of the body's origin), the
+// lever of the hull's centroid about it and the reach of its vertices.
+struct MovingHull {
+  MovingHull(const ConvexPolytope& hull_, const Sweep& sweep_, const Pose* local_ = nullptr)
+      : hull(&hull_), sweep(&sweep_), local(local_) {
+    if (local != nullptr) origin = -(local->rotation.transpose() * local->translation);
+    lever = (hull->centroid() - origin).stableNorm();
+    reach = lever + hull->bounding_radius();
+  }
+  // The hull's pose when the body is at `body`.
+  Pose placed(const Pose& body) const { return local != nullptr ? body * *local : body; }
 
-ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
-                            const ConvexPolytope& b, const Motion& motion_b,
-                            const ImpactOptions& options, DistanceCache* cache) {
-  detail::check_impact_options(options, "time_of_impact");
+  const ConvexPolytope* hull;
+  const Sweep* sweep;
+  const Pose* local;
+  Vec3 origin = Vec3::Zero();
+  double lever = 0.0;
+  double reach = 0.0;
+};
+
+// Conservative advancement of two moving hulls over [t_begin, t_end] (see
+// advance), towards options.target_separation, stopping within
+// `tolerance` of it.
+ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const ImpactOptions& options,
+                           double tolerance, DistanceCache& c, double t_begin = 0.0,
+                           double t_end = 1.0) {
+  const ConvexPolytope& a = *ha.hull;
+  const ConvexPolytope& b = *hb.hull;
   const double target = options.target_separation;
-  const Sweep ma =
-      checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
-  const Sweep mb =
-      checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
-  const Vec3 va = ma.linear_velocity();
-  const Vec3 vb = mb.linear_velocity();
-  const Vec3 wa = ma.angular_velocity();
-  const Vec3 wb = mb.angular_velocity();
-  const double reach_a = reach(a);
-  const double reach_b = reach(b);
+  const Vec3 va = ha.sweep->linear_velocity();
+  const Vec3 vb = hb.sweep->linear_velocity();
+  const Vec3 wa = ha.sweep->angular_velocity();
+  const Vec3 wb = hb.sweep->angular_velocity();
+  const double reach_a = ha.reach;
+  const double reach_b = hb.reach;
   const double any_speed = (vb - va).stableNorm() + wa.norm() * reach_a + wb.norm() * reach_b;
-  const double tolerance = options.tolerance > 0.0
-                               ? options.tolerance
-                               : 1e-6 * (a.bounding_radius() + b.bounding_radius());
 
-  DistanceCache local;
-  DistanceCache& c = cache != nullptr ? *cache : local;
+  const auto poses = [&](double t) {
+    return std::pair<Pose, Pose>(ha.placed(ha.sweep->at(t)), hb.placed(hb.sweep->at(t)));
+  };
   const auto query = [&](const Pose& pa, const Pose& pb) {
     return distance(a, pa, b, pb, options.distance, &c);
   };
@@ -464,8 +498,6 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
   // contact. In any direction: the certified lower bound closes no
   // faster than any_speed. All keep off the contact band of the accuracy
   // standard at these poses (the rounding of the query's coordinates).
-  const double lever_a = a.centroid().stableNorm();
-  const double lever_b = b.centroid().stableNorm();
   const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
     const double band =
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
@@ -479,10 +511,10 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     // have no span limit and no acceleration.
     const PlaneBound top_a[2] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
                                  {n.dot(pa.apply(a.centroid())) + a.bounding_radius(),
-                                  va.dot(n) + turn_a * lever_a, 0.0, inf}};
+                                  va.dot(n) + turn_a * ha.lever, 0.0, inf}};
     const PlaneBound bottom_b[2] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
                                     {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()),
-                                     -vb.dot(n) + turn_b * lever_b, 0.0, inf}};
+                                     -vb.dot(n) + turn_b * hb.lever, 0.0, inf}};
     SafeStep best = lower_bound_step(r.lower_bound - band, target, any_speed);
     // The step of planes x and y without their span limit, or 0 when their
     // gap is already closed.
@@ -504,10 +536,10 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     if (best.never) return best;
     // The pairs with a feature's plane: its span (costly) only where the
     // step before the span limit beats the best so far.
-    FeaturePlane feature_a(a, pa, feature_set(a, r.feature_a, hull.vertex_a), n, hull.direction_a,
-                           1.0, va, wa, turn_a);
-    FeaturePlane feature_b(b, pb, feature_set(b, r.feature_b, hull.vertex_b), n, hull.direction_b,
-                           -1.0, vb, wb, turn_b);
+    FeaturePlane feature_a(a, pa, ha.origin, feature_set(a, r.feature_a, hull.vertex_a), n,
+                           hull.direction_a, 1.0, va, wa, turn_a);
+    FeaturePlane feature_b(b, pb, hb.origin, feature_set(b, r.feature_b, hull.vertex_b), n,
+                           hull.direction_b, -1.0, vb, wb, turn_b);
     const PlaneBound& fa = feature_a.bound();
     const PlaneBound& fb = feature_b.bound();
     const auto with_span = [&](double step, FeaturePlane* x, FeaturePlane* y) {
@@ -521,7 +553,202 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
     for (const PlaneBound& x : top_a) with_span(unlimited(x, fb), nullptr, &feature_b);
     return best;
   };
-  return advance(ma, mb, options, tolerance, query, safe_step);
+  return advance(poses, options, tolerance, query, safe_step, t_begin, t_end);
+}
+
+// A ball carried by a moving body: its center in the body's frame.
+struct Ball {
+  Vec3 center = Vec3::Zero();
+  double radius = 0.0;
+};
+
+// Ball steps at most per node or piece pair before the hulls are looked at.
+constexpr int kMaxBallSteps = 8;
+// The balls' gap, as a fraction of their radii, below which their pair is
+// taken as it is (the children's balls, or the hulls' advancement, go on
+// from there): closer balls bound the hulls too loosely to be worth more
+// steps.
+constexpr double kBallCloseEnough = 0.25;
+
+// The earliest time in [t, t_end] at which balls ba (moving with body A by
+// `ma`) and bb (with B) can come within `target` of each other, or
+// infinity when they cannot before t_end: conservative advancement on the balls' gap
+// |x_b - x_a| - radii, which closes no faster than the centers' relative
+// speed, at most |v_b - v_a| + |w_a| |c_a| + |w_b| |c_b| (c the centers'
+// offsets from the reference points). The hulls inside the balls are no
+// closer before that time. Stops early once the balls are close
+// (kBallCloseEnough): the time returned is then where they are, still a
+// lower bound.
+double earliest_ball_contact(const Sweep& ma, const Ball& ba, const Sweep& mb, const Ball& bb,
+                             double target, double t, double t_end) {
+  const double speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
+                       ma.angular_velocity().norm() * ba.center.stableNorm() +
+                       mb.angular_velocity().norm() * bb.center.stableNorm();
+  const double radii = ba.radius + bb.radius;
+  const double never = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < kMaxBallSteps; ++step) {
+    const Vec3 xa = ma.at(t).apply(ba.center);
+    const Vec3 xb = mb.at(t).apply(bb.center);
+    // Off the rounding of the centers' coordinates.
+    const double band =
+        contact_band(std::max(xa.cwiseAbs().maxCoeff(), xb.cwiseAbs().maxCoeff()) + radii);
+    const double gap = fast_norm(xb - xa) - radii - target - band;
+    if (!(gap > kBallCloseEnough * radii)) return t;
+    if (!(speed > 0.0)) return never;
+    const double next = t + gap / speed;
+    if (!(next < t_end)) return never;
+    if (!(next > t)) return t;
+    t = next;
+  }
+  return t;
+}
+
+// A node pair or a piece pair of two compounds, and the earliest time its
+// balls allow a contact.
+struct Candidate {
+  double t = 0.0;
+  bool pieces = false;  // a piece pair (a, b piece ids), else a node pair
+  std::int32_t a = 0;
+  std::int32_t b = 0;
+  bool operator>(const Candidate& o) const { return t > o.t; }
+};
+
+bool is_identity(const Pose& p) {
+  return p.rotation == Mat3::Identity() && p.translation == Vec3::Zero();
+}
+
+// Time of impact of two Bodies made of convex pieces (compounds, a convex
+// body as its one piece): the earliest over piece pairs of their convex
+// advancement, by branch and bound over the two hierarchies. Candidates
+// (node or piece pairs) are taken in order of the earliest time their
+// moving balls allow a contact (earliest_ball_contact); a node pair is
+// split into its children's pairs, a piece pair is advanced (convex, from
+// that earliest time on, and only up to the best time found, since a later
+// contact changes nothing); everything from the best time on is pruned.
+// Each rule keeps the guarantee: a pruned pair cannot come within the
+// target before the reported t, and every pair advanced is advanced
+// safely.
+ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body& b, const Sweep& mb,
+                                     const ImpactOptions& options, double tolerance, BodyCache& c) {
+  const CompoundBody& ca = *a.compound();
+  const CompoundBody& cb = *b.compound();
+  ImpactOptions pair_options = options;
+  pair_options.target_separation += a.radius() + b.radius();
+  pair_options.tolerance = tolerance;
+  const double target = pair_options.target_separation;
+
+  ImpactResult best;  // separated at 1 until a pair says otherwise
+  bool met = false;   // a pair's advancement stopped before the end
+  int iterations = 0, pairs = 0;
+  // Whether a pair whose contact cannot come before t may still change the
+  // answer: before the best time, or at 0 while the best is a contact at 0
+  // (an overlapping pair there is the answer).
+  const auto may_beat = [&](double t) {
+    return t < best.t || (t == 0.0 && best.t == 0.0 && best.status == ImpactStatus::contact);
+  };
+  // The better of two answers at the same time: overlapping, then contact,
+  // then the iteration cap.
+  const auto rank = [](ImpactStatus s) {
+    return s == ImpactStatus::overlapping ? 0 : s == ImpactStatus::contact ? 1 : 2;
+  };
+
+  std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue;
+  const auto node_ball = [](const CompoundBody::Node& n) { return Ball{n.center, n.radius}; };
+  const auto piece_ball = [](const CompoundBody& body, std::int32_t i) {
+    const auto& s = body.piece_sphere(i);
+    return Ball{s.center, s.radius};
+  };
+  const auto push = [&](Candidate k, const Ball& ba, const Ball& bb) {
+    k.t = earliest_ball_contact(ma, ba, mb, bb, target, k.t, best.t);
+    if (may_beat(k.t)) queue.push(k);
+  };
+  push({0.0, false, 0, 0}, node_ball(ca.nodes()[0]), node_ball(cb.nodes()[0]));
+  while (!queue.empty()) {
+    const Candidate k = queue.top();
+    queue.pop();
+    if (!may_beat(k.t)) break;  // every later candidate starts later still
+    if (k.pieces) {
+      const CompoundPiece& pa = ca.piece(k.a);
+      const CompoundPiece& pb = cb.piece(k.b);
+      const MovingHull ha(*pa.polytope, ma, is_identity(pa.pose) ? nullptr : &pa.pose);
+      const MovingHull hb(*pb.polytope, mb, is_identity(pb.pose) ? nullptr : &pb.pose);
+      DistanceCache pair_cache;
+      const ImpactResult r =
+          advance_hulls(ha, hb, pair_options, tolerance, pair_cache, k.t, best.t);
+      iterations += r.iterations;
+      ++pairs;
+      if (r.status != ImpactStatus::separated &&
+          (r.t < best.t || (r.t == best.t && (best.status == ImpactStatus::separated ||
+                                              rank(r.status) < rank(best.status))))) {
+        best.t = r.t;
+        best.status = r.status;
+        met = true;
+      }
+      continue;
+    }
+    const CompoundBody::Node& na = ca.nodes()[static_cast<std::size_t>(k.a)];
+    const CompoundBody::Node& nb = cb.nodes()[static_cast<std::size_t>(k.b)];
+    const bool leaf_a = na.left < 0, leaf_b = nb.left < 0;
+    if (leaf_a && leaf_b) {
+      for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
+        const std::int32_t pa = ca.piece_order()[static_cast<std::size_t>(i)];
+        for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
+          const std::int32_t pb = cb.piece_order()[static_cast<std::size_t>(j)];
+          push({k.t, true, pa, pb}, piece_ball(ca, pa), piece_ball(cb, pb));
+        }
+      }
+    } else if (leaf_b || (!leaf_a && na.radius >= nb.radius)) {
+      for (const std::int32_t child : {na.left, na.right}) {
+        push({k.t, false, child, k.b}, node_ball(ca.nodes()[static_cast<std::size_t>(child)]),
+             node_ball(nb));
+      }
+    } else {
+      for (const std::int32_t child : {nb.left, nb.right}) {
+        push({k.t, false, k.a, child}, node_ball(na),
+             node_ball(cb.nodes()[static_cast<std::size_t>(child)]));
+      }
+    }
+  }
+
+  // The answer at the best time (1 when no pair met): the Bodies' query
+  // there, whose closest pair and features describe it.
+  const Pose pose_a = ma.at(best.t);
+  const Pose pose_b = mb.at(best.t);
+  const BodyDistance at = distance(a, pose_a, b, pose_b, options.distance, &c);
+  ImpactResult out;
+  out.t = best.t;
+  out.status = best.status;
+  out.pose_a = pose_a;
+  out.pose_b = pose_b;
+  out.at_t = at;
+  out.piece_a = at.piece_a;
+  out.piece_b = at.piece_b;
+  out.iterations = iterations + 1;
+  out.pairs_advanced = pairs;
+  if (!met && (at.status == Status::intersecting || at.status == Status::touching ||
+               at.signed_distance() <= options.target_separation + tolerance)) {
+    // No pair met before 1, and the bodies are within the tolerance at 1.
+    out.status = ImpactStatus::contact;
+  }
+  return out;
+}
+
+}  // namespace
+
+ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
+                            const ConvexPolytope& b, const Motion& motion_b,
+                            const ImpactOptions& options, DistanceCache* cache) {
+  detail::check_impact_options(options, "time_of_impact");
+  const Sweep ma =
+      checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
+  const Sweep mb =
+      checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
+  const double tolerance = options.tolerance > 0.0
+                               ? options.tolerance
+                               : 1e-6 * (a.bounding_radius() + b.bounding_radius());
+  DistanceCache local;
+  return advance_hulls(MovingHull(a, ma), MovingHull(b, mb), options, tolerance,
+                       cache != nullptr ? *cache : local);
 }
 
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
@@ -544,17 +771,22 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
     return r;
   }
 
-  // A compound or a mesh on either side: advancement by the certified lower
-  // bound of the Bodies' signed distance over the fastest point speed (an
-  // overlap with a mesh has lower bound -infinity: contact at once).
   const Sweep ma =
       checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
   const Sweep mb =
       checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
+  const double tolerance = options.tolerance > 0.0 ? options.tolerance : default_tolerance;
+  if (a.kind() != Body::Kind::mesh && b.kind() != Body::Kind::mesh) {
+    return compound_time_of_impact(a, ma, b, mb, options, tolerance, c);
+  }
+
+  // A mesh on either side: advancement by the certified lower bound of the
+  // Bodies' signed distance over the fastest point speed (an overlap with a
+  // mesh has lower bound -infinity: contact at once).
   const double any_speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
                            ma.angular_velocity().norm() * body_reach(a) +
                            mb.angular_velocity().norm() * body_reach(b);
-  const double tolerance = options.tolerance > 0.0 ? options.tolerance : default_tolerance;
+  const auto poses = [&](double t) { return std::pair<Pose, Pose>(ma.at(t), mb.at(t)); };
   const auto query = [&](const Pose& pa, const Pose& pb) -> DistanceResult {
     return distance(a, pa, b, pb, options.distance, &c);
   };
@@ -563,7 +795,7 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
     return lower_bound_step(r.signed_lower_bound() - band, options.target_separation, any_speed);
   };
-  return advance(ma, mb, options, tolerance, query, safe_step);
+  return advance(poses, options, tolerance, query, safe_step);
 }
 
 }  // namespace proxima

@@ -117,6 +117,13 @@ struct ImpactResult {
   // The distance query at t: closest points, normal, features, certificate.
   DistanceResult at_t;
   int iterations = 0;  // advancement steps (distance queries)
+  // Bodies with compounds: the pieces of at_t's closest pair (its features
+  // are theirs), -1 for a convex body or a mesh; and the piece pairs whose
+  // convex advancement ran (the others were pruned by their bounding
+  // balls).
+  std::int32_t piece_a = -1;
+  std::int32_t piece_b = -1;
+  int pairs_advanced = 0;
 };
 
 // First time of contact of hull a moving by `motion_a` and hull b moving by
