@@ -570,25 +570,45 @@ constexpr int kMaxBallSteps = 8;
 // steps.
 constexpr double kBallCloseEnough = 0.25;
 
-// The earliest time in [t, t_end] at which balls ba (moving with body A by
-// `ma`) and bb (with B) can come within `target` of each other, or
-// infinity when they cannot before t_end: conservative advancement on the balls' gap
+// Two motions' poses at the last time asked for: the candidates split from
+// one node pair all start at its time.
+class PosesAt {
+ public:
+  PosesAt(const Sweep& ma, const Sweep& mb) : ma_(&ma), mb_(&mb) {}
+  const std::pair<Pose, Pose>& at(double t) {
+    if (!(t == t_)) {
+      t_ = t;
+      poses_ = {ma_->at(t), mb_->at(t)};
+    }
+    return poses_;
+  }
+
+ private:
+  const Sweep* ma_;
+  const Sweep* mb_;
+  double t_ = std::numeric_limits<double>::quiet_NaN();
+  std::pair<Pose, Pose> poses_;
+};
+
+// The earliest time in [t, t_end] at which balls ba (moving with body A)
+// and bb (with B) can come within `target` of each other, or infinity when
+// they cannot before t_end: conservative advancement on the balls' gap
 // |x_b - x_a| - radii, which closes no faster than the centers' relative
 // speed, at most |v_b - v_a| + |w_a| |c_a| + |w_b| |c_b| (c the centers'
-// offsets from the reference points). The hulls inside the balls are no
-// closer before that time. Stops early once the balls are close
-// (kBallCloseEnough): the time returned is then where they are, still a
-// lower bound.
-double earliest_ball_contact(const Sweep& ma, const Ball& ba, const Sweep& mb, const Ball& bb,
+// offsets from the reference points; `speeds` holds |v_b - v_a|, |w_a|,
+// |w_b|). The hulls inside the balls are no closer before that time.
+// Stops early once the balls are close (kBallCloseEnough): the time
+// returned is then where they are, still a lower bound.
+double earliest_ball_contact(PosesAt& poses, const Vec3& speeds, const Ball& ba, const Ball& bb,
                              double target, double t, double t_end) {
-  const double speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
-                       ma.angular_velocity().norm() * ba.center.stableNorm() +
-                       mb.angular_velocity().norm() * bb.center.stableNorm();
+  const double speed =
+      speeds[0] + speeds[1] * fast_norm(ba.center) + speeds[2] * fast_norm(bb.center);
   const double radii = ba.radius + bb.radius;
   const double never = std::numeric_limits<double>::infinity();
   for (int step = 0; step < kMaxBallSteps; ++step) {
-    const Vec3 xa = ma.at(t).apply(ba.center);
-    const Vec3 xb = mb.at(t).apply(bb.center);
+    const auto& [pa, pb] = poses.at(t);
+    const Vec3 xa = pa.apply(ba.center);
+    const Vec3 xb = pb.apply(bb.center);
     // Off the rounding of the centers' coordinates.
     const double band =
         contact_band(std::max(xa.cwiseAbs().maxCoeff(), xb.cwiseAbs().maxCoeff()) + radii);
@@ -637,8 +657,9 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
   pair_options.tolerance = tolerance;
   const double target = pair_options.target_separation;
 
-  ImpactResult best;  // separated at 1 until a pair says otherwise
-  bool met = false;   // a pair's advancement stopped before the end
+  ImpactResult best;               // separated at 1 until a pair says otherwise
+  bool met = false;                // a pair's advancement stopped before the end
+  CompoundCache::Entry best_pair;  // its pieces and its cache at best.t
   int iterations = 0, pairs = 0;
   // Whether a pair whose contact cannot come before t may still change the
   // answer: before the best time, or at 0 while the best is a contact at 0
@@ -658,8 +679,12 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
     const auto& s = body.piece_sphere(i);
     return Ball{s.center, s.radius};
   };
+  PosesAt poses(ma, mb);
+  // |v_b - v_a|, |w_a|, |w_b|: the balls' speeds.
+  const Vec3 speeds((mb.linear_velocity() - ma.linear_velocity()).stableNorm(),
+                    ma.angular_velocity().norm(), mb.angular_velocity().norm());
   const auto push = [&](Candidate k, const Ball& ba, const Ball& bb) {
-    k.t = earliest_ball_contact(ma, ba, mb, bb, target, k.t, best.t);
+    k.t = earliest_ball_contact(poses, speeds, ba, bb, target, k.t, best.t);
     if (may_beat(k.t)) queue.push(k);
   };
   push({0.0, false, 0, 0}, node_ball(ca.nodes()[0]), node_ball(cb.nodes()[0]));
@@ -673,8 +698,7 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
       const MovingHull ha(*pa.polytope, ma, is_identity(pa.pose) ? nullptr : &pa.pose);
       const MovingHull hb(*pb.polytope, mb, is_identity(pb.pose) ? nullptr : &pb.pose);
       DistanceCache pair_cache;
-      const ImpactResult r =
-          advance_hulls(ha, hb, pair_options, tolerance, pair_cache, k.t, best.t);
+      ImpactResult r = advance_hulls(ha, hb, pair_options, tolerance, pair_cache, k.t, best.t);
       iterations += r.iterations;
       ++pairs;
       if (r.status != ImpactStatus::separated &&
@@ -683,6 +707,7 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
         best.t = r.t;
         best.status = r.status;
         met = true;
+        best_pair = {k.a, k.b, std::move(pair_cache)};
       }
       continue;
     }
@@ -711,7 +736,26 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
   }
 
   // The answer at the best time (1 when no pair met): the Bodies' query
-  // there, whose closest pair and features describe it.
+  // there, whose closest pair and features describe it. The pair that met
+  // seeds the query's cache (tried first, with its features at that time):
+  // its distance is the first bound of the query's branch and bound.
+  if (met) {
+    c.compound.piece_a = best_pair.piece_a;
+    c.compound.piece_b = best_pair.piece_b;
+    const auto less = [](const CompoundCache::Entry& x, const CompoundCache::Entry& y) {
+      return std::pair(x.piece_a, x.piece_b) < std::pair(y.piece_a, y.piece_b);
+    };
+    auto& near = c.compound.near;
+    if (std::is_sorted(near.begin(), near.end(), less)) {
+      const auto it = std::lower_bound(near.begin(), near.end(), best_pair, less);
+      if (it != near.end() && it->piece_a == best_pair.piece_a &&
+          it->piece_b == best_pair.piece_b) {
+        *it = std::move(best_pair);
+      } else {
+        near.insert(it, std::move(best_pair));
+      }
+    }
+  }
   const Pose pose_a = ma.at(best.t);
   const Pose pose_b = mb.at(best.t);
   const BodyDistance at = distance(a, pose_a, b, pose_b, options.distance, &c);
