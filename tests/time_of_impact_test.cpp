@@ -272,6 +272,30 @@ TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {
               static_cast<double>(steps) / contacts, capped);
 }
 
+// A vertex running into the face of a turning slab. Planes along a fixed
+// normal charge the face's fastest corner, so each step closed about
+// nine tenths of the gap (linear convergence); the slab's face plane
+// turning with it is approached at the vertex's true rate in the slab's
+// frame, and the gap closes at second order (src/time_of_impact.cpp
+// fixed_plane_step): 7 steps where the fixed planes alone took 34, and
+// still never late.
+TEST(TimeOfImpact, AVertexRunningIntoATurningFaceConvergesInFewSteps) {
+  const ConvexPolytope slab(box(Vec3(0.5, 3, 3)));
+  const ConvexPolytope spike(
+      {Vec3(0, 0, 0), Vec3(1, 0.3, 0), Vec3(1, -0.3, 0.2), Vec3(1, -0.1, -0.3), Vec3(1.2, 0, 0)});
+  const Motion turning = Motion::from_velocity(Pose::identity(), Vec3::Zero(), Vec3(0, 0.3, 1.2));
+  const Motion in{Pose::from_translation(Vec3(4, 0.4, -0.3)),
+                  Pose::from_translation(Vec3(-2, 0.2, 0.1))};
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult r = time_of_impact(slab, turning, spike, in, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  EXPECT_EQ(r.at_t.feature_a.type, FeatureType::face);
+  EXPECT_EQ(r.at_t.feature_b.type, FeatureType::vertex);
+  EXPECT_LE(r.iterations, 8);
+  check_against_sampling(slab, turning, spike, in, options, r, 4000);
+}
+
 TEST(TimeOfImpact, TheCacheTracksAlongTheSteps) {
   const ConvexPolytope a(sphere_points(200, 3, 1.0));
   const ConvexPolytope b(sphere_points(200, 4, 1.0));
