@@ -664,6 +664,55 @@ TEST(TimeOfImpact, ACompoundPrunesPiecePairsThatCannotMeetFirst) {
   EXPECT_NEAR(r.t, twin.t, 1e-9);
 }
 
+// The ends of the interval with a compound: a ball starting in one cube
+// and touching another (overlapping at t = 0), one
+// arriving exactly on a cube's top at t = 1 (contact at 1: its balls reach
+// the wall only at the end, the Bodies' query at 1 decides), and bodies
+// that do not move (no ball can close: nothing advanced).
+TEST(TimeOfImpact, CompoundContactsAtTheEndsAndNoMotion) {
+  std::vector<std::vector<Vec3>> cubes;
+  for (int i = 0; i < 4; ++i) {
+    std::vector<Vec3> c = box(Vec3(0.2, 0.2, 0.2));
+    for (Vec3& p : c) p += Vec3(0.5 * i, 0.0, 0.0);
+    cubes.push_back(c);
+  }
+  const Body wall(CompoundBody::from_point_sets(cubes));
+  const Body ball = make_sphere(0.1);
+  const Motion still = Motion::fixed(Pose::identity());
+  // A ball of radius 0.25 at x = 0.5 touching one cube (its face x = 0.25,
+  // exactly) and reaching into another (x >= 0.5) at the start:
+  // overlapping, whichever pair is advanced first (a contact at 0 does not
+  // end the search), in both orders of the pieces.
+  const Motion up{Pose::from_translation(Vec3(0.5, 0.0, 0.0)),
+                  Pose::from_translation(Vec3(0.5, 0.0, 3.0))};
+  for (const double first : {0.0, 1.0}) {
+    std::vector<std::vector<Vec3>> two = {box(Vec3(0.25, 0.25, 0.25)), box(Vec3(0.25, 0.25, 0.25))};
+    for (Vec3& p : two[0]) p.x() += 0.75 * first;
+    for (Vec3& p : two[1]) p.x() += 0.75 * (1.0 - first);
+    const ImpactResult start =
+        time_of_impact(Body(CompoundBody::from_point_sets(two)), still, make_sphere(0.25), up);
+    EXPECT_EQ(start.status, ImpactStatus::overlapping) << first;
+    EXPECT_EQ(start.t, 0.0);
+    EXPECT_EQ(start.piece_a, first == 0.0 ? 1 : 0);
+  }
+  // Arriving on cube 3's top (z = 0.2) at t = 1.
+  const Motion arrive{Pose::from_translation(Vec3(1.5, 0.0, 3.0)),
+                      Pose::from_translation(Vec3(1.5, 0.0, 0.3))};
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult end = time_of_impact(wall, still, ball, arrive, options);
+  EXPECT_EQ(end.status, ImpactStatus::contact);
+  EXPECT_GT(end.t, 1.0 - 1e-9);
+  EXPECT_EQ(end.piece_a, 3);
+  // No motion at all, 1 apart: separated, no pair advanced.
+  const ImpactResult idle = time_of_impact(
+      wall, still, ball, Motion::fixed(Pose::from_translation(Vec3(0.0, 0.0, 1.3))), options);
+  EXPECT_EQ(idle.status, ImpactStatus::separated);
+  EXPECT_EQ(idle.t, 1.0);
+  EXPECT_EQ(idle.pairs_advanced, 0);
+  EXPECT_NEAR(idle.at_t.distance, 1.0, 1e-12);
+}
+
 // Issue 13 with issue 12's meshes: a triangle mesh moving into a box and a
 // closed mesh sweeping over a ball. Before mesh bodies were handled here a
 // mesh Body was read as a compound (a null one): a crash.
