@@ -7,7 +7,6 @@
 // sample before t is in contact, and at t the distance is within the
 // tolerance of the target.
 #include "proxima/time_of_impact.h"
-#include "proxima/mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -21,6 +20,7 @@
 #include "proxima/body.h"
 #include "proxima/compound.h"
 #include "proxima/distance.h"
+#include "proxima/mesh.h"
 #include "proxima/primitives.h"
 #include "support/penetration_oracle.h"
 
@@ -272,6 +272,30 @@ TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {
               static_cast<double>(steps) / contacts, capped);
 }
 
+// A vertex running into the face of a turning slab. Planes along a fixed
+// normal charge the face's fastest corner, so each step closed about
+// nine tenths of the gap (linear convergence); the slab's face plane
+// turning with it is approached at the vertex's true rate in the slab's
+// frame, and the gap closes at second order (src/time_of_impact.cpp
+// fixed_plane_step): 7 steps where the fixed planes alone took 34, and
+// still never late.
+TEST(TimeOfImpact, AVertexRunningIntoATurningFaceConvergesInFewSteps) {
+  const ConvexPolytope slab(box(Vec3(0.5, 3, 3)));
+  const ConvexPolytope spike(
+      {Vec3(0, 0, 0), Vec3(1, 0.3, 0), Vec3(1, -0.3, 0.2), Vec3(1, -0.1, -0.3), Vec3(1.2, 0, 0)});
+  const Motion turning = Motion::from_velocity(Pose::identity(), Vec3::Zero(), Vec3(0, 0.3, 1.2));
+  const Motion in{Pose::from_translation(Vec3(4, 0.4, -0.3)),
+                  Pose::from_translation(Vec3(-2, 0.2, 0.1))};
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult r = time_of_impact(slab, turning, spike, in, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  EXPECT_EQ(r.at_t.feature_a.type, FeatureType::face);
+  EXPECT_EQ(r.at_t.feature_b.type, FeatureType::vertex);
+  EXPECT_LE(r.iterations, 8);
+  check_against_sampling(slab, turning, spike, in, options, r, 4000);
+}
+
 TEST(TimeOfImpact, TheCacheTracksAlongTheSteps) {
   const ConvexPolytope a(sphere_points(200, 3, 1.0));
   const ConvexPolytope b(sphere_points(200, 4, 1.0));
@@ -297,6 +321,31 @@ TEST(TimeOfImpact, MotionFromVelocityMatchesItsEndPoses) {
   const Mat3 expected = Eigen::AngleAxisd(0.25, Vec3::UnitZ()).toRotationMatrix() * p.rotation;
   EXPECT_TRUE(half.rotation.isApprox(expected, 1e-14));
   EXPECT_TRUE(m.at(0.0).rotation == p.rotation);
+}
+
+// Motion::at turns by Rodrigues' formula from products made once
+// (src/time_of_impact.cpp Sweep): the same rotation as an angle-axis turn
+// of t times the angle, and rigid to machine precision (within the pose
+// contract's kOrthonormalUlps, so that no step's query re-orthonormalizes
+// it), for turns from 1e-9 rad to a half turn.
+TEST(TimeOfImpact, MotionAtIsTheAngleAxisTurnAndStaysRigid) {
+  std::mt19937 rng(77);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Pose p(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3(g(rng), g(rng), g(rng)));
+    const Vec3 axis = Vec3(g(rng), g(rng), g(rng)).normalized();
+    const double angle = trial % 4 == 0 ? 1e-9 * u(rng) : M_PI * u(rng);
+    const Motion m = Motion::from_velocity(p, Vec3(g(rng), g(rng), g(rng)), angle * axis);
+    for (int i = 1; i < 16; ++i) {
+      const double t = i / 16.0;
+      const Pose at = m.at(t);
+      EXPECT_TRUE(detail::is_rigid(at)) << "trial " << trial << ", t = " << t;
+      const Mat3 expected = Eigen::AngleAxisd(t * angle, axis).toRotationMatrix() * p.rotation;
+      EXPECT_LE((at.rotation - expected).cwiseAbs().maxCoeff(), 1e-14)
+          << "trial " << trial << ", t = " << t;
+    }
+  }
 }
 
 // The exact first time of contact of the hull of `a` (fixed) and the hull of
@@ -484,6 +533,184 @@ TEST(TimeOfImpact, RoundedAndCompoundBodies) {
   sampled(pair, still, cube, through, comp);
   const ImpactResult flipped = time_of_impact(cube, through, pair, still, options);
   EXPECT_NEAR(flipped.t, comp.t, 1e-6);
+}
+
+// The slow, obvious twin of a compound's time of impact: every piece pair
+// on its own, each piece re-hulled in its body's frame (so that it moves
+// with the body's Motion as a convex body), the convex Body time of impact
+// of each pair, and the earliest (an overlapping pair, then a contact,
+// first at equal times). No pruning, no hierarchy.
+std::vector<Body> pieces_in_body_frame(const Body& body) {
+  std::vector<Body> out;
+  const CompoundBody& c = *body.compound();
+  for (const CompoundPiece& piece : c.pieces()) {
+    std::vector<Vec3> placed;
+    for (const Vec3& v : piece.polytope->vertices()) placed.push_back(piece.pose.apply(v));
+    out.emplace_back(ConvexPolytope(placed), body.radius());
+  }
+  return out;
+}
+
+ImpactResult every_pair_time_of_impact(const Body& a, const Motion& ma, const Body& b,
+                                       const Motion& mb, const ImpactOptions& options) {
+  const std::vector<Body> pa = pieces_in_body_frame(a), pb = pieces_in_body_frame(b);
+  ImpactResult best;
+  for (const Body& x : pa) {
+    for (const Body& y : pb) {
+      const ImpactResult r = time_of_impact(x, ma, y, mb, options);
+      if (r.status == ImpactStatus::separated) continue;
+      const bool first = best.status == ImpactStatus::separated || r.t < best.t ||
+                         (r.t == best.t && r.status == ImpactStatus::overlapping);
+      if (first) best = r;
+    }
+  }
+  if (best.status == ImpactStatus::separated) best.t = 1.0;
+  return best;
+}
+
+// A compound of `count` random hulls scattered in a box of half side
+// `spread`, some placed by a turned piece pose.
+CompoundBody random_compound(std::mt19937& rng, int count, double spread, double size) {
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<CompoundPiece> pieces;
+  for (int i = 0; i < count; ++i) {
+    auto hull = std::make_shared<const ConvexPolytope>(
+        sphere_points(5 + i % 6, 900 + static_cast<std::uint32_t>(rng() % 1000), size));
+    const Vec3 at(spread * u(rng), spread * u(rng), spread * u(rng));
+    const Pose pose = i % 2 == 0 ? Pose::from_translation(at)
+                                 : Pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), at);
+    pieces.push_back({hull, pose});
+  }
+  return CompoundBody(std::move(pieces));
+}
+
+// Compounds (2 to 12 pieces, some turned in their body, some rounded)
+// against convex bodies and against compounds, moving and turning through
+// each other: the hierarchy's pruned answer is the earliest of every piece
+// pair's own (the twin above) within the tolerance's time, with the same
+// status, and it stops where the Bodies are within the tolerance of the
+// target.
+TEST(TimeOfImpact, CompoundsPrunedAnswerIsTheEarliestOfEveryPiecePair) {
+  std::mt19937 rng(4242);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int contacts = 0, pruned = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const double radius_a = trial % 3 == 0 ? 0.05 : 0.0;
+    const Body a(random_compound(rng, 2 + trial % 11, 1.5, 0.4), radius_a);
+    const Body b = trial % 2 == 0 ? Body(ConvexPolytope(sphere_points(12, 50 + trial, 0.5)), 0.0)
+                                  : Body(random_compound(rng, 2 + trial % 5, 0.8, 0.3), 0.02);
+    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
+    const Motion ma =
+        Motion::from_velocity(Pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3::Zero()),
+                              0.3 * Vec3(g(rng), g(rng), g(rng)),
+                              M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), (4.0 + u(rng)) * dir);
+    const Motion mb =
+        Motion::from_velocity(b0, -(8.0 + 2.0 * u(rng)) * dir + 0.5 * Vec3(g(rng), g(rng), g(rng)),
+                              2.0 * M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+    ImpactOptions options;
+    options.tolerance = 1e-9;
+    options.target_separation = trial % 4 == 1 ? 0.05 : 0.0;
+    const ImpactResult got = time_of_impact(a, ma, b, mb, options);
+    const ImpactResult want = every_pair_time_of_impact(a, ma, b, mb, options);
+    ASSERT_EQ(got.status, want.status);
+    if (got.status == ImpactStatus::separated) continue;
+    EXPECT_NEAR(got.t, want.t, 1e-6);
+    const BodyDistance at = distance(a, got.pose_a, b, got.pose_b);
+    EXPECT_GE(at.signed_distance(), options.target_separation - 1e-9);
+    EXPECT_LE(at.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+    EXPECT_EQ(got.piece_a, at.piece_a);
+    EXPECT_EQ(got.piece_b, at.piece_b);
+    contacts += got.status == ImpactStatus::contact ? 1 : 0;
+    const int all = a.compound()->piece_count() * b.compound()->piece_count();
+    pruned += got.pairs_advanced < all ? 1 : 0;
+  }
+  EXPECT_GT(contacts, 20);
+  EXPECT_GT(pruned, 10);  // the hierarchy did prune
+}
+
+// A wall of 8 x 8 small cubes and a ball thrown at one corner of it: only
+// the pieces near where it lands are advanced (the others' balls cannot
+// be reached before that contact), and the answer is the twin's.
+TEST(TimeOfImpact, ACompoundPrunesPiecePairsThatCannotMeetFirst) {
+  std::vector<std::vector<Vec3>> cubes;
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      std::vector<Vec3> c = box(Vec3(0.2, 0.2, 0.2));
+      for (Vec3& p : c) p += Vec3(0.5 * i, 0.5 * j, 0.0);
+      cubes.push_back(c);
+    }
+  }
+  const Body wall(CompoundBody::from_point_sets(cubes));
+  const Body ball = make_sphere(0.1);
+  const Motion still = Motion::fixed(Pose::identity());
+  const Motion thrown{Pose::from_translation(Vec3(0.1, 0.05, 5)),
+                      Pose::from_translation(Vec3(0.0, 0.0, -5))};
+  ImpactOptions options;
+  options.tolerance = 1e-10;
+  const ImpactResult r = time_of_impact(wall, still, ball, thrown, options);
+  ASSERT_EQ(r.status, ImpactStatus::contact);
+  // The ball's lowest point reaches the first cube's top (z = 0.2) when
+  // its centre is at 0.3: t* = (5 - 0.3) / 10 (its x, y stay over the cube).
+  const double t_star = 4.7 / 10.0;
+  EXPECT_LE(r.t, t_star);
+  EXPECT_GE(r.t, t_star - 1e-9);
+  EXPECT_EQ(r.piece_a, 0);
+  EXPECT_LE(r.pairs_advanced, 4);  // of 64
+  const ImpactResult twin = every_pair_time_of_impact(wall, still, ball, thrown, options);
+  EXPECT_NEAR(r.t, twin.t, 1e-9);
+}
+
+// The ends of the interval with a compound: a ball starting in one cube
+// and touching another (overlapping at t = 0), one
+// arriving exactly on a cube's top at t = 1 (contact at 1: its balls reach
+// the wall only at the end, the Bodies' query at 1 decides), and bodies
+// that do not move (no ball can close: nothing advanced).
+TEST(TimeOfImpact, CompoundContactsAtTheEndsAndNoMotion) {
+  std::vector<std::vector<Vec3>> cubes;
+  for (int i = 0; i < 4; ++i) {
+    std::vector<Vec3> c = box(Vec3(0.2, 0.2, 0.2));
+    for (Vec3& p : c) p += Vec3(0.5 * i, 0.0, 0.0);
+    cubes.push_back(c);
+  }
+  const Body wall(CompoundBody::from_point_sets(cubes));
+  const Body ball = make_sphere(0.1);
+  const Motion still = Motion::fixed(Pose::identity());
+  // A ball of radius 0.25 at x = 0.5 touching one cube (its face x = 0.25,
+  // exactly) and reaching into another (x >= 0.5) at the start:
+  // overlapping, whichever pair is advanced first (a contact at 0 does not
+  // end the search), in both orders of the pieces.
+  const Motion up{Pose::from_translation(Vec3(0.5, 0.0, 0.0)),
+                  Pose::from_translation(Vec3(0.5, 0.0, 3.0))};
+  for (const double first : {0.0, 1.0}) {
+    std::vector<std::vector<Vec3>> two = {box(Vec3(0.25, 0.25, 0.25)), box(Vec3(0.25, 0.25, 0.25))};
+    for (Vec3& p : two[0]) p.x() += 0.75 * first;
+    for (Vec3& p : two[1]) p.x() += 0.75 * (1.0 - first);
+    const ImpactResult start =
+        time_of_impact(Body(CompoundBody::from_point_sets(two)), still, make_sphere(0.25), up);
+    EXPECT_EQ(start.status, ImpactStatus::overlapping) << first;
+    EXPECT_EQ(start.t, 0.0);
+    EXPECT_EQ(start.piece_a, first == 0.0 ? 1 : 0);
+  }
+  // Arriving on cube 3's top (z = 0.2) at t = 1.
+  const Motion arrive{Pose::from_translation(Vec3(1.5, 0.0, 3.0)),
+                      Pose::from_translation(Vec3(1.5, 0.0, 0.3))};
+  ImpactOptions options;
+  options.tolerance = 1e-9;
+  const ImpactResult end = time_of_impact(wall, still, ball, arrive, options);
+  EXPECT_EQ(end.status, ImpactStatus::contact);
+  EXPECT_GT(end.t, 1.0 - 1e-9);
+  EXPECT_EQ(end.piece_a, 3);
+  // No motion at all, 1 apart: separated, no pair advanced.
+  const ImpactResult idle = time_of_impact(
+      wall, still, ball, Motion::fixed(Pose::from_translation(Vec3(0.0, 0.0, 1.3))), options);
+  EXPECT_EQ(idle.status, ImpactStatus::separated);
+  EXPECT_EQ(idle.t, 1.0);
+  EXPECT_EQ(idle.pairs_advanced, 0);
+  EXPECT_NEAR(idle.at_t.distance, 1.0, 1e-12);
 }
 
 // Issue 13 with issue 12's meshes: a triangle mesh moving into a box and a

@@ -33,9 +33,12 @@
 // ball's, whose lever under the turn is the ball center's distance from
 // the reference point, and its witness feature's own, which moves at the
 // true rates of the feature's vertices while they hold the support (at
-// second order in the turn for a vertex). The cache
-// carried from step to step makes each step a tracked query (a few
-// hundred nanoseconds).
+// second order in the turn for a vertex). Where a body's witness feature
+// is a face, its support plane moving with the body bounds the gap too:
+// that body never crosses it, and the other body's feature vertices
+// approach it at their true rates in its frame (a vertex-face contact
+// closes at second order). The cache carried from step to step makes each
+// step a tracked query (a few hundred nanoseconds).
 //
 // Thread safety: as distance(); the cache belongs to one pair.
 #pragma once
@@ -117,6 +120,13 @@ struct ImpactResult {
   // The distance query at t: closest points, normal, features, certificate.
   DistanceResult at_t;
   int iterations = 0;  // advancement steps (distance queries)
+  // Bodies with compounds: the pieces of at_t's closest pair (its features
+  // are theirs), -1 for a convex body or a mesh; and the piece pairs whose
+  // convex advancement ran (the others were pruned by their bounding
+  // balls).
+  std::int32_t piece_a = -1;
+  std::int32_t piece_b = -1;
+  int pairs_advanced = 0;
 };
 
 // First time of contact of hull a moving by `motion_a` and hull b moving by
