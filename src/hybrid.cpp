@@ -97,15 +97,9 @@ struct FeatureSet {
   }
 };
 
-struct Local {
-  double distance_squared;
-  Vec3 xa, xb;
-  std::uint8_t active_a, active_b;
-};
-
-Local from_kernel(const ClosestPoints<double>& c) {
-  return {c.distance_squared, c.point_a, c.point_b, c.active_a, c.active_b};
-}
+// The local method's answer: the kernel's own result, used in place (the
+// tracked query's one kernel call is not copied into another struct).
+using Local = ClosestPoints<double>;
 
 // Barycentric coordinates of x in the tetrahedron t when x lies inside it
 // (signed volumes of the sub-tetrahedra over the whole), nothing otherwise or
@@ -126,17 +120,14 @@ std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Ve
   return c;
 }
 
-// Closest points of conv(fa) and conv(fb). Sizes 1..3 go to the closed-form
-// kernels. A fourth vertex only appears on the side that just received its
+// Closest points of conv(fa) and conv(fb) when one of them has four vertices.
+// A fourth vertex only appears on the side that just received its
 // support point (index 3): the feature is then a tetrahedron whose closest
 // point to the other feature lies on one of the three triangles through the
 // new vertex (the old triangle was the previous answer, which the new vertex
 // improves on), so the minimum over those three is the answer.
-Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
-                     const KernelTolerance<double>& tol) {
-  if (fa.n <= 3 && fb.n <= 3) {
-    return from_kernel(closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol));
-  }
+[[gnu::noinline]] Local tetrahedron_distance(const FeatureSet& fa, const FeatureSet& fb,
+                                             const KernelTolerance<double>& tol) {
   const bool on_a = fa.n == 4;
   const FeatureSet& four = on_a ? fa : fb;
   const FeatureSet& other = on_a ? fb : fa;
@@ -145,7 +136,10 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
   // one of its vertices: if the feature crosses the boundary instead, a
   // triangle below finds the crossing at distance 0.
   if (const auto inside = tetrahedron_coordinates(four.p, other.p[0])) {
-    Local hit{0.0, other.p[0], other.p[0], 0, 0};
+    Local hit;
+    hit.distance_squared = 0.0;
+    hit.point_a = other.p[0];
+    hit.point_b = other.p[0];
     std::uint8_t tet_bits = 0;
     for (int i = 0; i < 4; ++i) {
       if ((*inside)[static_cast<std::size_t>(i)] != 0.0)
@@ -173,7 +167,7 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
       if (tri_bits & (1u << i))
         mapped = static_cast<std::uint8_t>(mapped | (1u << tri[static_cast<std::size_t>(i)]));
     }
-    best = from_kernel(c);
+    best = c;
     if (on_a) {
       best.active_a = mapped;
     } else {
@@ -184,7 +178,20 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
   return best;
 }
 
-bool valid_id(std::int32_t id, int count) { return id >= 0 && id < count; }
+// Closest points of conv(fa) and conv(fb). Sizes 1..3 (every query's first
+// call, and all of a tracked one) go straight to the closed-form kernels,
+// whose result is the answer.
+inline Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
+                            const KernelTolerance<double>& tol) {
+  if (fa.n <= 3 && fb.n <= 3) [[likely]]
+    return closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol);
+  return tetrahedron_distance(fa, fb, tol);
+}
+
+// 0 <= id < count, in one comparison (count >= 0).
+bool valid_id(std::int32_t id, int count) {
+  return static_cast<std::uint32_t>(id) < static_cast<std::uint32_t>(count);
+}
 
 // Unit direction from A towards B, as accurate as the features allow. The
 // difference XB - XA of two computed points carries an absolute error of a
@@ -251,17 +258,37 @@ Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb, const Vec3& w,
 }
 
 // Loads a cached feature (ids range-checked, duplicates dropped). Returns
-// false when nothing usable is cached.
+// false when nothing usable is cached. Written out for the three slots: a
+// later id repeats an earlier one only if that one was valid and loaded.
 template <class MapPoint>
 bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f,
                   MapPoint map_point) {
-  f.n = 0;
-  for (int i = 0; i < 3; ++i) {
-    const std::int32_t v = cached[static_cast<std::size_t>(i)];
-    if (!valid_id(v, count) || f.contains(v)) continue;
-    f.push(v, map_point(v));
+  const std::int32_t v0 = cached[0];
+  const std::int32_t v1 = cached[1];
+  const std::int32_t v2 = cached[2];
+  int n = 0;
+  if (valid_id(v0, count)) {
+    f.id[0] = v0;
+    f.p[0] = map_point(v0);
+    n = 1;
   }
-  return f.n > 0;
+  if (valid_id(v1, count) && v1 != v0) {
+    f.id[static_cast<std::size_t>(n)] = v1;
+    f.p[static_cast<std::size_t>(n)] = map_point(v1);
+    ++n;
+  }
+  if (valid_id(v2, count) && v2 != v0 && v2 != v1) {
+    f.id[static_cast<std::size_t>(n)] = v2;
+    f.p[static_cast<std::size_t>(n)] = map_point(v2);
+    ++n;
+  }
+  f.n = n;
+  return n > 0;
+}
+
+// The cache's copy of a final feature: its first three ids, -1 where unused.
+void store_feature(const FeatureSet& f, std::array<std::int32_t, 4>& out) {
+  out = {f.n > 0 ? f.id[0] : -1, f.n > 1 ? f.id[1] : -1, f.n > 2 ? f.id[2] : -1, -1};
 }
 
 // Whether B moved so far relative to A since the cache's query that its
@@ -360,7 +387,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
       contact = true;
       break;
     }
-    const Vec3 w = search_direction(fa, fb, loc.xb - loc.xa, d);  // unit, from A towards B
+    const Vec3 w =
+        search_direction(fa, fb, loc.point_b - loc.point_a, d);  // unit, from A towards B
     last_direction = w;
     hint_a = support_hill_climb(a, w, hint_a);
     hint_b = support_hill_climb(b, -(rot.transpose() * w), hint_b);
@@ -377,8 +405,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     ++iterations;
 
     // Try the body whose support point is further out first, then the other.
-    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.xa);
-    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.xb) - wb;
+    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.point_a);
+    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.point_b) - wb;
     bool improved = false;
     for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
       const bool use_a = (attempt == 0) == (gain_a >= gain_b);
@@ -405,11 +433,11 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
 
   const double d = std::sqrt(loc.distance_squared);
   result.iterations = iterations;
-  result.point_a = loc.xa;
-  result.point_b = loc.xb;
+  result.point_a = loc.point_a;
+  result.point_b = loc.point_b;
   result.distance = d;
   result.lower_bound = std::min(std::max(lower, 0.0), d);
-  result.normal = d > 0.0 ? Vec3((loc.xb - loc.xa) / d) : last_direction;
+  result.normal = d > 0.0 ? Vec3((loc.point_b - loc.point_a) / d) : last_direction;
   if (contact) {
     // In contact at machine precision. Whether the bodies only touch or
     // overlap is decided by the contact unit (hybrid_distance, contact.h).
@@ -419,12 +447,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     result.status = Status::separated;
   }
   const double unit = kScaled ? 1.0 / scale : 1.0;  // exact: a power of two
-  cache.vertices_a = {-1, -1, -1, -1};
-  cache.vertices_b = {-1, -1, -1, -1};
-  for (int i = 0; i < fa.n && i < 3; ++i)
-    cache.vertices_a[static_cast<std::size_t>(i)] = fa.id[static_cast<std::size_t>(i)];
-  for (int i = 0; i < fb.n && i < 3; ++i)
-    cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
+  store_feature(fa, cache.vertices_a);
+  store_feature(fb, cache.vertices_b);
   cache.hint_a = hint_a;
   cache.hint_b = hint_b;
   cache.rotation = rot;
@@ -449,7 +473,7 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   result.feature_a = detail::witness_feature(
       a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
       [&] {
-        return detail::WitnessPoint{Vec3(loc.xa * unit), result.normal};
+        return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
       },
       locate);
   result.feature_b = detail::witness_feature(
@@ -457,7 +481,7 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
       [&] {
         // The outward side only matters on a polygon.
         return detail::WitnessPoint{
-            Vec3(rot.transpose() * (loc.xb * unit - tr)),
+            Vec3(rot.transpose() * (loc.point_b * unit - tr)),
             b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
       },
       locate);
