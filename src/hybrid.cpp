@@ -87,6 +87,11 @@ struct FeatureSet {
     p[static_cast<std::size_t>(n)] = x;
     ++n;
   }
+  // Undoes the last push.
+  void pop() {
+    --n;
+    id[static_cast<std::size_t>(n)] = -1;
+  }
   // Keeps the vertices whose bit is set in `active`, in order.
   void reduce(std::uint8_t active) {
     if (active == (1u << n) - 1u) return;  // all kept: the tracked case
@@ -421,20 +426,17 @@ template <bool kScaled>
     for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
       const bool use_a = (attempt == 0) == (gain_a >= gain_b);
       if ((use_a ? gain_a : gain_b) <= 0.0) continue;
-      FeatureSet na = fa;
-      FeatureSet nb = fb;
-      if (use_a) {
-        na.push(hint_a, pa);
-      } else {
-        nb.push(hint_b, pb);
-      }
-      const Local next = local_distance(na, nb, tol);
-      if (!(next.distance_squared < loc.distance_squared))
+      // The support point joins its feature in place, and leaves it again
+      // if the pair does not improve (no copies of the feature sets).
+      FeatureSet& grown = use_a ? fa : fb;
+      grown.push(use_a ? hint_a : hint_b, use_a ? pa : pb);
+      const Local next = local_distance(fa, fb, tol);
+      if (!(next.distance_squared < loc.distance_squared)) {
+        grown.pop();
         continue;  // unstable: no progress at this precision
-      na.reduce(next.active_a);
-      nb.reduce(next.active_b);
-      fa = na;
-      fb = nb;
+      }
+      fa.reduce(next.active_a);
+      fb.reduce(next.active_b);
       loc = next;
       improved = true;
     }
