@@ -304,6 +304,28 @@ void store_feature(const FeatureSet& f, std::array<std::int32_t, 4>& out) {
   out = {f.id[0], f.id[1], f.id[2], -1};
 }
 
+// How far, in witness bands, the closest point x on a two-vertex feature
+// must be from both of its vertices in A's frame for rule 1 of the witness
+// rule (witness_features.h) to keep both in the hull's own frame too. There
+// the point is R^T (x - t) and the vertices y exact, while here they are
+// R y + t: the two distances differ by the rounding of both maps (about
+// 10 u R each) and the pose's departure from orthonormality (at most
+// 3 kOrthonormalUlps u |y| <= 96 u R, pose.h), against a band of 16 u R
+// (witness_band). 64 bands (1024 u R) leave that error far behind, so the
+// decision is the one the hull's frame would make; nearer points take the
+// general path, which makes it there.
+constexpr double kWitnessFarBands = 64.0;
+
+// Whether x is farther than `far` from both vertices of f (two of them),
+// at magnitudes where squaring does not underflow or overflow (the range in
+// which witness_feature's edge case runs).
+bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& x,
+                        double far) {
+  const double far2 = far * far;
+  return poly.scale() > 0x1p-300 && poly.scale() < 0x1p300 && (f.p[0] - x).squaredNorm() > far2 &&
+         (f.p[1] - x).squaredNorm() > far2;
+}
+
 // Whether B moved so far relative to A since the cache's query that its
 // feature pair says nothing any more (a planner sampling unrelated
 // configurations with one cache per pair): a bound on how far any point of
@@ -482,21 +504,40 @@ template <bool kScaled>
   // The witness features by the rule all algorithms share
   // (witness_features.h), in each hull's own frame and units.
   const double witness_band = detail::witness_band(r_local * unit);
-  result.feature_a = detail::witness_feature(
-      a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
-      [&] {
-        return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
-      },
-      locate);
-  result.feature_b = detail::witness_feature(
-      b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
-      [&] {
-        // The outward side only matters on a polygon.
-        return detail::WitnessPoint{
-            Vec3(rot.transpose() * (loc.point_b * unit - tr)),
-            b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-      },
-      locate);
+  // The tracked edge: rule 1 keeps both vertices when the closest point is
+  // farther than the band from each of them, and rule 2 needs their ids
+  // only. A's frame is A's own (unscaled: the same arithmetic as
+  // witness_feature's); B's point is tested in A's frame, with the margin
+  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
+  // and the whole rule applied there.
+  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
+                                      const Vec3& x, double bands, Feature& out) {
+    if constexpr (kScaled) {
+      return false;
+    } else {
+      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
+             detail::hull_edge(poly, f.id[0], f.id[1], out);
+    }
+  };
+  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
+    result.feature_a = detail::witness_feature(
+        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+        [&] {
+          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
+        },
+        locate);
+  }
+  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
+    result.feature_b = detail::witness_feature(
+        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+        [&] {
+          // The outward side only matters on a polygon.
+          return detail::WitnessPoint{
+              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
+              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+        },
+        locate);
+  }
   cache.face_a = result.feature_a.face;
   cache.face_b = result.feature_b.face;
 
