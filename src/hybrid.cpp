@@ -309,11 +309,13 @@ void store_feature(const FeatureSet& f, std::array<std::int32_t, 4>& out) {
 // rule (witness_features.h) to keep both in the hull's own frame too. There
 // the point is R^T (x - t) and the vertices y exact, while here they are
 // R y + t: the two distances differ by the rounding of both maps (about
-// 10 u R each) and the pose's departure from orthonormality (at most
-// 3 kOrthonormalUlps u |y| <= 96 u R, pose.h), against a band of 16 u R
-// (witness_band). 64 bands (1024 u R) leave that error far behind, so the
-// decision is the one the hull's frame would make; nearer points take the
-// general path, which makes it there.
+// 10 u R each) and by R's departure from orthonormality, |(I - R^T R) y|:
+// R = R_a^T R_b, two rotations within kOrthonormalUlps u of orthonormal
+// (pose.h) and a rounded product, so R^T R - I has entries below about
+// 70 u and that term stays below about 210 u R (R >= |y|, the algorithm's
+// bound). Against a band of 16 u R (witness_band), 64 bands (1024 u R)
+// leave all of it far behind, so the decision is the one the hull's frame
+// would make; nearer points take the general path, which makes it there.
 constexpr double kWitnessFarBands = 64.0;
 
 // Whether x is farther than `far` from both vertices of f (two of them),
