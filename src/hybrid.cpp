@@ -336,7 +336,7 @@ bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const V
 // (bench/distance_bench WarmRandom: 7.7 iterations against 1.2, 2.7 times
 // the cold query's instructions at N = 4096), so the cold start is taken.
 // A cache without a pose (rotation zero: cold, or filled by GJK) moved
-// far. About 70 instructions on every query (callgrind,
+// far. About 50 instructions on every query (callgrind,
 // bench/tracked_instructions); a heuristic for speed only: any start ends
 // in the same certified answer.
 [[gnu::always_inline]] inline bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b,
