@@ -65,12 +65,17 @@ constexpr double kMaxUnscaled = 0x1p64;
 constexpr double kStaleMotion = 0.5;
 
 // A feature of one body: up to three hull vertex ids (a fourth slot for the
-// support point being added), with their positions in A's frame.
+// support point being added), with their positions in A's frame. The slots
+// from n on hold -1, so that the cache takes the ids as they are.
 struct FeatureSet {
-  std::array<std::int32_t, 4> id{};
+  std::array<std::int32_t, 4> id = {-1, -1, -1, -1};
   std::array<Vec3, 4> p;
   int n = 0;
 
+  void clear() {
+    id = {-1, -1, -1, -1};
+    n = 0;
+  }
   bool contains(std::int32_t v) const {
     for (int i = 0; i < n; ++i) {
       if (id[static_cast<std::size_t>(i)] == v) return true;
@@ -81,6 +86,11 @@ struct FeatureSet {
     id[static_cast<std::size_t>(n)] = v;
     p[static_cast<std::size_t>(n)] = x;
     ++n;
+  }
+  // Undoes the last push.
+  void pop() {
+    --n;
+    id[static_cast<std::size_t>(n)] = -1;
   }
   // Keeps the vertices whose bit is set in `active`, in order.
   void reduce(std::uint8_t active) {
@@ -93,19 +103,14 @@ struct FeatureSet {
         ++k;
       }
     }
+    for (int i = k; i < n; ++i) id[static_cast<std::size_t>(i)] = -1;
     n = k;
   }
 };
 
-struct Local {
-  double distance_squared;
-  Vec3 xa, xb;
-  std::uint8_t active_a, active_b;
-};
-
-Local from_kernel(const ClosestPoints<double>& c) {
-  return {c.distance_squared, c.point_a, c.point_b, c.active_a, c.active_b};
-}
+// The local method's answer: the kernel's own result, used in place (the
+// tracked query's one kernel call is not copied into another struct).
+using Local = ClosestPoints<double>;
 
 // Barycentric coordinates of x in the tetrahedron t when x lies inside it
 // (signed volumes of the sub-tetrahedra over the whole), nothing otherwise or
@@ -126,17 +131,14 @@ std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Ve
   return c;
 }
 
-// Closest points of conv(fa) and conv(fb). Sizes 1..3 go to the closed-form
-// kernels. A fourth vertex only appears on the side that just received its
+// Closest points of conv(fa) and conv(fb) when one of them has four vertices.
+// A fourth vertex only appears on the side that just received its
 // support point (index 3): the feature is then a tetrahedron whose closest
 // point to the other feature lies on one of the three triangles through the
 // new vertex (the old triangle was the previous answer, which the new vertex
 // improves on), so the minimum over those three is the answer.
-Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
-                     const KernelTolerance<double>& tol) {
-  if (fa.n <= 3 && fb.n <= 3) {
-    return from_kernel(closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol));
-  }
+[[gnu::noinline]] Local tetrahedron_distance(const FeatureSet& fa, const FeatureSet& fb,
+                                             const KernelTolerance<double>& tol) {
   const bool on_a = fa.n == 4;
   const FeatureSet& four = on_a ? fa : fb;
   const FeatureSet& other = on_a ? fb : fa;
@@ -145,7 +147,10 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
   // one of its vertices: if the feature crosses the boundary instead, a
   // triangle below finds the crossing at distance 0.
   if (const auto inside = tetrahedron_coordinates(four.p, other.p[0])) {
-    Local hit{0.0, other.p[0], other.p[0], 0, 0};
+    Local hit;
+    hit.distance_squared = 0.0;
+    hit.point_a = other.p[0];
+    hit.point_b = other.p[0];
     std::uint8_t tet_bits = 0;
     for (int i = 0; i < 4; ++i) {
       if ((*inside)[static_cast<std::size_t>(i)] != 0.0)
@@ -173,7 +178,7 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
       if (tri_bits & (1u << i))
         mapped = static_cast<std::uint8_t>(mapped | (1u << tri[static_cast<std::size_t>(i)]));
     }
-    best = from_kernel(c);
+    best = c;
     if (on_a) {
       best.active_a = mapped;
     } else {
@@ -184,7 +189,20 @@ Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
   return best;
 }
 
-bool valid_id(std::int32_t id, int count) { return id >= 0 && id < count; }
+// Closest points of conv(fa) and conv(fb). Sizes 1..3 (every query's first
+// call, and all of a tracked one) go straight to the closed-form kernels,
+// whose result is the answer.
+inline Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
+                            const KernelTolerance<double>& tol) {
+  if (fa.n <= 3 && fb.n <= 3) [[likely]]
+    return closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol);
+  return tetrahedron_distance(fa, fb, tol);
+}
+
+// 0 <= id < count, in one comparison (count >= 0).
+bool valid_id(std::int32_t id, int count) {
+  return static_cast<std::uint32_t>(id) < static_cast<std::uint32_t>(count);
+}
 
 // Unit direction from A towards B, as accurate as the features allow. The
 // difference XB - XA of two computed points carries an absolute error of a
@@ -229,7 +247,8 @@ Vec3 face_direction(const std::array<Vec3, 4>& t) {
   return across(e0.cross(e1), longest);
 }
 
-Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb, const Vec3& w, double d) {
+[[gnu::always_inline]] inline Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb,
+                                                    const Vec3& w, double d) {
   Vec3 n;
   if (fa.n == 1 && fb.n == 3) {
     n = face_direction(fb.p);
@@ -251,17 +270,62 @@ Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb, const Vec3& w,
 }
 
 // Loads a cached feature (ids range-checked, duplicates dropped). Returns
-// false when nothing usable is cached.
+// false when nothing usable is cached. Written out for the three slots: a
+// later id repeats an earlier one only if that one was valid and loaded.
 template <class MapPoint>
 bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f,
                   MapPoint map_point) {
-  f.n = 0;
-  for (int i = 0; i < 3; ++i) {
-    const std::int32_t v = cached[static_cast<std::size_t>(i)];
-    if (!valid_id(v, count) || f.contains(v)) continue;
-    f.push(v, map_point(v));
+  const std::int32_t v0 = cached[0];
+  const std::int32_t v1 = cached[1];
+  const std::int32_t v2 = cached[2];
+  int n = 0;
+  if (valid_id(v0, count)) {
+    f.id[0] = v0;
+    f.p[0] = map_point(v0);
+    n = 1;
   }
-  return f.n > 0;
+  if (valid_id(v1, count) && v1 != v0) {
+    f.id[static_cast<std::size_t>(n)] = v1;
+    f.p[static_cast<std::size_t>(n)] = map_point(v1);
+    ++n;
+  }
+  if (valid_id(v2, count) && v2 != v0 && v2 != v1) {
+    f.id[static_cast<std::size_t>(n)] = v2;
+    f.p[static_cast<std::size_t>(n)] = map_point(v2);
+    ++n;
+  }
+  f.n = n;
+  return n > 0;
+}
+
+// The cache's copy of a final feature: its first three ids, -1 where unused
+// (FeatureSet keeps unused slots at -1).
+void store_feature(const FeatureSet& f, std::array<std::int32_t, 4>& out) {
+  out = {f.id[0], f.id[1], f.id[2], -1};
+}
+
+// How far, in witness bands, the closest point x on a two-vertex feature
+// must be from both of its vertices in A's frame for rule 1 of the witness
+// rule (witness_features.h) to keep both in the hull's own frame too. There
+// the point is R^T (x - t) and the vertices y exact, while here they are
+// R y + t: the two distances differ by the rounding of both maps (about
+// 10 u R each) and by R's departure from orthonormality, |(I - R^T R) y|:
+// R = R_a^T R_b, two rotations within kOrthonormalUlps u of orthonormal
+// (pose.h) and a rounded product, so R^T R - I has entries below about
+// 70 u and that term stays below about 210 u R (R >= |y|, the algorithm's
+// bound). Against a band of 16 u R (witness_band), 64 bands (1024 u R)
+// leave all of it far behind, so the decision is the one the hull's frame
+// would make; nearer points take the general path, which makes it there.
+constexpr double kWitnessFarBands = 64.0;
+
+// Whether x is farther than `far` from both vertices of f (two of them),
+// at magnitudes where squaring does not underflow or overflow (the range in
+// which witness_feature's edge case runs).
+bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& x,
+                        double far) {
+  const double far2 = far * far;
+  return poly.scale() > 0x1p-300 && poly.scale() < 0x1p300 && (f.p[0] - x).squaredNorm() > far2 &&
+         (f.p[1] - x).squaredNorm() > far2;
 }
 
 // Whether B moved so far relative to A since the cache's query that its
@@ -272,11 +336,11 @@ bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureS
 // (bench/distance_bench WarmRandom: 7.7 iterations against 1.2, 2.7 times
 // the cold query's instructions at N = 4096), so the cold start is taken.
 // A cache without a pose (rotation zero: cold, or filled by GJK) moved
-// far. About 70 instructions on every query (callgrind,
+// far. About 50 instructions on every query (callgrind,
 // bench/tracked_instructions); a heuristic for speed only: any start ends
 // in the same certified answer.
-bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-               const DistanceCache& cache) {
+[[gnu::always_inline]] inline bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b,
+                                             const Pose& b_in_a, const DistanceCache& cache) {
   const double turn2 = (b_in_a.rotation - cache.rotation).squaredNorm();
   const double shift = (b_in_a.translation - cache.translation).norm();
   const double size = a.bounding_radius() + b.bounding_radius();
@@ -290,9 +354,11 @@ bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_i
 // in the caller's units, like the result returned. The unscaled instance is
 // the hot path and multiplies by nothing.
 template <bool kScaled>
-DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                          const DistanceOptions& options, double band, DistanceCache& cache,
-                          double magnitude, double scale) {
+[[gnu::always_inline]] inline DistanceResult run_hybrid(const ConvexPolytope& a,
+                                                        const ConvexPolytope& b, const Pose& b_in_a,
+                                                        const DistanceOptions& options, double band,
+                                                        DistanceCache& cache, double magnitude,
+                                                        double scale) {
   const double contact_tolerance = kScaled ? band * scale : band;
   const double r_local = kScaled ? magnitude * scale : magnitude;
   const Mat3& rot = b_in_a.rotation;
@@ -339,8 +405,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     const Vec3 dir = towards_b.squaredNorm() > 0.0 ? towards_b : Vec3::UnitX();
     hint_a = support_hill_climb(a, dir, hint_a);
     hint_b = support_hill_climb(b, -(rot.transpose() * dir), hint_b);
-    fa = FeatureSet{};
-    fb = FeatureSet{};
+    fa.clear();
+    fb.clear();
     fa.push(hint_a, a_point(hint_a));
     fb.push(hint_b, b_point(hint_b));
   }
@@ -360,7 +426,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
       contact = true;
       break;
     }
-    const Vec3 w = search_direction(fa, fb, loc.xb - loc.xa, d);  // unit, from A towards B
+    const Vec3 w =
+        search_direction(fa, fb, loc.point_b - loc.point_a, d);  // unit, from A towards B
     last_direction = w;
     hint_a = support_hill_climb(a, w, hint_a);
     hint_b = support_hill_climb(b, -(rot.transpose() * w), hint_b);
@@ -377,26 +444,23 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     ++iterations;
 
     // Try the body whose support point is further out first, then the other.
-    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.xa);
-    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.xb) - wb;
+    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.point_a);
+    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.point_b) - wb;
     bool improved = false;
     for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
       const bool use_a = (attempt == 0) == (gain_a >= gain_b);
       if ((use_a ? gain_a : gain_b) <= 0.0) continue;
-      FeatureSet na = fa;
-      FeatureSet nb = fb;
-      if (use_a) {
-        na.push(hint_a, pa);
-      } else {
-        nb.push(hint_b, pb);
-      }
-      const Local next = local_distance(na, nb, tol);
-      if (!(next.distance_squared < loc.distance_squared))
+      // The support point joins its feature in place, and leaves it again
+      // if the pair does not improve (no copies of the feature sets).
+      FeatureSet& grown = use_a ? fa : fb;
+      grown.push(use_a ? hint_a : hint_b, use_a ? pa : pb);
+      const Local next = local_distance(fa, fb, tol);
+      if (!(next.distance_squared < loc.distance_squared)) {
+        grown.pop();
         continue;  // unstable: no progress at this precision
-      na.reduce(next.active_a);
-      nb.reduce(next.active_b);
-      fa = na;
-      fb = nb;
+      }
+      fa.reduce(next.active_a);
+      fb.reduce(next.active_b);
       loc = next;
       improved = true;
     }
@@ -405,11 +469,11 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
 
   const double d = std::sqrt(loc.distance_squared);
   result.iterations = iterations;
-  result.point_a = loc.xa;
-  result.point_b = loc.xb;
+  result.point_a = loc.point_a;
+  result.point_b = loc.point_b;
   result.distance = d;
   result.lower_bound = std::min(std::max(lower, 0.0), d);
-  result.normal = d > 0.0 ? Vec3((loc.xb - loc.xa) / d) : last_direction;
+  result.normal = d > 0.0 ? Vec3((loc.point_b - loc.point_a) / d) : last_direction;
   if (contact) {
     // In contact at machine precision. Whether the bodies only touch or
     // overlap is decided by the contact unit (hybrid_distance, contact.h).
@@ -419,12 +483,8 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
     result.status = Status::separated;
   }
   const double unit = kScaled ? 1.0 / scale : 1.0;  // exact: a power of two
-  cache.vertices_a = {-1, -1, -1, -1};
-  cache.vertices_b = {-1, -1, -1, -1};
-  for (int i = 0; i < fa.n && i < 3; ++i)
-    cache.vertices_a[static_cast<std::size_t>(i)] = fa.id[static_cast<std::size_t>(i)];
-  for (int i = 0; i < fb.n && i < 3; ++i)
-    cache.vertices_b[static_cast<std::size_t>(i)] = fb.id[static_cast<std::size_t>(i)];
+  store_feature(fa, cache.vertices_a);
+  store_feature(fb, cache.vertices_b);
   cache.hint_a = hint_a;
   cache.hint_b = hint_b;
   cache.rotation = rot;
@@ -446,21 +506,40 @@ DistanceResult run_hybrid(const ConvexPolytope& a, const ConvexPolytope& b, cons
   // The witness features by the rule all algorithms share
   // (witness_features.h), in each hull's own frame and units.
   const double witness_band = detail::witness_band(r_local * unit);
-  result.feature_a = detail::witness_feature(
-      a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
-      [&] {
-        return detail::WitnessPoint{Vec3(loc.xa * unit), result.normal};
-      },
-      locate);
-  result.feature_b = detail::witness_feature(
-      b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
-      [&] {
-        // The outward side only matters on a polygon.
-        return detail::WitnessPoint{
-            Vec3(rot.transpose() * (loc.xb * unit - tr)),
-            b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-      },
-      locate);
+  // The tracked edge: rule 1 keeps both vertices when the closest point is
+  // farther than the band from each of them, and rule 2 needs their ids
+  // only. A's frame is A's own (unscaled: the same arithmetic as
+  // witness_feature's); B's point is tested in A's frame, with the margin
+  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
+  // and the whole rule applied there.
+  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
+                                      const Vec3& x, double bands, Feature& out) {
+    if constexpr (kScaled) {
+      return false;
+    } else {
+      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
+             detail::hull_edge(poly, f.id[0], f.id[1], out);
+    }
+  };
+  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
+    result.feature_a = detail::witness_feature(
+        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+        [&] {
+          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
+        },
+        locate);
+  }
+  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
+    result.feature_b = detail::witness_feature(
+        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+        [&] {
+          // The outward side only matters on a polygon.
+          return detail::WitnessPoint{
+              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
+              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+        },
+        locate);
+  }
   cache.face_a = result.feature_a.face;
   cache.face_b = result.feature_b.face;
 

@@ -63,6 +63,17 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
                                     const Vec3& point, double band, const Vec3& outward,
                                     std::int32_t cached_face, bool locate = true);
 
+// Rule 2 for two distinct vertices u and v that rule 1 keeps: when they are
+// adjacent, `f` becomes their hull edge and true is returned.
+inline bool hull_edge(const ConvexPolytope& poly, std::int32_t u, std::int32_t v, Feature& f) {
+  const auto nbrs = poly.neighbors(u);
+  if (std::find(nbrs.begin(), nbrs.end(), v) == nbrs.end()) return false;
+  f.type = FeatureType::edge;
+  f.vertices = {std::min(u, v), std::max(u, v), -1};
+  f.face = -1;
+  return true;
+}
+
 // The same, with the point and the outward direction given by a callable
 // returning a WitnessPoint, called only for two or more ids: a single vertex
 // is its own feature (the tracked vertex-face query's common case), and
@@ -87,12 +98,7 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
       f.vertices = {d0 <= d1 ? id[0] : id[1], -1, -1};
       return f;
     }
-    const auto nbrs = poly.neighbors(id[0]);
-    if (std::find(nbrs.begin(), nbrs.end(), id[1]) != nbrs.end()) {
-      f.type = FeatureType::edge;
-      f.vertices = {std::min(id[0], id[1]), std::max(id[0], id[1]), -1};
-      return f;
-    }
+    if (hull_edge(poly, id[0], id[1], f)) return f;
   }
   // Three distinct ids on a solid at ordinary magnitudes that the previous
   // answer's face holds, the tracked face case: rules 1 and 2 inline. The

@@ -126,6 +126,54 @@ TEST(Hybrid, EdgeToEdgeWitnesses) {
   EXPECT_NEAR(r.distance, brute_force_distance(a, pa, b, pb), 1e-14);
 }
 
+TEST(Hybrid, TrackedEdgeWitnessNearAVertexFollowsTheBand) {
+  // A tracked edge's witness is decided from the loop's own points in A's
+  // frame when the closest point is far from both ends (src/hybrid.cpp,
+  // kWitnessFarBands), in B's frame otherwise. Either way the rule is
+  // witness_features.h's: a closest point on B's edge within the band of a
+  // vertex is that vertex, beyond it the edge. A's apex moves along B's top
+  // edge, B rotated, from its middle (the cache then holds the edge) to 0.1,
+  // 8 and 1000 bands from its end y0 (a cold query would stop at y0 itself:
+  // the distance to y0 is larger by a second-order amount only).
+  const std::vector<Vec3> tb = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 1, -1), Vec3(0.5, -1, -1)};
+  const ConvexPolytope b(tb);
+  int id0 = -1, id1 = -1;
+  for (int i = 0; i < b.vertex_count(); ++i) {
+    if (b.vertex(i) == tb[0]) id0 = i;
+    if (b.vertex(i) == tb[1]) id1 = i;
+  }
+  ASSERT_GE(id0, 0);
+  ASSERT_GE(id1, 0);
+  const Pose pb(Quat(Eigen::AngleAxisd(0.7, Vec3(1, -2, 0.5).normalized())), Vec3(0.3, -0.2, 0.9));
+  // A: an apex at its origin, its base above it along B's z axis.
+  std::vector<Vec3> ta = {Vec3::Zero()};
+  for (const Vec3& d : {Vec3(-0.3, -0.3, 1), Vec3(0.6, 0, 1), Vec3(-0.3, 0.3, 1)})
+    ta.push_back(pb.rotation * d);
+  const ConvexPolytope a(ta);
+  const auto apex_at = [&](double s) { return Pose::from_translation(pb.apply(Vec3(s, 0, 0.5))); };
+  for (const double bands : {0.1, 8.0, 1000.0}) {
+    DistanceCache cache;
+    const auto middle = distance(a, apex_at(0.5), b, pb, {}, &cache);
+    ASSERT_EQ(middle.feature_b.type, FeatureType::edge);
+    // The witness band for coordinates bounded by r (witness_features.h): a
+    // quarter of the contact band; r >= the algorithm's bound in A's frame.
+    const double r = std::max(a.scale(), magnitude_bound(pb, b.scale())) + 2.0;
+    const double s = bands * 0.25 * contact_band(r);
+    const auto res = distance(a, apex_at(s), b, pb, {}, &cache);
+    ASSERT_EQ(res.status, Status::separated) << bands;
+    EXPECT_NEAR(res.distance, 0.5, 1e-12) << bands;
+    EXPECT_EQ(res.feature_a.type, FeatureType::vertex) << bands;
+    if (bands < 1.0) {
+      EXPECT_EQ(res.feature_b.type, FeatureType::vertex) << bands;
+      EXPECT_EQ(res.feature_b.vertices[0], id0) << bands;
+    } else {
+      EXPECT_EQ(res.feature_b.type, FeatureType::edge) << bands;
+      EXPECT_EQ(res.feature_b.vertices[0], std::min(id0, id1)) << bands;
+      EXPECT_EQ(res.feature_b.vertices[1], std::max(id0, id1)) << bands;
+    }
+  }
+}
+
 TEST(Hybrid, TouchingAndIntersecting) {
   const ConvexPolytope cube(box(Vec3(0.5, 0.5, 0.5)));
   // Stacked cubes sharing a face exactly: touching.
