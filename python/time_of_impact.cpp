@@ -79,6 +79,13 @@ void bind_time_of_impact(py::module_& m) {
       .def_readonly("at_t", &ImpactResult::at_t,
                     "The distance query at t (points, normal, features, bounds).")
       .def_readonly("iterations", &ImpactResult::iterations, "Distance queries made.")
+      .def_readonly("piece_a", &ImpactResult::piece_a,
+                    "Compound bodies: A's piece of the pair that met (at_t's features are its "
+                    "hull's); -1 for a convex body or a mesh.")
+      .def_readonly("piece_b", &ImpactResult::piece_b, "B's piece of the pair that met, as piece_a.")
+      .def_readonly("pairs_advanced", &ImpactResult::pairs_advanced,
+                    "Piece pairs whose advancement ran; the others were pruned by their moving "
+                    "bounding balls.")
       .def("__repr__", [](const ImpactResult& r) {
         return std::string("proxima.ImpactResult(status='") + to_string(r.status) +
                "', t=" + py::repr(py::float_(r.t)).cast<std::string>() + ")";

@@ -88,6 +88,9 @@ def test_bodies_of_any_kind():
                                (T((5, 2.2, 0)), T((-5, 2.2, 0))), cache=cache)
     assert r.status == "contact"
     assert r.t == pytest.approx((5 - 0.8) / 10, abs=1e-5)
+    # The cube meets piece 1 (at y = 2); piece 0 is pruned or advanced.
+    assert r.piece_a == 1 and r.piece_b == -1
+    assert 1 <= r.pairs_advanced <= 2
     with pytest.raises(TypeError, match="BodyCache"):
         proxima.time_of_impact(pair, proxima.Motion.fixed(None), cube(), proxima.Motion.fixed(
             T((5, 0, 0))), cache=proxima.DistanceCache())
