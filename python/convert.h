@@ -506,8 +506,15 @@ inline const py::dtype& column_dtype(int i) {
   return i == kStatus ? *status : *type;
 }
 
-// Where the rows of each column go: data pointers, C order.
-using BatchColumnData = std::array<void*, kBatchColumns>;
+// Where the rows of each column go: the data pointers (C order) and the
+// arrays themselves, held so that the memory stays alive while the GIL is
+// released (another thread may drop an answer's arrays meanwhile).
+struct BatchColumnData {
+  std::array<void*, kBatchColumns> data{};
+  std::array<py::object, kBatchColumns> arrays;
+
+  void* operator[](int column) const { return data[static_cast<std::size_t>(column)]; }
+};
 
 inline py::ssize_t batch_column_count(bool pieces) { return pieces ? kBatchColumns : kPieceA; }
 
@@ -519,8 +526,9 @@ inline BatchColumnData new_batch_columns(py::ssize_t k, bool pieces, py::dict& o
     py::array column = c.kind != 'U' && c.width > 1
                            ? py::array(column_dtype(i), std::vector<py::ssize_t>{k, c.width})
                            : py::array(column_dtype(i), std::vector<py::ssize_t>{k});
-    data[static_cast<std::size_t>(i)] = column.mutable_data();
-    out[c.key] = std::move(column);
+    data.data[static_cast<std::size_t>(i)] = column.mutable_data();
+    out[c.key] = column;
+    data.arrays[static_cast<std::size_t>(i)] = std::move(column);
   }
   return data;
 }
@@ -576,7 +584,8 @@ inline BatchColumnData batch_columns_of(py::handle out, py::ssize_t k, bool piec
              "']");
       }
     }
-    data[static_cast<std::size_t>(i)] = begin;
+    data.data[static_cast<std::size_t>(i)] = begin;
+    data.arrays[static_cast<std::size_t>(i)] = std::move(a);
   }
   return data;
 }
