@@ -3,14 +3,17 @@
 # C++, measured side by side in one run (issue 11, "Python at C++ speed").
 # SPDX-License-Identifier: BSD-3-Clause
 #
-#   PYTHONPATH=build/release/python bench/python_pair_batch.py [--pairs 1000] [--steps 200]
+#   PYTHONPATH=build/release/python /usr/bin/python3 bench/python_pair_batch.py [--pairs 1000] [--steps 200]
 #
 # Each step moves every pair's B a little (tracking) and calls
-# PairBatch.distance once. The Python time is the wall time of that call
-# (pose conversion, the batch, the numpy result dict); the C++ time is
+# PairBatch.distance once on each of two twin batches, in turns: one filling
+# the arrays of its previous answer again (out=, the loop a planner writes),
+# one returning new arrays (the default). The Python time is the wall time
+# of a call (pose conversion, the batch, the numpy result); the C++ time is
 # PairBatch.last_call_seconds, the part of the same call spent in C++'s
-# distance_batch. Prints the medians over the steps and their ratio, for
-# threads = 1 (all in the calling thread) and threads = 0 (all cores).
+# distance_batch, which is what the same batch costs from C++. Prints the
+# medians over the steps and their ratios, for threads = 1 (all in the
+# calling thread) and threads = 0 (all cores).
 import argparse
 import statistics
 import time
@@ -38,20 +41,29 @@ def main():
     poses_b[:, :3, 3] = directions * 2.5
     print(f"pairs {k}, steps {args.steps}, proxima {proxima.__file__}")
     for threads in (1, 0):
-        batch = proxima.PairBatch(a, b)
-        python_s, cpp_s = [], []
+        reused, fresh = proxima.PairBatch(a, b), proxima.PairBatch(a, b)
+        out = None
+        seconds = {"out": ([], []), "new": ([], [])}  # (Python, C++) per call
         for step in range(args.steps):
             angle = 0.01 * step
             poses_b[:, :3, 3] = directions * (2.5 + 0.3 * np.sin(angle))
-            start = time.perf_counter()
-            out = batch.distance(poses_a, poses_b, threads=threads)
-            python_s.append(time.perf_counter() - start)
-            cpp_s.append(batch.last_call_seconds)
-        py_us = statistics.median(python_s) * 1e6
-        cpp_us = statistics.median(cpp_s) * 1e6
-        print(f"threads {threads}: Python call {py_us:.0f} us, C++ batch {cpp_us:.0f} us "
-              f"(median of {args.steps}), ratio {py_us / cpp_us:.2f}; "
-              f"{cpp_us * 1e3 / k:.0f} ns per pair in C++, separated {np.mean(out['status'] == 'separated'):.2f}")
+            for kind in ("out", "new") if step % 2 == 0 else ("new", "out"):
+                start = time.perf_counter()
+                if kind == "out":
+                    out = reused.distance(poses_a, poses_b, threads=threads, out=out)
+                else:
+                    fresh_out = fresh.distance(poses_a, poses_b, threads=threads)
+                python_s = time.perf_counter() - start
+                seconds[kind][0].append(python_s)
+                seconds[kind][1].append((reused if kind == "out" else fresh).last_call_seconds)
+        assert all(np.array_equal(out[key], fresh_out[key]) for key in out)  # the same answers
+        us = {kind: [statistics.median(s) * 1e6 for s in seconds[kind]] for kind in seconds}
+        print(f"threads {threads}: Python call {us['out'][0]:.0f} us with out=, {us['new'][0]:.0f} us "
+              f"with new arrays; C++ batch {us['out'][1]:.0f} and {us['new'][1]:.0f} us (medians of "
+              f"{args.steps}); ratio {us['out'][0] / us['out'][1]:.2f} with out=, "
+              f"{us['new'][0] / us['new'][1]:.2f} with new arrays; "
+              f"{us['out'][1] * 1e3 / k:.0f} ns per pair in C++, "
+              f"separated {np.mean(out['status'] == 'separated'):.2f}")
 
 
 if __name__ == "__main__":

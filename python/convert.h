@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <concepts>
@@ -224,14 +225,26 @@ inline Pose to_pose(py::handle obj, const std::string& name) {
   return pose_from_matrix(m.data(), name);
 }
 
+// Who checks a batch's poses under the pose contract: the conversion
+// (`here`), or the C++ batch that the poses go to (`by_the_batch`:
+// distance_batch checks every pose before its first query and names it, so
+// the conversion only copies; a 4x4 matrix's bottom row, which the batch
+// never sees, is checked here either way).
+enum class PoseCheck { here, by_the_batch };
+
 // K poses for a batch: None (K identities), one pose for all, or a (K, 4, 4)
-// array. `k` is the batch size, or -1 when this argument decides it.
-inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::string& name) {
+// or (K, 3, 4) array, written into `poses` (resized to K; a caller that
+// keeps the vector from call to call allocates nothing). `k` is the batch
+// size, or -1 when this argument decides it. With PoseCheck::here every
+// pose meets the contract of proxima/pose.h on return (a refusal names the
+// pose, name[i]).
+inline void to_poses(py::handle obj, py::ssize_t k, const std::string& name, PoseCheck check,
+                     std::vector<Pose>& poses) {
   const auto one_for_all = [&] {
     if (k < 0)
       value_error(name +
                   ": give K poses as a (K, 4, 4) array (the other poses may be one pose or None)");
-    return std::vector<Pose>(static_cast<std::size_t>(k), to_pose(obj, name));
+    poses.assign(static_cast<std::size_t>(k), to_pose(obj, name));
   };
   if (obj.is_none() || py::isinstance<Pose>(obj) || py::isinstance<py::tuple>(obj) ||
       is_scipy_rotation(obj))
@@ -260,17 +273,19 @@ inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::stri
   };
   const double* data = m.data();
   const py::ssize_t stride = square ? 16 : 12;  // c_style: the matrices back to back
-  std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(count));
+  poses.resize(static_cast<std::size_t>(count));
   for (py::ssize_t i = 0; i < count; ++i) {
     const double* rows = data + i * stride;
-    poses.emplace_back(
-        Mat3{
-            {rows[0], rows[1], rows[2]}, {rows[4], rows[5], rows[6]}, {rows[8], rows[9], rows[10]}},
-        Vec3(rows[3], rows[7], rows[11]));
+    Pose& pose = poses[static_cast<std::size_t>(i)];
+    double* r = pose.rotation.data();  // column-major: r[3 j + i] = R(i, j) = rows[4 i + j]
+    r[0] = rows[0], r[1] = rows[4], r[2] = rows[8];
+    r[3] = rows[1], r[4] = rows[5], r[5] = rows[9];
+    r[6] = rows[2], r[7] = rows[6], r[8] = rows[10];
+    pose.translation = Vec3(rows[3], rows[7], rows[11]);
     if (square && !(rows[12] == 0.0 && rows[13] == 0.0 && rows[14] == 0.0 && rows[15] == 1.0))
-      poses.back() = full(i);  // the bottom row exactly (0, 0, 0, 1) or the full check
+      pose = full(i);  // the bottom row exactly (0, 0, 0, 1) or the full check
   }
+  if (check == PoseCheck::by_the_batch) return;
   for (py::ssize_t i = 0; i < count; i += 2) {
     const py::ssize_t j = std::min(i + 1, count - 1);
     if (detail::are_rigid(poses[static_cast<std::size_t>(i)], poses[static_cast<std::size_t>(j)]))
@@ -279,6 +294,10 @@ inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::stri
     poses[static_cast<std::size_t>(i)] = full(i);
     poses[static_cast<std::size_t>(j)] = full(j);
   }
+}
+inline std::vector<Pose> to_poses(py::handle obj, py::ssize_t k, const std::string& name) {
+  std::vector<Pose> poses;
+  to_poses(obj, k, name, PoseCheck::here, poses);
   return poses;
 }
 
@@ -383,108 +402,269 @@ inline int check_index(int i, int count, const char* what) {
   return i;
 }
 
-// A numpy array of fixed-width unicode strings (dtype <U{longest name}),
-// row i = names[codes[i]], written straight into numpy's UCS-4 buffer: a
-// fancy-indexing call in numpy cost 7 us per 1,000 rows, three of them a
-// third of PairBatch's Python overhead (bench/python_pair_batch.py).
-template <std::size_t M>
-py::array string_column(const std::vector<std::uint8_t>& codes,
-                        const std::array<std::string_view, M>& names) {
-  std::size_t width = 1;
-  for (const std::string_view n : names) width = std::max(width, n.size());
-  const py::dtype dtype("<U" + std::to_string(width));
-  py::array out(dtype, std::vector<py::ssize_t>{static_cast<py::ssize_t>(codes.size())});
-  auto* data = static_cast<char32_t*>(out.mutable_data());
-  std::fill(data, data + codes.size() * width, U'\0');
-  for (std::size_t i = 0; i < codes.size(); ++i) {
-    const std::string_view name = names[codes[i]];
-    for (std::size_t c = 0; c < name.size(); ++c)
-      data[i * width + c] = static_cast<char32_t>(name[c]);
-  }
-  return out;
-}
+// --- Batch answers as numpy arrays -------------------------------------------
+// A batch answer (distance_batch, PairBatch.distance) is a dict of numpy
+// arrays with K rows, one column per field: new arrays, or (PairBatch's
+// out=) the arrays of an earlier answer filled again in place, so that a
+// loop allocates nothing. The names (status, feature types) are fixed-width
+// unicode arrays written straight into numpy's UCS-4 buffer: a fancy-indexing
+// call in numpy cost 7 us per 1,000 rows, three of them a third of
+// PairBatch's Python overhead (bench/python_pair_batch.py).
+enum BatchColumn : int {
+  kStatus,
+  kDistance,
+  kLowerBound,
+  kSignedDistance,
+  kSignedLowerBound,
+  kSignedUpperBound,
+  kPointA,
+  kPointB,
+  kNormal,
+  kFeatureAType,
+  kFeatureAVertices,
+  kFeatureAFace,
+  kFeatureBType,
+  kFeatureBVertices,
+  kFeatureBFace,
+  kIterations,
+  kPieceA,  // the last two for Bodies only
+  kPieceB,
+  kBatchColumns
+};
 
-// The batch result as a dict of arrays (K rows each); for Bodies also the
-// pieces of the closest pairs (piece_a, piece_b; -1 for a convex body).
-template <class Result>
-py::dict batch_dict(const std::vector<Result>& results) {
-  const auto k = static_cast<py::ssize_t>(results.size());
-  py::array_t<double> distance_(k), lower_bound(k), signed_distance(k), signed_lower_bound(k),
-      signed_upper_bound(k), point_a({k, py::ssize_t{3}}), point_b({k, py::ssize_t{3}}),
-      normal({k, py::ssize_t{3}});
-  Int32Array iterations(k), face_a(k), face_b(k), vertices_a({k, py::ssize_t{3}}),
-      vertices_b({k, py::ssize_t{3}});
-  std::vector<std::uint8_t> status_code(static_cast<std::size_t>(k)),
-      type_a(static_cast<std::size_t>(k)), type_b(static_cast<std::size_t>(k));
-  auto d = distance_.mutable_unchecked<1>();
-  auto lb = lower_bound.mutable_unchecked<1>();
-  auto sd = signed_distance.mutable_unchecked<1>();
-  auto slb = signed_lower_bound.mutable_unchecked<1>();
-  auto sub = signed_upper_bound.mutable_unchecked<1>();
-  auto pa = point_a.mutable_unchecked<2>();
-  auto pb = point_b.mutable_unchecked<2>();
-  auto n = normal.mutable_unchecked<2>();
-  auto it = iterations.mutable_unchecked<1>();
-  auto fa = face_a.mutable_unchecked<1>();
-  auto fb = face_b.mutable_unchecked<1>();
-  auto va = vertices_a.mutable_unchecked<2>();
-  auto vb = vertices_b.mutable_unchecked<2>();
-  for (py::ssize_t i = 0; i < k; ++i) {
-    const Result& r = results[static_cast<std::size_t>(i)];
-    d(i) = r.distance;
-    lb(i) = r.lower_bound;
-    sd(i) = r.signed_distance();
-    slb(i) = r.signed_lower_bound();
-    sub(i) = r.signed_upper_bound();
-    for (int j = 0; j < 3; ++j) {
-      pa(i, j) = r.point_a[j];
-      pb(i, j) = r.point_b[j];
-      n(i, j) = r.normal[j];
-      va(i, j) = r.feature_a.vertices[static_cast<std::size_t>(j)];
-      vb(i, j) = r.feature_b.vertices[static_cast<std::size_t>(j)];
-    }
-    it(i) = r.iterations;
-    fa(i) = r.feature_a.face;
-    fb(i) = r.feature_b.face;
-    const auto u = static_cast<std::size_t>(i);
-    status_code[u] = static_cast<std::uint8_t>(r.status);
-    type_a[u] = static_cast<std::uint8_t>(r.feature_a.type);
-    type_b[u] = static_cast<std::uint8_t>(r.feature_b.type);
-  }
-  py::dict out;
-  // The names of every status and feature type, by their codes (to_string).
-  static const std::array<std::string_view, 4> kStatusNames = {
+// A column: its key, its numpy kind ('U' names, 'f' float64, 'i' int32)
+// and its width (characters for 'U', else columns: 1 for a (K,) array).
+struct BatchColumnSpec {
+  const char* key;
+  char kind;
+  py::ssize_t width;
+};
+
+// The names of every status and feature type, by their codes (to_string).
+inline const std::array<std::string_view, 4>& status_names() {
+  static const std::array<std::string_view, 4> names = {
       to_string(Status::separated), to_string(Status::touching), to_string(Status::intersecting),
       to_string(Status::iteration_cap)};
-  static const std::array<std::string_view, 3> kTypeNames = {
+  return names;
+}
+inline const std::array<std::string_view, 3>& feature_type_names() {
+  static const std::array<std::string_view, 3> names = {
       to_string(FeatureType::vertex), to_string(FeatureType::edge), to_string(FeatureType::face)};
-  out["status"] = string_column(status_code, kStatusNames);
-  out["distance"] = distance_;
-  out["lower_bound"] = lower_bound;
-  out["signed_distance"] = signed_distance;
-  out["signed_lower_bound"] = signed_lower_bound;
-  out["signed_upper_bound"] = signed_upper_bound;
-  out["point_a"] = point_a;
-  out["point_b"] = point_b;
-  out["normal"] = normal;
-  out["feature_a_type"] = string_column(type_a, kTypeNames);
-  out["feature_a_vertices"] = vertices_a;
-  out["feature_a_face"] = face_a;
-  out["feature_b_type"] = string_column(type_b, kTypeNames);
-  out["feature_b_vertices"] = vertices_b;
-  out["feature_b_face"] = face_b;
-  out["iterations"] = iterations;
-  if constexpr (std::is_same_v<Result, BodyDistance>) {
-    Int32Array piece_a(k), piece_b(k);
-    auto ia = piece_a.mutable_unchecked<1>();
-    auto ib = piece_b.mutable_unchecked<1>();
-    for (py::ssize_t i = 0; i < k; ++i) {
-      ia(i) = results[static_cast<std::size_t>(i)].piece_a;
-      ib(i) = results[static_cast<std::size_t>(i)].piece_b;
-    }
-    out["piece_a"] = piece_a;
-    out["piece_b"] = piece_b;
+  return names;
+}
+template <std::size_t M>
+py::ssize_t longest(const std::array<std::string_view, M>& names) {
+  std::size_t width = 1;
+  for (const std::string_view n : names) width = std::max(width, n.size());
+  return static_cast<py::ssize_t>(width);
+}
+
+inline const std::array<BatchColumnSpec, kBatchColumns>& batch_columns() {
+  static const py::ssize_t status = longest(status_names());
+  static const py::ssize_t type = longest(feature_type_names());
+  static const std::array<BatchColumnSpec, kBatchColumns> columns = {{
+      {"status", 'U', status},
+      {"distance", 'f', 1},
+      {"lower_bound", 'f', 1},
+      {"signed_distance", 'f', 1},
+      {"signed_lower_bound", 'f', 1},
+      {"signed_upper_bound", 'f', 1},
+      {"point_a", 'f', 3},
+      {"point_b", 'f', 3},
+      {"normal", 'f', 3},
+      {"feature_a_type", 'U', type},
+      {"feature_a_vertices", 'i', 3},
+      {"feature_a_face", 'i', 1},
+      {"feature_b_type", 'U', type},
+      {"feature_b_vertices", 'i', 3},
+      {"feature_b_face", 'i', 1},
+      {"iterations", 'i', 1},
+      {"piece_a", 'i', 1},
+      {"piece_b", 'i', 1},
+  }};
+  return columns;
+}
+
+inline py::ssize_t item_size(const BatchColumnSpec& c) {
+  return c.kind == 'U' ? 4 * c.width : c.kind == 'f' ? 8 : 4;
+}
+
+// The numpy dtype of column i, made once (parsing "<U13" costs a
+// microsecond) and never destroyed: the module outlives every call.
+inline const py::dtype& column_dtype(int i) {
+  static const auto* f64 = new py::dtype(py::dtype::of<double>());
+  static const auto* i32 = new py::dtype(py::dtype::of<std::int32_t>());
+  const auto unicode = [](int column) {
+    return new py::dtype("<U" +
+                         std::to_string(batch_columns()[static_cast<std::size_t>(column)].width));
+  };
+  static const auto* status = unicode(kStatus);
+  static const auto* type = unicode(kFeatureAType);  // kFeatureBType's too
+  const char kind = batch_columns()[static_cast<std::size_t>(i)].kind;
+  if (kind == 'f') return *f64;
+  if (kind == 'i') return *i32;
+  return i == kStatus ? *status : *type;
+}
+
+// Where the rows of each column go: the data pointers (C order) and the
+// arrays themselves, held so that the memory stays alive while the GIL is
+// released (another thread may drop an answer's arrays meanwhile).
+struct BatchColumnData {
+  std::array<void*, kBatchColumns> data{};
+  std::array<py::object, kBatchColumns> arrays;
+
+  void* operator[](int column) const { return data[static_cast<std::size_t>(column)]; }
+};
+
+inline py::ssize_t batch_column_count(bool pieces) { return pieces ? kBatchColumns : kPieceA; }
+
+// New arrays of K rows, put into `out` under their keys.
+inline BatchColumnData new_batch_columns(py::ssize_t k, bool pieces, py::dict& out) {
+  BatchColumnData data{};
+  for (int i = 0; i < batch_column_count(pieces); ++i) {
+    const BatchColumnSpec& c = batch_columns()[static_cast<std::size_t>(i)];
+    py::array column = c.kind != 'U' && c.width > 1
+                           ? py::array(column_dtype(i), std::vector<py::ssize_t>{k, c.width})
+                           : py::array(column_dtype(i), std::vector<py::ssize_t>{k});
+    data.data[static_cast<std::size_t>(i)] = column.mutable_data();
+    out[c.key] = column;
+    data.arrays[static_cast<std::size_t>(i)] = std::move(column);
   }
+  return data;
+}
+
+// The columns of `out`, an earlier answer to be filled again (`where` names
+// the argument): exactly the keys of a K-row answer (with or without the
+// pieces), each a C-contiguous, aligned, writeable array of its dtype and
+// shape in native byte order, no two sharing memory. Anything else raises
+// ValueError naming the key, before anything is written.
+inline BatchColumnData batch_columns_of(py::handle out, py::ssize_t k, bool pieces,
+                                        const char* where) {
+  const auto fail = [where](const std::string& what) { value_error(std::string(where) + what); };
+  if (!PyDict_Check(out.ptr())) {
+    fail(": expected the dict of an earlier answer of this batch, got " +
+         std::string(Py_TYPE(out.ptr())->tp_name));
+  }
+  const py::ssize_t count = batch_column_count(pieces);
+  if (PyDict_Size(out.ptr()) != count) {
+    fail(": expected the " + std::to_string(count) + " arrays of an answer of this batch" +
+         (pieces ? " (with piece_a and piece_b)" : " (without piece_a and piece_b)") + ", got " +
+         std::to_string(PyDict_Size(out.ptr())) + " entries");
+  }
+  constexpr char kForeignOrder = std::endian::native == std::endian::little ? '>' : '<';
+  constexpr int kFlags = py::detail::npy_api::NPY_ARRAY_C_CONTIGUOUS_ |
+                         py::detail::npy_api::NPY_ARRAY_ALIGNED_ |
+                         py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+  BatchColumnData data{};
+  std::array<std::pair<const char*, const char*>, kBatchColumns> bytes{};  // [begin, end)
+  for (int i = 0; i < count; ++i) {
+    const BatchColumnSpec& c = batch_columns()[static_cast<std::size_t>(i)];
+    const std::string name = std::string("['") + c.key + "']";
+    PyObject* item = PyDict_GetItemString(out.ptr(), c.key);  // borrowed; no error set
+    if (item == nullptr) fail(name + " is missing");
+    if (!py::array::check_(item)) fail(name + ": expected a numpy array");
+    auto a = py::reinterpret_borrow<py::array>(item);
+    const py::dtype dtype = a.dtype();
+    const bool two_d = c.kind != 'U' && c.width > 1;
+    if (dtype.kind() != c.kind || dtype.itemsize() != item_size(c) ||
+        dtype.byteorder() == kForeignOrder || a.ndim() != (two_d ? 2 : 1) || a.shape(0) != k ||
+        (two_d && a.shape(1) != c.width)) {
+      fail(name + ": expected " + py::str(py::handle(column_dtype(i))).cast<std::string>() +
+           " of shape (" + std::to_string(k) + (two_d ? ", " + std::to_string(c.width) : ",") +
+           "), got " + py::str(py::handle(dtype)).cast<std::string>() + " of shape " + shape_of(a));
+    }
+    if ((a.flags() & kFlags) != kFlags)
+      fail(name + ": the array must be C-contiguous, aligned and writeable");
+    auto* begin = static_cast<char*>(a.mutable_data());
+    bytes[static_cast<std::size_t>(i)] = {begin, begin + a.nbytes()};
+    for (int j = 0; j < i; ++j) {
+      const auto& other = bytes[static_cast<std::size_t>(j)];
+      if (begin < other.second && other.first < begin + a.nbytes()) {
+        fail(name + " shares memory with ['" + batch_columns()[static_cast<std::size_t>(j)].key +
+             "']");
+      }
+    }
+    data.data[static_cast<std::size_t>(i)] = begin;
+    data.arrays[static_cast<std::size_t>(i)] = std::move(a);
+  }
+  return data;
+}
+
+// The names of a column, each padded with zeros to the column's width, back
+// to back: row i of the column is a copy of name code[i]'s `width` characters.
+template <std::size_t M>
+std::vector<char32_t> padded_names(const std::array<std::string_view, M>& names,
+                                   py::ssize_t width) {
+  std::vector<char32_t> padded(M * static_cast<std::size_t>(width), U'\0');
+  for (std::size_t code = 0; code < M; ++code) {
+    for (std::size_t c = 0; c < names[code].size(); ++c)
+      padded[code * static_cast<std::size_t>(width) + c] = static_cast<char32_t>(names[code][c]);
+  }
+  return padded;
+}
+
+// Writes the K results into the columns; the pieces when Result has them
+// (BodyDistance: -1 for a convex body).
+template <class Result>
+void write_batch_rows(std::span<const Result> results, const BatchColumnData& data) {
+  const auto& columns = batch_columns();
+  const auto f64 = [&data](BatchColumn c) { return static_cast<double*>(data[c]); };
+  const auto i32 = [&data](BatchColumn c) { return static_cast<std::int32_t*>(data[c]); };
+  const auto chars = [&data](BatchColumn c) { return static_cast<char32_t*>(data[c]); };
+  double *distance_ = f64(kDistance), *lower_bound = f64(kLowerBound),
+         *signed_distance = f64(kSignedDistance), *signed_lower = f64(kSignedLowerBound),
+         *signed_upper = f64(kSignedUpperBound), *point_a = f64(kPointA), *point_b = f64(kPointB),
+         *normal = f64(kNormal);
+  std::int32_t *vertices_a = i32(kFeatureAVertices), *face_a = i32(kFeatureAFace),
+               *vertices_b = i32(kFeatureBVertices), *face_b = i32(kFeatureBFace),
+               *iterations = i32(kIterations);
+  char32_t *status = chars(kStatus), *type_a = chars(kFeatureAType), *type_b = chars(kFeatureBType);
+  const py::ssize_t status_width = columns[kStatus].width,
+                    type_width = columns[kFeatureAType].width;
+  static const std::vector<char32_t> status_padded = padded_names(status_names(), status_width);
+  static const std::vector<char32_t> type_padded = padded_names(feature_type_names(), type_width);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const Result& r = results[i];
+    distance_[i] = r.distance;
+    lower_bound[i] = r.lower_bound;
+    signed_distance[i] = r.signed_distance();
+    signed_lower[i] = r.signed_lower_bound();
+    signed_upper[i] = r.signed_upper_bound();
+    for (std::size_t j = 0; j < 3; ++j) {
+      point_a[3 * i + j] = r.point_a[static_cast<Eigen::Index>(j)];
+      point_b[3 * i + j] = r.point_b[static_cast<Eigen::Index>(j)];
+      normal[3 * i + j] = r.normal[static_cast<Eigen::Index>(j)];
+      vertices_a[3 * i + j] = r.feature_a.vertices[j];
+      vertices_b[3 * i + j] = r.feature_b.vertices[j];
+    }
+    face_a[i] = r.feature_a.face;
+    face_b[i] = r.feature_b.face;
+    iterations[i] = r.iterations;
+    const auto name = [i](char32_t* column, const char32_t* padded, py::ssize_t width, auto code) {
+      const auto w = static_cast<std::size_t>(width);
+      std::copy_n(padded + static_cast<std::size_t>(code) * w, w, column + i * w);
+    };
+    name(status, status_padded.data(), status_width, r.status);
+    name(type_a, type_padded.data(), type_width, r.feature_a.type);
+    name(type_b, type_padded.data(), type_width, r.feature_b.type);
+  }
+  if constexpr (std::is_same_v<Result, BodyDistance>) {
+    std::int32_t *piece_a = i32(kPieceA), *piece_b = i32(kPieceB);
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      piece_a[i] = results[i].piece_a;
+      piece_b[i] = results[i].piece_b;
+    }
+  }
+}
+
+// The batch result as a new dict of arrays (K rows each); for Bodies also
+// the pieces of the closest pairs (piece_a, piece_b; -1 for a convex body).
+template <class Result>
+py::dict batch_dict(const std::vector<Result>& results) {
+  py::dict out;
+  const BatchColumnData data = new_batch_columns(static_cast<py::ssize_t>(results.size()),
+                                                 std::is_same_v<Result, BodyDistance>, out);
+  write_batch_rows(std::span<const Result>(results), data);
   return out;
 }
 

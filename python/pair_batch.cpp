@@ -14,6 +14,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "convert.h"
@@ -34,11 +35,24 @@ struct PairBatchState {
   std::vector<BodyPair> body_pairs;
   std::vector<BodyCache> body_caches;
   std::vector<BodyDistance> body_results;
+  // The poses of the last call, converted; kept so that a call allocates
+  // nothing for them.
+  std::vector<Pose> poses_a;
+  std::vector<Pose> poses_b;
   double last_call_seconds = 0.0;
 
   std::size_t size() const { return pairs.size() + body_pairs.size(); }
 };
 using PyPairBatch = Guarded<PairBatchState>;
+
+// distance_batch's refusal as PairBatch.distance's: the poses are checked
+// there (the pose contract, once, by the batch itself), so its message
+// names the pose (poses_a[k]) or the pair; only the caller's name differs.
+std::string in_python_words(std::string_view message) {
+  constexpr std::string_view kBatch = "distance_batch: ";
+  if (message.starts_with(kBatch)) message.remove_prefix(kBatch.size());
+  return "PairBatch.distance: " + std::string(message);
+}
 
 py::sequence body_list(py::handle list, const std::string& name) {
   if (!py::isinstance<py::sequence>(list) || py::isinstance<py::str>(list))
@@ -108,34 +122,51 @@ void bind_pair_batch(py::module_& m) {
           "distance",
           [](PyPairBatch& s, py::object poses_a, py::object poses_b, int threads,
              const std::string& algorithm, double relative_tolerance, double absolute_tolerance,
-             int max_iterations, bool penetration) {
+             int max_iterations, bool penetration, py::object out) -> py::object {
             const InUse in_use(s, "PairBatch");
             const DistanceOptions options = make_options(
                 algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
             const auto k = static_cast<py::ssize_t>(s.size());
-            const std::vector<Pose> pa = to_poses(poses_a, k, "poses_a");
-            const std::vector<Pose> pb = to_poses(poses_b, k, "poses_b");
             const bool bodies = !s.body_pairs.empty();
+            // Everything is checked before any cache or array of `out`
+            // changes: the shapes and out here, the pose contract by
+            // distance_batch before its first query (so not twice: the
+            // conversion only copies the poses).
+            to_poses(poses_a, k, "poses_a", PoseCheck::by_the_batch, s.poses_a);
+            to_poses(poses_b, k, "poses_b", PoseCheck::by_the_batch, s.poses_b);
+            const BatchColumnData columns =
+                out.is_none() ? BatchColumnData{} : batch_columns_of(out, k, bodies, "out");
             {
               py::gil_scoped_release release;
               const auto start = std::chrono::steady_clock::now();
-              if (bodies) {
-                distance_batch(s.body_pairs, pa, pb, s.body_results, s.body_caches, options,
-                               threads);
-              } else {
-                distance_batch(s.pairs, pa, pb, s.results, s.caches, options, threads);
+              try {
+                if (bodies) {
+                  distance_batch(s.body_pairs, s.poses_a, s.poses_b, s.body_results, s.body_caches,
+                                 options, threads);
+                } else {
+                  distance_batch(s.pairs, s.poses_a, s.poses_b, s.results, s.caches, options,
+                                 threads);
+                }
+              } catch (const InvalidInput& e) {
+                throw InvalidInput(in_python_words(e.what()));
               }
               s.last_call_seconds =
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
             }
-            return bodies ? batch_dict(s.body_results) : batch_dict(s.results);
+            if (out.is_none()) return bodies ? batch_dict(s.body_results) : batch_dict(s.results);
+            if (bodies) {
+              write_batch_rows(std::span<const BodyDistance>(s.body_results), columns);
+            } else {
+              write_batch_rows(std::span<const DistanceResult>(s.results), columns);
+            }
+            return out;
           },
           py::arg("poses_a"), py::arg("poses_b"), py::arg("threads") = 0,
           py::arg("algorithm") = to_string(defaults.algorithm),
           py::arg("relative_tolerance") = defaults.relative_tolerance,
           py::arg("absolute_tolerance") = defaults.absolute_tolerance,
           py::arg("max_iterations") = defaults.max_iterations,
-          py::arg("penetration") = defaults.penetration,
+          py::arg("penetration") = defaults.penetration, py::arg("out") = py::none(),
           R"doc(Distance of every pair k at poses_a[k], poses_b[k], tracked from the previous call.
 
 poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices, or one pose (or None) for all K.
@@ -143,7 +174,10 @@ threads: 0 for all cores, 1 for the calling thread only, n for n threads.
 Returns the dict of distance_batch: arrays with K rows (status, distance, lower_bound,
 signed_distance and its bounds, point_a,
 point_b, normal, features, iterations). Row k equals
-distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).)doc")
+distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).
+out: None (new arrays), or the dict of an earlier answer of this batch: its arrays are
+filled again in place and the same dict is returned, so that a loop allocates nothing
+(a bad out raises ValueError before any cache or array changes).)doc")
       .def(
           "reset",
           [](PyPairBatch& s) {

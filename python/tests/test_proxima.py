@@ -731,6 +731,165 @@ def test_pair_batch_equals_single_tracked_queries():
         batch.distance(None, poses_b[:3])
 
 
+def pair_batch_scene(seed, k=40):
+    """K pairs of random hulls at random poses, some overlapping."""
+    rng = np.random.default_rng(seed)
+    shapes = [proxima.ConvexPolytope(rng.normal(size=(int(rng.integers(8, 50)), 3))) for _ in range(6)]
+    a = [shapes[i % 6] for i in range(k)]
+    b = [shapes[(5 * i + 2) % 6] for i in range(k)]
+    pa, pb = random_scene(rng, k, spread=1.5)
+    return rng, a, b, pa, pb
+
+
+def assert_same_answer(got, expected):
+    assert list(got) == list(expected)
+    for key, column in expected.items():
+        assert got[key].dtype == column.dtype and got[key].shape == column.shape, key
+        np.testing.assert_array_equal(got[key], column, err_msg=key)
+
+
+# Issue 11, Python at C++ speed: out=<an earlier answer> fills that answer's
+# arrays again in place, so that a tracking loop allocates nothing: the same
+# dict and the same array objects come back, every row equal, bit for bit,
+# to a twin batch's new arrays and to the single tracked query of its pair,
+# call after call, on 1 and 2 threads.
+def test_pair_batch_out_refills_the_same_arrays():
+    rng, a, b, pa, pb = pair_batch_scene(33)
+    k = len(a)
+    batch, twin = proxima.PairBatch(a, b), proxima.PairBatch(a, b)
+    caches = [proxima.DistanceCache() for _ in range(k)]
+    out, arrays, statuses = None, None, set()
+    for step in range(4):
+        pb[:, :3, 3] += rng.normal(size=(k, 3)) * 0.05
+        threads = 1 + step % 2
+        fresh = twin.distance(pa, pb, threads=threads)
+        got = batch.distance(pa, pb, threads=threads, out=out)
+        if out is None:
+            out, arrays = got, {key: id(column) for key, column in got.items()}
+        assert got is out and {key: id(column) for key, column in got.items()} == arrays
+        assert_same_answer(got, fresh)
+        for i in range(k):
+            single = proxima.distance(a[i], pa[i], b[i], pb[i], cache=caches[i])
+            assert got["distance"][i] == single.distance and got["status"][i] == single.status
+            assert got["signed_distance"][i] == single.signed_distance
+            np.testing.assert_array_equal(got["point_a"][i], single.point_a)
+            np.testing.assert_array_equal(got["normal"][i], single.normal)
+            assert got["feature_b_type"][i] == single.feature_b.type
+            statuses.add(single.status)
+    assert {"separated", "intersecting"} <= statuses  # premise: both kinds of pair
+    # A batch of Bodies fills its pieces too.
+    bodies_a = [proxima.Body(p, 0.1) for p in a]
+    body_batch, body_twin = proxima.PairBatch(bodies_a, b), proxima.PairBatch(bodies_a, b)
+    body_out = body_batch.distance(pa, pb)
+    body_twin.distance(pa, pb)
+    pb[:, :3, 3] += 0.05
+    assert body_batch.distance(pa, pb, out=body_out) is body_out
+    assert_same_answer(body_out, body_twin.distance(pa, pb))
+
+
+# out= is checked whole before anything runs: a dict that is not a K-row
+# answer of this kind of batch (a missing, extra or renamed key, another K,
+# dtype or byte order, a read-only or strided array, two keys sharing memory)
+# raises ValueError naming the key, and neither the batch (its caches, its
+# last_call_seconds) nor any array of out has changed.
+def test_pair_batch_refuses_a_bad_out_before_anything_changes():
+    rng, a, b, pa, pb = pair_batch_scene(34)
+    k = len(a)
+    batch, twin = proxima.PairBatch(a, b), proxima.PairBatch(a, b)
+    out = batch.distance(pa, pb)
+    twin.distance(pa, pb)
+    before = {key: column.copy() for key, column in out.items()}
+    seconds = batch.last_call_seconds
+    pb[:, :3, 3] += 0.05
+
+    def replaced(**columns):
+        d = dict(out)
+        d.update(columns)
+        return d
+
+    read_only = out["distance"].copy()
+    read_only.flags.writeable = False
+    renamed = dict(out)
+    renamed["normals"] = renamed.pop("normal")
+    body_answer = proxima.PairBatch([proxima.Body(p) for p in a], b).distance(pa, pb)
+    cases = [
+        ([out["distance"]], r"out: expected the dict of an earlier answer of this batch, got list"),
+        (proxima.PairBatch(a[:3], b[:3]).distance(pa[:3], pb[:3]), r"out\['status'\]: expected <U13 of shape \(40,\), got <U13 of shape \(3,\)"),
+        ({key: v for key, v in out.items() if key != "normal"}, r"expected the 16 arrays .*got 15 entries"),
+        (renamed, r"out\['normal'\] is missing"),
+        (body_answer, r"out: expected the 16 arrays of an answer of this batch \(without piece_a and piece_b\), got 18"),
+        (replaced(distance=out["distance"].astype(np.float32)), r"out\['distance'\]: expected float64 of shape \(40,\), got float32"),
+        (replaced(distance=out["distance"].astype(">f8")), r"out\['distance'\]: expected float64"),
+        (replaced(iterations=out["iterations"].astype(np.int64)), r"out\['iterations'\]: expected int32"),
+        (replaced(status=out["status"].astype("<U20")), r"out\['status'\]: expected <U13"),
+        (replaced(point_a=out["point_a"].reshape(-1)), r"out\['point_a'\]: expected float64 of shape \(40, 3\), got float64 of shape \(120,\)"),
+        (replaced(point_a=np.zeros((k, 6))[:, ::2]), r"out\['point_a'\]: the array must be C-contiguous, aligned and writeable"),
+        (replaced(distance=read_only), r"out\['distance'\]: the array must be C-contiguous, aligned and writeable"),
+        (replaced(lower_bound=out["distance"]), r"out\['lower_bound'\] shares memory with \['distance'\]"),
+        (replaced(feature_b_vertices=out["feature_a_vertices"][::-1]), r"out\['feature_b_vertices'\]: the array must be C-contiguous"),
+        (replaced(distance=list(out["distance"])), r"out\['distance'\]: expected a numpy array"),
+    ]
+    for bad, message in cases:
+        with pytest.raises(ValueError, match=message):
+            batch.distance(pa, pb, out=bad)
+        assert batch.last_call_seconds == seconds  # the batch did not run
+        for key, column in out.items():
+            np.testing.assert_array_equal(column, before[key], err_msg=key)
+    assert_same_answer(batch.distance(pa, pb, out=out), twin.distance(pa, pb))
+
+
+# The pose contract on PairBatch's poses is checked once, by the C++ batch
+# before its first query (the conversion only copies them): a non-finite
+# entry, a rotation that is not orthonormal, a reflection, a bad bottom row
+# or a complex array is refused naming the pose and its index, and neither
+# the caches nor out have changed. A rotation off by float32 rounding is
+# accepted and answered as the single query answers it (re-orthonormalized).
+def test_pair_batch_refuses_bad_poses_naming_the_index():
+    rng, a, b, pa, pb = pair_batch_scene(35)
+    k = len(a)
+    batch, twin = proxima.PairBatch(a, b), proxima.PairBatch(a, b)
+    out = batch.distance(pa, pb)
+    twin.distance(pa, pb)
+    before = {key: column.copy() for key, column in out.items()}
+    seconds = batch.last_call_seconds
+    pb[:, :3, 3] += 0.05
+
+    def changed(poses, index, entry, value):
+        poses = poses.copy()
+        poses[(index, *entry)] = value
+        return poses
+
+    reflected = pb.copy()
+    reflected[5, :3, 0] *= -1
+    stretched = pa.copy()
+    stretched[3, :3, :3] *= 1.01
+    cases = [
+        (pa, changed(pb, 7, (0, 1), np.nan), r"PairBatch.distance: poses_b\[7\] is not finite"),
+        (changed(pa, 39, (2, 3), np.inf), pb, r"PairBatch.distance: poses_a\[39\] is not finite"),
+        (pa[:, :3, :], changed(pb[:, :3, :], 4, (1, 3), -np.inf), r"poses_b\[4\] is not finite"),
+        (stretched, pb, r"PairBatch.distance: poses_a\[3\]: rotation is not orthonormal"),
+        (pa, reflected, r"PairBatch.distance: poses_b\[5\]: rotation is a reflection"),
+        (pa, changed(pb, 2, (3, 0), 0.5), r"poses_b\[2\]: the bottom row of a pose matrix must be \(0, 0, 0, 1\)"),
+        (pa, changed(pb, 6, (3, 3), np.nan), r"poses_b\[6\] is not finite"),
+        (pa, pb.astype(complex), r"poses_b: expected real numbers"),
+    ]
+    for poses_a, poses_b, message in cases:
+        for threads in (1, 2):
+            with pytest.raises(ValueError, match=message):
+                batch.distance(poses_a, poses_b, threads=threads, out=out)
+            assert batch.last_call_seconds == seconds  # the batch did not run
+            for key, column in out.items():
+                np.testing.assert_array_equal(column, before[key], err_msg=key)
+    assert_same_answer(batch.distance(pa, pb, out=out), twin.distance(pa, pb))
+    rounded = pb.astype(np.float32).astype(np.float64)
+    assert np.abs(rounded[:, :3, :3] - pb[:, :3, :3]).max() > 0  # premise: not orthonormal to u
+    cold = proxima.PairBatch(a, b).distance(pa, rounded, threads=2)
+    for i in range(k):
+        single = proxima.distance(a[i], pa[i], b[i], rounded[i])
+        assert cold["distance"][i] == single.distance
+        np.testing.assert_array_equal(cold["point_b"][i], single.point_b)
+
+
 # --- signed distance ---------------------------------------------------------
 # Every result carries the signed distance (distance when apart, minus the
 # penetration depth when overlapping) and its certificate; the batch and the
