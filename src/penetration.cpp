@@ -51,6 +51,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <memory_resource>
 #include <span>
 
 #include "power_of_two.h"
@@ -80,6 +81,12 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 // coplanar face-face contact or a parallel edge, seen through rounding.
 constexpr double kTieUlps = 64.0;
 
+// Hulls of at most this many faces get face_plane's normals at once
+// (Query::fast_normals). Measured on the cold sweep of
+// bench/penetration_peers' poses: fast normals first made N = 8 (12
+// faces) 7% slower and N = 64 (124 faces) 10% faster.
+constexpr std::size_t kFastNormalsMinFaces = 32;
+
 struct Arc {
   Vec3 p, q;         // unit endpoints
   Vec3 k;            // axis: p x q along +k
@@ -106,9 +113,11 @@ struct Query {
   Vec3 translation;  // scaled
   double inverse = 1.0;
   double unit = 1.0;
-  double magnitude = 0.0;           // R, unscaled
-  std::span<const Vec3> normals_a;  // outward unit face normals of A (the shapes')
-  std::vector<Vec3> normals_b;      // of -B in A's frame: -(rotation n)
+  double magnitude = 0.0;  // R, unscaled
+  // Face normals of each hull in its own frame (fast or exact: see
+  // PenetrationCache::HullNormals); the shapes outlive the query.
+  PenetrationCache::HullNormals* shapes_a = nullptr;
+  PenetrationCache::HullNormals* shapes_b = nullptr;
   // Pruning (cold fast path only): the centroids (scaled, A's frame) and
   // the radii of balls about them inside the hulls (0 for flat hulls), so
   // that h_X(n) >= n.centroid_X + inradius_X for every unit n.
@@ -133,48 +142,89 @@ struct Query {
   Vec3 point_a(int i) const { return a.vertex(i) * inverse; }
   Vec3 point_b(int j) const { return rotation * (b.vertex(j) * inverse) + translation; }
 
-  // All face normals (each hull in its own frame, from `shapes` when it
-  // holds them for this pair), B's rotated into A's frame, and the
-  // inradii.
-  void compute_all_normals(PenetrationCache::Shapes& shapes) {
-    if (shapes.normals_a.size() != static_cast<std::size_t>(a.face_count()) ||
-        shapes.normals_b.size() != static_cast<std::size_t>(b.face_count())) {
-      shapes.normals_a.resize(static_cast<std::size_t>(a.face_count()));
-      shapes.normals_b.resize(static_cast<std::size_t>(b.face_count()));
-      shapes.inradius_a = inradius(a, shapes.normals_a);
-      shapes.inradius_b = inradius(b, shapes.normals_b);
+  // Points the query at the hulls' normals and inradii in `shapes`,
+  // computed first when they are not (or not for these hulls).
+  void use_shapes(PenetrationCache::Shapes& shapes) {
+    if (shapes.a.normals.size() != static_cast<std::size_t>(a.face_count()) ||
+        shapes.b.normals.size() != static_cast<std::size_t>(b.face_count())) {
+      fast_normals(a, shapes.a);
+      fast_normals(b, shapes.b);
     }
-    normals_a = shapes.normals_a;  // a view: the shapes outlive the query
-    normals_b.resize(shapes.normals_b.size());
-    for (std::size_t g = 0; g < normals_b.size(); ++g)
-      normals_b[g] = -(rotation * shapes.normals_b[g]);
+    shapes_a = &shapes.a;
+    shapes_b = &shapes.b;
     centroid_a = a.centroid() * inverse;
     centroid_b = rotation * (b.centroid() * inverse) + translation;
-    inradius_a = shapes.inradius_a * inverse;
-    inradius_b = shapes.inradius_b * inverse;
+    inradius_a = shapes.a.inradius * inverse;
+    inradius_b = shapes.b.inradius * inverse;
   }
 
-  // Fills `normals` with the hull's face normals and returns the radius of
-  // a ball about its centroid inside it: the least distance from the
-  // centroid to a face plane, less the rounding of that distance; 0 for a
-  // flat hull (its two faces' planes hold the centroid).
-  static double inradius(const ConvexPolytope& poly, std::vector<Vec3>& normals) {
+  // Fills `out` with fast face normals of the hull (its own frame) and the
+  // radius of a ball about its centroid inside it. A triangle's normal is
+  // its rounded cross product c = p x q (p, q its edges from its first
+  // vertex, in units of a power of two near the hull's scale), normalized:
+  // |c - c*| <= 8 u |p||q| (the roundings of p, q and of the products), so
+  // the unit normal is within 16 u |p||q| / |c| of the exact one, plus the
+  // division's rounding; kept with twice that bound when |c| >= 2^-10
+  // |p||q| (an angle above 0.06 degree), else, and for faces of more
+  // vertices, face_plane's (error 0); face_plane's for all faces of a
+  // small hull (at most kFastNormalsMinFaces faces: the query evaluates
+  // most of them, so fast normals would be computed twice). The inradius: the least over the
+  // faces of n.(v - centroid) less the normal's error times |v -
+  // centroid| and the rounding, then less 64 u R; 0 for a flat hull (its
+  // two faces' planes hold the centroid).
+  static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out) {
+    const auto count = static_cast<std::size_t>(poly.face_count());
+    out.normals.resize(count);
+    out.error.resize(count);
+    out.exact.assign(count, 0);
+    const detail::PowerOfTwoUnit s = detail::power_of_two_unit(poly.scale());
+    const Vec3 centroid = poly.centroid() * s.inverse;
+    const double u = kUnitRoundoff;
     double r = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < poly.face_count(); ++f) {
-      const Plane plane = poly.face_plane(f);
-      normals[static_cast<std::size_t>(f)] = plane.normal;
-      r = std::min(r, plane.offset - plane.normal.dot(poly.centroid()));
+    for (std::size_t f = 0; f < count; ++f) {
+      const auto cycle = poly.face(static_cast<int>(f));
+      if (cycle.size() == 3 && count > kFastNormalsMinFaces) {
+        const Vec3 v0 = poly.vertex(cycle[0]) * s.inverse;
+        const Vec3 p = poly.vertex(cycle[1]) * s.inverse - v0;
+        const Vec3 q = poly.vertex(cycle[2]) * s.inverse - v0;
+        const Vec3 c = p.cross(q);
+        const double pn = p.norm(), qn = q.norm(), length = c.norm();
+        // Coordinates of at least 2^-900 (no subnormal roundings).
+        if (std::min(pn, qn) > 0x1p-900 && length >= 0x1p-10 * pn * qn) {
+          const Vec3 n = c / length;
+          const double e = (32.0 * pn * qn / length + 8.0) * u;
+          out.normals[f] = n;
+          out.error[f] = e;
+          const Vec3 w = v0 - centroid;
+          r = std::min(r, n.dot(w) - (e + 8.0 * u) * w.norm());
+          continue;
+        }
+      }
+      const Plane plane = poly.face_plane(static_cast<int>(f));
+      out.normals[f] = plane.normal;
+      out.error[f] = 0.0;
+      out.exact[f] = 1;
+      r = std::min(r, (plane.offset - plane.normal.dot(poly.centroid())) * s.inverse);
     }
-    if (poly.dimension() < 3 || !(r > 0.0)) return 0.0;
-    return std::max(0.0, r - kValueSlackUlps * kUnitRoundoff * poly.scale());
+    out.inradius = poly.dimension() < 3 || !(r > 0.0)
+                       ? 0.0
+                       : std::max(0.0, r * s.unit - kValueSlackUlps * u * poly.scale());
   }
-  Vec3 normal_a(int f) const {
-    return normals_a.empty() ? a.face_plane(f).normal : normals_a[static_cast<std::size_t>(f)];
+
+  // face_plane's normal of face f of the hull, computed once.
+  static const Vec3& exact_normal(const ConvexPolytope& poly, PenetrationCache::HullNormals& h,
+                                  int f) {
+    const auto i = static_cast<std::size_t>(f);
+    if (!h.exact[i]) {
+      h.normals[i] = poly.face_plane(f).normal;
+      h.error[i] = 0.0;
+      h.exact[i] = 1;
+    }
+    return h.normals[i];
   }
-  Vec3 normal_b(int g) const {
-    return normals_b.empty() ? Vec3(-(rotation * b.face_plane(g).normal))
-                             : normals_b[static_cast<std::size_t>(g)];
-  }
+  Vec3 normal_a(int f) const { return exact_normal(a, *shapes_a, f); }
+  // Of -B, in A's frame.
+  Vec3 normal_b(int g) const { return -(rotation * exact_normal(b, *shapes_b, g)); }
 };
 
 // The face to the left of the directed edge v -> w, or -1.
@@ -220,16 +270,20 @@ int edge_arcs(int dimension, const Vec3& k, const Vec3& nl, const Vec3& nr, bool
   return 4;
 }
 
-int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+// The arcs of A's edge v -> w, whose left and right faces are l and r
+// (left_face's; read only for dimensions 2 and 3).
+int arcs_of_a(const Query& q, int v, int w, int l, int r, std::array<Arc, 4>& out) {
   const int dim = q.a.dimension();
   const Vec3 k = q.point_a(w) - q.point_a(v);
   if (dim == 3 || dim == 2) {
-    const int l = left_face(q.a, v, w);
-    const int r = left_face(q.a, w, v);
     if (l < 0 || r < 0) return 0;
     return edge_arcs(dim, k, q.normal_a(l), q.normal_a(r), false, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), false, out);
+}
+
+int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+  return arcs_of_a(q, v, w, left_face(q.a, v, w), left_face(q.a, w, v), out);
 }
 
 int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
@@ -355,12 +409,27 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
   keep(q, evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0), out);
 }
 
-// Appends every face candidate (faces of A, faces of B).
+// A lower bound on n.w for the exact unit normal n of a face, from its
+// stored normal `m` (within `error` of n; a few u more for B's, turned by
+// the rotation).
+double face_lower(const Vec3& m, double error, const Vec3& w) {
+  const double dot = m.dot(w);
+  return error > 0.0 ? dot - error * w.norm() : dot;
+}
+
+// Appends every face candidate (faces of A, faces of B), the ones that
+// pruned_by leaves. The pruning test reads the fast normals; a face kept
+// is evaluated along its exact one.
 void add_face_candidates(Query& q, std::vector<Candidate>& out) {
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const PenetrationCache::HullNormals& sb = *q.shapes_b;
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
-    const Vec3& n = q.normals_a[static_cast<std::size_t>(f)];
-    if (pruned_by(q, n.dot(q.point_a(q.a.face(f)[0]) - q.centroid_b) + q.inradius_b)) continue;
+    const auto i = static_cast<std::size_t>(f);
+    if (q.prune && pruned_by(q, face_lower(sa.normals[i], sa.error[i],
+                                           q.point_a(q.a.face(f)[0]) - q.centroid_b) +
+                                    q.inradius_b))
+      continue;
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
     Candidate c = evaluate_face(q, id);
     c.id.b0 = c.support_b;
@@ -369,8 +438,14 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   }
   int hint_a = 0;
   for (int g = 0; g < q.b.face_count(); ++g) {
-    const Vec3& n = q.normals_b[static_cast<std::size_t>(g)];
-    if (pruned_by(q, n.dot(q.centroid_a - q.point_b(q.b.face(g)[0])) + q.inradius_a)) continue;
+    const auto i = static_cast<std::size_t>(g);
+    if (q.prune) {
+      const Vec3 n = -(q.rotation * sb.normals[i]);
+      const double error = sb.error[i] > 0.0 ? sb.error[i] + 8.0 * kUnitRoundoff : 0.0;
+      if (pruned_by(q,
+                    face_lower(n, error, q.centroid_a - q.point_b(q.b.face(g)[0])) + q.inradius_a))
+        continue;
+    }
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
     Candidate c = evaluate_face(q, id);
     c.id.a0 = c.support_a;
@@ -433,61 +508,87 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   const std::size_t slots = memo ? q.b.adjacency().size() : 0;
   const std::unique_ptr<Arc[]> slot_arc = std::make_unique_for_overwrite<Arc[]>(slots);
   std::vector<char> slot_ready(slots, 0);
-  for (const auto& e : q.a.edges()) {
-    const int nx = arcs_of_a(q, e[0], e[1], xs);
-    if (q.prune && nx > 0) {
-      const Vec3 w = q.point_a(e[0]) - q.centroid_b;
-      double lower = std::numeric_limits<double>::infinity();
-      for (int i = 0; i < nx; ++i)
-        lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
-      if (pruned_by(q, lower + q.inradius_b)) continue;
-    }
-    for (int i = 0; i < nx; ++i) {
-      const Arc& x = xs[static_cast<std::size_t>(i)];
-      // The B cell of direction p: B's support along -p.
-      const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), hint);
-      hint = start;
-      chain.clear();
-      chain.push_back(start);
-      visited[static_cast<std::size_t>(start)] = 1;
-      for (std::size_t head = 0; head < chain.size(); ++head) {
-        const int j = chain[head];
-        const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
-        const auto nbrs = q.b.neighbors(j);
-        for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
-          const std::int32_t k = nbrs[slot - slot0];
-          int ny = 0;
-          if (memo) {
-            if (!slot_ready[slot]) {
-              const int count = arcs_of_b(q, j, k, ys);
-              slot_ready[slot] = count == 1 ? 1 : 2;
-              slot_arc[slot] = ys[0];
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const bool solid_a = q.a.dimension() == 3;
+  const auto offsets_a = q.a.adjacency_offsets();
+  const auto adjacency_a = q.a.adjacency();
+  const auto faces_a = q.a.adjacency_faces();
+  // Every edge of A once, as ConvexPolytope::edges() lists them (v < w, in
+  // adjacency order), with the face to its left from the slot.
+  for (int v = 0; v < q.a.vertex_count(); ++v) {
+    for (auto at = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v)]);
+         at < static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v) + 1]); ++at) {
+      const int w_end = adjacency_a[at];
+      if (!(v < w_end)) continue;
+      const std::array<int, 2> e = {v, w_end};
+      const int l = q.a.dimension() >= 2 ? faces_a[at] : -1;
+      const int r = q.a.dimension() >= 2 ? left_face(q.a, w_end, v) : -1;
+      if (q.prune && solid_a && l >= 0 && r >= 0) {
+        // First from the faces' stored normals, without the arc: every n
+        // on the arc from nL to nR is c1 nL + c2 nR with c1, c2 >= 0 and
+        // c1 + c2 >= 1, so n.w >= min(nL.w, nR.w) when that is >= 0
+        // (arc_minimum).
+        const Vec3 w = q.point_a(v) - q.centroid_b;
+        const auto il = static_cast<std::size_t>(l), ir = static_cast<std::size_t>(r);
+        const double m = std::min(face_lower(sa.normals[il], sa.error[il], w),
+                                  face_lower(sa.normals[ir], sa.error[ir], w));
+        if (m >= 0.0 && pruned_by(q, m + q.inradius_b)) continue;
+      }
+      const int nx = arcs_of_a(q, v, w_end, l, r, xs);
+      if (q.prune && nx > 0) {
+        const Vec3 w = q.point_a(e[0]) - q.centroid_b;
+        double lower = std::numeric_limits<double>::infinity();
+        for (int i = 0; i < nx; ++i)
+          lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
+        if (pruned_by(q, lower + q.inradius_b)) continue;
+      }
+      for (int i = 0; i < nx; ++i) {
+        const Arc& x = xs[static_cast<std::size_t>(i)];
+        // The B cell of direction p: B's support along -p.
+        const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), hint);
+        hint = start;
+        chain.clear();
+        chain.push_back(start);
+        visited[static_cast<std::size_t>(start)] = 1;
+        for (std::size_t head = 0; head < chain.size(); ++head) {
+          const int j = chain[head];
+          const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
+          const auto nbrs = q.b.neighbors(j);
+          for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
+            const std::int32_t k = nbrs[slot - slot0];
+            int ny = 0;
+            if (memo) {
+              if (!slot_ready[slot]) {
+                const int count = arcs_of_b(q, j, k, ys);
+                slot_ready[slot] = count == 1 ? 1 : 2;
+                slot_arc[slot] = ys[0];
+              }
+              ny = slot_ready[slot] == 1 ? 1 : 0;
+              ys[0] = slot_arc[slot];
+            } else {
+              ny = arcs_of_b(q, j, k, ys);
             }
-            ny = slot_ready[slot] == 1 ? 1 : 0;
-            ys[0] = slot_arc[slot];
-          } else {
-            ny = arcs_of_b(q, j, k, ys);
-          }
-          bool crosses = false;
-          for (int m = 0; m < ny && !crosses; ++m)
-            crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
-          if (!crosses) continue;
-          // Each crossing edge once: from its first-visited end.
-          if (!visited[static_cast<std::size_t>(k)]) {
-            visited[static_cast<std::size_t>(k)] = 1;
-            chain.push_back(k);
-            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
-                               std::max(j, static_cast<int>(k)), ys, ny, out);
-          } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
-                               k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
-            // k was reached from another cell of this chain, not expanded
-            // yet: the edge j-k is another crossing of the arc.
-            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
-                               std::max(j, static_cast<int>(k)), ys, ny, out);
+            bool crosses = false;
+            for (int m = 0; m < ny && !crosses; ++m)
+              crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
+            if (!crosses) continue;
+            // Each crossing edge once: from its first-visited end.
+            if (!visited[static_cast<std::size_t>(k)]) {
+              visited[static_cast<std::size_t>(k)] = 1;
+              chain.push_back(k);
+              add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                                 std::max(j, static_cast<int>(k)), ys, ny, out);
+            } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
+                                 k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
+              // k was reached from another cell of this chain, not expanded
+              // yet: the edge j-k is another crossing of the arc.
+              add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                                 std::max(j, static_cast<int>(k)), ys, ny, out);
+            }
           }
         }
+        for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
       }
-      for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
     }
   }
 }
@@ -506,18 +607,21 @@ struct Simplex {
   int face = -1;
 };
 
+// The lists live in `memory` (finish's buffer on the stack: a tracked
+// query's regions are a face and a vertex, and six heap allocations were
+// a tenth of it at N = 8).
 template <class PointOf>
-std::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d,
-                                    int v, double tie) {
+std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d,
+                                         int v, double tie, std::pmr::memory_resource* memory) {
   const double top = d.dot(point(v));
   const auto in = [&](int w) { return d.dot(point(w)) >= top - tie; };
-  std::vector<int> region{v};
+  std::pmr::vector<int> region({v}, memory);
   // Bounded by the vertex count: each vertex enters once.
   for (std::size_t head = 0; head < region.size(); ++head)
     for (const std::int32_t w : poly.neighbors(region[head]))
       if (std::find(region.begin(), region.end(), w) == region.end() && in(w)) region.push_back(w);
-  std::vector<Simplex> out;
-  std::vector<int> faces_seen;
+  std::pmr::vector<Simplex> out(memory);
+  std::pmr::vector<int> faces_seen(memory);
   const auto faces = poly.adjacency_faces();
   for (const int x : region) {
     const auto offset =
@@ -568,10 +672,12 @@ PenetrationResult finish(const Query& q, const Candidate& best, double lower_sca
   // of their points that differ by value * n: the closest points of
   // feature A and feature B moved by value * n.
   const double tie = kTieUlps * kUnitRoundoff;
+  std::array<std::byte, 2048> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
   const auto ta = support_region(
-      q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie);
+      q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie, &memory);
   const auto tb = support_region(
-      q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie);
+      q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie, &memory);
   const Vec3 shift = std::max(value, 0.0) * n;
   ClosestPoints<double> closest;
   closest.point_a = closest.point_b = Vec3::Zero();
@@ -719,7 +825,7 @@ void build_tree(PenetrationCache& cache) {
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start) {
   PenetrationCache::Shapes local;
-  q.compute_all_normals(cache != nullptr ? cache->shapes : local);
+  q.use_shapes(cache != nullptr ? cache->shapes : local);
   Candidate first;
   if (walk) {
     // The first upper bound: the last answer's direction (a rotated B), or

@@ -203,12 +203,20 @@ struct PenetrationCache {
   // even where a lower bound would prune them: it grows while B translates
   // past it (so that tracking finds them cached) and halves when B turns.
   double prune_margin = 0.0;
-  // What the query needs of the two hulls whatever the pose: face normals
-  // (each in its own frame) and the radii of balls about the centroids
-  // inside them.
+  // What the query needs of each hull whatever the pose, in its own frame:
+  // face normals and the radius of a ball about the centroid inside it.
+  // A normal is first a fast one (a triangle's rounded cross product,
+  // within error[f] of the exact unit normal), good for pruning; a face
+  // the query evaluates, or whose Gauss-map arc it tests, gets
+  // ConvexPolytope::face_plane's (exact[f] set, error 0), once.
+  struct HullNormals {
+    std::vector<Vec3> normals;
+    std::vector<double> error;
+    std::vector<char> exact;
+    double inradius = 0.0;
+  };
   struct Shapes {
-    std::vector<Vec3> normals_a, normals_b;
-    double inradius_a = 0.0, inradius_b = 0.0;
+    HullNormals a, b;
   } shapes;
   std::int64_t search_work = 0;  // nodes and faces visited since the anchor
 
