@@ -81,6 +81,8 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 // coplanar face-face contact or a parallel edge, seen through rounding.
 constexpr double kTieUlps = 64.0;
 
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
 // Hulls of at most this many faces get face_plane's normals at once
 // (Query::fast_normals). Measured on the cold sweep of
 // bench/penetration_peers' poses: fast normals first made N = 8 (12
@@ -129,6 +131,10 @@ struct Query {
   double bound = std::numeric_limits<double>::infinity();   // upper bound on the depth (scaled)
   double pruned = std::numeric_limits<double>::infinity();  // least lower bound of a pruned face
   double prune_margin = 0.0;  // faces within this of the bound are kept (scaled)
+  // Points of A and of B (scaled, A's frame): the supports of the best
+  // candidate so far (see pruned_by).
+  Vec3 reference_a = Vec3::Zero();
+  Vec3 reference_b = Vec3::Zero();
 
   Query(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& b_in_a)
       : a(pa), b(pb), rotation(b_in_a.rotation), rotation_t(b_in_a.rotation.transpose()) {
@@ -367,9 +373,16 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
 //   face f of A, normal n:   n.a_f + h_B(-n) >= n.(a_f - c_B) + r_B,
 //   face g of B, normal n:   h_A(n) - n.b_g >= n.(c_A - b_g) + r_A,
 //   edge e of A, n on its arc: n.a_e + h_B(-n) >= min over the arc of
-//                            n.(a_e - c_B), plus r_B (arc_minimum).
-// The face that realizes the depth has a lower bound at most the depth, so
-// it is never pruned.
+//                            n.(a_e - c_B), plus r_B (arc_minimum);
+// and from points a' of A and b' of B (h_A(n) >= n.a', h_B(-n) >= -n.b'):
+//   face f of A:  >= n.(a_f - b'),   face g of B:  >= n.(a' - b_g),
+//   edge e of A:  >= min over the arc of n.(a_e - b').
+// The points are the supports of the best candidate so far (reference_a,
+// reference_b): for the faces whose normals are near its direction, the
+// ones that can realize the depth, they bound h_A and h_B to second order
+// in the angle, where the balls leave the gap between the hulls'
+// circumradius and inradius. The face that realizes the depth has a lower
+// bound at most the depth, so it is never pruned.
 bool pruned_by(Query& q, double lower) {
   if (!q.prune || !(lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff))
     return false;
@@ -379,7 +392,11 @@ bool pruned_by(Query& q, double lower) {
 
 void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
   out.push_back(c);
-  q.bound = std::min(q.bound, c.value);
+  if (c.value < q.bound) {
+    q.bound = c.value;
+    q.reference_a = q.point_a(c.support_a);
+    q.reference_b = q.point_b(c.support_b);
+  }
 }
 
 // The candidates of an edge pair whose arcs may cross (xa: A's arcs, yb:
@@ -426,10 +443,14 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
     const auto i = static_cast<std::size_t>(f);
-    if (q.prune && pruned_by(q, face_lower(sa.normals[i], sa.error[i],
-                                           q.point_a(q.a.face(f)[0]) - q.centroid_b) +
-                                    q.inradius_b))
-      continue;
+    if (q.prune) {
+      const Vec3 af = q.point_a(q.a.face(f)[0]);
+      const Vec3& n = sa.normals[i];
+      const double error = sa.error[i];
+      if (pruned_by(q, std::max(face_lower(n, error, af - q.centroid_b) + q.inradius_b,
+                                face_lower(n, error, af - q.reference_b))))
+        continue;
+    }
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
     Candidate c = evaluate_face(q, id);
     c.id.b0 = c.support_b;
@@ -442,8 +463,9 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
     if (q.prune) {
       const Vec3 n = -(q.rotation * sb.normals[i]);
       const double error = sb.error[i] > 0.0 ? sb.error[i] + 8.0 * kUnitRoundoff : 0.0;
-      if (pruned_by(q,
-                    face_lower(n, error, q.centroid_a - q.point_b(q.b.face(g)[0])) + q.inradius_a))
+      const Vec3 bg = q.point_b(q.b.face(g)[0]);
+      if (pruned_by(q, std::max(face_lower(n, error, q.centroid_a - bg) + q.inradius_a,
+                                face_lower(n, error, q.reference_a - bg))))
         continue;
     }
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
@@ -528,19 +550,27 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         // on the arc from nL to nR is c1 nL + c2 nR with c1, c2 >= 0 and
         // c1 + c2 >= 1, so n.w >= min(nL.w, nR.w) when that is >= 0
         // (arc_minimum).
-        const Vec3 w = q.point_a(v) - q.centroid_b;
         const auto il = static_cast<std::size_t>(l), ir = static_cast<std::size_t>(r);
-        const double m = std::min(face_lower(sa.normals[il], sa.error[il], w),
-                                  face_lower(sa.normals[ir], sa.error[ir], w));
-        if (m >= 0.0 && pruned_by(q, m + q.inradius_b)) continue;
+        const auto least = [&](const Vec3& w) {
+          return std::min(face_lower(sa.normals[il], sa.error[il], w),
+                          face_lower(sa.normals[ir], sa.error[ir], w));
+        };
+        const Vec3 av = q.point_a(v);
+        const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
+        const double lower =
+            std::max(m >= 0.0 ? m + q.inradius_b : -kInfinity, m2 >= 0.0 ? m2 : -kInfinity);
+        if (pruned_by(q, lower)) continue;
       }
       const int nx = arcs_of_a(q, v, w_end, l, r, xs);
       if (q.prune && nx > 0) {
         const Vec3 w = q.point_a(e[0]) - q.centroid_b;
-        double lower = std::numeric_limits<double>::infinity();
-        for (int i = 0; i < nx; ++i)
+        const Vec3 w2 = q.point_a(e[0]) - q.reference_b;
+        double lower = kInfinity, lower2 = kInfinity;
+        for (int i = 0; i < nx; ++i) {
           lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
-        if (pruned_by(q, lower + q.inradius_b)) continue;
+          lower2 = std::min(lower2, arc_minimum(xs[static_cast<std::size_t>(i)], w2));
+        }
+        if (pruned_by(q, std::max(lower + q.inradius_b, lower2))) continue;
       }
       for (int i = 0; i < nx; ++i) {
         const Arc& x = xs[static_cast<std::size_t>(i)];
@@ -838,6 +868,8 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     first = evaluate(q, {}, d, start != nullptr ? start->support_a : -1,
                      start != nullptr ? start->support_b : -1);
     q.bound = first.value;
+    q.reference_a = q.point_a(first.support_a);
+    q.reference_b = q.point_b(first.support_b);
   }
   std::vector<Candidate> candidates;
   candidates.reserve(static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
