@@ -135,6 +135,9 @@ struct Query {
   // candidate so far (see pruned_by).
   Vec3 reference_a = Vec3::Zero();
   Vec3 reference_b = Vec3::Zero();
+  // A bound on |x - y| for x in A and y in B (scaled): twice the sum of
+  // the bounding radii and the centroids' distance.
+  double reach = 0.0;
 
   Query(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& b_in_a)
       : a(pa), b(pb), rotation(b_in_a.rotation), rotation_t(b_in_a.rotation.transpose()) {
@@ -162,6 +165,8 @@ struct Query {
     centroid_b = rotation * (b.centroid() * inverse) + translation;
     inradius_a = shapes.a.inradius * inverse;
     inradius_b = shapes.b.inradius * inverse;
+    reach = 2.0 * ((a.bounding_radius() + b.bounding_radius()) * inverse +
+                   (centroid_a - centroid_b).norm());
   }
 
   // Fills `out` with fast face normals of the hull (its own frame) and the
@@ -174,10 +179,11 @@ struct Query {
   // |p||q| (an angle above 0.06 degree), else, and for faces of more
   // vertices, face_plane's (error 0); face_plane's for all faces of a
   // small hull (at most kFastNormalsMinFaces faces: the query evaluates
-  // most of them, so fast normals would be computed twice). The inradius: the least over the
-  // faces of n.(v - centroid) less the normal's error times |v -
-  // centroid| and the rounding, then less 64 u R; 0 for a flat hull (its
-  // two faces' planes hold the centroid).
+  // most of them, so fast normals would be computed twice). The inradius:
+  // the least over the faces of n.(v - centroid) less the normal's error
+  // and the rounding times twice the bounding radius (>= |v - centroid|),
+  // then less 64 u R; 0 for a flat hull (its two faces' planes hold the
+  // centroid).
   static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out) {
     const auto count = static_cast<std::size_t>(poly.face_count());
     out.normals.resize(count);
@@ -186,6 +192,8 @@ struct Query {
     const detail::PowerOfTwoUnit s = detail::power_of_two_unit(poly.scale());
     const Vec3 centroid = poly.centroid() * s.inverse;
     const double u = kUnitRoundoff;
+    // |v - centroid| <= reach for every vertex v (no square root).
+    const double reach = 2.0 * poly.bounding_radius() * s.inverse;
     double r = std::numeric_limits<double>::infinity();
     for (std::size_t f = 0; f < count; ++f) {
       const auto cycle = poly.face(static_cast<int>(f));
@@ -194,15 +202,15 @@ struct Query {
         const Vec3 p = poly.vertex(cycle[1]) * s.inverse - v0;
         const Vec3 q = poly.vertex(cycle[2]) * s.inverse - v0;
         const Vec3 c = p.cross(q);
-        const double pn = p.norm(), qn = q.norm(), length = c.norm();
-        // Coordinates of at least 2^-900 (no subnormal roundings).
-        if (std::min(pn, qn) > 0x1p-900 && length >= 0x1p-10 * pn * qn) {
+        const double p2 = p.squaredNorm(), q2 = q.squaredNorm();
+        const double pq = std::sqrt(p2 * q2), length = c.norm();
+        // Edges of at least 2^-450 (no subnormal roundings in p2 q2).
+        if (std::min(p2, q2) > 0x1p-900 && length >= 0x1p-10 * pq) {
           const Vec3 n = c / length;
-          const double e = (32.0 * pn * qn / length + 8.0) * u;
+          const double e = (32.0 * pq / length + 8.0) * u;
           out.normals[f] = n;
           out.error[f] = e;
-          const Vec3 w = v0 - centroid;
-          r = std::min(r, n.dot(w) - (e + 8.0 * u) * w.norm());
+          r = std::min(r, n.dot(v0 - centroid) - (e + 8.0 * u) * reach);
           continue;
         }
       }
@@ -428,10 +436,9 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
 
 // A lower bound on n.w for the exact unit normal n of a face, from its
 // stored normal `m` (within `error` of n; a few u more for B's, turned by
-// the rotation).
-double face_lower(const Vec3& m, double error, const Vec3& w) {
-  const double dot = m.dot(w);
-  return error > 0.0 ? dot - error * w.norm() : dot;
+// the rotation), |w| <= reach (Query::reach: no square root).
+double face_lower(const Vec3& m, double error, const Vec3& w, double reach) {
+  return m.dot(w) - error * reach;
 }
 
 // Appends every face candidate (faces of A, faces of B), the ones that
@@ -447,8 +454,8 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       const Vec3 af = q.point_a(q.a.face(f)[0]);
       const Vec3& n = sa.normals[i];
       const double error = sa.error[i];
-      if (pruned_by(q, std::max(face_lower(n, error, af - q.centroid_b) + q.inradius_b,
-                                face_lower(n, error, af - q.reference_b))))
+      if (pruned_by(q, std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
+                                face_lower(n, error, af - q.reference_b, q.reach))))
         continue;
     }
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
@@ -464,8 +471,8 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       const Vec3 n = -(q.rotation * sb.normals[i]);
       const double error = sb.error[i] > 0.0 ? sb.error[i] + 8.0 * kUnitRoundoff : 0.0;
       const Vec3 bg = q.point_b(q.b.face(g)[0]);
-      if (pruned_by(q, std::max(face_lower(n, error, q.centroid_a - bg) + q.inradius_a,
-                                face_lower(n, error, q.reference_a - bg))))
+      if (pruned_by(q, std::max(face_lower(n, error, q.centroid_a - bg, q.reach) + q.inradius_a,
+                                face_lower(n, error, q.reference_a - bg, q.reach))))
         continue;
     }
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
@@ -552,8 +559,8 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         // (arc_minimum).
         const auto il = static_cast<std::size_t>(l), ir = static_cast<std::size_t>(r);
         const auto least = [&](const Vec3& w) {
-          return std::min(face_lower(sa.normals[il], sa.error[il], w),
-                          face_lower(sa.normals[ir], sa.error[ir], w));
+          return std::min(face_lower(sa.normals[il], sa.error[il], w, q.reach),
+                          face_lower(sa.normals[ir], sa.error[ir], w, q.reach));
         };
         const Vec3 av = q.point_a(v);
         const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
