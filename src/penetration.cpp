@@ -658,6 +658,25 @@ std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& p
     for (const std::int32_t w : poly.neighbors(region[head]))
       if (std::find(region.begin(), region.end(), w) == region.end() && in(w)) region.push_back(w);
   std::pmr::vector<Simplex> out(memory);
+  // A vertex, or an edge (the BFS joined its two ends along it): no face
+  // has all its vertices in (what the general case below finds, without
+  // evaluating the faces around it).
+  if (region.size() == 1) {
+    out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
+    return out;
+  }
+  if (region.size() == 2) {
+    out.push_back({{std::min(region[0], region[1]), std::max(region[0], region[1]), -1},
+                   FeatureType::edge,
+                   -1});
+    return out;
+  }
+  // A face's vertices are all within the tie exactly when they are all in
+  // the region: its boundary runs along hull edges, so they are connected
+  // to the region's vertex it was found from.
+  const auto in_region = [&](int w) {
+    return std::find(region.begin(), region.end(), w) != region.end();
+  };
   std::pmr::vector<int> faces_seen(memory);
   const auto faces = poly.adjacency_faces();
   for (const int x : region) {
@@ -670,7 +689,7 @@ std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& p
       faces_seen.push_back(f);
       const auto cycle = poly.face(f);
       bool all = true;
-      for (const std::int32_t w : cycle) all = all && in(w);
+      for (const std::int32_t w : cycle) all = all && in_region(w);
       if (!all) continue;
       for (std::size_t i = 1; i + 1 < cycle.size(); ++i)
         out.push_back({{cycle[0], cycle[i], cycle[i + 1]}, FeatureType::face, f});
@@ -679,8 +698,7 @@ std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& p
   if (!out.empty()) return out;
   for (const int x : region)
     for (const std::int32_t w : poly.neighbors(x))
-      if (x < w && std::find(region.begin(), region.end(), w) != region.end())
-        out.push_back({{x, w, -1}, FeatureType::edge, -1});
+      if (x < w && in_region(w)) out.push_back({{x, w, -1}, FeatureType::edge, -1});
   if (!out.empty()) return out;
   out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
   return out;
