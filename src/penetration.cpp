@@ -545,8 +545,33 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   // Every edge of A once, as ConvexPolytope::edges() lists them (v < w, in
   // adjacency order), with the face to its left from the slot.
   for (int v = 0; v < q.a.vertex_count(); ++v) {
-    for (auto at = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v)]);
-         at < static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v) + 1]); ++at) {
+    const auto slot_begin = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v)]);
+    const auto slot_end = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v) + 1]);
+    if (q.prune && solid_a) {
+      // All edges at v at once: the faces to the left of v -> w over its
+      // neighbours w are all the faces around v, so both faces of every
+      // edge at v; the bound below (the per-edge one, with the least over
+      // all of them) is at most each edge's. Saves finding each edge's
+      // right face (a scan of its other end's neighbours) away from the
+      // answer.
+      const Vec3 av = q.point_a(v);
+      const Vec3 wc = av - q.centroid_b, wr = av - q.reference_b;
+      double mc = kInfinity, mr = kInfinity;
+      bool all = true;
+      for (std::size_t at = slot_begin; at < slot_end && all; ++at) {
+        const int f = faces_a[at];
+        all = f >= 0;
+        if (!all) break;
+        const auto i = static_cast<std::size_t>(f);
+        mc = std::min(mc, face_lower(sa.normals[i], sa.error[i], wc, q.reach));
+        mr = std::min(mr, face_lower(sa.normals[i], sa.error[i], wr, q.reach));
+      }
+      if (all && slot_begin < slot_end &&
+          pruned_by(
+              q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity)))
+        continue;
+    }
+    for (std::size_t at = slot_begin; at < slot_end; ++at) {
       const int w_end = adjacency_a[at];
       if (!(v < w_end)) continue;
       const std::array<int, 2> e = {v, w_end};
