@@ -135,6 +135,14 @@ struct Query {
   // candidate so far (see pruned_by).
   Vec3 reference_a = Vec3::Zero();
   Vec3 reference_b = Vec3::Zero();
+  // centroid_a and reference_a in B's frame (scaled): R^T (x - t).
+  Vec3 centroid_a_in_b = Vec3::Zero();
+  Vec3 reference_a_in_b = Vec3::Zero();
+  void set_references(int support_a, int support_b) {
+    reference_a = point_a(support_a);
+    reference_b = point_b(support_b);
+    reference_a_in_b = rotation_t * (reference_a - translation);
+  }
   // A bound on |x - y| for x in A and y in B (scaled): twice the sum of
   // the bounding radii and the centroids' distance.
   double reach = 0.0;
@@ -163,6 +171,7 @@ struct Query {
     shapes_b = &shapes.b;
     centroid_a = a.centroid() * inverse;
     centroid_b = rotation * (b.centroid() * inverse) + translation;
+    centroid_a_in_b = rotation_t * (centroid_a - translation);
     inradius_a = shapes.a.inradius * inverse;
     inradius_b = shapes.b.inradius * inverse;
     reach = 2.0 * ((a.bounding_radius() + b.bounding_radius()) * inverse +
@@ -175,8 +184,9 @@ struct Query {
   // vertex, in units of a power of two near the hull's scale), normalized:
   // |c - c*| <= 8 u |p||q| (the roundings of p, q and of the products), so
   // the unit normal is within 16 u |p||q| / |c| of the exact one, plus the
-  // division's rounding; kept with twice that bound when |c| >= 2^-10
-  // |p||q| (an angle above 0.06 degree), else, and for faces of more
+  // normalization's rounding; kept with twice that bound (|p||q| read as
+  // (|p|^2 + |q|^2) / 2, no square root) when |c| >= 2^-10 |p||q| (an
+  // angle above 0.06 degree), else, and for faces of more
   // vertices, face_plane's (error 0); face_plane's for all faces of a
   // small hull (at most kFastNormalsMinFaces faces: the query evaluates
   // most of them, so fast normals would be computed twice). The inradius:
@@ -203,11 +213,15 @@ struct Query {
         const Vec3 q = poly.vertex(cycle[2]) * s.inverse - v0;
         const Vec3 c = p.cross(q);
         const double p2 = p.squaredNorm(), q2 = q.squaredNorm();
-        const double pq = std::sqrt(p2 * q2), length = c.norm();
-        // Edges of at least 2^-450 (no subnormal roundings in p2 q2).
-        if (std::min(p2, q2) > 0x1p-900 && length >= 0x1p-10 * pq) {
-          const Vec3 n = c / length;
-          const double e = (32.0 * pq / length + 8.0) * u;
+        const double c2 = c.squaredNorm();
+        // Edges of at least 2^-450 (no subnormal roundings in p2 q2); |c|
+        // >= 2^-10 |p||q| as squares (no square root); |p||q| <= (p2 +
+        // q2) / 2 in the error bound; one rounding more from multiplying
+        // by 1 / |c| (within the 8 u).
+        if (std::min(p2, q2) > 0x1p-900 && c2 >= 0x1p-20 * (p2 * q2)) {
+          const double inverse_length = 1.0 / std::sqrt(c2);
+          const Vec3 n = c * inverse_length;
+          const double e = (16.0 * (p2 + q2) * inverse_length + 8.0) * u;
           out.normals[f] = n;
           out.error[f] = e;
           r = std::min(r, n.dot(v0 - centroid) - (e + 8.0 * u) * reach);
@@ -402,8 +416,7 @@ void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
   out.push_back(c);
   if (c.value < q.bound) {
     q.bound = c.value;
-    q.reference_a = q.point_a(c.support_a);
-    q.reference_b = q.point_b(c.support_b);
+    q.set_references(c.support_a, c.support_b);
   }
 }
 
@@ -468,11 +481,15 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   for (int g = 0; g < q.b.face_count(); ++g) {
     const auto i = static_cast<std::size_t>(g);
     if (q.prune) {
-      const Vec3 n = -(q.rotation * sb.normals[i]);
-      const double error = sb.error[i] > 0.0 ? sb.error[i] + 8.0 * kUnitRoundoff : 0.0;
-      const Vec3 bg = q.point_b(q.b.face(g)[0]);
-      if (pruned_by(q, std::max(face_lower(n, error, q.centroid_a - bg, q.reach) + q.inradius_a,
-                                face_lower(n, error, q.reference_a - bg, q.reach))))
+      // In B's frame (scaled): with n = -(R m), b_g = R b'_g + t and x' =
+      // R^T (x - t), n.(x - b_g) = m.(b'_g - x'); 8 u more of error for
+      // the rotations' roundings.
+      const Vec3& m = sb.normals[i];
+      const double error = sb.error[i] + 8.0 * kUnitRoundoff;
+      const Vec3 bg = q.b.vertex(q.b.face(g)[0]) * q.inverse;
+      if (pruned_by(q,
+                    std::max(face_lower(m, error, bg - q.centroid_a_in_b, q.reach) + q.inradius_a,
+                             face_lower(m, error, bg - q.reference_a_in_b, q.reach))))
         continue;
     }
     MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
@@ -918,8 +935,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     first = evaluate(q, {}, d, start != nullptr ? start->support_a : -1,
                      start != nullptr ? start->support_b : -1);
     q.bound = first.value;
-    q.reference_a = q.point_a(first.support_a);
-    q.reference_b = q.point_b(first.support_b);
+    q.set_references(first.support_a, first.support_b);
   }
   std::vector<Candidate> candidates;
   candidates.reserve(static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
