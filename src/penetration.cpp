@@ -135,6 +135,9 @@ struct Query {
   // candidate so far (see pruned_by).
   Vec3 reference_a = Vec3::Zero();
   Vec3 reference_b = Vec3::Zero();
+  // Per vertex v of A (empty until a face of A is evaluated): B's support
+  // found for the last face through v evaluated, or -1 (a hint).
+  std::vector<std::int32_t> near_b;
   // centroid_a and reference_a in B's frame (scaled): R^T (x - t).
   Vec3 centroid_a_in_b = Vec3::Zero();
   Vec3 reference_a_in_b = Vec3::Zero();
@@ -460,6 +463,13 @@ double face_lower(const Vec3& m, double error, const Vec3& w, double reach) {
 void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   const PenetrationCache::HullNormals& sa = *q.shapes_a;
   const PenetrationCache::HullNormals& sb = *q.shapes_b;
+  // Hints for the other hull's support: the last one found for a face
+  // through each vertex (neighbouring faces have near normals, so the
+  // climb from it is short; the previous face's, in index order, can be
+  // anywhere: at N = 4096 an enumeration that keeps many faces spent most
+  // of its time climbing). Allocated with the first face evaluated.
+  std::vector<std::int32_t>& near_b = q.near_b;
+  std::vector<std::int32_t> near_a;
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
     const auto i = static_cast<std::size_t>(f);
@@ -471,10 +481,14 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
                                 face_lower(n, error, af - q.reference_b, q.reach))))
         continue;
     }
-    MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
+    const auto cycle = q.a.face(f);
+    if (near_b.empty()) near_b.assign(static_cast<std::size_t>(q.a.vertex_count()), -1);
+    const std::int32_t near = near_b[static_cast<std::size_t>(cycle[0])];
+    MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, near >= 0 ? near : hint_b, -1};
     Candidate c = evaluate_face(q, id);
     c.id.b0 = c.support_b;
     hint_b = c.support_b;
+    for (const std::int32_t v : cycle) near_b[static_cast<std::size_t>(v)] = c.support_b;
     keep(q, c, out);
   }
   int hint_a = 0;
@@ -492,10 +506,14 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
                              face_lower(m, error, bg - q.reference_a_in_b, q.reach))))
         continue;
     }
-    MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
+    const auto cycle = q.b.face(g);
+    if (near_a.empty()) near_a.assign(static_cast<std::size_t>(q.b.vertex_count()), -1);
+    const std::int32_t near = near_a[static_cast<std::size_t>(cycle[0])];
+    MinkowskiFaceId id{MinkowskiFace::vertex_face, near >= 0 ? near : hint_a, -1, g, -1};
     Candidate c = evaluate_face(q, id);
     c.id.a0 = c.support_a;
     hint_a = c.support_a;
+    for (const std::int32_t v : cycle) near_a[static_cast<std::size_t>(v)] = c.support_a;
     keep(q, c, out);
   }
 }
@@ -624,7 +642,10 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
       for (int i = 0; i < nx; ++i) {
         const Arc& x = xs[static_cast<std::size_t>(i)];
         // The B cell of direction p: B's support along -p.
-        const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), hint);
+        // From the support found for a face through v, when one was
+        // evaluated (for a solid A, p is the normal of such a face).
+        const std::int32_t near = q.near_b.empty() ? -1 : q.near_b[static_cast<std::size_t>(v)];
+        const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), near >= 0 ? near : hint);
         hint = start;
         chain.clear();
         chain.push_back(start);
