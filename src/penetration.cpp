@@ -878,17 +878,26 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
           static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
 }
 
+// The value at B's translation t of a cached face: its offset at the
+// enumeration moved by -n.(t - t_enumeration) (`enumerated_delta`), one
+// rounding whatever the path.
+double facet_value(const PenetrationCache::Facet& f, const Vec3& enumerated_delta) {
+  return f.enumerated_offset - f.normal.dot(enumerated_delta);
+}
+
 // Fills node `at` (already allocated) over cache.facets[begin, end): the
-// ball around their normals and their least offset; not split.
-void make_node(PenetrationCache& cache, int at, int begin, int end) {
+// ball around their normals and their least value at B's translation t
+// (its anchor; `enumerated_delta` = t - t_enumeration); not split.
+void make_node(PenetrationCache& cache, int at, int begin, int end, const Vec3& t,
+               const Vec3& enumerated_delta) {
   const auto first = cache.facets.begin() + begin;
   const auto last = cache.facets.begin() + end;
   Vec3 lo = first->normal, hi = first->normal;
-  double least = first->offset;
+  double least = std::numeric_limits<double>::infinity();
   for (auto f = first; f != last; ++f) {
     lo = lo.cwiseMin(f->normal);
     hi = hi.cwiseMax(f->normal);
-    least = std::min(least, f->offset);
+    least = std::min(least, facet_value(*f, enumerated_delta));
   }
   const Vec3 center = 0.5 * (lo + hi);
   double radius = 0.0;
@@ -900,6 +909,7 @@ void make_node(PenetrationCache& cache, int at, int begin, int end) {
   node.center = center;
   node.radius = radius;
   node.least_offset = least;
+  node.anchor = t;
   node.begin = begin;
   node.end = end;
   node.left = -1;
@@ -908,7 +918,7 @@ void make_node(PenetrationCache& cache, int at, int begin, int end) {
 // Splits node `at` (more than kLeaf faces, no children yet) at the median
 // of its normals' coordinate of largest spread: O(its faces). Children
 // come after their parent in nodes.
-void split_node(PenetrationCache& cache, int at) {
+void split_node(PenetrationCache& cache, int at, const Vec3& t, const Vec3& enumerated_delta) {
   const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
   const auto first = cache.facets.begin() + node.begin;
   const auto last = cache.facets.begin() + node.end;
@@ -927,17 +937,18 @@ void split_node(PenetrationCache& cache, int at) {
   const int left = static_cast<int>(cache.nodes.size());
   cache.nodes.resize(cache.nodes.size() + 2);
   cache.nodes[static_cast<std::size_t>(at)].left = left;
-  make_node(cache, left, node.begin, middle);
-  make_node(cache, left + 1, middle, node.end);
+  make_node(cache, left, node.begin, middle, t, enumerated_delta);
+  make_node(cache, left + 1, middle, node.end, t, enumerated_delta);
 }
 
-// The tree's root over all cached faces (the searches split it).
-void build_tree(PenetrationCache& cache) {
+// The tree's root over all cached faces (the searches split it), anchored
+// at B's translation t.
+void build_tree(PenetrationCache& cache, const Vec3& t, const Vec3& enumerated_delta) {
   cache.nodes.clear();
   if (cache.facets.empty()) return;
   cache.nodes.reserve(4 * cache.facets.size() / PenetrationCache::kLeaf + 2);
   cache.nodes.resize(1);
-  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()));
+  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()), t, enumerated_delta);
 }
 
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
@@ -990,16 +1001,10 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     cache->b = &q.b;
     cache->fingerprint = fingerprint(q.a, q.b);
     cache->rotation = b_in_a.rotation;
-    cache->translation = b_in_a.translation;
-    cache->search_work = 0;
     cache->facets.resize(candidates.size());
     for (std::size_t i = 0; i < candidates.size(); ++i)
-      cache->facets[i] = {candidates[i].id,
-                          candidates[i].normal,
-                          candidates[i].value * q.unit,
-                          candidates[i].value * q.unit,
-                          candidates[i].support_a,
-                          candidates[i].support_b};
+      cache->facets[i] = {candidates[i].id, candidates[i].normal, candidates[i].value * q.unit,
+                          candidates[i].support_a, candidates[i].support_b};
     cache->enumerated_translation = b_in_a.translation;
     cache->pruned = q.pruned * q.unit;
     // The tree is built by the first tracked query (a rotating B, which
@@ -1011,97 +1016,81 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
   return r;
 }
 
-// Moves the anchor to translation t: every offset moved by -n.(t -
-// t_enumeration) from the enumeration's (one rounding each, however many
-// re-anchors), and the nodes' least offsets again, children before parents
-// (they come after them in nodes).
-void re_anchor(PenetrationCache& cache, const Vec3& t) {
-  const Vec3 delta = t - cache.enumerated_translation;
-  for (PenetrationCache::Facet& f : cache.facets)
-    f.offset = f.enumerated_offset - f.normal.dot(delta);
-  for (std::size_t k = cache.nodes.size(); k-- > 0;) {
-    PenetrationCache::Node& node = cache.nodes[k];
-    if (node.left < 0) {
-      double least = std::numeric_limits<double>::infinity();
-      for (int i = node.begin; i < node.end; ++i)
-        least = std::min(least, cache.facets[static_cast<std::size_t>(i)].offset);
-      node.least_offset = least;
-    } else {
-      node.least_offset =
-          std::min(cache.nodes[static_cast<std::size_t>(node.left)].least_offset,
-                   cache.nodes[static_cast<std::size_t>(node.left) + 1].least_offset);
-    }
-  }
-  cache.translation = t;
-  cache.search_work = 0;
-}
+// A translation-only tracked query: the least of the cached faces' values
+// at B's translation t (facet_value), by branch and bound on the tree
+// (PenetrationCache::Node), starting from the last answer's face. A node's
+// bound at t: its least value at its anchor less the most any of its
+// normals can gain, c.delta + rho |delta| and at most |delta| (delta = t -
+// anchor), rounded up; it is skipped when that is at least the best value
+// found: every face skipped has a value at least the best (up to the
+// rounding of the values themselves, which the certificate's slack
+// covers). A node the search enters is re-anchored at t: a leaf with the
+// least of its faces' values, an inner node with the lesser of its
+// children's bounds at t (each a lower bound there), so the nodes near the
+// answer stay tight however far B goes, and the ones far from it, never
+// entered, keep their anchors (their bounds loosen by at most the distance
+// moved, and only one node's gain per level of the tree is ever chained).
+// A node not split yet is split when the search enters it.
+struct TreeSearch {
+  PenetrationCache& cache;
+  Vec3 t;                            // B's translation
+  Vec3 enumerated_delta;             // t - t_enumeration
+  double inverse = 1.0, unit = 1.0;  // the query's power-of-two unit
+  double best = 0.0;
+  PenetrationCache::Facet winner;
+  int work = 0;
 
-// A translation-only tracked query: the least of the cached faces' offsets
-// moved by -n.delta (delta = B's translation since the anchor, |delta| =
-// `moved`), by branch and bound on the tree (PenetrationCache::Node),
-// starting from the last answer's face (its value from the enumeration's
-// offset: `enumerated_delta` = B's translation since the enumeration). A
-// node is skipped when its bound (least offset less the most any of its
-// normals can gain, c.delta + rho |delta| and at most |delta|, rounded up)
-// is at least the best value found: every face skipped has a value at
-// least the best (up to the rounding of the values themselves, which the
-// certificate's slack covers). A node not split yet is split when the
-// search descends into it. Returns the best face, its value in `best` and
-// the faces and nodes visited in `work`.
-PenetrationCache::Facet search_tree(PenetrationCache& cache, const Vec3& delta, double moved,
-                                    const Vec3& enumerated_delta, double& best, int& work) {
-  // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
-  const double gain_slack = 0x1p-44 * moved;
-  PenetrationCache::Facet winner = cache.last;
-  best = winner.enumerated_offset - winner.normal.dot(enumerated_delta);
-  work = 1;
-  const auto bound = [&](const PenetrationCache::Node& node) {
+  // A lower bound at t on the values of the faces under node `at` (its
+  // bound, or after entering it the least found).
+  double bound(const PenetrationCache::Node& node) const {
+    const Vec3 delta = t - node.anchor;
+    const double moved = (delta * inverse).norm() * unit;
+    // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
     const double gain = std::min(moved, node.center.dot(delta) + node.radius * moved);
-    return node.least_offset - gain - gain_slack;
-  };
-  // Depth-first, nearer child first; the stack holds at most one sibling
-  // per level (depth <= 2 log2(entries)).
-  std::array<std::int32_t, 128> stack;
-  int top = 0;
-  stack[static_cast<std::size_t>(top++)] = 0;
-  while (top > 0) {
-    const int at = stack[static_cast<std::size_t>(--top)];
-    // A copy: splitting appends to nodes.
-    PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+    return node.least_offset - gain - 0x1p-44 * moved;
+  }
+
+  double visit(int at, double node_bound) {
     ++work;
-    if (!(bound(node) < best)) continue;
-    if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf) {
-      // Not counted in `work`: a split is done once per enumeration (a
-      // re-anchor keeps it), and counting it would re-anchor sooner.
-      split_node(cache, at);
-      node = cache.nodes[static_cast<std::size_t>(at)];
+    if (!(node_bound < best)) return node_bound;
+    {
+      const PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
+      if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf)
+        split_node(cache, at, t, enumerated_delta);
     }
+    // A copy: splitting below appends to nodes.
+    const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+    double least = std::numeric_limits<double>::infinity();
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
-        const double value = f.offset - f.normal.dot(delta);
+        const double value = facet_value(f, enumerated_delta);
         ++work;
+        least = std::min(least, value);
         if (value < best) {
           best = value;
           winner = f;
         }
       }
-      continue;
-    }
-    const int l = node.left;
-    const double bl = bound(cache.nodes[static_cast<std::size_t>(l)]);
-    const double br = bound(cache.nodes[static_cast<std::size_t>(l) + 1]);
-    // Pushed far child first, so that the near one is searched first.
-    if (bl <= br) {
-      if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
-      if (bl < best) stack[static_cast<std::size_t>(top++)] = l;
     } else {
-      if (bl < best) stack[static_cast<std::size_t>(top++)] = l;
-      if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
+      const int l = node.left;
+      const double bl = bound(cache.nodes[static_cast<std::size_t>(l)]);
+      const double br = bound(cache.nodes[static_cast<std::size_t>(l) + 1]);
+      // The nearer child first.
+      if (bl <= br) {
+        least = visit(l, bl);
+        least = std::min(least, visit(l + 1, br));
+      } else {
+        least = visit(l + 1, br);
+        least = std::min(least, visit(l, bl));
+      }
     }
+    PenetrationCache::Node& stored = cache.nodes[static_cast<std::size_t>(at)];
+    stored.least_offset = least;
+    stored.anchor = t;
+    return least;
   }
-  return winner;
-}
+};
 
 }  // namespace
 
@@ -1126,23 +1115,24 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     const auto distance = [&](const Vec3& from) {
       return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
     };
-    if (cache.nodes.empty()) build_tree(cache);
+    const Vec3 enumerated_delta = b_in_a.translation - cache.enumerated_translation;
+    if (cache.nodes.empty()) build_tree(cache, b_in_a.translation, enumerated_delta);
     const double moved = distance(cache.enumerated_translation);
     const double pruned_cut = cache.pruned - moved;
-    double best = 0.0;
-    int work = 0;
-    const PenetrationCache::Facet f =
-        search_tree(cache, b_in_a.translation - cache.translation, distance(cache.translation),
-                    b_in_a.translation - cache.enumerated_translation, best, work);
+    TreeSearch search{cache,
+                      b_in_a.translation,
+                      enumerated_delta,
+                      q.inverse,
+                      q.unit,
+                      facet_value(cache.last, enumerated_delta),
+                      cache.last,
+                      1};
+    search.visit(0, search.bound(cache.nodes[0]));
+    const double best = search.best;
+    const PenetrationCache::Facet& f = search.winner;
+    const int work = search.work;
     if (best <= pruned_cut) {
       cache.last = f;
-      cache.search_work += work;
-      if (cache.search_work > static_cast<std::int64_t>(cache.facets.size())) {
-        // Certified, but the searches since the anchor cost as much as
-        // moving it: move it here for the queries to come.
-        re_anchor(cache, b_in_a.translation);
-        work += static_cast<int>(cache.facets.size() + cache.nodes.size());
-      }
       // The winner evaluated with true supports (they do not move under a
       // translation: the cached ones are checked by one hill-climbing step).
       Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
