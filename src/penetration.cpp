@@ -900,11 +900,12 @@ void make_node(PenetrationCache& cache, int at, int begin, int end, const Vec3& 
     least = std::min(least, facet_value(*f, enumerated_delta));
   }
   const Vec3 center = 0.5 * (lo + hi);
-  double radius = 0.0;
-  for (auto f = first; f != last; ++f) radius = std::max(radius, (f->normal - center).norm());
+  double radius2 = 0.0;
+  for (auto f = first; f != last; ++f)
+    radius2 = std::max(radius2, (f->normal - center).squaredNorm());
   // Rounded up: the norm is within a few u of the exact one (normals are
   // unit, so |n - c| <= 2), and the query adds its own slack.
-  radius = radius * (1.0 + 0x1p-48) + 0x1p-48;
+  const double radius = std::sqrt(radius2) * (1.0 + 0x1p-48) + 0x1p-48;
   PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
   node.center = center;
   node.radius = radius;
