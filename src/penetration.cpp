@@ -51,6 +51,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <memory_resource>
 #include <span>
 
 #include "power_of_two.h"
@@ -80,6 +81,14 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 // coplanar face-face contact or a parallel edge, seen through rounding.
 constexpr double kTieUlps = 64.0;
 
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Hulls of at most this many faces get face_plane's normals at once
+// (Query::fast_normals). Measured on the cold sweep of
+// bench/penetration_peers' poses: fast normals first made N = 8 (12
+// faces) 7% slower and N = 64 (124 faces) 10% faster.
+constexpr std::size_t kFastNormalsMinFaces = 32;
+
 struct Arc {
   Vec3 p, q;         // unit endpoints
   Vec3 k;            // axis: p x q along +k
@@ -106,9 +115,11 @@ struct Query {
   Vec3 translation;  // scaled
   double inverse = 1.0;
   double unit = 1.0;
-  double magnitude = 0.0;           // R, unscaled
-  std::span<const Vec3> normals_a;  // outward unit face normals of A (the shapes')
-  std::vector<Vec3> normals_b;      // of -B in A's frame: -(rotation n)
+  double magnitude = 0.0;  // R, unscaled
+  // Face normals of each hull in its own frame (fast or exact: see
+  // PenetrationCache::HullNormals); the shapes outlive the query.
+  PenetrationCache::HullNormals* shapes_a = nullptr;
+  PenetrationCache::HullNormals* shapes_b = nullptr;
   // Pruning (cold fast path only): the centroids (scaled, A's frame) and
   // the radii of balls about them inside the hulls (0 for flat hulls), so
   // that h_X(n) >= n.centroid_X + inradius_X for every unit n.
@@ -120,6 +131,24 @@ struct Query {
   double bound = std::numeric_limits<double>::infinity();   // upper bound on the depth (scaled)
   double pruned = std::numeric_limits<double>::infinity();  // least lower bound of a pruned face
   double prune_margin = 0.0;  // faces within this of the bound are kept (scaled)
+  // Points of A and of B (scaled, A's frame): the supports of the best
+  // candidate so far (see pruned_by).
+  Vec3 reference_a = Vec3::Zero();
+  Vec3 reference_b = Vec3::Zero();
+  // Per vertex v of A (empty until a face of A is evaluated): B's support
+  // found for the last face through v evaluated, or -1 (a hint).
+  std::vector<std::int32_t> near_b;
+  // centroid_a and reference_a in B's frame (scaled): R^T (x - t).
+  Vec3 centroid_a_in_b = Vec3::Zero();
+  Vec3 reference_a_in_b = Vec3::Zero();
+  void set_references(int support_a, int support_b) {
+    reference_a = point_a(support_a);
+    reference_b = point_b(support_b);
+    reference_a_in_b = rotation_t * (reference_a - translation);
+  }
+  // A bound on |x - y| for x in A and y in B (scaled): twice the sum of
+  // the bounding radii and the centroids' distance.
+  double reach = 0.0;
 
   Query(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& b_in_a)
       : a(pa), b(pb), rotation(b_in_a.rotation), rotation_t(b_in_a.rotation.transpose()) {
@@ -133,48 +162,100 @@ struct Query {
   Vec3 point_a(int i) const { return a.vertex(i) * inverse; }
   Vec3 point_b(int j) const { return rotation * (b.vertex(j) * inverse) + translation; }
 
-  // All face normals (each hull in its own frame, from `shapes` when it
-  // holds them for this pair), B's rotated into A's frame, and the
-  // inradii.
-  void compute_all_normals(PenetrationCache::Shapes& shapes) {
-    if (shapes.normals_a.size() != static_cast<std::size_t>(a.face_count()) ||
-        shapes.normals_b.size() != static_cast<std::size_t>(b.face_count())) {
-      shapes.normals_a.resize(static_cast<std::size_t>(a.face_count()));
-      shapes.normals_b.resize(static_cast<std::size_t>(b.face_count()));
-      shapes.inradius_a = inradius(a, shapes.normals_a);
-      shapes.inradius_b = inradius(b, shapes.normals_b);
+  // Points the query at the hulls' normals and inradii in `shapes`,
+  // computed first when they are not (or not for these hulls).
+  void use_shapes(PenetrationCache::Shapes& shapes) {
+    if (shapes.a.normals.size() != static_cast<std::size_t>(a.face_count()) ||
+        shapes.b.normals.size() != static_cast<std::size_t>(b.face_count())) {
+      fast_normals(a, shapes.a);
+      fast_normals(b, shapes.b);
     }
-    normals_a = shapes.normals_a;  // a view: the shapes outlive the query
-    normals_b.resize(shapes.normals_b.size());
-    for (std::size_t g = 0; g < normals_b.size(); ++g)
-      normals_b[g] = -(rotation * shapes.normals_b[g]);
+    shapes_a = &shapes.a;
+    shapes_b = &shapes.b;
     centroid_a = a.centroid() * inverse;
     centroid_b = rotation * (b.centroid() * inverse) + translation;
-    inradius_a = shapes.inradius_a * inverse;
-    inradius_b = shapes.inradius_b * inverse;
+    centroid_a_in_b = rotation_t * (centroid_a - translation);
+    inradius_a = shapes.a.inradius * inverse;
+    inradius_b = shapes.b.inradius * inverse;
+    reach = 2.0 * ((a.bounding_radius() + b.bounding_radius()) * inverse +
+                   (centroid_a - centroid_b).norm());
   }
 
-  // Fills `normals` with the hull's face normals and returns the radius of
-  // a ball about its centroid inside it: the least distance from the
-  // centroid to a face plane, less the rounding of that distance; 0 for a
-  // flat hull (its two faces' planes hold the centroid).
-  static double inradius(const ConvexPolytope& poly, std::vector<Vec3>& normals) {
+  // Fills `out` with fast face normals of the hull (its own frame) and the
+  // radius of a ball about its centroid inside it. A triangle's normal is
+  // its rounded cross product c = p x q (p, q its edges from its first
+  // vertex, in units of a power of two near the hull's scale), normalized:
+  // |c - c*| <= 8 u |p||q| (the roundings of p, q and of the products), so
+  // the unit normal is within 16 u |p||q| / |c| of the exact one, plus the
+  // normalization's rounding; kept with twice that bound (|p||q| read as
+  // (|p|^2 + |q|^2) / 2, no square root) when |c| >= 2^-10 |p||q| (an
+  // angle above 0.06 degree), else, and for faces of more
+  // vertices, face_plane's (error 0); face_plane's for all faces of a
+  // small hull (at most kFastNormalsMinFaces faces: the query evaluates
+  // most of them, so fast normals would be computed twice). The inradius:
+  // the least over the faces of n.(v - centroid) less the normal's error
+  // and the rounding times twice the bounding radius (>= |v - centroid|),
+  // then less 64 u R; 0 for a flat hull (its two faces' planes hold the
+  // centroid).
+  static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out) {
+    const auto count = static_cast<std::size_t>(poly.face_count());
+    out.normals.resize(count);
+    out.error.resize(count);
+    out.exact.assign(count, 0);
+    const detail::PowerOfTwoUnit s = detail::power_of_two_unit(poly.scale());
+    const Vec3 centroid = poly.centroid() * s.inverse;
+    const double u = kUnitRoundoff;
+    // |v - centroid| <= reach for every vertex v (no square root).
+    const double reach = 2.0 * poly.bounding_radius() * s.inverse;
     double r = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < poly.face_count(); ++f) {
-      const Plane plane = poly.face_plane(f);
-      normals[static_cast<std::size_t>(f)] = plane.normal;
-      r = std::min(r, plane.offset - plane.normal.dot(poly.centroid()));
+    for (std::size_t f = 0; f < count; ++f) {
+      const auto cycle = poly.face(static_cast<int>(f));
+      if (cycle.size() == 3 && count > kFastNormalsMinFaces) {
+        const Vec3 v0 = poly.vertex(cycle[0]) * s.inverse;
+        const Vec3 p = poly.vertex(cycle[1]) * s.inverse - v0;
+        const Vec3 q = poly.vertex(cycle[2]) * s.inverse - v0;
+        const Vec3 c = p.cross(q);
+        const double p2 = p.squaredNorm(), q2 = q.squaredNorm();
+        const double c2 = c.squaredNorm();
+        // Edges of at least 2^-450 (no subnormal roundings in p2 q2); |c|
+        // >= 2^-10 |p||q| as squares (no square root); |p||q| <= (p2 +
+        // q2) / 2 in the error bound; one rounding more from multiplying
+        // by 1 / |c| (within the 8 u).
+        if (std::min(p2, q2) > 0x1p-900 && c2 >= 0x1p-20 * (p2 * q2)) {
+          const double inverse_length = 1.0 / std::sqrt(c2);
+          const Vec3 n = c * inverse_length;
+          const double e = (16.0 * (p2 + q2) * inverse_length + 8.0) * u;
+          out.normals[f] = n;
+          out.error[f] = e;
+          r = std::min(r, n.dot(v0 - centroid) - (e + 8.0 * u) * reach);
+          continue;
+        }
+      }
+      const Plane plane = poly.face_plane(static_cast<int>(f));
+      out.normals[f] = plane.normal;
+      out.error[f] = 0.0;
+      out.exact[f] = 1;
+      r = std::min(r, (plane.offset - plane.normal.dot(poly.centroid())) * s.inverse);
     }
-    if (poly.dimension() < 3 || !(r > 0.0)) return 0.0;
-    return std::max(0.0, r - kValueSlackUlps * kUnitRoundoff * poly.scale());
+    out.inradius = poly.dimension() < 3 || !(r > 0.0)
+                       ? 0.0
+                       : std::max(0.0, r * s.unit - kValueSlackUlps * u * poly.scale());
   }
-  Vec3 normal_a(int f) const {
-    return normals_a.empty() ? a.face_plane(f).normal : normals_a[static_cast<std::size_t>(f)];
+
+  // face_plane's normal of face f of the hull, computed once.
+  static const Vec3& exact_normal(const ConvexPolytope& poly, PenetrationCache::HullNormals& h,
+                                  int f) {
+    const auto i = static_cast<std::size_t>(f);
+    if (!h.exact[i]) {
+      h.normals[i] = poly.face_plane(f).normal;
+      h.error[i] = 0.0;
+      h.exact[i] = 1;
+    }
+    return h.normals[i];
   }
-  Vec3 normal_b(int g) const {
-    return normals_b.empty() ? Vec3(-(rotation * b.face_plane(g).normal))
-                             : normals_b[static_cast<std::size_t>(g)];
-  }
+  Vec3 normal_a(int f) const { return exact_normal(a, *shapes_a, f); }
+  // Of -B, in A's frame.
+  Vec3 normal_b(int g) const { return -(rotation * exact_normal(b, *shapes_b, g)); }
 };
 
 // The face to the left of the directed edge v -> w, or -1.
@@ -220,16 +301,20 @@ int edge_arcs(int dimension, const Vec3& k, const Vec3& nl, const Vec3& nr, bool
   return 4;
 }
 
-int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+// The arcs of A's edge v -> w, whose left and right faces are l and r
+// (left_face's; read only for dimensions 2 and 3).
+int arcs_of_a(const Query& q, int v, int w, int l, int r, std::array<Arc, 4>& out) {
   const int dim = q.a.dimension();
   const Vec3 k = q.point_a(w) - q.point_a(v);
   if (dim == 3 || dim == 2) {
-    const int l = left_face(q.a, v, w);
-    const int r = left_face(q.a, w, v);
     if (l < 0 || r < 0) return 0;
     return edge_arcs(dim, k, q.normal_a(l), q.normal_a(r), false, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), false, out);
+}
+
+int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+  return arcs_of_a(q, v, w, left_face(q.a, v, w), left_face(q.a, w, v), out);
 }
 
 int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
@@ -313,9 +398,16 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
 //   face f of A, normal n:   n.a_f + h_B(-n) >= n.(a_f - c_B) + r_B,
 //   face g of B, normal n:   h_A(n) - n.b_g >= n.(c_A - b_g) + r_A,
 //   edge e of A, n on its arc: n.a_e + h_B(-n) >= min over the arc of
-//                            n.(a_e - c_B), plus r_B (arc_minimum).
-// The face that realizes the depth has a lower bound at most the depth, so
-// it is never pruned.
+//                            n.(a_e - c_B), plus r_B (arc_minimum);
+// and from points a' of A and b' of B (h_A(n) >= n.a', h_B(-n) >= -n.b'):
+//   face f of A:  >= n.(a_f - b'),   face g of B:  >= n.(a' - b_g),
+//   edge e of A:  >= min over the arc of n.(a_e - b').
+// The points are the supports of the best candidate so far (reference_a,
+// reference_b): for the faces whose normals are near its direction, the
+// ones that can realize the depth, they bound h_A and h_B to second order
+// in the angle, where the balls leave the gap between the hulls'
+// circumradius and inradius. The face that realizes the depth has a lower
+// bound at most the depth, so it is never pruned.
 bool pruned_by(Query& q, double lower) {
   if (!q.prune || !(lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff))
     return false;
@@ -325,7 +417,10 @@ bool pruned_by(Query& q, double lower) {
 
 void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
   out.push_back(c);
-  q.bound = std::min(q.bound, c.value);
+  if (c.value < q.bound) {
+    q.bound = c.value;
+    q.set_references(c.support_a, c.support_b);
+  }
 }
 
 // The candidates of an edge pair whose arcs may cross (xa: A's arcs, yb:
@@ -355,26 +450,70 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
   keep(q, evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0), out);
 }
 
-// Appends every face candidate (faces of A, faces of B).
+// A lower bound on n.w for the exact unit normal n of a face, from its
+// stored normal `m` (within `error` of n; a few u more for B's, turned by
+// the rotation), |w| <= reach (Query::reach: no square root).
+double face_lower(const Vec3& m, double error, const Vec3& w, double reach) {
+  return m.dot(w) - error * reach;
+}
+
+// Appends every face candidate (faces of A, faces of B), the ones that
+// pruned_by leaves. The pruning test reads the fast normals; a face kept
+// is evaluated along its exact one.
 void add_face_candidates(Query& q, std::vector<Candidate>& out) {
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const PenetrationCache::HullNormals& sb = *q.shapes_b;
+  // Hints for the other hull's support: the last one found for a face
+  // through each vertex (neighbouring faces have near normals, so the
+  // climb from it is short; the previous face's, in index order, can be
+  // anywhere: at N = 4096 an enumeration that keeps many faces spent most
+  // of its time climbing). Allocated with the first face evaluated.
+  std::vector<std::int32_t>& near_b = q.near_b;
+  std::vector<std::int32_t> near_a;
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
-    const Vec3& n = q.normals_a[static_cast<std::size_t>(f)];
-    if (pruned_by(q, n.dot(q.point_a(q.a.face(f)[0]) - q.centroid_b) + q.inradius_b)) continue;
-    MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, hint_b, -1};
+    const auto i = static_cast<std::size_t>(f);
+    if (q.prune) {
+      const Vec3 af = q.point_a(q.a.face(f)[0]);
+      const Vec3& n = sa.normals[i];
+      const double error = sa.error[i];
+      if (pruned_by(q, std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
+                                face_lower(n, error, af - q.reference_b, q.reach))))
+        continue;
+    }
+    const auto cycle = q.a.face(f);
+    if (near_b.empty()) near_b.assign(static_cast<std::size_t>(q.a.vertex_count()), -1);
+    const std::int32_t near = near_b[static_cast<std::size_t>(cycle[0])];
+    MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, near >= 0 ? near : hint_b, -1};
     Candidate c = evaluate_face(q, id);
     c.id.b0 = c.support_b;
     hint_b = c.support_b;
+    for (const std::int32_t v : cycle) near_b[static_cast<std::size_t>(v)] = c.support_b;
     keep(q, c, out);
   }
   int hint_a = 0;
   for (int g = 0; g < q.b.face_count(); ++g) {
-    const Vec3& n = q.normals_b[static_cast<std::size_t>(g)];
-    if (pruned_by(q, n.dot(q.centroid_a - q.point_b(q.b.face(g)[0])) + q.inradius_a)) continue;
-    MinkowskiFaceId id{MinkowskiFace::vertex_face, hint_a, -1, g, -1};
+    const auto i = static_cast<std::size_t>(g);
+    if (q.prune) {
+      // In B's frame (scaled): with n = -(R m), b_g = R b'_g + t and x' =
+      // R^T (x - t), n.(x - b_g) = m.(b'_g - x'); 8 u more of error for
+      // the rotations' roundings.
+      const Vec3& m = sb.normals[i];
+      const double error = sb.error[i] + 8.0 * kUnitRoundoff;
+      const Vec3 bg = q.b.vertex(q.b.face(g)[0]) * q.inverse;
+      if (pruned_by(q,
+                    std::max(face_lower(m, error, bg - q.centroid_a_in_b, q.reach) + q.inradius_a,
+                             face_lower(m, error, bg - q.reference_a_in_b, q.reach))))
+        continue;
+    }
+    const auto cycle = q.b.face(g);
+    if (near_a.empty()) near_a.assign(static_cast<std::size_t>(q.b.vertex_count()), -1);
+    const std::int32_t near = near_a[static_cast<std::size_t>(cycle[0])];
+    MinkowskiFaceId id{MinkowskiFace::vertex_face, near >= 0 ? near : hint_a, -1, g, -1};
     Candidate c = evaluate_face(q, id);
     c.id.a0 = c.support_a;
     hint_a = c.support_a;
+    for (const std::int32_t v : cycle) near_a[static_cast<std::size_t>(v)] = c.support_a;
     keep(q, c, out);
   }
 }
@@ -433,61 +572,123 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   const std::size_t slots = memo ? q.b.adjacency().size() : 0;
   const std::unique_ptr<Arc[]> slot_arc = std::make_unique_for_overwrite<Arc[]>(slots);
   std::vector<char> slot_ready(slots, 0);
-  for (const auto& e : q.a.edges()) {
-    const int nx = arcs_of_a(q, e[0], e[1], xs);
-    if (q.prune && nx > 0) {
-      const Vec3 w = q.point_a(e[0]) - q.centroid_b;
-      double lower = std::numeric_limits<double>::infinity();
-      for (int i = 0; i < nx; ++i)
-        lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
-      if (pruned_by(q, lower + q.inradius_b)) continue;
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const bool solid_a = q.a.dimension() == 3;
+  const auto offsets_a = q.a.adjacency_offsets();
+  const auto adjacency_a = q.a.adjacency();
+  const auto faces_a = q.a.adjacency_faces();
+  // Every edge of A once, as ConvexPolytope::edges() lists them (v < w, in
+  // adjacency order), with the face to its left from the slot.
+  for (int v = 0; v < q.a.vertex_count(); ++v) {
+    const auto slot_begin = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v)]);
+    const auto slot_end = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v) + 1]);
+    if (q.prune && solid_a) {
+      // All edges at v at once: the faces to the left of v -> w over its
+      // neighbours w are all the faces around v, so both faces of every
+      // edge at v; the bound below (the per-edge one, with the least over
+      // all of them) is at most each edge's. Saves finding each edge's
+      // right face (a scan of its other end's neighbours) away from the
+      // answer.
+      const Vec3 av = q.point_a(v);
+      const Vec3 wc = av - q.centroid_b, wr = av - q.reference_b;
+      double mc = kInfinity, mr = kInfinity;
+      bool all = true;
+      for (std::size_t at = slot_begin; at < slot_end && all; ++at) {
+        const int f = faces_a[at];
+        all = f >= 0;
+        if (!all) break;
+        const auto i = static_cast<std::size_t>(f);
+        mc = std::min(mc, face_lower(sa.normals[i], sa.error[i], wc, q.reach));
+        mr = std::min(mr, face_lower(sa.normals[i], sa.error[i], wr, q.reach));
+      }
+      if (all && slot_begin < slot_end &&
+          pruned_by(
+              q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity)))
+        continue;
     }
-    for (int i = 0; i < nx; ++i) {
-      const Arc& x = xs[static_cast<std::size_t>(i)];
-      // The B cell of direction p: B's support along -p.
-      const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), hint);
-      hint = start;
-      chain.clear();
-      chain.push_back(start);
-      visited[static_cast<std::size_t>(start)] = 1;
-      for (std::size_t head = 0; head < chain.size(); ++head) {
-        const int j = chain[head];
-        const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
-        const auto nbrs = q.b.neighbors(j);
-        for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
-          const std::int32_t k = nbrs[slot - slot0];
-          int ny = 0;
-          if (memo) {
-            if (!slot_ready[slot]) {
-              const int count = arcs_of_b(q, j, k, ys);
-              slot_ready[slot] = count == 1 ? 1 : 2;
-              slot_arc[slot] = ys[0];
+    for (std::size_t at = slot_begin; at < slot_end; ++at) {
+      const int w_end = adjacency_a[at];
+      if (!(v < w_end)) continue;
+      const std::array<int, 2> e = {v, w_end};
+      const int l = q.a.dimension() >= 2 ? faces_a[at] : -1;
+      const int r = q.a.dimension() >= 2 ? left_face(q.a, w_end, v) : -1;
+      if (q.prune && solid_a && l >= 0 && r >= 0) {
+        // First from the faces' stored normals, without the arc: every n
+        // on the arc from nL to nR is c1 nL + c2 nR with c1, c2 >= 0 and
+        // c1 + c2 >= 1, so n.w >= min(nL.w, nR.w) when that is >= 0
+        // (arc_minimum).
+        const auto il = static_cast<std::size_t>(l), ir = static_cast<std::size_t>(r);
+        const auto least = [&](const Vec3& w) {
+          return std::min(face_lower(sa.normals[il], sa.error[il], w, q.reach),
+                          face_lower(sa.normals[ir], sa.error[ir], w, q.reach));
+        };
+        const Vec3 av = q.point_a(v);
+        const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
+        const double lower =
+            std::max(m >= 0.0 ? m + q.inradius_b : -kInfinity, m2 >= 0.0 ? m2 : -kInfinity);
+        if (pruned_by(q, lower)) continue;
+      }
+      const int nx = arcs_of_a(q, v, w_end, l, r, xs);
+      if (q.prune && nx > 0) {
+        const Vec3 w = q.point_a(e[0]) - q.centroid_b;
+        const Vec3 w2 = q.point_a(e[0]) - q.reference_b;
+        double lower = kInfinity, lower2 = kInfinity;
+        for (int i = 0; i < nx; ++i) {
+          lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
+          lower2 = std::min(lower2, arc_minimum(xs[static_cast<std::size_t>(i)], w2));
+        }
+        if (pruned_by(q, std::max(lower + q.inradius_b, lower2))) continue;
+      }
+      for (int i = 0; i < nx; ++i) {
+        const Arc& x = xs[static_cast<std::size_t>(i)];
+        // The B cell of direction p: B's support along -p.
+        // From the support found for a face through v, when one was
+        // evaluated (for a solid A, p is the normal of such a face).
+        const std::int32_t near = q.near_b.empty() ? -1 : q.near_b[static_cast<std::size_t>(v)];
+        const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), near >= 0 ? near : hint);
+        hint = start;
+        chain.clear();
+        chain.push_back(start);
+        visited[static_cast<std::size_t>(start)] = 1;
+        for (std::size_t head = 0; head < chain.size(); ++head) {
+          const int j = chain[head];
+          const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
+          const auto nbrs = q.b.neighbors(j);
+          for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
+            const std::int32_t k = nbrs[slot - slot0];
+            int ny = 0;
+            if (memo) {
+              if (!slot_ready[slot]) {
+                const int count = arcs_of_b(q, j, k, ys);
+                slot_ready[slot] = count == 1 ? 1 : 2;
+                slot_arc[slot] = ys[0];
+              }
+              ny = slot_ready[slot] == 1 ? 1 : 0;
+              ys[0] = slot_arc[slot];
+            } else {
+              ny = arcs_of_b(q, j, k, ys);
             }
-            ny = slot_ready[slot] == 1 ? 1 : 0;
-            ys[0] = slot_arc[slot];
-          } else {
-            ny = arcs_of_b(q, j, k, ys);
-          }
-          bool crosses = false;
-          for (int m = 0; m < ny && !crosses; ++m)
-            crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
-          if (!crosses) continue;
-          // Each crossing edge once: from its first-visited end.
-          if (!visited[static_cast<std::size_t>(k)]) {
-            visited[static_cast<std::size_t>(k)] = 1;
-            chain.push_back(k);
-            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
-                               std::max(j, static_cast<int>(k)), ys, ny, out);
-          } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
-                               k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
-            // k was reached from another cell of this chain, not expanded
-            // yet: the edge j-k is another crossing of the arc.
-            add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
-                               std::max(j, static_cast<int>(k)), ys, ny, out);
+            bool crosses = false;
+            for (int m = 0; m < ny && !crosses; ++m)
+              crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
+            if (!crosses) continue;
+            // Each crossing edge once: from its first-visited end.
+            if (!visited[static_cast<std::size_t>(k)]) {
+              visited[static_cast<std::size_t>(k)] = 1;
+              chain.push_back(k);
+              add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                                 std::max(j, static_cast<int>(k)), ys, ny, out);
+            } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
+                                 k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
+              // k was reached from another cell of this chain, not expanded
+              // yet: the edge j-k is another crossing of the arc.
+              add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                                 std::max(j, static_cast<int>(k)), ys, ny, out);
+            }
           }
         }
+        for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
       }
-      for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
     }
   }
 }
@@ -506,18 +707,40 @@ struct Simplex {
   int face = -1;
 };
 
+// The lists live in `memory` (finish's buffer on the stack: a tracked
+// query's regions are a face and a vertex, and six heap allocations were
+// a tenth of it at N = 8).
 template <class PointOf>
-std::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d,
-                                    int v, double tie) {
+std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d,
+                                         int v, double tie, std::pmr::memory_resource* memory) {
   const double top = d.dot(point(v));
   const auto in = [&](int w) { return d.dot(point(w)) >= top - tie; };
-  std::vector<int> region{v};
+  std::pmr::vector<int> region({v}, memory);
   // Bounded by the vertex count: each vertex enters once.
   for (std::size_t head = 0; head < region.size(); ++head)
     for (const std::int32_t w : poly.neighbors(region[head]))
       if (std::find(region.begin(), region.end(), w) == region.end() && in(w)) region.push_back(w);
-  std::vector<Simplex> out;
-  std::vector<int> faces_seen;
+  std::pmr::vector<Simplex> out(memory);
+  // A vertex, or an edge (the BFS joined its two ends along it): no face
+  // has all its vertices in (what the general case below finds, without
+  // evaluating the faces around it).
+  if (region.size() == 1) {
+    out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
+    return out;
+  }
+  if (region.size() == 2) {
+    out.push_back({{std::min(region[0], region[1]), std::max(region[0], region[1]), -1},
+                   FeatureType::edge,
+                   -1});
+    return out;
+  }
+  // A face's vertices are all within the tie exactly when they are all in
+  // the region: its boundary runs along hull edges, so they are connected
+  // to the region's vertex it was found from.
+  const auto in_region = [&](int w) {
+    return std::find(region.begin(), region.end(), w) != region.end();
+  };
+  std::pmr::vector<int> faces_seen(memory);
   const auto faces = poly.adjacency_faces();
   for (const int x : region) {
     const auto offset =
@@ -529,7 +752,7 @@ std::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point,
       faces_seen.push_back(f);
       const auto cycle = poly.face(f);
       bool all = true;
-      for (const std::int32_t w : cycle) all = all && in(w);
+      for (const std::int32_t w : cycle) all = all && in_region(w);
       if (!all) continue;
       for (std::size_t i = 1; i + 1 < cycle.size(); ++i)
         out.push_back({{cycle[0], cycle[i], cycle[i + 1]}, FeatureType::face, f});
@@ -538,8 +761,7 @@ std::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point,
   if (!out.empty()) return out;
   for (const int x : region)
     for (const std::int32_t w : poly.neighbors(x))
-      if (x < w && std::find(region.begin(), region.end(), w) != region.end())
-        out.push_back({{x, w, -1}, FeatureType::edge, -1});
+      if (x < w && in_region(w)) out.push_back({{x, w, -1}, FeatureType::edge, -1});
   if (!out.empty()) return out;
   out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
   return out;
@@ -568,10 +790,12 @@ PenetrationResult finish(const Query& q, const Candidate& best, double lower_sca
   // of their points that differ by value * n: the closest points of
   // feature A and feature B moved by value * n.
   const double tie = kTieUlps * kUnitRoundoff;
+  std::array<std::byte, 2048> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
   const auto ta = support_region(
-      q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie);
+      q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie, &memory);
   const auto tb = support_region(
-      q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie);
+      q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie, &memory);
   const Vec3 shift = std::max(value, 0.0) * n;
   ClosestPoints<double> closest;
   closest.point_a = closest.point_b = Vec3::Zero();
@@ -654,28 +878,39 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
           static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
 }
 
+// The value at B's translation t of a cached face: its offset at the
+// enumeration moved by -n.(t - t_enumeration) (`enumerated_delta`), one
+// rounding whatever the path.
+double facet_value(const PenetrationCache::Facet& f, const Vec3& enumerated_delta) {
+  return f.enumerated_offset - f.normal.dot(enumerated_delta);
+}
+
 // Fills node `at` (already allocated) over cache.facets[begin, end): the
-// ball around their normals and their least offset; not split.
-void make_node(PenetrationCache& cache, int at, int begin, int end) {
+// ball around their normals and their least value at B's translation t
+// (its anchor; `enumerated_delta` = t - t_enumeration); not split.
+void make_node(PenetrationCache& cache, int at, int begin, int end, const Vec3& t,
+               const Vec3& enumerated_delta) {
   const auto first = cache.facets.begin() + begin;
   const auto last = cache.facets.begin() + end;
   Vec3 lo = first->normal, hi = first->normal;
-  double least = first->offset;
+  double least = std::numeric_limits<double>::infinity();
   for (auto f = first; f != last; ++f) {
     lo = lo.cwiseMin(f->normal);
     hi = hi.cwiseMax(f->normal);
-    least = std::min(least, f->offset);
+    least = std::min(least, facet_value(*f, enumerated_delta));
   }
   const Vec3 center = 0.5 * (lo + hi);
-  double radius = 0.0;
-  for (auto f = first; f != last; ++f) radius = std::max(radius, (f->normal - center).norm());
+  double radius2 = 0.0;
+  for (auto f = first; f != last; ++f)
+    radius2 = std::max(radius2, (f->normal - center).squaredNorm());
   // Rounded up: the norm is within a few u of the exact one (normals are
   // unit, so |n - c| <= 2), and the query adds its own slack.
-  radius = radius * (1.0 + 0x1p-48) + 0x1p-48;
+  const double radius = std::sqrt(radius2) * (1.0 + 0x1p-48) + 0x1p-48;
   PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
   node.center = center;
   node.radius = radius;
   node.least_offset = least;
+  node.anchor = t;
   node.begin = begin;
   node.end = end;
   node.left = -1;
@@ -684,7 +919,7 @@ void make_node(PenetrationCache& cache, int at, int begin, int end) {
 // Splits node `at` (more than kLeaf faces, no children yet) at the median
 // of its normals' coordinate of largest spread: O(its faces). Children
 // come after their parent in nodes.
-void split_node(PenetrationCache& cache, int at) {
+void split_node(PenetrationCache& cache, int at, const Vec3& t, const Vec3& enumerated_delta) {
   const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
   const auto first = cache.facets.begin() + node.begin;
   const auto last = cache.facets.begin() + node.end;
@@ -703,23 +938,24 @@ void split_node(PenetrationCache& cache, int at) {
   const int left = static_cast<int>(cache.nodes.size());
   cache.nodes.resize(cache.nodes.size() + 2);
   cache.nodes[static_cast<std::size_t>(at)].left = left;
-  make_node(cache, left, node.begin, middle);
-  make_node(cache, left + 1, middle, node.end);
+  make_node(cache, left, node.begin, middle, t, enumerated_delta);
+  make_node(cache, left + 1, middle, node.end, t, enumerated_delta);
 }
 
-// The tree's root over all cached faces (the searches split it).
-void build_tree(PenetrationCache& cache) {
+// The tree's root over all cached faces (the searches split it), anchored
+// at B's translation t.
+void build_tree(PenetrationCache& cache, const Vec3& t, const Vec3& enumerated_delta) {
   cache.nodes.clear();
   if (cache.facets.empty()) return;
   cache.nodes.reserve(4 * cache.facets.size() / PenetrationCache::kLeaf + 2);
   cache.nodes.resize(1);
-  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()));
+  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()), t, enumerated_delta);
 }
 
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start) {
   PenetrationCache::Shapes local;
-  q.compute_all_normals(cache != nullptr ? cache->shapes : local);
+  q.use_shapes(cache != nullptr ? cache->shapes : local);
   Candidate first;
   if (walk) {
     // The first upper bound: the last answer's direction (a rotated B), or
@@ -732,10 +968,15 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     first = evaluate(q, {}, d, start != nullptr ? start->support_a : -1,
                      start != nullptr ? start->support_b : -1);
     q.bound = first.value;
+    q.set_references(first.support_a, first.support_b);
   }
   std::vector<Candidate> candidates;
-  candidates.reserve(static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
-                                              2 * (q.a.vertex_count() + q.b.vertex_count())));
+  // Every face and crossing for the slow twin; a pruned walk keeps a few
+  // hundred at most on the benchmarks' spheres (reserving for all of them,
+  // 2 MB at N = 4096, cost an mmap and its page faults per cold query).
+  const auto all = static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
+                                            2 * (q.a.vertex_count() + q.b.vertex_count()));
+  candidates.reserve(walk ? std::min<std::size_t>(all, 512) : all);
   add_face_candidates(q, candidates);
   if (walk)
     add_edge_candidates_walk(q, candidates);
@@ -761,16 +1002,10 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     cache->b = &q.b;
     cache->fingerprint = fingerprint(q.a, q.b);
     cache->rotation = b_in_a.rotation;
-    cache->translation = b_in_a.translation;
-    cache->search_work = 0;
     cache->facets.resize(candidates.size());
     for (std::size_t i = 0; i < candidates.size(); ++i)
-      cache->facets[i] = {candidates[i].id,
-                          candidates[i].normal,
-                          candidates[i].value * q.unit,
-                          candidates[i].value * q.unit,
-                          candidates[i].support_a,
-                          candidates[i].support_b};
+      cache->facets[i] = {candidates[i].id, candidates[i].normal, candidates[i].value * q.unit,
+                          candidates[i].support_a, candidates[i].support_b};
     cache->enumerated_translation = b_in_a.translation;
     cache->pruned = q.pruned * q.unit;
     // The tree is built by the first tracked query (a rotating B, which
@@ -782,97 +1017,81 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
   return r;
 }
 
-// Moves the anchor to translation t: every offset moved by -n.(t -
-// t_enumeration) from the enumeration's (one rounding each, however many
-// re-anchors), and the nodes' least offsets again, children before parents
-// (they come after them in nodes).
-void re_anchor(PenetrationCache& cache, const Vec3& t) {
-  const Vec3 delta = t - cache.enumerated_translation;
-  for (PenetrationCache::Facet& f : cache.facets)
-    f.offset = f.enumerated_offset - f.normal.dot(delta);
-  for (std::size_t k = cache.nodes.size(); k-- > 0;) {
-    PenetrationCache::Node& node = cache.nodes[k];
-    if (node.left < 0) {
-      double least = std::numeric_limits<double>::infinity();
-      for (int i = node.begin; i < node.end; ++i)
-        least = std::min(least, cache.facets[static_cast<std::size_t>(i)].offset);
-      node.least_offset = least;
-    } else {
-      node.least_offset =
-          std::min(cache.nodes[static_cast<std::size_t>(node.left)].least_offset,
-                   cache.nodes[static_cast<std::size_t>(node.left) + 1].least_offset);
-    }
-  }
-  cache.translation = t;
-  cache.search_work = 0;
-}
+// A translation-only tracked query: the least of the cached faces' values
+// at B's translation t (facet_value), by branch and bound on the tree
+// (PenetrationCache::Node), starting from the last answer's face. A node's
+// bound at t: its least value at its anchor less the most any of its
+// normals can gain, c.delta + rho |delta| and at most |delta| (delta = t -
+// anchor), rounded up; it is skipped when that is at least the best value
+// found: every face skipped has a value at least the best (up to the
+// rounding of the values themselves, which the certificate's slack
+// covers). A node the search enters is re-anchored at t: a leaf with the
+// least of its faces' values, an inner node with the lesser of its
+// children's bounds at t (each a lower bound there), so the nodes near the
+// answer stay tight however far B goes, and the ones far from it, never
+// entered, keep their anchors (their bounds loosen by at most the distance
+// moved, and only one node's gain per level of the tree is ever chained).
+// A node not split yet is split when the search enters it.
+struct TreeSearch {
+  PenetrationCache& cache;
+  Vec3 t;                            // B's translation
+  Vec3 enumerated_delta;             // t - t_enumeration
+  double inverse = 1.0, unit = 1.0;  // the query's power-of-two unit
+  double best = 0.0;
+  PenetrationCache::Facet winner;
+  int work = 0;
 
-// A translation-only tracked query: the least of the cached faces' offsets
-// moved by -n.delta (delta = B's translation since the anchor, |delta| =
-// `moved`), by branch and bound on the tree (PenetrationCache::Node),
-// starting from the last answer's face (its value from the enumeration's
-// offset: `enumerated_delta` = B's translation since the enumeration). A
-// node is skipped when its bound (least offset less the most any of its
-// normals can gain, c.delta + rho |delta| and at most |delta|, rounded up)
-// is at least the best value found: every face skipped has a value at
-// least the best (up to the rounding of the values themselves, which the
-// certificate's slack covers). A node not split yet is split when the
-// search descends into it. Returns the best face, its value in `best` and
-// the faces and nodes visited in `work`.
-PenetrationCache::Facet search_tree(PenetrationCache& cache, const Vec3& delta, double moved,
-                                    const Vec3& enumerated_delta, double& best, int& work) {
-  // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
-  const double gain_slack = 0x1p-44 * moved;
-  PenetrationCache::Facet winner = cache.last;
-  best = winner.enumerated_offset - winner.normal.dot(enumerated_delta);
-  work = 1;
-  const auto bound = [&](const PenetrationCache::Node& node) {
+  // A lower bound at t on the values of the faces under node `at` (its
+  // bound, or after entering it the least found).
+  double bound(const PenetrationCache::Node& node) const {
+    const Vec3 delta = t - node.anchor;
+    const double moved = (delta * inverse).norm() * unit;
+    // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
     const double gain = std::min(moved, node.center.dot(delta) + node.radius * moved);
-    return node.least_offset - gain - gain_slack;
-  };
-  // Depth-first, nearer child first; the stack holds at most one sibling
-  // per level (depth <= 2 log2(entries)).
-  std::array<std::int32_t, 128> stack;
-  int top = 0;
-  stack[static_cast<std::size_t>(top++)] = 0;
-  while (top > 0) {
-    const int at = stack[static_cast<std::size_t>(--top)];
-    // A copy: splitting appends to nodes.
-    PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+    return node.least_offset - gain - 0x1p-44 * moved;
+  }
+
+  double visit(int at, double node_bound) {
     ++work;
-    if (!(bound(node) < best)) continue;
-    if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf) {
-      // Not counted in `work`: a split is done once per enumeration (a
-      // re-anchor keeps it), and counting it would re-anchor sooner.
-      split_node(cache, at);
-      node = cache.nodes[static_cast<std::size_t>(at)];
+    if (!(node_bound < best)) return node_bound;
+    {
+      const PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
+      if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf)
+        split_node(cache, at, t, enumerated_delta);
     }
+    // A copy: splitting below appends to nodes.
+    const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+    double least = std::numeric_limits<double>::infinity();
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
-        const double value = f.offset - f.normal.dot(delta);
+        const double value = facet_value(f, enumerated_delta);
         ++work;
+        least = std::min(least, value);
         if (value < best) {
           best = value;
           winner = f;
         }
       }
-      continue;
-    }
-    const int l = node.left;
-    const double bl = bound(cache.nodes[static_cast<std::size_t>(l)]);
-    const double br = bound(cache.nodes[static_cast<std::size_t>(l) + 1]);
-    // Pushed far child first, so that the near one is searched first.
-    if (bl <= br) {
-      if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
-      if (bl < best) stack[static_cast<std::size_t>(top++)] = l;
     } else {
-      if (bl < best) stack[static_cast<std::size_t>(top++)] = l;
-      if (br < best) stack[static_cast<std::size_t>(top++)] = l + 1;
+      const int l = node.left;
+      const double bl = bound(cache.nodes[static_cast<std::size_t>(l)]);
+      const double br = bound(cache.nodes[static_cast<std::size_t>(l) + 1]);
+      // The nearer child first.
+      if (bl <= br) {
+        least = visit(l, bl);
+        least = std::min(least, visit(l + 1, br));
+      } else {
+        least = visit(l + 1, br);
+        least = std::min(least, visit(l, bl));
+      }
     }
+    PenetrationCache::Node& stored = cache.nodes[static_cast<std::size_t>(at)];
+    stored.least_offset = least;
+    stored.anchor = t;
+    return least;
   }
-  return winner;
-}
+};
 
 }  // namespace
 
@@ -897,23 +1116,24 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     const auto distance = [&](const Vec3& from) {
       return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
     };
-    if (cache.nodes.empty()) build_tree(cache);
+    const Vec3 enumerated_delta = b_in_a.translation - cache.enumerated_translation;
+    if (cache.nodes.empty()) build_tree(cache, b_in_a.translation, enumerated_delta);
     const double moved = distance(cache.enumerated_translation);
     const double pruned_cut = cache.pruned - moved;
-    double best = 0.0;
-    int work = 0;
-    const PenetrationCache::Facet f =
-        search_tree(cache, b_in_a.translation - cache.translation, distance(cache.translation),
-                    b_in_a.translation - cache.enumerated_translation, best, work);
+    TreeSearch search{cache,
+                      b_in_a.translation,
+                      enumerated_delta,
+                      q.inverse,
+                      q.unit,
+                      facet_value(cache.last, enumerated_delta),
+                      cache.last,
+                      1};
+    search.visit(0, search.bound(cache.nodes[0]));
+    const double best = search.best;
+    const PenetrationCache::Facet& f = search.winner;
+    const int work = search.work;
     if (best <= pruned_cut) {
       cache.last = f;
-      cache.search_work += work;
-      if (cache.search_work > static_cast<std::int64_t>(cache.facets.size())) {
-        // Certified, but the searches since the anchor cost as much as
-        // moving it: move it here for the queries to come.
-        re_anchor(cache, b_in_a.translation);
-        work += static_cast<int>(cache.facets.size() + cache.nodes.size());
-      }
       // The winner evaluated with true supports (they do not move under a
       // translation: the cached ones are checked by one hill-climbing step).
       Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);

@@ -203,6 +203,47 @@ TEST(PenetrationOracle, RandomOverlapsFromGrazingToContainment) {
   EXPECT_GE(flat_or_touching, 3);
 }
 
+// Hulls of more faces than Query::fast_normals' threshold (32), whose
+// pruning reads the fast face normals (a triangle's rounded cross product
+// within a certified error of the exact normal): spheres, and ellipsoids
+// flattened up to 1e-5 (long thin triangles, some below the 0.06 degree
+// angle that takes face_plane's normal instead), from grazing to deep,
+// with a warm cache of the previous pair's answer direction as well as
+// cold, against the exact depth.
+TEST(PenetrationOracle, ManyFacedAndSliverHullsAgainstTheExactDepth) {
+  Rng rng(20261126);
+  ExactOracle oracle;
+  int penetrating = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const auto body = [&](double radius) {
+      Points p = points_on_sphere(rng, uniform_int(rng, 20, 48), radius);
+      if (trial % 2 == 1) {
+        const double flat = log_uniform(rng, 1e-5, 0.1);
+        for (Vec3& v : p) v.z() *= flat;
+      }
+      return p;
+    };
+    const Points a = body(1.0);
+    Points b = place_along(a, body(0.7), random_unit_vector(rng), 0.25);
+    const std::optional<ExactDistance> d = oracle.distance(a, b);
+    ASSERT_TRUE(d && !d->is_zero()) << trial;
+    const Vec3 w = (to_double(d->point_b) - to_double(d->point_a)).normalized();
+    b = translated(b, -(d->distance() + log_uniform(rng, 1e-12, 1.0)) * w);
+    const ConvexPolytope pa(a), pb(b);
+    ASSERT_GT(pa.face_count(), 32) << trial;
+    PenetrationCache cache;
+    const PenetrationResult cold = penetration_depth(pa, pb, Pose::identity(), cache);
+    ASSERT_TRUE(meets_standard(a, b, cold, oracle)) << "cold, trial " << trial;
+    // Again through the cache made to hold another rotation: a turned B
+    // enumerates again, pruned from the cached answer's direction.
+    cache.rotation(0, 0) = 2.0;
+    const PenetrationResult again = penetration_depth(pa, pb, Pose::identity(), cache);
+    ASSERT_TRUE(meets_standard(a, b, again, oracle)) << "re-enumerated, trial " << trial;
+    penetrating += cold.status == PenetrationStatus::penetrating;
+  }
+  EXPECT_GE(penetrating, 24);
+}
+
 TEST(PenetrationOracle, RotatedPoseMatchesPretransformedPoints) {
   // The pose path: B given in its own frame with b_in_a; the oracle sees
   // B's points mapped in double (the same rounding up to a few u R).

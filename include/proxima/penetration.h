@@ -126,8 +126,8 @@ struct PenetrationResult {
   Feature feature_a;
   Feature feature_b;
   // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
-  // crossing edge pairs) for a cold query; faces and tree nodes visited,
-  // plus every cached face when it re-anchored, for a tracked one.
+  // crossing edge pairs) for a cold query; faces and tree nodes visited
+  // for a tracked one.
   int candidates = 0;
   // True when the cache certified the answer (no enumeration of M).
   bool tracked = false;
@@ -141,33 +141,32 @@ struct PenetrationResult {
 // same two polytope objects (addresses, sizes and a few coordinates are
 // checked: a cache of another pair is ignored, at worst making a query
 // cold) and B's rotation is unchanged bit for bit: then the faces of A - B
-// are the cached ones translated, each offset moved by -n.delta (delta = t
-// - t_enumeration), and the depth is the least of them. The faces are kept
-// in a tree over their normals: each node holds a ball around its faces'
-// normals (centre c, radius rho) and their least offset o, so that every
-// face under it has an offset now of at least o - min(|delta|, c.delta +
-// rho |delta|). A query evaluates the last answer's face first, then
-// descends (nearer child first) into the nodes whose bound is below the
-// best value found: the faces whose normals point away from delta, or
-// whose offsets are far above the depth, are never touched. The bound
-// loosens with |delta|, so offsets are taken at an anchor (delta = t -
-// t_anchor) that moves to the query's translation once the searches since
-// the last move visited as many nodes and faces as there are faces: one
-// pass over the faces and the nodes (the tree over the normals does not
-// change; amortized, at most doubling the work; offsets always moved from
-// the enumeration's, one rounding each). A rotated B enumerates again.
+// are the cached ones translated, each offset moved by -n.(t -
+// t_enumeration) (one rounding), and the depth is the least of them. The
+// faces are kept in a tree over their normals: each node holds a ball
+// around its faces' normals (centre c, radius rho) and a lower bound o on
+// their values at B's translation t_node (its anchor), so that every face
+// under it has a value now of at least o - min(|delta|, c.delta + rho
+// |delta|), delta = t - t_node. A query evaluates the last answer's face
+// first, then descends (nearer child first) into the nodes whose bound is
+// below the best value found: the faces whose normals point away from
+// delta, or whose values are far above the depth, are never touched. Each
+// node it enters is anchored again at t (a leaf with its faces' least
+// value, an inner node with its children's least bound), so the bounds
+// near the answer stay tight wherever B goes, at no cost beyond the
+// search. A rotated B enumerates again.
 struct PenetrationCache {
   struct Facet {
     MinkowskiFaceId id;
     Vec3 normal = Vec3::UnitX();     // outward unit normal of the face of A - B
-    double offset = 0.0;             // h_A(n) + h_B(-n) at the anchor, A's units
-    double enumerated_offset = 0.0;  // the same at the enumeration
+    double enumerated_offset = 0.0;  // h_A(n) + h_B(-n) at the enumeration, A's units
     std::int32_t support_a = -1;     // supports along n and -n (they do not
     std::int32_t support_b = -1;     // change under a translation)
   };
   // A node of the tree over facets[begin, end): the ball |n - center| <=
-  // radius holds their normals (radius rounded up), least_offset the least
-  // of their offsets; children (two, at `left` and `left` + 1) or none yet
+  // radius holds their normals (radius rounded up), least_offset a lower
+  // bound on their values at B's translation `anchor` (see above);
+  // children (two, at `left` and `left` + 1) or none yet
   // (left = -1: a leaf of at most kLeaf faces, or a node not split yet:
   // a search splits the nodes it descends into, so the tree is only as
   // deep as the searches went). nodes[0] is the root.
@@ -175,6 +174,7 @@ struct PenetrationCache {
     Vec3 center = Vec3::Zero();
     double radius = 0.0;
     double least_offset = 0.0;
+    Vec3 anchor = Vec3::Zero();
     std::int32_t begin = 0, end = 0;
     std::int32_t left = -1;
   };
@@ -185,10 +185,8 @@ struct PenetrationCache {
   const ConvexPolytope* a = nullptr;
   const ConvexPolytope* b = nullptr;
   std::array<double, 4> fingerprint = {0, 0, 0, 0};
-  // B's rotation, its translation at the anchor (where `offset` and the
-  // nodes' least offsets are taken) and at the enumeration.
+  // B's rotation, and its translation at the enumeration.
   Mat3 rotation = Mat3::Zero();
-  Vec3 translation = Vec3::Zero();
   Vec3 enumerated_translation = Vec3::Zero();
   // All faces of A - B found, in tree order, and the tree.
   std::vector<Facet> facets;
@@ -203,14 +201,21 @@ struct PenetrationCache {
   // even where a lower bound would prune them: it grows while B translates
   // past it (so that tracking finds them cached) and halves when B turns.
   double prune_margin = 0.0;
-  // What the query needs of the two hulls whatever the pose: face normals
-  // (each in its own frame) and the radii of balls about the centroids
-  // inside them.
+  // What the query needs of each hull whatever the pose, in its own frame:
+  // face normals and the radius of a ball about the centroid inside it.
+  // A normal is first a fast one (a triangle's rounded cross product,
+  // within error[f] of the exact unit normal), good for pruning; a face
+  // the query evaluates, or whose Gauss-map arc it tests, gets
+  // ConvexPolytope::face_plane's (exact[f] set, error 0), once.
+  struct HullNormals {
+    std::vector<Vec3> normals;
+    std::vector<double> error;
+    std::vector<char> exact;
+    double inradius = 0.0;
+  };
   struct Shapes {
-    std::vector<Vec3> normals_a, normals_b;
-    double inradius_a = 0.0, inradius_b = 0.0;
+    HullNormals a, b;
   } shapes;
-  std::int64_t search_work = 0;  // nodes and faces visited since the anchor
 
   bool is_cold() const { return a == nullptr; }
   void reset() { *this = PenetrationCache{}; }
