@@ -153,6 +153,30 @@ struct MarginMemo {
 // far above it.
 constexpr double kMarginSlack = 1e-14;
 
+// How far the unit direction seen from a body (`direction`, times `sign`)
+// may turn, as |e(t) - e(0)|, before a neighbour of the vertex set S may
+// overtake S's highest vertex: the smallest margin of PlaneBound's comment,
+// a hair inside, >= 0 (0 when S does not hold the support).
+double cone_margin(const ConvexPolytope& body, const VertexSet& set, const Vec3& direction,
+                   double sign) {
+  // Each edge's ratio on its own and the smallest kept: no chain of
+  // divisions through a running margin (that chain, not the arithmetic,
+  // was the cost of a step). A falling edge (rise < 0) ends it at 0.
+  double margin = 1.0;
+  for (std::size_t k = 0; k < set.size; ++k) {
+    const Vec3& q = body.vertex(set.ids[k]);
+    for (const std::int32_t y : body.neighbors(set.ids[k])) {
+      if (set.has(y)) continue;
+      const Vec3 edge = q - body.vertex(y);
+      const double rise = sign * direction.dot(edge);
+      if (rise < 0.0) return 0.0;
+      const double length = fast_norm(edge);
+      margin = std::min(margin, length > 0.0 ? rise / length : 1.0);
+    }
+  }
+  return margin * kConeMarginShrink;
+}
+
 // The witness feature's plane of one body at one step. Its value, rate and
 // acceleration cost O(|S|) and are computed at once; its span (the margin
 // loop, O(|S| degree |S|)) only when a pair of planes could take a longer
@@ -213,24 +237,7 @@ class FeaturePlane {
   const VertexSet& set() const { return set_; }
 
  private:
-  double fresh_margin() const {
-    // Each edge's ratio on its own and the smallest kept: no chain of
-    // divisions through a running margin (that chain, not the arithmetic,
-    // was the cost of a step). A falling edge (rise < 0) ends it at 0.
-    double margin = 1.0;
-    for (std::size_t k = 0; k < set_.size; ++k) {
-      const Vec3& q = body_->vertex(set_.ids[k]);
-      for (const std::int32_t y : body_->neighbors(set_.ids[k])) {
-        if (set_.has(y)) continue;
-        const Vec3 edge = q - body_->vertex(y);
-        const double rise = sign_ * direction_.dot(edge);
-        if (rise < 0.0) return 0.0;
-        const double length = fast_norm(edge);
-        margin = std::min(margin, length > 0.0 ? rise / length : 1.0);
-      }
-    }
-    return margin * kConeMarginShrink;
-  }
+  double fresh_margin() const { return cone_margin(*body_, set_, direction_, sign_); }
 
   const ConvexPolytope* body_;
   VertexSet set_;
@@ -299,6 +306,136 @@ double fixed_plane_step(double plane, const Vec3& d, const Vec3& origin_f, const
     step = std::min(step, first_closing(gap, closing, acceleration, horizon));
   }
   return step;
+}
+
+// The step that the plane through two edges allows (an edge-edge witness
+// pair), exact at first order where the planes above charge the edges'
+// fastest ends. Let e_a(s), e_b(s) be the two edges' unit directions
+// turning with their bodies, c = e_a x e_b, rho = |c| and m = c / rho
+// (oriented from A to B). m stays perpendicular to both edges, so while
+// A's edge holds A's support along m and B's edge B's lowest along m, the
+// gap between the support planes along m is exactly
+//   l(s) = m(s).D(s),  D = y(s) - x(s),
+// x a point of A's edge line and y one of B's carried by their bodies (the
+// witness points p and q: D(0) = q - p, of length the distance d), a lower
+// bound on the distance (any plane's gap is). Its rate is exact,
+//   l'(0) = m'.D + m.D'  with  m' = (I - m m^T) c' / rho,
+//   c' = (w_a x e_a) x e_b + e_a x (w_b x e_b),
+// so an edge-edge contact closes at second order. The second derivative,
+// l'' = m''.D + 2 m'.D' + m.D'', with W = |w_a| + |w_b|: |c'| <= W,
+// |c''| <= W^2, |m'| <= |c'| / rho and (differentiating m = c / rho twice)
+// |m''| <= 2 |c''| / rho + 5 |c'|^2 / rho^2; |D'| <= V = |v_b - v_a| +
+// |w_a| |p - T_a| + |w_b| |q - T_b| (T the reference points), |D(s)| <=
+// |D(0)| + V s, |D''| <= |w_a|^2 |p - T_a| + |w_b|^2 |q - T_b|. rho
+// depends only on the relative turn w_r = w_b - w_a: rho(s) >= rho(0) -
+// |w_r| s, kept >= rho(0) / 2 by the horizon. Seen from either body, m
+// turns at most at |w_r| / rho (the other edge turns at |w_r| about it),
+// so by time s it has turned at most -ln(1 - |w_r| s / rho(0)) (as an
+// arc, more than the chord of the cone margins): each edge holds its
+// body's support while that is below the edge's cone margin (cone_margin
+// of its two vertices along m), i.e. for s <= rho(0) (1 - e^-margin) /
+// |w_r|. The witness points are the query's (off the edge lines by a few
+// u R in the body frames, which stays so as they move: inside the band),
+// and m(0) comes from edges nearly perpendicular only (rho(0) >= 1/2), so
+// that its rounding, times |D| and the edges' lengths, stays inside the
+// band too; `keep_off` (twice the band, and the target) is kept off.
+// Returns 0 where the bound does not apply, and the step before the
+// spans' limit where that is not longer than `best` (no use then).
+// What edge_pair_step takes from the whole interval: the motions' speeds,
+// the hulls' reaches (bounds on |p - T_a| and |q - T_b|), and the edges'
+// cone margins of an earlier step, kept while the same edges are the
+// witnesses (1-Lipschitz in the direction, as MarginMemo).
+struct EdgePairs {
+  double turn_a = 0.0;    // |w_a|
+  double turn_b = 0.0;    // |w_b|
+  double relative = 0.0;  // |w_b - w_a|
+  double speed = 0.0;     // |v_b - v_a|
+  double reach_a = 0.0;
+  double reach_b = 0.0;
+  std::array<std::int32_t, 4> edges = {-1, -1, -1, -1};
+  Vec3 direction_a = Vec3::Zero();
+  Vec3 direction_b = Vec3::Zero();
+  double margin_a = -1.0;
+  double margin_b = -1.0;
+};
+
+double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origin_a, const Vec3& va,
+                      const Vec3& wa, const Feature& fa, const Vec3& p, const ConvexPolytope& b,
+                      const Pose& pb, const Vec3& origin_b, const Vec3& vb, const Vec3& wb,
+                      const Feature& fb, const Vec3& q, const Vec3& n, double keep_off,
+                      double horizon, double best, EdgePairs& k) {
+  const std::int32_t a1 = fa.vertices[0], a2 = fa.vertices[1];
+  const std::int32_t b1 = fb.vertices[0], b2 = fb.vertices[1];
+  if (a1 < 0 || a2 < 0 || b1 < 0 || b2 < 0 || a1 >= a.vertex_count() || a2 >= a.vertex_count() ||
+      b1 >= b.vertex_count() || b2 >= b.vertex_count())
+    return 0.0;
+  const Vec3 edge_a = pa.rotation * (a.vertex(a2) - a.vertex(a1));
+  const Vec3 edge_b = pb.rotation * (b.vertex(b2) - b.vertex(b1));
+  // e_a x e_b of the unit edges: one root for both lengths (out of range:
+  // no bound).
+  const double lengths2 = edge_a.squaredNorm() * edge_b.squaredNorm();
+  if (!(lengths2 >= std::numeric_limits<double>::min() && lengths2 < 0x1p1000)) return 0.0;
+  const double inverse = 1.0 / std::sqrt(lengths2);
+  const Vec3 c = edge_a.cross(edge_b) * inverse;
+  const double rho = std::sqrt(c.squaredNorm());
+  if (!(rho >= 0.5)) return 0.0;
+  Vec3 m = c / rho;
+  if (m.dot(n) < 0.0) m = -m;
+  const Vec3 d0 = q - p;
+  const double gap = m.dot(d0) - keep_off;
+  if (!(gap > 0.0)) return 0.0;
+
+  // The rate: l'(0) = m'.D + m.D' (closing: its negative).
+  const Vec3 c_dot = (wa.cross(edge_a).cross(edge_b) + edge_a.cross(wb.cross(edge_b))) * inverse;
+  const Vec3 m_dot = (c_dot - m * m.dot(c_dot)) / rho;
+  const Vec3 d_dot = (vb + wb.cross(q - origin_b)) - (va + wa.cross(p - origin_a));
+  const double closing = -(m_dot.dot(d0) + m.dot(d_dot));
+  // The second derivative's bound up to the horizon, where rho stays
+  // >= rho(0) / 2 (the spans of the edges' supports may end it sooner: the
+  // bound holds over the shorter span too).
+  const double wr = k.relative;
+  double span = wr > 0.0 ? std::min(horizon, 0.5 * rho / wr) : horizon;
+  const double na = k.turn_a, nb = k.turn_b;
+  const double w = na + nb;
+  const double speed = k.speed + na * k.reach_a + nb * k.reach_b;
+  const double rho_min = 0.5 * rho;
+  const double m_ddot = (2.0 * w * w + 5.0 * w * w / rho_min) / rho_min;
+  const double acceleration = m_ddot * (fast_norm(d0) + speed * span) +
+                              2.0 * (w / rho_min) * speed + na * na * k.reach_a +
+                              nb * nb * k.reach_b;
+  const double step = first_closing(gap, closing, acceleration, span);
+  // The supports' spans (the cone margins, O(degree) each) only where the
+  // step could beat `best`: s <= rho(0) (1 - e^-margin) / |w_r|, with
+  // 1 - e^-x >= x (1 - x / 2) (margins are <= 1).
+  if (!(step > best) || !(wr > 0.0)) return step;
+  const Vec3 direction_a = pa.rotation.transpose() * m;
+  const Vec3 direction_b = pb.rotation.transpose() * m;
+  const std::array<std::int32_t, 4> edges = {a1, a2, b1, b2};
+  double margin_a = -1.0, margin_b = -1.0;
+  if (a1 == k.edges[0] && a2 == k.edges[1] && b1 == k.edges[2] && b2 == k.edges[3] &&
+      k.margin_a > 0.0 && k.margin_b > 0.0) {
+    margin_a = k.margin_a - fast_norm(direction_a - k.direction_a) - kMarginSlack;
+    margin_b = k.margin_b - fast_norm(direction_b - k.direction_b) - kMarginSlack;
+    if (!(margin_a >= 0.5 * k.margin_a) || !(margin_b >= 0.5 * k.margin_b)) margin_a = -1.0;
+  }
+  if (margin_a < 0.0) {
+    VertexSet set_a, set_b;
+    set_a.add(a1);
+    set_a.add(a2);
+    set_b.add(b1);
+    set_b.add(b2);
+    margin_a = cone_margin(a, set_a, direction_a, 1.0);
+    margin_b = cone_margin(b, set_b, direction_b, -1.0);
+    k.edges = edges;
+    k.direction_a = direction_a;
+    k.direction_b = direction_b;
+    k.margin_a = margin_a;
+    k.margin_b = margin_b;
+  }
+  const double margin = std::min(margin_a, margin_b);
+  if (!(margin > 0.0)) return 0.0;
+  span = std::min(span, margin * (1.0 - 0.5 * margin) * rho / wr);
+  return std::min(step, span);
 }
 
 // A motion with its turn precomputed (Motion::at would convert the rotation
@@ -573,6 +710,13 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
   // standard at these poses (the rounding of the query's coordinates).
   const double relative_turn = fast_norm(wa - wb);
   MarginMemo memo_a, memo_b;
+  EdgePairs edge_pairs;
+  edge_pairs.turn_a = fast_norm(wa);
+  edge_pairs.turn_b = fast_norm(wb);
+  edge_pairs.relative = relative_turn;
+  edge_pairs.speed = fast_norm(vb - va);
+  edge_pairs.reach_a = reach_a;
+  edge_pairs.reach_b = reach_b;
   const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb, double t) {
     const double band =
         contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
@@ -609,6 +753,18 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
       for (const PlaneBound& y : bottom_b) take(unlimited(x, y));
     }
     if (best.never) return best;
+    const double horizon = 1.0 - t;
+    const Vec3 origin_a = pa.apply(ha.origin);
+    const Vec3 origin_b = pb.apply(hb.origin);
+    // The plane through two edges (edge_pair_step): an edge-edge contact
+    // closes at its true rate, at second order. Before the feature planes,
+    // whose spans it then mostly spares.
+    if (r.feature_a.type == FeatureType::edge && r.feature_b.type == FeatureType::edge) {
+      const double step = edge_pair_step(a, pa, origin_a, va, wa, r.feature_a, r.point_a, b, pb,
+                                         origin_b, vb, wb, r.feature_b, r.point_b, n,
+                                         2.0 * band + target, horizon, best.step, edge_pairs);
+      if (step > best.step) take(step);
+    }
     // The pairs with a feature's plane: its span (costly) only where the
     // step before the span limit beats the best so far.
     FeaturePlane feature_a(a, pa, ha.origin, feature_set(a, r.feature_a, hull.vertex_a), n,
@@ -634,9 +790,6 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     // the planes along a fixed n charge the fastest vertex of both
     // features. Against an edge or a vertex the gain is small and the cost
     // shows (toi_bench, N = 8: 3.3 us with them everywhere, 3.1 us so).
-    const double horizon = 1.0 - t;
-    const Vec3 origin_a = pa.apply(ha.origin);
-    const Vec3 origin_b = pb.apply(hb.origin);
     const auto fixed = [&](double step, FeaturePlane& moving) {
       if (!(step > best.step)) return;
       if (relative_turn > 0.0) step = std::min(step, moving.margin() / relative_turn);

@@ -37,7 +37,10 @@
 // is a face, its support plane moving with the body bounds the gap too:
 // that body never crosses it, and the other body's feature vertices
 // approach it at their true rates in its frame (a vertex-face contact
-// closes at second order). The cache carried from step to step makes each
+// closes at second order). Where both witness features are edges, the
+// plane through both edges (its normal e_a x e_b turning with them) bounds
+// the gap at the edges' true closing rate, so an edge-edge contact closes
+// at second order too. The cache carried from step to step makes each
 // step a tracked query (a few hundred nanoseconds).
 //
 // Thread safety: as distance(); the cache belongs to one pair.
