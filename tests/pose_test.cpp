@@ -178,6 +178,78 @@ TEST(Pose, EveryEntryPointUsesTheContract) {
 namespace proxima {
 namespace {
 
+// The fast path of the check refuses a rotation entry of 2 or more on the
+// bits (before any arithmetic, so that no trap fires on an infinite entry);
+// the full test would refuse it too (a column's squared norm >= 4). Each is
+// refused with the contract's words, whatever its sign, under the test
+// main's traps.
+TEST(Pose, RotationEntriesOfTwoOrMoreAreRefusedAsNotOrthonormal) {
+  const auto cube = std::make_shared<const ConvexPolytope>(cube_points());
+  for (const double x : {2.0, -2.0, 3.99, 4.0, 1e300, -1e300}) {
+    for (int k = 0; k < 9; ++k) {
+      Pose pose;
+      pose.rotation.data()[k] = x;
+      EXPECT_FALSE(detail::is_rigid(pose)) << x << " at " << k;
+      EXPECT_FALSE(detail::are_rigid(pose, Pose()));
+      EXPECT_FALSE(detail::are_rigid(Pose(), pose));
+      EXPECT_NE(message_of([&] {
+                  (void)distance(*cube, Pose(), *cube, pose);
+                }).find("distance: pose_b: rotation is not orthonormal"),
+                std::string::npos)
+          << x << " at " << k;
+    }
+  }
+  // Just below 2 passes the bounds and is decided by the arithmetic.
+  Pose almost;
+  almost.rotation(1, 1) = std::nextafter(2.0, 0.0);
+  EXPECT_FALSE(detail::is_rigid(almost));
+  EXPECT_NE(message_of([&] {
+              (void)distance(*cube, almost, *cube, Pose());
+            }).find("distance: pose_a: rotation is not orthonormal"),
+            std::string::npos);
+}
+
+// distance() tests its options on the bits first (sign clear and exponent
+// below all ones in both tolerances) and runs the exact test only when that
+// fails: -0.0 is still accepted (it is >= 0), the largest finite tolerance
+// and a subnormal one too, and every non-finite or negative one is refused
+// with the same words. Regression: a NaN tolerance was compared as a
+// double (comisd raises FE_INVALID on any NaN), so under the traps of the
+// test main (a caller's traps) distance() died of SIGFPE instead of
+// refusing it.
+TEST(Pose, DistanceOptionsAreCheckedExactly) {
+  const auto cube = std::make_shared<const ConvexPolytope>(cube_points());
+  const Pose far = Pose::from_translation(Vec3(3, 0, 0));
+  const DistanceResult plain = distance(*cube, Pose(), *cube, far);
+  const double largest = std::numeric_limits<double>::max();
+  for (const double x : {-0.0, 0.0, 4.9e-324, 1e-3, largest}) {
+    DistanceOptions relative;
+    relative.relative_tolerance = x;
+    EXPECT_EQ(distance(*cube, Pose(), *cube, far, relative).status, plain.status) << x;
+    DistanceOptions absolute;
+    absolute.absolute_tolerance = x;
+    if (x < 1.0) {
+      EXPECT_EQ(distance(*cube, Pose(), *cube, far, absolute).distance, plain.distance);
+    }
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double x : {nan, -nan, inf, -inf, -1e-300, -4.9e-324, -1.0}) {
+    for (const bool relative : {true, false}) {
+      DistanceOptions options;
+      (relative ? options.relative_tolerance : options.absolute_tolerance) = x;
+      EXPECT_EQ(message_of([&] { (void)distance(*cube, Pose(), *cube, far, options); }),
+                "distance: options.relative_tolerance and options.absolute_tolerance must be "
+                "finite and >= 0")
+          << x;
+    }
+  }
+  DistanceOptions none;
+  none.max_iterations = 0;
+  EXPECT_EQ(message_of([&] { (void)distance(*cube, Pose(), *cube, far, none); }),
+            "distance: options.max_iterations must be at least 1");
+}
+
 // are_rigid (both poses in the two SIMD lanes, the check every query pays)
 // decides exactly as is_rigid on each pose: rotations from quaternions and
 // products of them, ones perturbed around the 32 u threshold, float32

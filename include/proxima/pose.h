@@ -140,20 +140,22 @@ namespace detail {
 // True when `pose` needs nothing: finite, orthonormal to kOrthonormalUlps u
 // and det > 0. O(1), the common case of every query.
 inline bool is_rigid(const Pose& pose) {
-  // Bounds first, on the bits: every rotation entry below 4 in magnitude
-  // and every translation entry finite (NaN and infinity have all exponent
-  // bits set), so that the arithmetic below raises no FE_INVALID (inf * 0,
-  // inf - inf) under a caller's traps. For a magnitude's bits e and a
-  // limit's bits L, e + (2^63 - L) has its top bit set exactly when e >= L:
-  // one and, one add and one or per entry, which the compiler vectorizes.
+  // Bounds first, on the bits, so that the arithmetic below raises no
+  // FE_INVALID (inf * 0, inf - inf) under a caller's traps:
+  //  - every rotation entry below 2 in magnitude: exactly when bit 62 (the
+  //    top exponent bit) is clear in each, i.e. in their bitwise or (NaN and
+  //    infinity have all exponent bits set). An entry of 2 or more fails the
+  //    orthonormality test below anyway (its column's squared norm is >= 4),
+  //    so the decision is the one of the full test;
+  //  - every translation entry finite: for a magnitude's bits e,
+  //    e + (2^63 - bits of inf) has its top bit set exactly when e >= inf.
   const double* m = pose.rotation.data();  // column-major: column k at m + 3 k
   constexpr std::uint64_t kMagnitude = 0x7fffffffffffffffULL;
   constexpr std::uint64_t kTop = 0x8000000000000000ULL;
-  constexpr std::uint64_t kFour = 0x4010000000000000ULL;      // the bits of 4.0
   constexpr std::uint64_t kInfinity = 0x7ff0000000000000ULL;  // the bits of +inf
-  std::uint64_t out_of_range = 0;
-  for (int k = 0; k < 9; ++k)
-    out_of_range |= (std::bit_cast<std::uint64_t>(m[k]) & kMagnitude) + (kTop - kFour);
+  std::uint64_t rotation_bits = 0;
+  for (int k = 0; k < 9; ++k) rotation_bits |= std::bit_cast<std::uint64_t>(m[k]);
+  std::uint64_t out_of_range = rotation_bits << 1;
   for (int k = 0; k < 3; ++k) {
     out_of_range |=
         (std::bit_cast<std::uint64_t>(pose.translation[k]) & kMagnitude) + (kTop - kInfinity);
@@ -188,17 +190,15 @@ inline bool are_rigid(const Pose& pose_a, const Pose& pose_b) {
   };
   __m128d r[9];
   for (int k = 0; k < 9; ++k) r[k] = pair(ma[k], mb[k]);
-  // The bounds of is_rigid on the bits, lane-wise 64-bit integers.
+  // The bounds of is_rigid on the bits, lane-wise: the or of the rotation's
+  // entries shifted so that bit 62 is the top bit, or'ed with the
+  // translations' finiteness tests.
+  __m128i rotation_bits = _mm_castpd_si128(r[0]);
+  for (int k = 1; k < 9; ++k) rotation_bits = _mm_or_si128(rotation_bits, _mm_castpd_si128(r[k]));
+  __m128i out_of_range = _mm_slli_epi64(rotation_bits, 1);
   const __m128i magnitude = _mm_set1_epi64x(0x7fffffffffffffffLL);
-  const __m128i below_four =
-      _mm_set1_epi64x(static_cast<long long>(0x8000000000000000ULL - 0x4010000000000000ULL));
   const __m128i finite =
       _mm_set1_epi64x(static_cast<long long>(0x8000000000000000ULL - 0x7ff0000000000000ULL));
-  __m128i out_of_range = _mm_setzero_si128();
-  for (int k = 0; k < 9; ++k) {
-    out_of_range = _mm_or_si128(
-        out_of_range, _mm_add_epi64(_mm_and_si128(_mm_castpd_si128(r[k]), magnitude), below_four));
-  }
   for (int k = 0; k < 3; ++k) {
     const __m128d t = pair(pose_a.translation[k], pose_b.translation[k]);
     out_of_range = _mm_or_si128(
@@ -213,8 +213,8 @@ inline bool are_rigid(const Pose& pose_a, const Pose& pose_b) {
         _mm_mul_pd(r[3 * i + 2], r[3 * j + 2]));
   };
   const __m128d one = _mm_set1_pd(1.0);
-  const __m128d sign = _mm_set1_pd(-0.0);
-  const auto abs = [sign](__m128d x) { return _mm_andnot_pd(sign, x); };
+  const __m128d no_sign = _mm_castsi128_pd(magnitude);
+  const auto abs = [no_sign](__m128d x) { return _mm_and_pd(x, no_sign); };
   const __m128d d00 = abs(_mm_sub_pd(dot(0, 0), one)), d11 = abs(_mm_sub_pd(dot(1, 1), one)),
                 d22 = abs(_mm_sub_pd(dot(2, 2), one));
   const __m128d d01 = abs(dot(0, 1)), d02 = abs(dot(0, 2)), d12 = abs(dot(1, 2));
