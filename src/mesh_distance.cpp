@@ -73,7 +73,7 @@ Query make_query(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& 
                  const Pose& pose_b, const DistanceOptions& options) {
   const Pose pa = checked_pose(pose_a, "mesh distance: pose_a");
   const Pose pb = checked_pose(pose_b, "mesh distance: pose_b");
-  if (!(options.absolute_tolerance >= 0.0) || !is_finite_bits(options.absolute_tolerance))
+  if (!is_finite_bits(options.absolute_tolerance) || !(options.absolute_tolerance >= 0.0))
     throw InvalidInput("mesh distance: absolute_tolerance must be finite and >= 0");
   const Pose rel = pa.inverse() * pb;
   Query q{a, b, rel.rotation, rel.translation, {}, 1.0, 0, 0.0, 0.0, 1.0, 1.0, {}, {}};

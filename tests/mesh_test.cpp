@@ -165,6 +165,26 @@ TEST(MeshValidation, RefusesBadInputNamingTheIndex) {
             std::string::npos);
 }
 
+// A NaN absolute tolerance was compared as a double before its bits were
+// tested, and that comparison raises FE_INVALID: under the traps of this
+// test's main (a caller's feenableexcept) the mesh query died of SIGFPE
+// instead of refusing the option, as distance() of hulls once did
+// (Pose.DistanceOptionsAreCheckedExactly).
+TEST(MeshValidation, NonFiniteToleranceIsRefusedWithoutRaisingAnException) {
+  const std::vector<Vec3> v = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<Tri> t = {{0, 1, 2}};
+  const TriangleMesh mesh(v, t);
+  for (const double x : {std::nan(""), -std::nan(""), HUGE_VAL, -HUGE_VAL, -1.0}) {
+    DistanceOptions options;
+    options.absolute_tolerance = x;
+    EXPECT_EQ(error_of([&] {
+                (void)distance(mesh, Pose(), mesh, Pose::from_translation(Vec3(0, 0, 1)), options);
+              }),
+              "mesh distance: absolute_tolerance must be finite and >= 0")
+        << x;
+  }
+}
+
 // --- 2. the build ------------------------------------------------------------
 
 TEST(MeshBuild, DegenerateTrianglesAreFoundExactly) {
