@@ -590,7 +590,12 @@ ImpactResult advance(const Poses& poses, const ImpactOptions& options, double to
   ImpactResult out;
   double t = t_begin;
   for (;;) {
-    const auto [pa, pb] = poses(t);
+    // Named poses, not a structured binding: the lambda below captures
+    // them, which clang (the fuzz build) refuses for bindings before C++20's
+    // P1091 support.
+    const auto placed = poses(t);
+    const Pose& pa = placed.first;
+    const Pose& pb = placed.second;
     const DistanceResult r = query(pa, pb);
     ++out.iterations;
     // The answer at t (copied out only when the loop stops there).
