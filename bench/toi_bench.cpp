@@ -133,8 +133,22 @@ proxima::CompoundBody grid(int side, double spacing, double size) {
   return proxima::CompoundBody::from_point_sets(sets);
 }
 
+// The fastest of three runs of `run` in ns, as every row of this benchmark
+// times a query (what `run` writes is the last run's).
+template <class Run>
+double best_of_three_ns(Run&& run) {
+  double best = 1e300;
+  for (int rep = 0; rep < 3; ++rep) {
+    const auto t0 = std::chrono::steady_clock::now();
+    run();
+    best = std::min(
+        best,
+        std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
 void compound_section(int count) {
-  using Clock = std::chrono::steady_clock;
   std::printf(
       "\n# compounds: K pieces against a hull of 64 points, %d motions per K (median ns per "
       "query)\n",
@@ -158,29 +172,19 @@ void compound_section(int count) {
     int contacts = 0;
     double worst = 0.0;
     for (const Case& c : cases) {
-      double best = 1e300;
       proxima::ImpactResult r;
-      for (int rep = 0; rep < 3; ++rep) {
-        const auto t0 = Clock::now();
-        r = proxima::time_of_impact(a, c.a, b, c.b);
-        best = std::min(best, std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
-      }
-      ours_ns.push_back(best);
+      ours_ns.push_back(best_of_three_ns([&] { r = proxima::time_of_impact(a, c.a, b, c.b); }));
       pairs += r.pairs_advanced;
       queries += r.iterations;
       contacts += r.status == proxima::ImpactStatus::contact ? 1 : 0;
-      best = 1e300;
       double earliest = 1.0;
-      for (int rep = 0; rep < 3; ++rep) {
-        const auto t0 = Clock::now();
+      every_ns.push_back(best_of_three_ns([&] {
         earliest = 1.0;
         for (const proxima::Body& piece : pieces) {
           const proxima::ImpactResult p = proxima::time_of_impact(piece, c.a, b, c.b);
           if (p.status != proxima::ImpactStatus::separated) earliest = std::min(earliest, p.t);
         }
-        best = std::min(best, std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
-      }
-      every_ns.push_back(best);
+      }));
       worst = std::max(worst, std::abs(earliest - r.t));
     }
     std::printf("| %d | %.0f | %.1f | %.1f | %d/%d | %.0f | %.2g |\n", compound.piece_count(),
@@ -197,7 +201,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: toi_bench [motions per N >= 1]\n");
     return 2;
   }
-  using Clock = std::chrono::steady_clock;
   std::printf(
       "# time of impact, %d motions per N (median ns per query; steps: mean distance queries of "
       "motions that meet)\n",
@@ -223,14 +226,8 @@ int main(int argc, char** argv) {
     double worst = 0.0;
     for (const Case& c : cases) {
       // Interleaved: each motion timed for both libraries in turn, best of 3.
-      double best = 1e300;
       proxima::ImpactResult r;
-      for (int rep = 0; rep < 3; ++rep) {
-        const auto t0 = Clock::now();
-        r = proxima::time_of_impact(a, c.a, b, c.b);
-        best = std::min(best, std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
-      }
-      ours_ns.push_back(best);
+      ours_ns.push_back(best_of_three_ns([&] { r = proxima::time_of_impact(a, c.a, b, c.b); }));
       const bool ours_hit = r.status == proxima::ImpactStatus::contact ||
                             r.status == proxima::ImpactStatus::overlapping;
       if (ours_hit) {
@@ -245,17 +242,13 @@ int main(int argc, char** argv) {
       request.num_max_iterations = 256;
       request.toc_err = 1e-6;
       fcl::ContinuousCollisionResultd result;
-      best = 1e300;
-      for (int rep = 0; rep < 3; ++rep) {
+      fcl_ns.push_back(best_of_three_ns([&] {
         result = fcl::ContinuousCollisionResultd();
-        const auto t0 = Clock::now();
         fcl::continuousCollide(fa.get(), proxima::bench::fcl_transform(c.a.start),
                                proxima::bench::fcl_transform(c.a.end), fb.get(),
                                proxima::bench::fcl_transform(c.b.start),
                                proxima::bench::fcl_transform(c.b.end), request, result);
-        best = std::min(best, std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
-      }
-      fcl_ns.push_back(best);
+      }));
       if (ours_hit && !result.is_collide) ++misses;
       if (!ours_hit && result.is_collide) ++extra;
       if (ours_hit && result.is_collide)
@@ -264,9 +257,7 @@ int main(int argc, char** argv) {
       // Bullet: a fresh solver per query, as its users call it.
       bool bullet_hit = false;
       double bullet_t = 0.0;
-      best = 1e300;
-      for (int rep = 0; rep < 3; ++rep) {
-        const auto t0 = Clock::now();
+      bullet_ns.push_back(best_of_three_ns([&] {
         btVoronoiSimplexSolver simplex;
         btGjkEpaPenetrationDepthSolver epa;
         btContinuousConvexCollision cast(ba.get(), bb.get(), &simplex, &epa);
@@ -275,9 +266,7 @@ int main(int argc, char** argv) {
                                            bullet_transform(c.b.start), bullet_transform(c.b.end),
                                            cast_result);
         bullet_t = cast_result.m_fraction;
-        best = std::min(best, std::chrono::duration<double, std::nano>(Clock::now() - t0).count());
-      }
-      bullet_ns.push_back(best);
+      }));
       if (ours_hit && !bullet_hit) ++bullet_misses;
       if (!ours_hit && bullet_hit) ++bullet_extra;
       if (ours_hit && bullet_hit) bullet_worst = std::max(bullet_worst, std::abs(bullet_t - r.t));
