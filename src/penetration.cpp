@@ -53,6 +53,7 @@
 #include <memory>
 #include <memory_resource>
 #include <span>
+#include <type_traits>
 
 #include "power_of_two.h"
 #include "proxima/closest_point.h"
@@ -130,6 +131,8 @@ struct Query {
   bool prune = false;
   double bound = std::numeric_limits<double>::infinity();   // upper bound on the depth (scaled)
   double pruned = std::numeric_limits<double>::infinity();  // least lower bound of a pruned face
+  // Where pruned groups are recorded (PenetrationCache::bounds), or null.
+  std::vector<PenetrationCache::Bound>* bounds_out = nullptr;
   double prune_margin = 0.0;  // faces within this of the bound are kept (scaled)
   // Points of A and of B (scaled, A's frame): the supports of the best
   // candidate so far (see pruned_by).
@@ -393,8 +396,10 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
 // Pruning (fast cold query): a face of A - B whose lower bound exceeds the
 // best value found so far (an upper bound on the depth, q.bound) by more
 // than rounding cannot realize the depth and is not evaluated; q.pruned
-// keeps the least such lower bound (the tracking cache needs it). Lower
-// bounds from the balls inside the hulls (Query::inradius):
+// keeps the least such lower bound, and q.bounds_out (when set) the group
+// with the ball around its normals that `cone` gives (the tracking cache
+// needs them: PenetrationCache::Bound). Lower bounds from the balls inside
+// the hulls (Query::inradius):
 //   face f of A, normal n:   n.a_f + h_B(-n) >= n.(a_f - c_B) + r_B,
 //   face g of B, normal n:   h_A(n) - n.b_g >= n.(c_A - b_g) + r_A,
 //   edge e of A, n on its arc: n.a_e + h_B(-n) >= min over the arc of
@@ -408,11 +413,42 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
 // in the angle, where the balls leave the gap between the hulls'
 // circumradius and inradius. The face that realizes the depth has a lower
 // bound at most the depth, so it is never pruned.
-bool pruned_by(Query& q, double lower) {
+template <class Cone>
+bool pruned_by(Query& q, double lower, Cone&& cone) {
   if (!q.prune || !(lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff))
     return false;
   q.pruned = std::min(q.pruned, lower);
+  if (q.bounds_out != nullptr) {
+    PenetrationCache::Bound b = cone();
+    b.lower = lower * q.unit;
+    q.bounds_out->push_back(b);
+  }
   return true;
+}
+
+// Balls around a pruned group's normals (PenetrationCache::Bound). Slack
+// on a ball's radius for the roundings of its centre and of the distances
+// to it (a few u each).
+constexpr double kConeSlack = 0x1p-40;
+// A cap of the unit sphere about a unit centre c is geodesically convex
+// when its angular radius is below 90 degrees, i.e. its chord radius below
+// sqrt(2): then it holds the arcs between any of its points. Balls wider
+// than this are replaced by the whole sphere.
+constexpr double kMaxConeChord = 1.4;
+
+PenetrationCache::Bound whole_sphere() { return {Vec3::Zero(), 2.0, 0.0}; }
+
+// The ball around the normals on the arc between the unit normals p and q
+// (a face's normals within ep and eq of them): the cap about the
+// normalized p + q through both ends.
+PenetrationCache::Bound cone_of_arc(const Vec3& p, double ep, const Vec3& q, double eq) {
+  const Vec3 sum = p + q;
+  const double length = sum.norm();
+  if (!(length > 0.25)) return whole_sphere();
+  const Vec3 c = sum / length;
+  const double spread = std::max((p - c).norm(), (q - c).norm()) + std::max(ep, eq) + kConeSlack;
+  if (!(spread < kMaxConeChord)) return whole_sphere();
+  return {c, spread, 0.0};
 }
 
 void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
@@ -477,8 +513,12 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       const Vec3 af = q.point_a(q.a.face(f)[0]);
       const Vec3& n = sa.normals[i];
       const double error = sa.error[i];
-      if (pruned_by(q, std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
-                                face_lower(n, error, af - q.reference_b, q.reach))))
+      if (pruned_by(q,
+                    std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
+                             face_lower(n, error, af - q.reference_b, q.reach)),
+                    [&] {
+                      return PenetrationCache::Bound{n, error + kConeSlack, 0.0};
+                    }))
         continue;
     }
     const auto cycle = q.a.face(f);
@@ -501,9 +541,14 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       const Vec3& m = sb.normals[i];
       const double error = sb.error[i] + 8.0 * kUnitRoundoff;
       const Vec3 bg = q.b.vertex(q.b.face(g)[0]) * q.inverse;
+      // The face's normal of A - B is -(R m), within error of it (8 u
+      // for the rotation's rounding included).
       if (pruned_by(q,
                     std::max(face_lower(m, error, bg - q.centroid_a_in_b, q.reach) + q.inradius_a,
-                             face_lower(m, error, bg - q.reference_a_in_b, q.reach))))
+                             face_lower(m, error, bg - q.reference_a_in_b, q.reach)),
+                    [&] {
+                      return PenetrationCache::Bound{-(q.rotation * m), error + kConeSlack, 0.0};
+                    }))
         continue;
     }
     const auto cycle = q.b.face(g);
@@ -601,9 +646,32 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         mc = std::min(mc, face_lower(sa.normals[i], sa.error[i], wc, q.reach));
         mr = std::min(mr, face_lower(sa.normals[i], sa.error[i], wr, q.reach));
       }
+      // The faces of A - B of the edges at v have their normals in v's
+      // cell of A's Gauss map, the spherical polygon of the normals of the
+      // faces around v: inside the cap about their normalized sum that
+      // holds them all.
+      const auto cone = [&] {
+        Vec3 sum = Vec3::Zero();
+        double error = 0.0;
+        for (std::size_t at = slot_begin; at < slot_end; ++at) {
+          const auto i = static_cast<std::size_t>(faces_a[at]);
+          sum += sa.normals[i];
+          error = std::max(error, sa.error[i]);
+        }
+        const double length = sum.norm();
+        if (!(length > 0.25)) return whole_sphere();
+        const Vec3 c = sum / length;
+        double spread = 0.0;
+        for (std::size_t at = slot_begin; at < slot_end; ++at)
+          spread = std::max(spread, (sa.normals[static_cast<std::size_t>(faces_a[at])] - c).norm());
+        spread += error + kConeSlack;
+        if (!(spread < kMaxConeChord)) return whole_sphere();
+        return PenetrationCache::Bound{c, spread, 0.0};
+      };
       if (all && slot_begin < slot_end &&
           pruned_by(
-              q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity)))
+              q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity),
+              cone))
         continue;
     }
     for (std::size_t at = slot_begin; at < slot_end; ++at) {
@@ -626,7 +694,10 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
         const double lower =
             std::max(m >= 0.0 ? m + q.inradius_b : -kInfinity, m2 >= 0.0 ? m2 : -kInfinity);
-        if (pruned_by(q, lower)) continue;
+        if (pruned_by(q, lower, [&] {
+              return cone_of_arc(sa.normals[il], sa.error[il], sa.normals[ir], sa.error[ir]);
+            }))
+          continue;
       }
       const int nx = arcs_of_a(q, v, w_end, l, r, xs);
       if (q.prune && nx > 0) {
@@ -637,7 +708,12 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
           lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
           lower2 = std::min(lower2, arc_minimum(xs[static_cast<std::size_t>(i)], w2));
         }
-        if (pruned_by(q, std::max(lower + q.inradius_b, lower2))) continue;
+        if (pruned_by(q, std::max(lower + q.inradius_b, lower2), [&] {
+              // A solid's one arc; a polygon's or a segment's half or
+              // whole circle: anywhere.
+              return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
+            }))
+          continue;
       }
       for (int i = 0; i < nx; ++i) {
         const Arc& x = xs[static_cast<std::size_t>(i)];
@@ -878,35 +954,62 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
           static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
 }
 
-// The value at B's translation t of a cached face: its offset at the
-// enumeration moved by -n.(t - t_enumeration) (`enumerated_delta`), one
-// rounding whatever the path.
-double facet_value(const PenetrationCache::Facet& f, const Vec3& enumerated_delta) {
-  return f.enumerated_offset - f.normal.dot(enumerated_delta);
-}
+// B's translation since the enumeration: delta = t - t_enumeration and its
+// length (computed in the query's unit: no overflow, no underflow).
+struct Moved {
+  Vec3 delta;
+  double length;
+};
 
-// Fills node `at` (already allocated) over cache.facets[begin, end): the
-// ball around their normals and their least value at B's translation t
-// (its anchor; `enumerated_delta` = t - t_enumeration); not split.
-void make_node(PenetrationCache& cache, int at, int begin, int end, const Vec3& t,
-               const Vec3& enumerated_delta) {
-  const auto first = cache.facets.begin() + begin;
-  const auto last = cache.facets.begin() + end;
-  Vec3 lo = first->normal, hi = first->normal;
+// The value at B's translation t of a cached face: its offset at the
+// enumeration moved by -n.(t - t_enumeration), one rounding whatever the
+// path.
+double entry_value(const PenetrationCache::Facet& f, const Moved& m) {
+  return f.enumerated_offset - f.normal.dot(m.delta);
+}
+// A lower bound at t on the values of a pruned group's faces: each normal
+// n has n.delta <= c.delta + spread |delta| (|n - c| <= spread) and
+// <= |delta| (unit), plus the rounding of c.delta (|c| <= 1) and of the
+// sums, a few u of |delta|.
+double entry_value(const PenetrationCache::Bound& b, const Moved& m) {
+  return b.lower - std::min(m.length, b.center.dot(m.delta) + b.spread * m.length) -
+         0x1p-44 * m.length;
+}
+const Vec3& entry_normal(const PenetrationCache::Facet& f) { return f.normal; }
+const Vec3& entry_normal(const PenetrationCache::Bound& b) { return b.center; }
+double entry_spread(const PenetrationCache::Bound& b) { return b.spread; }
+
+// Fills node `at` (already allocated) over entries[begin, end) (the cached
+// faces or the pruned groups): the ball around their normals (and their
+// balls) and their least value at B's translation t (its anchor; `moved`
+// from the enumeration to t); not split.
+template <class Entry>
+void make_node(const std::vector<Entry>& entries, std::vector<PenetrationCache::Node>& nodes,
+               int at, int begin, int end, const Vec3& t, const Moved& moved) {
+  const auto first = entries.begin() + begin;
+  const auto last = entries.begin() + end;
+  Vec3 lo = entry_normal(*first), hi = entry_normal(*first);
   double least = std::numeric_limits<double>::infinity();
   for (auto f = first; f != last; ++f) {
-    lo = lo.cwiseMin(f->normal);
-    hi = hi.cwiseMax(f->normal);
-    least = std::min(least, facet_value(*f, enumerated_delta));
+    lo = lo.cwiseMin(entry_normal(*f));
+    hi = hi.cwiseMax(entry_normal(*f));
+    least = std::min(least, entry_value(*f, moved));
   }
   const Vec3 center = 0.5 * (lo + hi);
-  double radius2 = 0.0;
-  for (auto f = first; f != last; ++f)
-    radius2 = std::max(radius2, (f->normal - center).squaredNorm());
+  double radius = 0.0;
+  if constexpr (std::is_same_v<Entry, PenetrationCache::Facet>) {
+    double radius2 = 0.0;
+    for (auto f = first; f != last; ++f)
+      radius2 = std::max(radius2, (f->normal - center).squaredNorm());
+    radius = std::sqrt(radius2);
+  } else {
+    for (auto f = first; f != last; ++f)
+      radius = std::max(radius, (entry_normal(*f) - center).norm() + entry_spread(*f));
+  }
   // Rounded up: the norm is within a few u of the exact one (normals are
   // unit, so |n - c| <= 2), and the query adds its own slack.
-  const double radius = std::sqrt(radius2) * (1.0 + 0x1p-48) + 0x1p-48;
-  PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
+  radius = radius * (1.0 + 0x1p-48) + 0x1p-48;
+  PenetrationCache::Node& node = nodes[static_cast<std::size_t>(at)];
   node.center = center;
   node.radius = radius;
   node.least_offset = least;
@@ -916,46 +1019,58 @@ void make_node(PenetrationCache& cache, int at, int begin, int end, const Vec3& 
   node.left = -1;
 }
 
-// Splits node `at` (more than kLeaf faces, no children yet) at the median
-// of its normals' coordinate of largest spread: O(its faces). Children
-// come after their parent in nodes.
-void split_node(PenetrationCache& cache, int at, const Vec3& t, const Vec3& enumerated_delta) {
-  const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
-  const auto first = cache.facets.begin() + node.begin;
-  const auto last = cache.facets.begin() + node.end;
-  Vec3 lo = first->normal, hi = first->normal;
+// Splits node `at` (more than kLeaf entries, no children yet) at the
+// median of its normals' coordinate of largest spread: O(its entries).
+// Children come after their parent in nodes.
+template <class Entry>
+void split_node(std::vector<Entry>& entries, std::vector<PenetrationCache::Node>& nodes, int at,
+                const Vec3& t, const Moved& moved) {
+  const PenetrationCache::Node node = nodes[static_cast<std::size_t>(at)];
+  const auto first = entries.begin() + node.begin;
+  const auto last = entries.begin() + node.end;
+  Vec3 lo = entry_normal(*first), hi = entry_normal(*first);
   for (auto f = first; f != last; ++f) {
-    lo = lo.cwiseMin(f->normal);
-    hi = hi.cwiseMax(f->normal);
+    lo = lo.cwiseMin(entry_normal(*f));
+    hi = hi.cwiseMax(entry_normal(*f));
   }
   int axis = 0;
   (hi - lo).maxCoeff(&axis);
   const int middle = node.begin + (node.end - node.begin) / 2;
-  std::nth_element(first, cache.facets.begin() + middle, last,
-                   [axis](const PenetrationCache::Facet& x, const PenetrationCache::Facet& y) {
-                     return x.normal[axis] < y.normal[axis];
-                   });
-  const int left = static_cast<int>(cache.nodes.size());
-  cache.nodes.resize(cache.nodes.size() + 2);
-  cache.nodes[static_cast<std::size_t>(at)].left = left;
-  make_node(cache, left, node.begin, middle, t, enumerated_delta);
-  make_node(cache, left + 1, middle, node.end, t, enumerated_delta);
+  std::nth_element(first, entries.begin() + middle, last, [axis](const Entry& x, const Entry& y) {
+    return entry_normal(x)[axis] < entry_normal(y)[axis];
+  });
+  const int left = static_cast<int>(nodes.size());
+  nodes.resize(nodes.size() + 2);
+  nodes[static_cast<std::size_t>(at)].left = left;
+  make_node(entries, nodes, left, node.begin, middle, t, moved);
+  make_node(entries, nodes, left + 1, middle, node.end, t, moved);
 }
 
-// The tree's root over all cached faces (the searches split it), anchored
-// at B's translation t.
-void build_tree(PenetrationCache& cache, const Vec3& t, const Vec3& enumerated_delta) {
-  cache.nodes.clear();
-  if (cache.facets.empty()) return;
-  cache.nodes.reserve(4 * cache.facets.size() / PenetrationCache::kLeaf + 2);
-  cache.nodes.resize(1);
-  make_node(cache, 0, 0, static_cast<int>(cache.facets.size()), t, enumerated_delta);
+// The tree's root over all entries (the searches split it), anchored at
+// B's translation t.
+template <class Entry>
+void build_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache::Node>& nodes,
+                const Vec3& t, const Moved& moved) {
+  nodes.clear();
+  if (entries.empty()) return;
+  nodes.reserve(4 * entries.size() / PenetrationCache::kLeaf + 2);
+  nodes.resize(1);
+  make_node(entries, nodes, 0, 0, static_cast<int>(entries.size()), t, moved);
 }
 
+// `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
-                             const PenetrationCache::Facet* start) {
+                             const PenetrationCache::Facet* start, bool record) {
   PenetrationCache::Shapes local;
   q.use_shapes(cache != nullptr ? cache->shapes : local);
+  if (cache != nullptr) {
+    // Filled by this enumeration; until the cache is written below, the
+    // last one's faces are certified by the scalar `pruned` alone.
+    cache->bounds.clear();
+    cache->bound_nodes.clear();
+    cache->bounded = false;
+    if (record) q.bounds_out = &cache->bounds;
+  }
   Candidate first;
   if (walk) {
     // The first upper bound: the last answer's direction (a rotated B), or
@@ -1008,7 +1123,8 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
                           candidates[i].support_a, candidates[i].support_b};
     cache->enumerated_translation = b_in_a.translation;
     cache->pruned = q.pruned * q.unit;
-    // The tree is built by the first tracked query (a rotating B, which
+    cache->bounded = record;
+    // The trees are built by the first tracked query (a rotating B, which
     // enumerates every query, never pays for it); until then `last` is the
     // answer's face.
     cache->nodes.clear();
@@ -1032,40 +1148,44 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
 // entered, keep their anchors (their bounds loosen by at most the distance
 // moved, and only one node's gain per level of the tree is ever chained).
 // A node not split yet is split when the search enters it.
+// The same search over the pruned groups (PenetrationCache::Bound), from
+// the faces' best value, finds whether any group's bound is below it.
+template <class Entry>
 struct TreeSearch {
-  PenetrationCache& cache;
+  std::vector<Entry>& entries;
+  std::vector<PenetrationCache::Node>& nodes;
   Vec3 t;                            // B's translation
-  Vec3 enumerated_delta;             // t - t_enumeration
+  Moved moved;                       // from the enumeration to t
   double inverse = 1.0, unit = 1.0;  // the query's power-of-two unit
   double best = 0.0;
-  PenetrationCache::Facet winner;
+  Entry winner;
   int work = 0;
 
   // A lower bound at t on the values of the faces under node `at` (its
   // bound, or after entering it the least found).
   double bound(const PenetrationCache::Node& node) const {
     const Vec3 delta = t - node.anchor;
-    const double moved = (delta * inverse).norm() * unit;
+    const double length = (delta * inverse).norm() * unit;
     // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
-    const double gain = std::min(moved, node.center.dot(delta) + node.radius * moved);
-    return node.least_offset - gain - 0x1p-44 * moved;
+    const double gain = std::min(length, node.center.dot(delta) + node.radius * length);
+    return node.least_offset - gain - 0x1p-44 * length;
   }
 
   double visit(int at, double node_bound) {
     ++work;
     if (!(node_bound < best)) return node_bound;
     {
-      const PenetrationCache::Node& node = cache.nodes[static_cast<std::size_t>(at)];
+      const PenetrationCache::Node& node = nodes[static_cast<std::size_t>(at)];
       if (node.left < 0 && node.end - node.begin > PenetrationCache::kLeaf)
-        split_node(cache, at, t, enumerated_delta);
+        split_node(entries, nodes, at, t, moved);
     }
     // A copy: splitting below appends to nodes.
-    const PenetrationCache::Node node = cache.nodes[static_cast<std::size_t>(at)];
+    const PenetrationCache::Node node = nodes[static_cast<std::size_t>(at)];
     double least = std::numeric_limits<double>::infinity();
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
-        const PenetrationCache::Facet& f = cache.facets[static_cast<std::size_t>(i)];
-        const double value = facet_value(f, enumerated_delta);
+        const Entry& f = entries[static_cast<std::size_t>(i)];
+        const double value = entry_value(f, moved);
         ++work;
         least = std::min(least, value);
         if (value < best) {
@@ -1075,8 +1195,8 @@ struct TreeSearch {
       }
     } else {
       const int l = node.left;
-      const double bl = bound(cache.nodes[static_cast<std::size_t>(l)]);
-      const double br = bound(cache.nodes[static_cast<std::size_t>(l) + 1]);
+      const double bl = bound(nodes[static_cast<std::size_t>(l)]);
+      const double br = bound(nodes[static_cast<std::size_t>(l) + 1]);
       // The nearer child first.
       if (bl <= br) {
         least = visit(l, bl);
@@ -1086,7 +1206,7 @@ struct TreeSearch {
         least = std::min(least, visit(l, bl));
       }
     }
-    PenetrationCache::Node& stored = cache.nodes[static_cast<std::size_t>(at)];
+    PenetrationCache::Node& stored = nodes[static_cast<std::size_t>(at)];
     stored.least_offset = least;
     stored.anchor = t;
     return least;
@@ -1098,7 +1218,7 @@ struct TreeSearch {
 PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const ConvexPolytope& b,
                                                 const Pose& b_in_a) {
   Query q(a, b, b_in_a);
-  return solve_cold(q, false, nullptr, b_in_a, nullptr);
+  return solve_cold(q, false, nullptr, b_in_a, nullptr, false);
 }
 
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
@@ -1116,23 +1236,47 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     const auto distance = [&](const Vec3& from) {
       return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
     };
-    const Vec3 enumerated_delta = b_in_a.translation - cache.enumerated_translation;
-    if (cache.nodes.empty()) build_tree(cache, b_in_a.translation, enumerated_delta);
-    const double moved = distance(cache.enumerated_translation);
-    const double pruned_cut = cache.pruned - moved;
-    TreeSearch search{cache,
-                      b_in_a.translation,
-                      enumerated_delta,
-                      q.inverse,
-                      q.unit,
-                      facet_value(cache.last, enumerated_delta),
-                      cache.last,
-                      1};
+    const Moved moved{b_in_a.translation - cache.enumerated_translation,
+                      distance(cache.enumerated_translation)};
+    if (cache.nodes.empty()) build_tree(cache.facets, cache.nodes, b_in_a.translation, moved);
+    TreeSearch<PenetrationCache::Facet> search{cache.facets,
+                                               cache.nodes,
+                                               b_in_a.translation,
+                                               moved,
+                                               q.inverse,
+                                               q.unit,
+                                               entry_value(cache.last, moved),
+                                               cache.last,
+                                               1};
     search.visit(0, search.bound(cache.nodes[0]));
     const double best = search.best;
     const PenetrationCache::Facet& f = search.winner;
-    const int work = search.work;
-    if (best <= pruned_cut) {
+    int work = search.work;
+    // The pruned faces: no group's bound below the best (searched on their
+    // tree), or when they were not recorded, their least bound at the
+    // enumeration less the distance moved since.
+    bool certified = false;
+    if (!cache.bounded) {
+      certified = best <= cache.pruned - moved.length;
+    } else if (cache.bounds.empty()) {
+      certified = true;
+    } else {
+      if (cache.bound_nodes.empty())
+        build_tree(cache.bounds, cache.bound_nodes, b_in_a.translation, moved);
+      TreeSearch<PenetrationCache::Bound> check{cache.bounds,
+                                                cache.bound_nodes,
+                                                b_in_a.translation,
+                                                moved,
+                                                q.inverse,
+                                                q.unit,
+                                                best,
+                                                {},
+                                                0};
+      check.visit(0, check.bound(cache.bound_nodes[0]));
+      certified = !(check.best < best);
+      work += check.work;
+    }
+    if (certified) {
       cache.last = f;
       // The winner evaluated with true supports (they do not move under a
       // translation: the cached ones are checked by one hill-climbing step).
@@ -1143,17 +1287,19 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
     // them for the translations to come (twice the distance moved since the
     // enumeration, and at least twice the last margin). Capped at half the
     // bodies' radii: a B that jumps keeps pruning.
-    cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved),
+    cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved.length),
                                   0.5 * (a.bounding_radius() + b.bounding_radius()));
     cache.last = f;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
-  // the fewer faces kept, the faster).
+  // the fewer faces kept, the faster) and does not record the pruned
+  // groups (the next query is likely rotated too).
   const bool has_start = same_polytopes && !cache.facets.empty();
-  if (has_start && cache.rotation != b_in_a.rotation) cache.prune_margin *= 0.5;
+  const bool turned = has_start && cache.rotation != b_in_a.rotation;
+  if (turned) cache.prune_margin *= 0.5;
   const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
-  return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr);
+  return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr, !turned);
 }
 
 }  // namespace proxima

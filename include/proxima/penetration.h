@@ -154,7 +154,14 @@ struct PenetrationResult {
 // node it enters is anchored again at t (a leaf with its faces' least
 // value, an inner node with its children's least bound), so the bounds
 // near the answer stay tight wherever B goes, at no cost beyond the
-// search. A rotated B enumerates again.
+// search. The faces the enumeration pruned are not lost: each pruned group
+// (a face of A or of B, an edge of A, or all the edges at a vertex of A)
+// is kept as a Bound, a lower bound on its faces' values at the
+// enumeration with a ball around their normals, so that it moves with B
+// like a face (its value now is at least lower - (c.delta + spread
+// |delta|)) and sits in a second tree searched the same way: the answer is
+// certified when no Bound is below it, and only a B that moved towards a
+// pruned group's normals enumerates again. A rotated B enumerates again.
 struct PenetrationCache {
   struct Facet {
     MinkowskiFaceId id;
@@ -178,6 +185,15 @@ struct PenetrationCache {
     std::int32_t begin = 0, end = 0;
     std::int32_t left = -1;
   };
+  // A group of faces of A - B the enumeration pruned: their outward unit
+  // normals lie within `spread` of `center` (spread 2: anywhere), and
+  // `lower` bounds their values h_A(n) + h_B(-n) from below at the
+  // enumeration's translation of B (A's units).
+  struct Bound {
+    Vec3 center = Vec3::Zero();
+    double spread = 2.0;
+    double lower = 0.0;
+  };
   // Faces at most this many to a leaf.
   static constexpr int kLeaf = 8;
 
@@ -194,8 +210,15 @@ struct PenetrationCache {
   // The facet of the last answer (a copy: the tree reorders facets while
   // it is built, lazily, by the searches that descend into it).
   Facet last;
-  // Least lower bound of the faces the enumeration pruned (not in facets),
-  // at the enumeration's translation; +infinity when none.
+  // The faces the enumeration pruned (not in facets): their groups and a
+  // tree over them like `nodes` (built by the first tracked query), when
+  // recorded (`bounded`: an enumeration for a B that turned since the last
+  // one does not record them, rotating bodies enumerate every query), and
+  // in any case their least lower bound at the enumeration's translation
+  // (+infinity when none), the certificate when they are not recorded.
+  std::vector<Bound> bounds;
+  std::vector<Node> bound_nodes;
+  bool bounded = false;
   double pruned = 0.0;
   // Faces within this of the first upper bound are kept by the enumeration
   // even where a lower bound would prune them: it grows while B translates
