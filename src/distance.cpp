@@ -226,6 +226,16 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   const Pose b_in_a = relative_pose(pose_a, pose_b);
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
+  // A pair that was penetrating: the tracked depth first, and when it
+  // certifies the overlap, its answer without the algorithm's
+  // (src/signed_distance.cpp).
+  if (c.penetration) [[unlikely]] {
+    DistanceResult overlap;
+    if (detail::tracked_overlap(a, b, b_in_a, options, band_bound, c, overlap)) {
+      to_world(pose_a, overlap);
+      return overlap;
+    }
+  }
   DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
   // Most contacts (overlapping bodies) end with a distance of a few
   // roundings: inside the band of a lower bound on R taken from the cached

@@ -1213,83 +1213,81 @@ struct TreeSearch {
   }
 };
 
-}  // namespace
-
-PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const ConvexPolytope& b,
-                                                const Pose& b_in_a) {
-  Query q(a, b, b_in_a);
-  return solve_cold(q, false, nullptr, b_in_a, nullptr, false);
+// The tracked query (a cache of this pair at B's rotation): the least of
+// the cached faces' values, certified against the pruned ones. True with
+// the answer in `out`; false when a pruned group may be nearer now (then
+// `moved` is B's translation since the enumeration), `cache.last` the best
+// cached face.
+bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationResult& out,
+           double& moved_length) {
+  // M is the reference's M translated by -(t - t_ref): the cached facets
+  // are all of its facets but the pruned ones, each offset moved by
+  // -n.(t - t_ref).
+  const double slack = kValueSlackUlps * kUnitRoundoff * q.magnitude;
+  const Moved moved{
+      b_in_a.translation - cache.enumerated_translation,
+      ((b_in_a.translation - cache.enumerated_translation) * q.inverse).norm() * q.unit};
+  moved_length = moved.length;
+  if (cache.nodes.empty()) build_tree(cache.facets, cache.nodes, b_in_a.translation, moved);
+  TreeSearch<PenetrationCache::Facet> search{cache.facets,
+                                             cache.nodes,
+                                             b_in_a.translation,
+                                             moved,
+                                             q.inverse,
+                                             q.unit,
+                                             entry_value(cache.last, moved),
+                                             cache.last,
+                                             1};
+  search.visit(0, search.bound(cache.nodes[0]));
+  const double best = search.best;
+  const PenetrationCache::Facet& f = search.winner;
+  int work = search.work;
+  cache.last = f;
+  // The pruned faces: no group's bound below the best (searched on their
+  // tree), or when they were not recorded, their least bound at the
+  // enumeration less the distance moved since.
+  bool certified = false;
+  if (!cache.bounded) {
+    certified = best <= cache.pruned - moved.length;
+  } else if (cache.bounds.empty()) {
+    certified = true;
+  } else {
+    if (cache.bound_nodes.empty())
+      build_tree(cache.bounds, cache.bound_nodes, b_in_a.translation, moved);
+    TreeSearch<PenetrationCache::Bound> check{
+        cache.bounds, cache.bound_nodes, b_in_a.translation, moved, q.inverse, q.unit, best, {}, 0};
+    check.visit(0, check.bound(cache.bound_nodes[0]));
+    certified = !(check.best < best);
+    work += check.work;
+  }
+  if (!certified) return false;
+  // The winner evaluated with true supports (they do not move under a
+  // translation: the cached ones are checked by one hill-climbing step).
+  Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
+  out = finish(q, c, (best - slack) * q.inverse, work, true);
+  return true;
 }
 
-PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
-                                    const Pose& b_in_a, PenetrationCache& cache) {
+bool same_pair(const PenetrationCache& cache, const ConvexPolytope& a, const ConvexPolytope& b) {
+  return cache.a == &a && cache.b == &b && cache.fingerprint == fingerprint(a, b);
+}
+
+PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                        PenetrationCache& cache) {
   Query q(a, b, b_in_a);
-  const bool same_polytopes =
-      cache.a == &a && cache.b == &b && cache.fingerprint == fingerprint(a, b);
+  const bool same_polytopes = same_pair(cache, a, b);
   if (!same_polytopes) {
     cache.reset();
   } else if (!cache.facets.empty() && cache.rotation == b_in_a.rotation) {
-    // M is the reference's M translated by -(t - t_ref): the cached facets
-    // are all of its facets but the pruned ones, each offset moved by
-    // -n.(t - t_ref).
-    const double slack = kValueSlackUlps * kUnitRoundoff * q.magnitude;
-    const auto distance = [&](const Vec3& from) {
-      return ((b_in_a.translation - from) * q.inverse).norm() * q.unit;
-    };
-    const Moved moved{b_in_a.translation - cache.enumerated_translation,
-                      distance(cache.enumerated_translation)};
-    if (cache.nodes.empty()) build_tree(cache.facets, cache.nodes, b_in_a.translation, moved);
-    TreeSearch<PenetrationCache::Facet> search{cache.facets,
-                                               cache.nodes,
-                                               b_in_a.translation,
-                                               moved,
-                                               q.inverse,
-                                               q.unit,
-                                               entry_value(cache.last, moved),
-                                               cache.last,
-                                               1};
-    search.visit(0, search.bound(cache.nodes[0]));
-    const double best = search.best;
-    const PenetrationCache::Facet& f = search.winner;
-    int work = search.work;
-    // The pruned faces: no group's bound below the best (searched on their
-    // tree), or when they were not recorded, their least bound at the
-    // enumeration less the distance moved since.
-    bool certified = false;
-    if (!cache.bounded) {
-      certified = best <= cache.pruned - moved.length;
-    } else if (cache.bounds.empty()) {
-      certified = true;
-    } else {
-      if (cache.bound_nodes.empty())
-        build_tree(cache.bounds, cache.bound_nodes, b_in_a.translation, moved);
-      TreeSearch<PenetrationCache::Bound> check{cache.bounds,
-                                                cache.bound_nodes,
-                                                b_in_a.translation,
-                                                moved,
-                                                q.inverse,
-                                                q.unit,
-                                                best,
-                                                {},
-                                                0};
-      check.visit(0, check.bound(cache.bound_nodes[0]));
-      certified = !(check.best < best);
-      work += check.work;
-    }
-    if (certified) {
-      cache.last = f;
-      // The winner evaluated with true supports (they do not move under a
-      // translation: the cached ones are checked by one hill-climbing step).
-      Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
-      return finish(q, c, (best - slack) * q.inverse, work, true);
-    }
+    PenetrationResult r;
+    double moved = 0.0;
+    if (track(q, cache, b_in_a, r, moved)) return r;
     // The pruned faces may be nearer now: enumerate again, keeping more of
     // them for the translations to come (twice the distance moved since the
     // enumeration, and at least twice the last margin). Capped at half the
     // bodies' radii: a B that jumps keeps pruning.
-    cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved.length),
+    cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved),
                                   0.5 * (a.bounding_radius() + b.bounding_radius()));
-    cache.last = f;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
@@ -1300,6 +1298,32 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
   if (turned) cache.prune_margin *= 0.5;
   const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
   return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr, !turned);
+}
+
+}  // namespace
+
+PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const ConvexPolytope& b,
+                                                const Pose& b_in_a) {
+  Query q(a, b, b_in_a);
+  return solve_cold(q, false, nullptr, b_in_a, nullptr, false);
+}
+
+PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
+                                    const Pose& b_in_a, PenetrationCache& cache) {
+  PenetrationResult r = depth(a, b, b_in_a, cache);
+  cache.last_status = r.status;
+  return r;
+}
+
+bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                               PenetrationCache& cache, PenetrationResult& out) {
+  if (cache.facets.empty() || !same_pair(cache, a, b) || cache.rotation != b_in_a.rotation)
+    return false;
+  Query q(a, b, b_in_a);
+  double moved = 0.0;
+  if (!track(q, cache, b_in_a, out, moved)) return false;
+  cache.last_status = out.status;
+  return true;
 }
 
 }  // namespace proxima

@@ -134,6 +134,30 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
   take_depth(penetration_depth(a, b, b_in_a, cache.penetration.get_or_create()), result);
 }
 
+bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                     const DistanceOptions& options, double band, DistanceCache& cache,
+                     DistanceResult& result) {
+  PenetrationCache* depth_cache = cache.penetration.get();
+  if (depth_cache == nullptr || depth_cache->last_status != PenetrationStatus::penetrating ||
+      !options.penetration || options.algorithm != Algorithm::hybrid) {
+    return false;
+  }
+  PenetrationResult p;
+  if (!penetration_depth_tracked(a, b, b_in_a, *depth_cache, p) ||
+      p.status != PenetrationStatus::penetrating || !(p.lower_bound > band)) {
+    // Not certified here: distance()'s algorithm decides, and the depth is
+    // asked again (penetration_depth) only if it finds an overlap.
+    depth_cache->last_status = PenetrationStatus::separated;
+    return false;
+  }
+  // depth >= lower_bound > the band: the origin is inside A - B deeper
+  // than the band, which the algorithm would certify intersecting.
+  result = DistanceResult{};
+  result.status = Status::intersecting;
+  take_depth(p, result);
+  return true;
+}
+
 }  // namespace detail
 
 SignedDistanceGradient signed_distance_gradient(const DistanceResult& result, const Pose& pose_a,

@@ -23,4 +23,15 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
                             const DistanceOptions& options, DistanceCache& cache,
                             DistanceResult& result);
 
+// Before distance()'s algorithm runs: for a pair whose last depth was
+// penetrating (options.penetration, the hybrid), the tracked depth alone
+// (penetration_depth_tracked). When it certifies an overlap deeper than
+// `band` (distance()'s contact band, at least the exact one), `result` is
+// the intersecting answer the algorithm and finish_signed_distance would
+// give (A's frame; no iterations) and the function returns true; else
+// false, and the pair is not tried again until its depth is penetrating.
+bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                     const DistanceOptions& options, double band, DistanceCache& cache,
+                     DistanceResult& result);
+
 }  // namespace proxima::detail

@@ -240,6 +240,9 @@ struct PenetrationCache {
     HullNormals a, b;
   } shapes;
 
+  // The status of the last answer given with this cache.
+  PenetrationStatus last_status = PenetrationStatus::separated;
+
   bool is_cold() const { return a == nullptr; }
   void reset() { *this = PenetrationCache{}; }
 };
@@ -257,6 +260,17 @@ struct PenetrationCache {
 // bound). Not thread-safe on one cache; the polytopes may be shared.
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, PenetrationCache& cache);
+
+// The tracked query alone: when `cache` holds this pair's faces of A - B
+// at B's rotation and certifies their least value without enumerating
+// again (the translation-only path of penetration_depth), fills `out` with
+// the answer penetration_depth would give and returns true; else returns
+// false, `out` and the answer's cache state unchanged (the tree's bounds
+// may have been tightened), and the caller decides whether the depth is
+// wanted (distance() asks it first for a pair that was penetrating, and
+// skips its own algorithm when the depth certifies the overlap).
+bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                               PenetrationCache& cache, PenetrationResult& out);
 
 // The slow, obvious twin: every face of A, every face of B, and every pair
 // (edge of A, edge of B) through the Gauss-map arc test,

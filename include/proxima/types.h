@@ -126,7 +126,9 @@ struct DistanceOptions {
   // distance's negative side, proxima/penetration.h): the deepest points,
   // the separating normal and the Minkowski face's features. Costs nothing
   // for separated or touching pairs (the depth is computed only after the
-  // algorithm answered intersecting or touching). False: an intersecting answer is
+  // algorithm answered intersecting or touching; a tracked pair that was
+  // penetrating tries its cached depth first, once, and when that certifies
+  // the overlap the algorithm does not run). False: an intersecting answer is
   // reported as without it, distance 0, signed_distance() 0 in the
   // certificate [-infinity, 0] (depth_upper_bound +infinity: not computed);
   // for a caller that only needs the status (a scene of resting contacts).
