@@ -851,9 +851,18 @@ Feature to_feature(const Simplex& s) {
   return f;
 }
 
-// Builds the result from the winning candidate.
+Simplex to_simplex(const Feature& f) { return {f.vertices, f.type, f.face}; }
+
+bool same_face(const MinkowskiFaceId& x, const MinkowskiFaceId& y) {
+  return x.kind == y.kind && x.a0 == y.a0 && x.a1 == y.a1 && x.b0 == y.b0 && x.b1 == y.b1;
+}
+
+// Builds the result from the winning candidate. `memo` (a tracking cache's,
+// or null) keeps the supporting features of the answer's direction: a
+// tracked answer along the same face of A - B (same id, same normal: B
+// only translated) reads them instead of walking the hulls again.
 PenetrationResult finish(const Query& q, const Candidate& best, double lower_scaled, int candidates,
-                         bool tracked) {
+                         bool tracked, PenetrationCache::Witnesses* memo = nullptr) {
   PenetrationResult r;
   r.candidates = candidates;
   r.tracked = tracked;
@@ -868,10 +877,24 @@ PenetrationResult finish(const Query& q, const Candidate& best, double lower_sca
   const double tie = kTieUlps * kUnitRoundoff;
   std::array<std::byte, 2048> buffer;
   std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
-  const auto ta = support_region(
-      q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie, &memory);
-  const auto tb = support_region(
-      q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie, &memory);
+  std::pmr::vector<Simplex> ta(&memory), tb(&memory);
+  if (memo != nullptr && !memo->a.empty() && same_face(memo->id, best.id) && memo->normal == n) {
+    for (const Feature& f : memo->a) ta.push_back(to_simplex(f));
+    for (const Feature& f : memo->b) tb.push_back(to_simplex(f));
+  } else {
+    ta = support_region(
+        q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie, &memory);
+    tb = support_region(
+        q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie, &memory);
+    if (memo != nullptr) {
+      memo->id = best.id;
+      memo->normal = n;
+      memo->a.clear();
+      memo->b.clear();
+      for (const Simplex& x : ta) memo->a.push_back(to_feature(x));
+      for (const Simplex& x : tb) memo->b.push_back(to_feature(x));
+    }
+  }
   const Vec3 shift = std::max(value, 0.0) * n;
   ClosestPoints<double> closest;
   closest.point_a = closest.point_b = Vec3::Zero();
@@ -1124,6 +1147,9 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     cache->enumerated_translation = b_in_a.translation;
     cache->pruned = q.pruned * q.unit;
     cache->bounded = record;
+    // B's rotation may have changed: its supporting features with it.
+    cache->witnesses.a.clear();
+    cache->witnesses.b.clear();
     // The trees are built by the first tracked query (a rotating B, which
     // enumerates every query, never pays for it); until then `last` is the
     // answer's face.
@@ -1261,10 +1287,17 @@ bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationRes
     work += check.work;
   }
   if (!certified) return false;
-  // The winner evaluated with true supports (they do not move under a
-  // translation: the cached ones are checked by one hill-climbing step).
-  Candidate c = evaluate(q, f.id, f.normal, f.support_a, f.support_b);
-  out = finish(q, c, (best - slack) * q.inverse, work, true);
+  // The winner's value with its true supports: the cached ones, which a
+  // translation does not move (hill climbing along the same normal, with
+  // B's rotation the same bits, from them stays at them: they were found by
+  // it, and it moves only to a strictly larger value).
+  Candidate c;
+  c.id = f.id;
+  c.normal = f.normal;
+  c.support_a = f.support_a;
+  c.support_b = f.support_b;
+  c.value = f.normal.dot(q.point_a(f.support_a) - q.point_b(f.support_b));
+  out = finish(q, c, (best - slack) * q.inverse, work, true, &cache.witnesses);
   return true;
 }
 

@@ -240,6 +240,15 @@ struct PenetrationCache {
     HullNormals a, b;
   } shapes;
 
+  // The supporting features of the last answer's direction (its face's id
+  // and normal): the simplices of each hull searched for the witness
+  // points (support_region in penetration.cpp), which a translation of B
+  // does not change; empty when none.
+  struct Witnesses {
+    MinkowskiFaceId id;
+    Vec3 normal = Vec3::Zero();
+    std::vector<Feature> a, b;
+  } witnesses;
   // The status of the last answer given with this cache.
   PenetrationStatus last_status = PenetrationStatus::separated;
 
