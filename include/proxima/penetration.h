@@ -212,8 +212,10 @@ struct PenetrationCache {
   Facet last;
   // The faces the enumeration pruned (not in facets): their groups and a
   // tree over them like `nodes` (built by the first tracked query), when
-  // recorded (`bounded`: an enumeration for a B that turned since the last
-  // one does not record them, rotating bodies enumerate every query), and
+  // recorded (`bounded`: only by an enumeration after a translation
+  // outgrew the cached faces; a cold one or one for a B that turned does
+  // not record them: a caller querying cold, or a rotating B, enumerates
+  // every query), and
   // in any case their least lower bound at the enumeration's translation
   // (+infinity when none), the certificate when they are not recorded.
   std::vector<Bound> bounds;
