@@ -265,6 +265,26 @@ double first_closing(double gap0, double rate, double acceleration, double span)
   return std::min(t, span);
 }
 
+// The longest safe step, nearly, of a gap gap0 > 0 closing at `rate` whose
+// acceleration over [0, s] is at most acceleration(s), a bound that grows
+// with s (it charges the motion over the whole span: the farther the bodies
+// may move, the more the planes may turn), for s up to `span`. For any
+// S <= span, first_closing with acceleration(S) capped at S is safe: if its
+// root r(S) is at least S the bound holds up to S; if it is shorter, the
+// bound over [0, S] holds over [0, r(S)] too. So S is best taken near the
+// step itself, not the span: near a contact the step is a small fraction
+// of the span, and so is the acceleration the motion can build up over it.
+// S = gap0 / rate (the step without acceleration, longer than every root)
+// gives a root at least that of the span at the cost of one division, and
+// close to the best S where the gap closes mostly at its rate (a contact
+// near): a smaller constant of the quadratic convergence, fewer steps
+// (toi_bench, N = 8: 6.38 to 5.97 distance queries per contact).
+template <class Acceleration>
+double widest_closing(double gap0, double rate, const Acceleration& acceleration, double span) {
+  const double s = rate > 0.0 ? std::min(span, gap0 / rate) : span;
+  return first_closing(gap0, rate, acceleration(s), s);
+}
+
 // The step that a plane fixed in one body allows. Take body F's support
 // plane along the unit d at time t (F below it, at height `plane`; the
 // other body M above) and let it move with F: F never crosses it (F's
@@ -279,10 +299,11 @@ double first_closing(double gap0, double rate, double acceleration, double span)
 // the exact rate of q along d in F's frame (a vertex-face contact closes at
 // second order), and g'' = d''.u + 2 d'.u' + d.u'' with |d''| <= |w_F|^2,
 // |u'| <= V = |v_M - v_F| + |w_M| |r|, |u''| <= |w_M|^2 |r| and
-// |u(s)| <= |u(0)| + V s: over s <= horizon,
-//   |g''| <= |w_F|^2 (|u(0)| + V horizon) + 2 |w_F| V + |w_M|^2 |r|.
+// |u(s)| <= |u(0)| + V s: over s <= S (S <= horizon),
+//   |g''| <= |w_F|^2 (|u(0)| + V S) + 2 |w_F| V + |w_M|^2 |r|.
 // The step is the first closing over S of the gap less `keep_off` (the
-// band and the target), at most `horizon`; the caller applies the span.
+// band and the target), at most `horizon`, with S chosen by
+// widest_closing; the caller applies the span.
 double fixed_plane_step(double plane, const Vec3& d, const Vec3& origin_f, const Vec3& v_f,
                         const Vec3& w_f, const ConvexPolytope& m, const Pose& pose_m,
                         const Vec3& origin_m, const Vec3& v_m, const Vec3& w_m,
@@ -302,8 +323,9 @@ double fixed_plane_step(double plane, const Vec3& d, const Vec3& origin_f, const
     const double arm = fast_norm(r);
     const double closing = -d.dot(dv + w_m.cross(r) - w_f.cross(u));
     const double v = speed + wm * arm;
-    const double acceleration = wf * wf * (fast_norm(u) + v * horizon) + 2.0 * wf * v + wm2 * arm;
-    step = std::min(step, first_closing(gap, closing, acceleration, horizon));
+    const double still = wf * wf * fast_norm(u) + 2.0 * wf * v + wm2 * arm;
+    const auto acceleration = [&](double span) { return still + wf * wf * v * span; };
+    step = std::min(step, widest_closing(gap, closing, acceleration, horizon));
   }
   return step;
 }
@@ -390,20 +412,24 @@ double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origi
   const Vec3 m_dot = (c_dot - m * m.dot(c_dot)) / rho;
   const Vec3 d_dot = (vb + wb.cross(q - origin_b)) - (va + wa.cross(p - origin_a));
   const double closing = -(m_dot.dot(d0) + m.dot(d_dot));
-  // The second derivative's bound up to the horizon, where rho stays
-  // >= rho(0) / 2 (the spans of the edges' supports may end it sooner: the
-  // bound holds over the shorter span too).
+  // The second derivative's bound over [0, s] for s up to the horizon and
+  // while rho stays >= rho(0) / 2 (the spans of the edges' supports may end
+  // it sooner: the bound holds over the shorter span too), narrowed to the
+  // step by widest_closing.
   const double wr = k.relative;
   double span = wr > 0.0 ? std::min(horizon, 0.5 * rho / wr) : horizon;
   const double na = k.turn_a, nb = k.turn_b;
   const double w = na + nb;
   const double speed = k.speed + na * k.reach_a + nb * k.reach_b;
-  const double rho_min = 0.5 * rho;
-  const double m_ddot = (2.0 * w * w + 5.0 * w * w / rho_min) / rho_min;
-  const double acceleration = m_ddot * (fast_norm(d0) + speed * span) +
-                              2.0 * (w / rho_min) * speed + na * na * k.reach_a +
-                              nb * nb * k.reach_b;
-  const double step = first_closing(gap, closing, acceleration, span);
+  // Over [0, s]: rho >= rho(0) - |w_r| s (>= rho(0) / 2 within the span).
+  const double distance0 = fast_norm(d0);
+  const double turning = na * na * k.reach_a + nb * nb * k.reach_b;
+  const auto acceleration = [&](double s) {
+    const double rho_min = rho - wr * s;
+    const double m_ddot = (2.0 * w * w + 5.0 * w * w / rho_min) / rho_min;
+    return m_ddot * (distance0 + speed * s) + 2.0 * (w / rho_min) * speed + turning;
+  };
+  const double step = widest_closing(gap, closing, acceleration, span);
   // The supports' spans (the cone margins, O(degree) each) only where the
   // step could beat `best`: s <= rho(0) (1 - e^-margin) / |w_r|, with
   // 1 - e^-x >= x (1 - x / 2) (margins are <= 1).
