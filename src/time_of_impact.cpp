@@ -104,8 +104,11 @@ double fast_norm(const Vec3& x) {
 // S: the witness feature's vertices (a face's whole polygon when it is
 // small) and the support vertex, without repeats.
 struct VertexSet {
-  std::array<std::int32_t, kMaxFeatureVertices + 4> ids{};
+  std::array<std::int32_t, kMaxFeatureVertices + 4> ids;  // the first `size` only
   std::size_t size = 0;
+  // A vertex known not to be in S yet (a face's own, distinct, into an
+  // empty S).
+  void push(std::int32_t v) { ids[size++] = v; }
   void add(std::int32_t v) {
     if (v < 0 || std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
                      ids.begin() + static_cast<std::ptrdiff_t>(size))
@@ -126,7 +129,7 @@ VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int su
   VertexSet set;
   if (feature.type == FeatureType::face && feature.face >= 0 && feature.face < body.face_count() &&
       body.face(feature.face).size() <= kMaxFeatureVertices) {
-    for (const std::int32_t v : body.face(feature.face)) set.add(v);
+    for (const std::int32_t v : body.face(feature.face)) set.push(v);
   } else {
     for (const std::int32_t v : feature.vertices) {
       if (v < body.vertex_count()) set.add(v);
@@ -197,12 +200,20 @@ class FeaturePlane {
     const Vec3 spin = pose.rotation.transpose() * n.cross(w);
     double top = -std::numeric_limits<double>::infinity();
     double rise = -std::numeric_limits<double>::infinity();
-    double arm = 0.0;
+    // The longest arm from its square (one root), where no square over- or
+    // underflows; else arm by arm without overflow.
+    double arm2 = 0.0;
     for (std::size_t k = 0; k < set.size; ++k) {
       const Vec3& q = body.vertex(set.ids[k]);
       top = std::max(top, sign * direction.dot(q));
       rise = std::max(rise, sign * spin.dot(q));
-      arm = std::max(arm, fast_norm(q - origin));
+      arm2 = std::max(arm2, (q - origin).squaredNorm());
+    }
+    double arm = std::sqrt(arm2);
+    if (!(arm2 >= std::numeric_limits<double>::min() && arm2 < 0x1p1000)) {
+      arm = 0.0;
+      for (std::size_t k = 0; k < set.size; ++k)
+        arm = std::max(arm, (body.vertex(set.ids[k]) - origin).stableNorm());
     }
     bound_.value = sign * n.dot(pose.translation) + top;
     bound_.rate = sign * (n.dot(v) - spin.dot(origin)) + rise;
