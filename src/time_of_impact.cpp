@@ -13,6 +13,7 @@
 #include <queue>
 #include <string>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -24,12 +25,9 @@ namespace {
 
 bool finite(const Vec3& v) { return v.allFinite(); }
 
-// An upper bound on the distance of any hull vertex from the body's
-// reference point (its frame's origin): |centroid| + the bounding radius
-// about the centroid. O(1). Norms here and below without overflow or
-// underflow of their squares (stableNorm): speeds and sizes near 1e-300
-// and 1e300 are valid.
-double reach(const ConvexPolytope& p) { return p.centroid().stableNorm() + p.bounding_radius(); }
+// Norms here and below without overflow or underflow of their squares
+// (stableNorm, fast_norm): speeds and sizes near 1e-300 and 1e300 are
+// valid.
 
 // How far the hull of A reaches along the unit direction n (world frame),
 // and how far B's hull starts, at the placed poses: max over A of n.x and
@@ -521,22 +519,6 @@ class Sweep {
   Mat3 kk_r0_ = Mat3::Zero();
 };
 
-// Bound on the distance of any point of the body (its rounded surface
-// included) from its reference point.
-double body_reach(const Body& body) {
-  switch (body.kind()) {
-    case Body::Kind::convex:
-      return reach(*body.convex()) + body.radius();
-    case Body::Kind::compound: {
-      const CompoundBody& c = *body.compound();
-      return c.center().stableNorm() + c.bounding_radius() + body.radius();
-    }
-    case Body::Kind::mesh:
-      return body.mesh()->center().stableNorm() + body.mesh()->bounding_radius() + body.radius();
-  }
-  return 0.0;
-}
-
 double body_size(const Body& body) {
   switch (body.kind()) {
     case Body::Kind::convex:
@@ -933,21 +915,112 @@ bool is_identity(const Pose& p) {
   return p.rotation == Mat3::Identity() && p.translation == Vec3::Zero();
 }
 
-// Time of impact of two Bodies made of convex pieces (compounds, a convex
-// body as its one piece): the earliest over piece pairs of their convex
-// advancement, by branch and bound over the two hierarchies. Candidates
-// (node or piece pairs) are taken in order of the earliest time their
-// moving balls allow a contact (earliest_ball_contact); a node pair is
-// split into its children's pairs, a piece pair is advanced (convex, from
-// that earliest time on, and only up to the best time found, since a later
-// contact changes nothing); everything from the best time on is pruned.
-// Each rule keeps the guarantee: a pruned pair cannot come within the
-// target before the reported t, and every pair advanced is advanced
-// safely.
-ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body& b, const Sweep& mb,
-                                     const ImpactOptions& options, double tolerance, BodyCache& c) {
-  const CompoundBody& ca = *a.compound();
-  const CompoundBody& cb = *b.compound();
+// One side of the branch and bound over piece pairs: a Body's convex
+// pieces under its hierarchy, each node and piece bounded by a ball in the
+// body's frame. A compound's pieces (a convex body as its one piece) under
+// its sphere tree; or a mesh's triangles under its box tree, each triangle
+// the flat hull of its three corners (a segment or a point where it is
+// degenerate), built when its pair is first advanced: a mesh's surface
+// first comes within the target where one of its triangles does.
+class PieceTree {
+ public:
+  explicit PieceTree(const Body& body) {
+    if (body.kind() == Body::Kind::mesh) {
+      mesh_ = body.mesh().get();
+    } else {
+      compound_ = body.compound();
+    }
+  }
+
+  Ball node_ball(std::int32_t n) const {
+    if (mesh_ == nullptr) {
+      const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
+      return {node.center, node.radius};
+    }
+    // The box's ball: its center and half diagonal (the rounding of both,
+    // a few u of the coordinates, is inside the contact band that
+    // earliest_ball_contact keeps off).
+    Vec3 lo, hi;
+    mesh_->box(n, lo, hi);
+    return {0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()};
+  }
+  bool is_leaf(std::int32_t n) const {
+    return mesh_ == nullptr ? compound_->nodes()[static_cast<std::size_t>(n)].left < 0
+                            : mesh_->nodes()[static_cast<std::size_t>(n)].is_leaf();
+  }
+  std::pair<std::int32_t, std::int32_t> children(std::int32_t n) const {
+    if (mesh_ == nullptr) {
+      const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
+      return {node.left, node.right};
+    }
+    return {n + 1, mesh_->nodes()[static_cast<std::size_t>(n)].first_or_right};
+  }
+  // A leaf's pieces: the ids order[first .. first + count).
+  std::span<const std::int32_t> pieces(std::int32_t n) const {
+    if (mesh_ == nullptr) {
+      const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
+      return compound_->piece_order().subspan(static_cast<std::size_t>(node.first),
+                                              static_cast<std::size_t>(node.count));
+    }
+    const TriangleMesh::Node& node = mesh_->nodes()[static_cast<std::size_t>(n)];
+    return mesh_->triangle_order().subspan(static_cast<std::size_t>(node.first_or_right),
+                                           static_cast<std::size_t>(node.count));
+  }
+  Ball piece_ball(std::int32_t p) const {
+    if (mesh_ == nullptr) {
+      const auto& sphere = compound_->piece_sphere(p);
+      return {sphere.center, sphere.radius};
+    }
+    const auto corners = triangle_corners(p);
+    const Vec3 center = (corners[0] + corners[1] + corners[2]) / 3.0;
+    double radius = 0.0;
+    for (const Vec3& x : corners) radius = std::max(radius, (x - center).stableNorm());
+    return {center, radius};
+  }
+  // The piece's hull and its pose in the body (null: the body's frame).
+  const ConvexPolytope& hull(std::int32_t p) {
+    if (mesh_ == nullptr) return *compound_->piece(p).polytope;
+    auto it = triangles_.find(p);
+    if (it == triangles_.end()) {
+      const auto corners = triangle_corners(p);
+      it = triangles_.emplace(p, ConvexPolytope(std::span<const Vec3>(corners))).first;
+    }
+    return it->second;
+  }
+  const Pose* local(std::int32_t p) const {
+    if (mesh_ != nullptr) return nullptr;
+    const Pose& pose = compound_->piece(p).pose;
+    return is_identity(pose) ? nullptr : &pose;
+  }
+
+ private:
+  std::array<Vec3, 3> triangle_corners(std::int32_t p) const {
+    const TriangleMesh::Triangle& t = mesh_->triangle(p);
+    return {mesh_->vertex(static_cast<int>(t[0])), mesh_->vertex(static_cast<int>(t[1])),
+            mesh_->vertex(static_cast<int>(t[2]))};
+  }
+
+  std::shared_ptr<const CompoundBody> compound_;  // null for a mesh
+  const TriangleMesh* mesh_ = nullptr;
+  // The triangles' hulls built so far (a map: references stay valid).
+  std::unordered_map<std::int32_t, ConvexPolytope> triangles_;
+};
+
+// Time of impact of two Bodies made of convex pieces (PieceTree: compounds,
+// a convex body as its one piece, meshes' triangles): the earliest over
+// piece pairs of their convex advancement, by branch and bound over the two
+// hierarchies. Candidates (node or piece pairs) are taken in order of the
+// earliest time their moving balls allow a contact
+// (earliest_ball_contact); a node pair is split into its children's pairs,
+// a piece pair is advanced (convex, from that earliest time on, and only
+// up to the best time found, since a later contact changes nothing);
+// everything from the best time on is pruned. Each rule keeps the
+// guarantee: a pruned pair cannot come within the target before the
+// reported t, and every pair advanced is advanced safely.
+ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b, const Sweep& mb,
+                                   const ImpactOptions& options, double tolerance, BodyCache& c) {
+  PieceTree ta(a);
+  PieceTree tb(b);
   ImpactOptions pair_options = options;
   pair_options.target_separation += a.radius() + b.radius();
   pair_options.tolerance = tolerance;
@@ -970,11 +1043,6 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
   };
 
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue;
-  const auto node_ball = [](const CompoundBody::Node& n) { return Ball{n.center, n.radius}; };
-  const auto piece_ball = [](const CompoundBody& body, std::int32_t i) {
-    const auto& s = body.piece_sphere(i);
-    return Ball{s.center, s.radius};
-  };
   PosesAt poses(ma, mb);
   // |v_b - v_a|, |w_a|, |w_b|: the balls' speeds.
   const Vec3 speeds((mb.linear_velocity() - ma.linear_velocity()).stableNorm(),
@@ -983,16 +1051,14 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
     k.t = earliest_ball_contact(poses, speeds, ba, bb, target, k.t, best.t);
     if (may_beat(k.t)) queue.push(k);
   };
-  push({0.0, false, 0, 0}, node_ball(ca.nodes()[0]), node_ball(cb.nodes()[0]));
+  push({0.0, false, 0, 0}, ta.node_ball(0), tb.node_ball(0));
   while (!queue.empty()) {
     const Candidate k = queue.top();
     queue.pop();
     if (!may_beat(k.t)) break;  // every later candidate starts later still
     if (k.pieces) {
-      const CompoundPiece& pa = ca.piece(k.a);
-      const CompoundPiece& pb = cb.piece(k.b);
-      const MovingHull ha(*pa.polytope, ma, is_identity(pa.pose) ? nullptr : &pa.pose);
-      const MovingHull hb(*pb.polytope, mb, is_identity(pb.pose) ? nullptr : &pb.pose);
+      const MovingHull ha(ta.hull(k.a), ma, ta.local(k.a));
+      const MovingHull hb(tb.hull(k.b), mb, tb.local(k.b));
       DistanceCache pair_cache;
       ImpactResult r = advance_hulls(ha, hb, pair_options, tolerance, pair_cache, k.t, best.t);
       iterations += r.iterations;
@@ -1007,35 +1073,33 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
       }
       continue;
     }
-    const CompoundBody::Node& na = ca.nodes()[static_cast<std::size_t>(k.a)];
-    const CompoundBody::Node& nb = cb.nodes()[static_cast<std::size_t>(k.b)];
-    const bool leaf_a = na.left < 0, leaf_b = nb.left < 0;
+    const Ball na = ta.node_ball(k.a);
+    const Ball nb = tb.node_ball(k.b);
+    const bool leaf_a = ta.is_leaf(k.a), leaf_b = tb.is_leaf(k.b);
     if (leaf_a && leaf_b) {
-      for (std::int32_t i = na.first; i < na.first + na.count; ++i) {
-        const std::int32_t pa = ca.piece_order()[static_cast<std::size_t>(i)];
-        for (std::int32_t j = nb.first; j < nb.first + nb.count; ++j) {
-          const std::int32_t pb = cb.piece_order()[static_cast<std::size_t>(j)];
-          push({k.t, true, pa, pb}, piece_ball(ca, pa), piece_ball(cb, pb));
-        }
+      for (const std::int32_t pa : ta.pieces(k.a)) {
+        const Ball ba = ta.piece_ball(pa);
+        for (const std::int32_t pb : tb.pieces(k.b))
+          push({k.t, true, pa, pb}, ba, tb.piece_ball(pb));
       }
     } else if (leaf_b || (!leaf_a && na.radius >= nb.radius)) {
-      for (const std::int32_t child : {na.left, na.right}) {
-        push({k.t, false, child, k.b}, node_ball(ca.nodes()[static_cast<std::size_t>(child)]),
-             node_ball(nb));
-      }
+      const auto [left, right] = ta.children(k.a);
+      for (const std::int32_t child : {left, right})
+        push({k.t, false, child, k.b}, ta.node_ball(child), nb);
     } else {
-      for (const std::int32_t child : {nb.left, nb.right}) {
-        push({k.t, false, k.a, child}, node_ball(na),
-             node_ball(cb.nodes()[static_cast<std::size_t>(child)]));
-      }
+      const auto [left, right] = tb.children(k.b);
+      for (const std::int32_t child : {left, right})
+        push({k.t, false, k.a, child}, na, tb.node_ball(child));
     }
   }
 
   // The answer at the best time (1 when no pair met): the Bodies' query
-  // there, whose closest pair and features describe it. The pair that met
-  // seeds the query's cache (tried first, with its features at that time):
-  // its distance is the first bound of the query's branch and bound.
-  if (met) {
+  // there, whose closest pair and features describe it. Between compounds
+  // the pair that met seeds the query's cache (tried first, with its
+  // features at that time): its distance is the first bound of the query's
+  // branch and bound.
+  const bool meshes = a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh;
+  if (met && !meshes) {
     c.compound.piece_a = best_pair.piece_a;
     c.compound.piece_b = best_pair.piece_b;
     const auto less = [](const CompoundCache::Entry& x, const CompoundCache::Entry& y) {
@@ -1061,8 +1125,8 @@ ImpactResult compound_time_of_impact(const Body& a, const Sweep& ma, const Body&
   out.pose_a = pose_a;
   out.pose_b = pose_b;
   out.at_t = at;
-  out.piece_a = at.piece_a;
-  out.piece_b = at.piece_b;
+  out.piece_a = a.kind() == Body::Kind::mesh ? at.triangle_a : at.piece_a;
+  out.piece_b = b.kind() == Body::Kind::mesh ? at.triangle_b : at.piece_b;
   out.iterations = iterations + 1;
   out.pairs_advanced = pairs;
   if (!met && (at.status == Status::intersecting || at.status == Status::touching ||
@@ -1116,26 +1180,32 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
   const Sweep mb =
       checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
   const double tolerance = options.tolerance > 0.0 ? options.tolerance : default_tolerance;
-  if (a.kind() != Body::Kind::mesh && b.kind() != Body::Kind::mesh) {
-    return compound_time_of_impact(a, ma, b, mb, options, tolerance, c);
+  // A closed mesh has an inside: a body that starts there overlaps it
+  // without touching a triangle. Otherwise the surfaces first come within
+  // the target where two pieces do (a body outside a closed mesh enters
+  // it only through a triangle), which the branch and bound finds.
+  const auto closed = [](const Body& body) {
+    return body.kind() == Body::Kind::mesh && body.mesh()->is_closed();
+  };
+  if (closed(a) || closed(b)) {
+    const Pose pa = ma.at(0.0);
+    const Pose pb = mb.at(0.0);
+    const BodyDistance at = distance(a, pa, b, pb, options.distance, &c);
+    const double target = options.target_separation;
+    if (at.status == Status::intersecting || at.signed_distance() < target) {
+      ImpactResult out;
+      out.status = ImpactStatus::overlapping;
+      out.t = 0.0;
+      out.pose_a = pa;
+      out.pose_b = pb;
+      out.at_t = at;
+      out.piece_a = a.kind() == Body::Kind::mesh ? at.triangle_a : at.piece_a;
+      out.piece_b = b.kind() == Body::Kind::mesh ? at.triangle_b : at.piece_b;
+      out.iterations = 1;
+      return out;
+    }
   }
-
-  // A mesh on either side: advancement by the certified lower bound of the
-  // Bodies' signed distance over the fastest point speed (an overlap with a
-  // mesh has lower bound -infinity: contact at once).
-  const double any_speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
-                           ma.angular_velocity().norm() * body_reach(a) +
-                           mb.angular_velocity().norm() * body_reach(b);
-  const auto poses = [&](double t) { return std::pair<Pose, Pose>(ma.at(t), mb.at(t)); };
-  const auto query = [&](const Pose& pa, const Pose& pb) -> DistanceResult {
-    return distance(a, pa, b, pb, options.distance, &c);
-  };
-  const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb, double) {
-    const double band =
-        contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
-    return lower_bound_step(r.signed_lower_bound() - band, options.target_separation, any_speed);
-  };
-  return advance(poses, options, tolerance, query, safe_step);
+  return pieces_time_of_impact(a, ma, b, mb, options, tolerance, c);
 }
 
 }  // namespace proxima
