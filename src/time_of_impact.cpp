@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "proxima/closest_point.h"
 #include "proxima/compound.h"
 #include "proxima/support.h"
 
@@ -901,6 +902,76 @@ double earliest_ball_contact(PosesAt& poses, const Vec3& speeds, const Ball& ba,
   return t;
 }
 
+// A node's or a piece's bound in its body's frame: its ball, and for a
+// mesh the node's box or the piece's triangle itself, far closer to what
+// it holds than the ball where that is flat (a floor's triangles, and the
+// boxes around them).
+struct Bound {
+  enum class Shape : std::uint8_t { ball, box, triangle };
+  Ball ball;
+  Shape shape = Shape::ball;
+  std::array<Vec3, 3> corners{};  // box: lo, hi; triangle: its corners
+
+  // The distance from q (body frame) to the box or the triangle, and the
+  // largest coordinate magnitude of q and of the shape (for the rounding).
+  double distance_to(const Vec3& q, double& magnitude) const {
+    magnitude = q.cwiseAbs().maxCoeff();
+    if (shape == Shape::box) {
+      magnitude =
+          std::max({magnitude, corners[0].cwiseAbs().maxCoeff(), corners[1].cwiseAbs().maxCoeff()});
+      return fast_norm((corners[0] - q).cwiseMax(q - corners[1]).cwiseMax(0.0));
+    }
+    for (const Vec3& x : corners) magnitude = std::max(magnitude, x.cwiseAbs().maxCoeff());
+    const ClosestPoints<double> c =
+        closest_point_triangle(q, corners[0], corners[1], corners[2], kernel_tolerance(magnitude));
+    return fast_norm(c.point_b - q);
+  }
+};
+
+// earliest_ball_contact where one side's bound is a box or a triangle
+// (A's if both are): the gap from the other side's ball to that shape,
+// dist(x_o, S) - r_o, is 1-Lipschitz in the ball's center and in the
+// shape's points, which (relative to the reference point of the shape's
+// body, whose translation the center's speed already counts) move at most
+// at |w| (|c| + r) (the shape inside its ball, c its center): it closes no
+// faster than |v_b - v_a| + |w_s| (|c_s| + r_s) + |w_o| |c_o|. The same
+// rules otherwise: a lower bound on the first time the hulls inside can
+// come within the target, infinity when not before t_end.
+double earliest_contact(PosesAt& poses, const Vec3& speeds, const Bound& ba, const Bound& bb,
+                        double target, double t, double t_end) {
+  if (ba.shape == Bound::Shape::ball && bb.shape == Bound::Shape::ball)
+    return earliest_ball_contact(poses, speeds, ba.ball, bb.ball, target, t, t_end);
+  const bool on_a = ba.shape != Bound::Shape::ball;
+  const Bound& shape = on_a ? ba : bb;
+  const Ball& other = on_a ? bb.ball : ba.ball;
+  const double speed = speeds[0] +
+                       speeds[on_a ? 1 : 2] * (fast_norm(shape.ball.center) + shape.ball.radius) +
+                       speeds[on_a ? 2 : 1] * fast_norm(other.center);
+  const double never = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < kMaxBallSteps; ++step) {
+    const auto& [pa, pb] = poses.at(t);
+    const Pose& ps = on_a ? pa : pb;
+    const Pose& po = on_a ? pb : pa;
+    const Vec3 x = po.apply(other.center);
+    const Vec3 q = ps.rotation.transpose() * (x - ps.translation);
+    double magnitude = 0.0;
+    const double d = shape.distance_to(q, magnitude);
+    // Off the rounding of the center's coordinates in both frames and of
+    // the distance kernel.
+    const double band = contact_band(
+        std::max({magnitude, x.cwiseAbs().maxCoeff(), ps.translation.cwiseAbs().maxCoeff()}) +
+        shape.ball.radius + other.radius);
+    const double gap = d - other.radius - target - band;
+    if (!(gap > kBallCloseEnough * other.radius)) return t;
+    if (!(speed > 0.0)) return never;
+    const double next = t + gap / speed;
+    if (!(next < t_end)) return never;
+    if (!(next > t)) return t;
+    t = next;
+  }
+  return t;
+}
+
 // A node pair or a piece pair of two compounds, and the earliest time its
 // balls allow a contact.
 struct Candidate {
@@ -932,17 +1003,17 @@ class PieceTree {
     }
   }
 
-  Ball node_ball(std::int32_t n) const {
+  Bound node_bound(std::int32_t n) const {
     if (mesh_ == nullptr) {
       const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
-      return {node.center, node.radius};
+      return {{node.center, node.radius}};
     }
-    // The box's ball: its center and half diagonal (the rounding of both,
-    // a few u of the coordinates, is inside the contact band that
-    // earliest_ball_contact keeps off).
+    // The box, and its ball: its center and half diagonal (the rounding of
+    // both, a few u of the coordinates, is inside the contact band that
+    // earliest_contact keeps off).
     Vec3 lo, hi;
     mesh_->box(n, lo, hi);
-    return {0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()};
+    return {{0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()}, Bound::Shape::box, {lo, hi, hi}};
   }
   bool is_leaf(std::int32_t n) const {
     return mesh_ == nullptr ? compound_->nodes()[static_cast<std::size_t>(n)].left < 0
@@ -966,16 +1037,18 @@ class PieceTree {
     return mesh_->triangle_order().subspan(static_cast<std::size_t>(node.first_or_right),
                                            static_cast<std::size_t>(node.count));
   }
-  Ball piece_ball(std::int32_t p) const {
+  Bound piece_bound(std::int32_t p) const {
     if (mesh_ == nullptr) {
       const auto& sphere = compound_->piece_sphere(p);
-      return {sphere.center, sphere.radius};
+      return {{sphere.center, sphere.radius}};
     }
+    // The triangle, and its ball about its centroid (the radius a hair
+    // out, for its rounding: the speed bound needs every corner inside).
     const auto corners = triangle_corners(p);
     const Vec3 center = (corners[0] + corners[1] + corners[2]) / 3.0;
     double radius = 0.0;
     for (const Vec3& x : corners) radius = std::max(radius, (x - center).stableNorm());
-    return {center, radius};
+    return {{center, radius * (1.0 + 1e-12)}, Bound::Shape::triangle, corners};
   }
   // The piece's hull and its pose in the body (null: the body's frame).
   const ConvexPolytope& hull(std::int32_t p) {
@@ -1047,11 +1120,11 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
   // |v_b - v_a|, |w_a|, |w_b|: the balls' speeds.
   const Vec3 speeds((mb.linear_velocity() - ma.linear_velocity()).stableNorm(),
                     ma.angular_velocity().norm(), mb.angular_velocity().norm());
-  const auto push = [&](Candidate k, const Ball& ba, const Ball& bb) {
-    k.t = earliest_ball_contact(poses, speeds, ba, bb, target, k.t, best.t);
+  const auto push = [&](Candidate k, const Bound& ba, const Bound& bb) {
+    k.t = earliest_contact(poses, speeds, ba, bb, target, k.t, best.t);
     if (may_beat(k.t)) queue.push(k);
   };
-  push({0.0, false, 0, 0}, ta.node_ball(0), tb.node_ball(0));
+  push({0.0, false, 0, 0}, ta.node_bound(0), tb.node_bound(0));
   while (!queue.empty()) {
     const Candidate k = queue.top();
     queue.pop();
@@ -1073,23 +1146,23 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
       }
       continue;
     }
-    const Ball na = ta.node_ball(k.a);
-    const Ball nb = tb.node_ball(k.b);
+    const Bound na = ta.node_bound(k.a);
+    const Bound nb = tb.node_bound(k.b);
     const bool leaf_a = ta.is_leaf(k.a), leaf_b = tb.is_leaf(k.b);
     if (leaf_a && leaf_b) {
       for (const std::int32_t pa : ta.pieces(k.a)) {
-        const Ball ba = ta.piece_ball(pa);
+        const Bound ba = ta.piece_bound(pa);
         for (const std::int32_t pb : tb.pieces(k.b))
-          push({k.t, true, pa, pb}, ba, tb.piece_ball(pb));
+          push({k.t, true, pa, pb}, ba, tb.piece_bound(pb));
       }
-    } else if (leaf_b || (!leaf_a && na.radius >= nb.radius)) {
+    } else if (leaf_b || (!leaf_a && na.ball.radius >= nb.ball.radius)) {
       const auto [left, right] = ta.children(k.a);
       for (const std::int32_t child : {left, right})
-        push({k.t, false, child, k.b}, ta.node_ball(child), nb);
+        push({k.t, false, child, k.b}, ta.node_bound(child), nb);
     } else {
       const auto [left, right] = tb.children(k.b);
       for (const std::int32_t child : {left, right})
-        push({k.t, false, k.a, child}, na, tb.node_ball(child));
+        push({k.t, false, k.a, child}, na, tb.node_bound(child));
     }
   }
 
