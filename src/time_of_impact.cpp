@@ -1066,18 +1066,113 @@ class PieceTree {
     return is_identity(pose) ? nullptr : &pose;
   }
 
- private:
+  bool is_mesh() const { return mesh_ != nullptr; }
+  // The lowest value of n.y over the piece's points y at the body's pose
+  // (n unit, world frame): the triangle's lowest corner, or the hull's
+  // support vertex along -n by hill climbing (from the last one found:
+  // the same piece meets many triangles).
+  double lowest(std::int32_t p, const Pose& pose, const Vec3& n) {
+    if (mesh_ != nullptr) {
+      double low = std::numeric_limits<double>::infinity();
+      for (const Vec3& x : triangle_corners(p)) low = std::min(low, n.dot(pose.apply(x)));
+      return low;
+    }
+    const CompoundPiece& piece = compound_->piece(p);
+    const Pose placed = pose * piece.pose;
+    hint_ = support_hill_climb(*piece.polytope, -(placed.rotation.transpose() * n), hint_);
+    return n.dot(placed.apply(piece.polytope->vertex(hint_)));
+  }
+  // A bound on the distance of the piece's points from the body's
+  // reference point (its frame's origin).
+  double reach(std::int32_t p) const {
+    if (mesh_ != nullptr) {
+      double r = 0.0;
+      for (const Vec3& x : triangle_corners(p)) r = std::max(r, x.stableNorm());
+      return r * (1.0 + 1e-12);
+    }
+    const auto& sphere = compound_->piece_sphere(p);
+    return sphere.center.stableNorm() + sphere.radius;
+  }
   std::array<Vec3, 3> triangle_corners(std::int32_t p) const {
     const TriangleMesh::Triangle& t = mesh_->triangle(p);
     return {mesh_->vertex(static_cast<int>(t[0])), mesh_->vertex(static_cast<int>(t[1])),
             mesh_->vertex(static_cast<int>(t[2]))};
   }
 
+ private:
   std::shared_ptr<const CompoundBody> compound_;  // null for a mesh
+  int hint_ = 0;                                  // lowest()'s last support vertex
   const TriangleMesh* mesh_ = nullptr;
   // The triangles' hulls built so far (a map: references stay valid).
   std::unordered_map<std::int32_t, ConvexPolytope> triangles_;
 };
+
+// Plane steps at most per triangle pair before its hull is built.
+constexpr int kMaxPlaneSteps = 4;
+
+// The first time from t that a mesh's triangle (piece `ps` of tree `s`,
+// moving by `ms`) and a piece of the other body (`po` of `o`, moving by
+// `mo`) can come within `target`, or infinity when not before t_end, by
+// conservative advancement on the planes of the triangle's normal n (the
+// side towards the other piece's ball): the triangle's highest corner and
+// the other piece's lowest point along n bound the distance from below by
+// their gap, and along a fixed n a point r from its body's reference point
+// moves at most at v.n + |w x n| |r| (as the hulls' planes of
+// advance_hulls). Where the triangle faces the other piece (a body landing
+// on a floor) this settles most pairs before their triangle's hull is
+// built, which costs more than their advancement (exact predicates on
+// three coplanar points). Stops at the first step that does not, or after
+// kMaxPlaneSteps: the time reached is still a lower bound.
+double triangle_plane_advance(PieceTree& s, std::int32_t ps, const Sweep& ms, PieceTree& o,
+                              std::int32_t po, const Sweep& mo, const Vec3& other_center,
+                              double target, double t, double t_end) {
+  const auto corners = s.triangle_corners(ps);
+  const Vec3 normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+  const double length = normal.stableNorm();
+  if (!(length > 0.0)) return t;  // a degenerate triangle: its hull decides
+  const Vec3 unit = normal / length;
+  const double reach_s = s.reach(ps), reach_o = o.reach(po);
+  const Vec3 vs = ms.linear_velocity(), vo = mo.linear_velocity();
+  const Vec3 ws = ms.angular_velocity(), wo = mo.angular_velocity();
+  const double never = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < kMaxPlaneSteps; ++step) {
+    const Pose pose_s = ms.at(t), pose_o = mo.at(t);
+    const std::array<Vec3, 3> placed = {pose_s.apply(corners[0]), pose_s.apply(corners[1]),
+                                        pose_s.apply(corners[2])};
+    const Vec3 center = pose_o.apply(other_center);
+    // Off the rounding of the placed coordinates.
+    const double band = contact_band(std::max(pose_s.translation.cwiseAbs().maxCoeff() + reach_s,
+                                              pose_o.translation.cwiseAbs().maxCoeff() + reach_o));
+    // Two normals: the triangle's, and the one from its closest point to
+    // the other piece's ball center (where the triangle's plane cuts the
+    // other piece beside the triangle); the longer step of the two.
+    std::array<Vec3, 2> normals = {pose_s.rotation * unit, Vec3::Zero()};
+    if (normals[0].dot(center - placed[0]) < 0.0) normals[0] = -normals[0];
+    const Vec3 foot = closest_point_triangle(center, placed[0], placed[1], placed[2],
+                                             kernel_tolerance(band / kUnitRoundoff))
+                          .point_b;
+    const double apart = fast_norm(center - foot);
+    const int count = apart > 0.0 ? 2 : 1;
+    if (count == 2) normals[1] = (center - foot) / apart;
+    double longest = 0.0;
+    for (int k = 0; k < count; ++k) {
+      const Vec3& n = normals[static_cast<std::size_t>(k)];
+      double top = -std::numeric_limits<double>::infinity();
+      for (const Vec3& x : placed) top = std::max(top, n.dot(x));
+      const double gap = o.lowest(po, pose_o, n) - top - target - band;
+      if (!(gap > 0.0)) continue;
+      const double rate =
+          (vs - vo).dot(n) + fast_norm(ws.cross(n)) * reach_s + fast_norm(wo.cross(n)) * reach_o;
+      if (!(rate > 0.0)) return never;
+      longest = std::max(longest, gap / rate);
+    }
+    const double next = t + longest;
+    if (!(next < t_end)) return never;
+    if (!(next > t)) return t;
+    t = next;
+  }
+  return t;
+}
 
 // Time of impact of two Bodies made of convex pieces (PieceTree: compounds,
 // a convex body as its one piece, meshes' triangles): the earliest over
@@ -1130,10 +1225,20 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
     queue.pop();
     if (!may_beat(k.t)) break;  // every later candidate starts later still
     if (k.pieces) {
+      // A mesh's triangle: its planes first (triangle_plane_advance).
+      double from = k.t;
+      if (ta.is_mesh()) {
+        from = triangle_plane_advance(ta, k.a, ma, tb, k.b, mb, tb.piece_bound(k.b).ball.center,
+                                      target, from, best.t);
+      } else if (tb.is_mesh()) {
+        from = triangle_plane_advance(tb, k.b, mb, ta, k.a, ma, ta.piece_bound(k.a).ball.center,
+                                      target, from, best.t);
+      }
+      if (!may_beat(from)) continue;
       const MovingHull ha(ta.hull(k.a), ma, ta.local(k.a));
       const MovingHull hb(tb.hull(k.b), mb, tb.local(k.b));
       DistanceCache pair_cache;
-      ImpactResult r = advance_hulls(ha, hb, pair_options, tolerance, pair_cache, k.t, best.t);
+      ImpactResult r = advance_hulls(ha, hb, pair_options, tolerance, pair_cache, from, best.t);
       iterations += r.iterations;
       ++pairs;
       if (r.status != ImpactStatus::separated &&
