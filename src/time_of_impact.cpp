@@ -13,6 +13,7 @@
 #include <queue>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -93,7 +94,9 @@ constexpr std::size_t kMaxFeatureVertices = 16;
 
 // |x| from its square where that neither overflows nor underflows (the
 // common case, one sqrt), else the stable norm.
-double fast_norm(const Vec3& x) {
+// Inlined: with the mesh traversal in this file GCC stopped inlining it,
+// a call for three multiplies and a root on every bound (callgrind).
+[[gnu::always_inline]] inline double fast_norm(const Vec3& x) {
   const double squared = x.squaredNorm();
   if (squared >= std::numeric_limits<double>::min() && squared < 0x1p1000)
     return std::sqrt(squared);
@@ -878,8 +881,9 @@ class PosesAt {
 // |w_b|). The hulls inside the balls are no closer before that time.
 // Stops early once the balls are close (kBallCloseEnough): the time
 // returned is then where they are, still a lower bound.
-double earliest_ball_contact(PosesAt& poses, const Vec3& speeds, const Ball& ba, const Ball& bb,
-                             double target, double t, double t_end) {
+[[gnu::always_inline]] inline double earliest_ball_contact(PosesAt& poses, const Vec3& speeds,
+                                                           const Ball& ba, const Ball& bb,
+                                                           double target, double t, double t_end) {
   const double speed =
       speeds[0] + speeds[1] * fast_norm(ba.center) + speeds[2] * fast_norm(bb.center);
   const double radii = ba.radius + bb.radius;
@@ -908,9 +912,12 @@ double earliest_ball_contact(PosesAt& poses, const Vec3& speeds, const Ball& ba,
 // boxes around them).
 struct Bound {
   enum class Shape : std::uint8_t { ball, box, triangle };
+  explicit Bound(const Ball& b) : ball(b) {}
+  Bound(const Ball& b, Shape s, const std::array<Vec3, 3>& c) : ball(b), shape(s), corners(c) {}
+
   Ball ball;
   Shape shape = Shape::ball;
-  std::array<Vec3, 3> corners{};  // box: lo, hi; triangle: its corners
+  std::array<Vec3, 3> corners;  // box: lo, hi; triangle: its corners (unset for a ball)
 
   // The distance from q (body frame) to the box or the triangle, and the
   // largest coordinate magnitude of q and of the shape (for the rounding).
@@ -987,97 +994,51 @@ bool is_identity(const Pose& p) {
 }
 
 // One side of the branch and bound over piece pairs: a Body's convex
-// pieces under its hierarchy, each node and piece bounded by a ball in the
-// body's frame. A compound's pieces (a convex body as its one piece) under
-// its sphere tree; or a mesh's triangles under its box tree, each triangle
-// the flat hull of its three corners (a segment or a point where it is
-// degenerate), built when its pair is first advanced: a mesh's surface
-// first comes within the target where one of its triangles does.
-class PieceTree {
+// pieces under its hierarchy, each node and piece bounded in the body's
+// frame. Two kinds, each its own class so that the branch and bound is
+// compiled for each pair of kinds (a compound pair pays for no mesh test):
+// a compound's pieces (a convex body as its one piece) under its sphere
+// tree, bounded by balls (CompoundTree); a mesh's triangles under its box
+// tree (MeshTree), each triangle the flat hull of its three corners (a
+// segment or a point where it is degenerate), built when its pair is first
+// advanced: a mesh's surface first comes within the target where one of
+// its triangles does.
+class CompoundTree {
  public:
-  explicit PieceTree(const Body& body) {
-    if (body.kind() == Body::Kind::mesh) {
-      mesh_ = body.mesh().get();
-    } else {
-      compound_ = body.compound();
-    }
-  }
+  static constexpr bool kMesh = false;
+  explicit CompoundTree(const Body& body) : owner_(body.compound()), c_(owner_.get()) {}
 
-  Bound node_bound(std::int32_t n) const {
-    if (mesh_ == nullptr) {
-      const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
-      return {{node.center, node.radius}};
-    }
-    // The box, and its ball: its center and half diagonal (the rounding of
-    // both, a few u of the coordinates, is inside the contact band that
-    // earliest_contact keeps off).
-    Vec3 lo, hi;
-    mesh_->box(n, lo, hi);
-    return {{0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()}, Bound::Shape::box, {lo, hi, hi}};
+  Ball node_bound(std::int32_t n) const {
+    const CompoundBody::Node& node = c_->nodes()[static_cast<std::size_t>(n)];
+    return {node.center, node.radius};
   }
-  bool is_leaf(std::int32_t n) const {
-    return mesh_ == nullptr ? compound_->nodes()[static_cast<std::size_t>(n)].left < 0
-                            : mesh_->nodes()[static_cast<std::size_t>(n)].is_leaf();
-  }
+  bool is_leaf(std::int32_t n) const { return c_->nodes()[static_cast<std::size_t>(n)].left < 0; }
   std::pair<std::int32_t, std::int32_t> children(std::int32_t n) const {
-    if (mesh_ == nullptr) {
-      const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
-      return {node.left, node.right};
-    }
-    return {n + 1, mesh_->nodes()[static_cast<std::size_t>(n)].first_or_right};
+    const CompoundBody::Node& node = c_->nodes()[static_cast<std::size_t>(n)];
+    return {node.left, node.right};
   }
   // A leaf's pieces: the ids order[first .. first + count).
   std::span<const std::int32_t> pieces(std::int32_t n) const {
-    if (mesh_ == nullptr) {
-      const CompoundBody::Node& node = compound_->nodes()[static_cast<std::size_t>(n)];
-      return compound_->piece_order().subspan(static_cast<std::size_t>(node.first),
-                                              static_cast<std::size_t>(node.count));
-    }
-    const TriangleMesh::Node& node = mesh_->nodes()[static_cast<std::size_t>(n)];
-    return mesh_->triangle_order().subspan(static_cast<std::size_t>(node.first_or_right),
-                                           static_cast<std::size_t>(node.count));
+    const CompoundBody::Node& node = c_->nodes()[static_cast<std::size_t>(n)];
+    return c_->piece_order().subspan(static_cast<std::size_t>(node.first),
+                                     static_cast<std::size_t>(node.count));
   }
-  Bound piece_bound(std::int32_t p) const {
-    if (mesh_ == nullptr) {
-      const auto& sphere = compound_->piece_sphere(p);
-      return {{sphere.center, sphere.radius}};
-    }
-    // The triangle, and its ball about its centroid (the radius a hair
-    // out, for its rounding: the speed bound needs every corner inside).
-    const auto corners = triangle_corners(p);
-    const Vec3 center = (corners[0] + corners[1] + corners[2]) / 3.0;
-    double radius = 0.0;
-    for (const Vec3& x : corners) radius = std::max(radius, (x - center).stableNorm());
-    return {{center, radius * (1.0 + 1e-12)}, Bound::Shape::triangle, corners};
+  Ball piece_bound(std::int32_t p) const {
+    const auto& sphere = c_->piece_sphere(p);
+    return {sphere.center, sphere.radius};
   }
   // The piece's hull and its pose in the body (null: the body's frame).
-  const ConvexPolytope& hull(std::int32_t p) {
-    if (mesh_ == nullptr) return *compound_->piece(p).polytope;
-    auto it = triangles_.find(p);
-    if (it == triangles_.end()) {
-      const auto corners = triangle_corners(p);
-      it = triangles_.emplace(p, ConvexPolytope(std::span<const Vec3>(corners))).first;
-    }
-    return it->second;
-  }
+  const ConvexPolytope& hull(std::int32_t p) { return *c_->piece(p).polytope; }
   const Pose* local(std::int32_t p) const {
-    if (mesh_ != nullptr) return nullptr;
-    const Pose& pose = compound_->piece(p).pose;
+    const Pose& pose = c_->piece(p).pose;
     return is_identity(pose) ? nullptr : &pose;
   }
-
-  bool is_mesh() const { return mesh_ != nullptr; }
   // The lowest value of n.y over the piece's points y at the body's pose
-  // (n unit, world frame): the triangle's lowest corner, or the hull's
-  // support vertex along -n by hill climbing (from the last one found:
-  // the same piece meets many triangles).
+  // (n unit, world frame): the hull's support vertex along -n by hill
+  // climbing (from the last one found: the same piece meets many
+  // triangles).
   double lowest(std::int32_t p, const Pose& pose, const Vec3& n) {
-    if (mesh_ != nullptr) {
-      double low = std::numeric_limits<double>::infinity();
-      for (const Vec3& x : triangle_corners(p)) low = std::min(low, n.dot(pose.apply(x)));
-      return low;
-    }
-    const CompoundPiece& piece = compound_->piece(p);
+    const CompoundPiece& piece = c_->piece(p);
     const Pose placed = pose * piece.pose;
     hint_ = support_hill_climb(*piece.polytope, -(placed.rotation.transpose() * n), hint_);
     return n.dot(placed.apply(piece.polytope->vertex(hint_)));
@@ -1085,13 +1046,67 @@ class PieceTree {
   // A bound on the distance of the piece's points from the body's
   // reference point (its frame's origin).
   double reach(std::int32_t p) const {
-    if (mesh_ != nullptr) {
-      double r = 0.0;
-      for (const Vec3& x : triangle_corners(p)) r = std::max(r, x.stableNorm());
-      return r * (1.0 + 1e-12);
-    }
-    const auto& sphere = compound_->piece_sphere(p);
+    const auto& sphere = c_->piece_sphere(p);
     return sphere.center.stableNorm() + sphere.radius;
+  }
+
+ private:
+  std::shared_ptr<const CompoundBody> owner_;
+  const CompoundBody* c_;
+  int hint_ = 0;  // lowest()'s last support vertex
+};
+
+class MeshTree {
+ public:
+  static constexpr bool kMesh = true;
+  explicit MeshTree(const Body& body) : mesh_(body.mesh().get()) {}
+
+  Bound node_bound(std::int32_t n) const {
+    // The box, and its ball: its center and half diagonal (the rounding of
+    // both, a few u of the coordinates, is inside the contact band that
+    // earliest_contact keeps off).
+    Vec3 lo, hi;
+    mesh_->box(n, lo, hi);
+    return {Ball{0.5 * (lo + hi), 0.5 * (hi - lo).stableNorm()}, Bound::Shape::box, {lo, hi, hi}};
+  }
+  bool is_leaf(std::int32_t n) const {
+    return mesh_->nodes()[static_cast<std::size_t>(n)].is_leaf();
+  }
+  std::pair<std::int32_t, std::int32_t> children(std::int32_t n) const {
+    return {n + 1, mesh_->nodes()[static_cast<std::size_t>(n)].first_or_right};
+  }
+  std::span<const std::int32_t> pieces(std::int32_t n) const {
+    const TriangleMesh::Node& node = mesh_->nodes()[static_cast<std::size_t>(n)];
+    return mesh_->triangle_order().subspan(static_cast<std::size_t>(node.first_or_right),
+                                           static_cast<std::size_t>(node.count));
+  }
+  Bound piece_bound(std::int32_t p) const {
+    // The triangle, and its ball about its centroid (the radius a hair
+    // out, for its rounding: the speed bound needs every corner inside).
+    const auto corners = triangle_corners(p);
+    const Vec3 center = (corners[0] + corners[1] + corners[2]) / 3.0;
+    double radius = 0.0;
+    for (const Vec3& x : corners) radius = std::max(radius, (x - center).stableNorm());
+    return {Ball{center, radius * (1.0 + 1e-12)}, Bound::Shape::triangle, corners};
+  }
+  const ConvexPolytope& hull(std::int32_t p) {
+    auto it = triangles_.find(p);
+    if (it == triangles_.end()) {
+      const auto corners = triangle_corners(p);
+      it = triangles_.emplace(p, ConvexPolytope(std::span<const Vec3>(corners))).first;
+    }
+    return it->second;
+  }
+  const Pose* local(std::int32_t) const { return nullptr; }
+  double lowest(std::int32_t p, const Pose& pose, const Vec3& n) const {
+    double low = std::numeric_limits<double>::infinity();
+    for (const Vec3& x : triangle_corners(p)) low = std::min(low, n.dot(pose.apply(x)));
+    return low;
+  }
+  double reach(std::int32_t p) const {
+    double r = 0.0;
+    for (const Vec3& x : triangle_corners(p)) r = std::max(r, x.stableNorm());
+    return r * (1.0 + 1e-12);
   }
   std::array<Vec3, 3> triangle_corners(std::int32_t p) const {
     const TriangleMesh::Triangle& t = mesh_->triangle(p);
@@ -1100,12 +1115,33 @@ class PieceTree {
   }
 
  private:
-  std::shared_ptr<const CompoundBody> compound_;  // null for a mesh
-  int hint_ = 0;                                  // lowest()'s last support vertex
-  const TriangleMesh* mesh_ = nullptr;
+  const TriangleMesh* mesh_;
   // The triangles' hulls built so far (a map: references stay valid).
   std::unordered_map<std::int32_t, ConvexPolytope> triangles_;
 };
+
+const Ball& ball_of(const Ball& b) { return b; }
+const Ball& ball_of(const Bound& b) { return b.ball; }
+
+// earliest_contact for the bounds of either tree: two balls as
+// earliest_ball_contact, else with the box or the triangle.
+[[gnu::always_inline]] inline double earliest_of(PosesAt& poses, const Vec3& speeds, const Ball& ba,
+                                                 const Ball& bb, double target, double t,
+                                                 double t_end) {
+  return earliest_ball_contact(poses, speeds, ba, bb, target, t, t_end);
+}
+template <class BA, class BB>
+double earliest_of(PosesAt& poses, const Vec3& speeds, const BA& ba, const BB& bb, double target,
+                   double t, double t_end) {
+  const auto bound = [](const auto& x) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(x)>, Ball>) {
+      return Bound(x);
+    } else {
+      return x;
+    }
+  };
+  return earliest_contact(poses, speeds, bound(ba), bound(bb), target, t, t_end);
+}
 
 // Plane steps at most per triangle pair before its hull is built.
 constexpr int kMaxPlaneSteps = 4;
@@ -1123,7 +1159,8 @@ constexpr int kMaxPlaneSteps = 4;
 // built, which costs more than their advancement (exact predicates on
 // three coplanar points). Stops at the first step that does not, or after
 // kMaxPlaneSteps: the time reached is still a lower bound.
-double triangle_plane_advance(PieceTree& s, std::int32_t ps, const Sweep& ms, PieceTree& o,
+template <class Other>
+double triangle_plane_advance(const MeshTree& s, std::int32_t ps, const Sweep& ms, Other& o,
                               std::int32_t po, const Sweep& mo, const Vec3& other_center,
                               double target, double t, double t_end) {
   const auto corners = s.triangle_corners(ps);
@@ -1185,10 +1222,11 @@ double triangle_plane_advance(PieceTree& s, std::int32_t ps, const Sweep& ms, Pi
 // everything from the best time on is pruned. Each rule keeps the
 // guarantee: a pruned pair cannot come within the target before the
 // reported t, and every pair advanced is advanced safely.
+template <class TreeA, class TreeB>
 ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b, const Sweep& mb,
                                    const ImpactOptions& options, double tolerance, BodyCache& c) {
-  PieceTree ta(a);
-  PieceTree tb(b);
+  TreeA ta(a);
+  TreeB tb(b);
   ImpactOptions pair_options = options;
   pair_options.target_separation += a.radius() + b.radius();
   pair_options.tolerance = tolerance;
@@ -1215,8 +1253,8 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
   // |v_b - v_a|, |w_a|, |w_b|: the balls' speeds.
   const Vec3 speeds((mb.linear_velocity() - ma.linear_velocity()).stableNorm(),
                     ma.angular_velocity().norm(), mb.angular_velocity().norm());
-  const auto push = [&](Candidate k, const Bound& ba, const Bound& bb) {
-    k.t = earliest_contact(poses, speeds, ba, bb, target, k.t, best.t);
+  const auto push = [&](Candidate k, const auto& ba, const auto& bb) {
+    k.t = earliest_of(poses, speeds, ba, bb, target, k.t, best.t);
     if (may_beat(k.t)) queue.push(k);
   };
   push({0.0, false, 0, 0}, ta.node_bound(0), tb.node_bound(0));
@@ -1227,11 +1265,11 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
     if (k.pieces) {
       // A mesh's triangle: its planes first (triangle_plane_advance).
       double from = k.t;
-      if (ta.is_mesh()) {
-        from = triangle_plane_advance(ta, k.a, ma, tb, k.b, mb, tb.piece_bound(k.b).ball.center,
+      if constexpr (TreeA::kMesh) {
+        from = triangle_plane_advance(ta, k.a, ma, tb, k.b, mb, ball_of(tb.piece_bound(k.b)).center,
                                       target, from, best.t);
-      } else if (tb.is_mesh()) {
-        from = triangle_plane_advance(tb, k.b, mb, ta, k.a, ma, ta.piece_bound(k.a).ball.center,
+      } else if constexpr (TreeB::kMesh) {
+        from = triangle_plane_advance(tb, k.b, mb, ta, k.a, ma, ball_of(ta.piece_bound(k.a)).center,
                                       target, from, best.t);
       }
       if (!may_beat(from)) continue;
@@ -1251,16 +1289,16 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
       }
       continue;
     }
-    const Bound na = ta.node_bound(k.a);
-    const Bound nb = tb.node_bound(k.b);
+    const auto na = ta.node_bound(k.a);
+    const auto nb = tb.node_bound(k.b);
     const bool leaf_a = ta.is_leaf(k.a), leaf_b = tb.is_leaf(k.b);
     if (leaf_a && leaf_b) {
       for (const std::int32_t pa : ta.pieces(k.a)) {
-        const Bound ba = ta.piece_bound(pa);
+        const auto ba = ta.piece_bound(pa);
         for (const std::int32_t pb : tb.pieces(k.b))
           push({k.t, true, pa, pb}, ba, tb.piece_bound(pb));
       }
-    } else if (leaf_b || (!leaf_a && na.ball.radius >= nb.ball.radius)) {
+    } else if (leaf_b || (!leaf_a && ball_of(na).radius >= ball_of(nb).radius)) {
       const auto [left, right] = ta.children(k.a);
       for (const std::int32_t child : {left, right})
         push({k.t, false, child, k.b}, ta.node_bound(child), nb);
@@ -1276,8 +1314,7 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
   // the pair that met seeds the query's cache (tried first, with its
   // features at that time): its distance is the first bound of the query's
   // branch and bound.
-  const bool meshes = a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh;
-  if (met && !meshes) {
+  if (met && !TreeA::kMesh && !TreeB::kMesh) {
     c.compound.piece_a = best_pair.piece_a;
     c.compound.piece_b = best_pair.piece_b;
     const auto less = [](const CompoundCache::Entry& x, const CompoundCache::Entry& y) {
@@ -1383,7 +1420,14 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
       return out;
     }
   }
-  return pieces_time_of_impact(a, ma, b, mb, options, tolerance, c);
+  const bool mesh_a = a.kind() == Body::Kind::mesh, mesh_b = b.kind() == Body::Kind::mesh;
+  if (mesh_a && mesh_b)
+    return pieces_time_of_impact<MeshTree, MeshTree>(a, ma, b, mb, options, tolerance, c);
+  if (mesh_a)
+    return pieces_time_of_impact<MeshTree, CompoundTree>(a, ma, b, mb, options, tolerance, c);
+  if (mesh_b)
+    return pieces_time_of_impact<CompoundTree, MeshTree>(a, ma, b, mb, options, tolerance, c);
+  return pieces_time_of_impact<CompoundTree, CompoundTree>(a, ma, b, mb, options, tolerance, c);
 }
 
 }  // namespace proxima
