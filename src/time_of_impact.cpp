@@ -1211,15 +1211,16 @@ double triangle_plane_advance(const MeshTree& s, std::int32_t ps, const Sweep& m
   return t;
 }
 
-// Time of impact of two Bodies made of convex pieces (PieceTree: compounds,
-// a convex body as its one piece, meshes' triangles): the earliest over
-// piece pairs of their convex advancement, by branch and bound over the two
-// hierarchies. Candidates (node or piece pairs) are taken in order of the
-// earliest time their moving balls allow a contact
-// (earliest_ball_contact); a node pair is split into its children's pairs,
-// a piece pair is advanced (convex, from that earliest time on, and only
-// up to the best time found, since a later contact changes nothing);
-// everything from the best time on is pruned. Each rule keeps the
+// Time of impact of two Bodies made of convex pieces (CompoundTree,
+// MeshTree: compounds, a convex body as its one piece, meshes' triangles):
+// the earliest over piece pairs of their convex advancement, by branch and
+// bound over the two hierarchies. Candidates (node or piece pairs) are
+// taken in order of the earliest time their moving bounds allow a contact
+// (earliest_of); a node pair is split into its children's pairs, a piece
+// pair is first advanced on its triangle's planes where one side is a mesh
+// (triangle_plane_advance), then advanced as two hulls (from the time
+// reached on, and only up to the best time found, since a later contact
+// changes nothing); everything from the best time on is pruned. Each rule keeps the
 // guarantee: a pruned pair cannot come within the target before the
 // reported t, and every pair advanced is advanced safely.
 template <class TreeA, class TreeB>

@@ -925,7 +925,7 @@ double first_contact_of_bodies(const Body& a, const Motion& ma, const Body& b, c
 }
 
 // Issue 13 for meshes: the branch and bound over the mesh's triangles (each
-// a flat convex piece, src/time_of_impact.cpp PieceTree) against its slow
+// a flat convex piece, src/time_of_impact.cpp MeshTree) against its slow
 // twin, every triangle advanced on its own against the convex body (the
 // convex call per triangle, the earliest kept), and against the oracle
 // (dense sampling and bisection of the Bodies' exact distance): never
