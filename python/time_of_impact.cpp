@@ -81,7 +81,7 @@ void bind_time_of_impact(py::module_& m) {
       .def_readonly("iterations", &ImpactResult::iterations, "Distance queries made.")
       .def_readonly("piece_a", &ImpactResult::piece_a,
                     "Compound bodies: A's piece of the pair that met (at_t's features are its "
-                    "hull's); -1 for a convex body or a mesh.")
+                    "hull's); a mesh: its triangle; -1 for a convex body.")
       .def_readonly("piece_b", &ImpactResult::piece_b, "B's piece of the pair that met, as piece_a.")
       .def_readonly("pairs_advanced", &ImpactResult::pairs_advanced,
                     "Piece pairs whose advancement ran; the others were pruned by their moving "

@@ -123,10 +123,11 @@ struct ImpactResult {
   // The distance query at t: closest points, normal, features, certificate.
   DistanceResult at_t;
   int iterations = 0;  // advancement steps (distance queries)
-  // Bodies with compounds: the pieces of at_t's closest pair (its features
-  // are theirs), -1 for a convex body or a mesh; and the piece pairs whose
-  // convex advancement ran (the others were pruned by their bounding
-  // balls).
+  // Bodies with compounds or meshes: the pieces of at_t's closest pair, a
+  // compound's piece index or a mesh's triangle index (at_t's features are
+  // theirs: BodyDistance's piece_a / triangle_a), -1 for a convex body; and
+  // the piece pairs (a mesh's pieces being its triangles) whose convex
+  // advancement ran (the others were pruned by their bounding balls).
   std::int32_t piece_a = -1;
   std::int32_t piece_b = -1;
   int pairs_advanced = 0;
@@ -149,9 +150,14 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
 // radius adds to the target separation (the cores' distance must stay
 // above the target plus both radii), and at_t describes the rounded bodies
 // (BodyDistance's conventions, sliced to a DistanceResult: points on the
-// rounded surfaces). A compound on either side advances by its certified
-// lower bound over the fastest point speed only (no support gap along the
-// normal: more steps than a convex pair). `cache` may be null.
+// rounded surfaces). Compounds and meshes: the earliest over pairs of
+// convex pieces (a compound's pieces, a convex body as its one piece, each
+// triangle of a mesh as the flat hull of its corners) of their convex
+// advancement, by branch and bound over the two hierarchies: pairs are
+// taken in order of the earliest time their moving bounding balls can meet
+// and pruned from the best time found on, so that only the pieces that can
+// be hit first are advanced (pairs_advanced). A body that starts inside a
+// closed mesh is overlapping at t = 0. `cache` may be null.
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
                             const Motion& motion_b, const ImpactOptions& options = {},
                             BodyCache* cache = nullptr);
