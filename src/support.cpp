@@ -22,4 +22,21 @@ int support_brute_force(std::span<const Vec3> vertices, const Vec3& dir) {
   return best;
 }
 
+int support_without_hint(const ConvexPolytope& polytope, const Vec3& dir) {
+  const int n = polytope.vertex_count();
+  if (n <= kScanVertices) return support_brute_force(polytope.vertices(), dir);
+  const Vec3* vertices = polytope.vertices().data();
+  const int stride = n / kSupportSeeds;  // >= 1
+  int seed = 0;
+  double seed_dot = dir.dot(vertices[0]);
+  for (int i = stride; i < n; i += stride) {
+    const double d = dir.dot(vertices[i]);
+    if (d > seed_dot) {
+      seed_dot = d;
+      seed = i;
+    }
+  }
+  return support_hill_climb(polytope, dir, seed);
+}
+
 }  // namespace proxima

@@ -19,7 +19,6 @@
 // kPlateauSlack = 32 leaves a margin of two. The test records how often the
 // slack was needed (most plateau queries: rounding noise makes many local
 // maxima).
-#include "proxima/polytope.h"
 #include "proxima/support.h"
 
 #include <gtest/gtest.h>
@@ -31,6 +30,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "proxima/polytope.h"
 
 namespace proxima {
 namespace {
@@ -116,8 +117,8 @@ void compare(const ConvexPolytope& p, const Vec3& dir, int hint, bool must_be_ex
     ++tally.exact;
     return;
   }
-  ASSERT_FALSE(must_be_exact) << "hill climbing value " << got << " != brute force " << best << " (dir "
-                              << dir.transpose() << ", hint " << hint << ")";
+  ASSERT_FALSE(must_be_exact) << "hill climbing value " << got << " != brute force " << best
+                              << " (dir " << dir.transpose() << ", hint " << hint << ")";
   const double slack = kPlateauSlack * kUnitRoundoff * dir.lpNorm<1>() * p.scale();
   ASSERT_LE(best - got, slack) << "dir " << dir.transpose() << ", hint " << hint;
   ++tally.within_slack;
@@ -155,7 +156,8 @@ void compare_face_normals(const ConvexPolytope& p, bool integer_data, Tally& tal
     }
     const bool all_hints = p.vertex_count() <= 200;
     for (int h = 0; h < (all_hints ? p.vertex_count() : 20); ++h) {
-      const int hint = all_hints ? h : static_cast<int>((static_cast<long>(h) * 7919) % p.vertex_count());
+      const int hint =
+          all_hints ? h : static_cast<int>((static_cast<long>(h) * 7919) % p.vertex_count());
       compare(p, dir, hint, true, tally);
     }
   }
@@ -197,8 +199,60 @@ TEST(Support, OutOfRangeHintIsVertexZero) {
   const ConvexPolytope p(sphere_points(rng, 100));
   const Vec3 dir(0.3, -0.2, 0.9);
   const int expected = support_hill_climb(p, dir, 0);
-  for (const int hint : {-1, -100, 100, 101, INT_MAX, INT_MIN}) EXPECT_EQ(support_hill_climb(p, dir, hint), expected);
+  for (const int hint : {-1, -100, 100, 101, INT_MAX, INT_MIN})
+    EXPECT_EQ(support_hill_climb(p, dir, hint), expected);
   EXPECT_EQ(dir.dot(p.vertex(expected)), dir.dot(p.vertex(support_brute_force(p.vertices(), dir))));
+}
+
+// support_without_hint (a cold start's search): the brute-force scan itself
+// up to kScanVertices vertices, the same index; beyond, a climb from the
+// best of evenly spaced seeds, a maximizer like the scan's. Sizes around
+// the scan limit and around multiples of the seed count (the stride
+// n / kSupportSeeds, the last seed next to the end), plateaus of boxes with
+// face grids (integer coordinates: exact dot products), polygons, a
+// segment and a point.
+TEST(Support, WithoutHintIsTheScanOnSmallBodiesAndAMaximizerOnLarge) {
+  Rng rng(107);
+  std::vector<ConvexPolytope> bodies;
+  for (const int n : {4, 5, 8, kScanVertices - 1, kScanVertices, kScanVertices + 1, 31, 32, 33,
+                      2 * kSupportSeeds - 1, 100, 1000, 4097}) {
+    bodies.emplace_back(sphere_points(rng, n));
+  }
+  bodies.emplace_back(box_with_face_grids(Vec3(2, 1, 3), 4));
+  bodies.emplace_back(annulus_prism(6, 1.0));
+  Points hexagon;
+  for (int k = 0; k < 6; ++k)
+    hexagon.emplace_back(std::cos(k * M_PI / 3), std::sin(k * M_PI / 3), 0.5);
+  bodies.emplace_back(hexagon);
+  bodies.emplace_back(Points{{0, 0, 0}, {1, 2, 3}});
+  bodies.emplace_back(Points{{1, 2, 3}});
+  long scanned = 0;
+  long climbed = 0;
+  for (const ConvexPolytope& p : bodies) {
+    SCOPED_TRACE("vertices " + std::to_string(p.vertex_count()));
+    std::vector<Vec3> dirs;
+    for (int i = 0; i < 300; ++i) dirs.push_back(random_direction(rng));
+    for (int f = 0; f < p.face_count(); ++f) dirs.push_back(p.face_plane(f).normal);
+    for (const Vec3& axis : {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}) {
+      dirs.push_back(axis);
+      dirs.push_back(-axis);
+    }
+    for (const Vec3& dir : dirs) {
+      const int brute = support_brute_force(p.vertices(), dir);
+      const int got = support_without_hint(p, dir);
+      ASSERT_GE(got, 0);
+      ASSERT_LT(got, p.vertex_count());
+      if (p.vertex_count() <= kScanVertices) {
+        ASSERT_EQ(got, brute) << dir.transpose();
+        ++scanned;
+      } else {
+        ASSERT_EQ(dir.dot(p.vertex(got)), dir.dot(p.vertex(brute))) << dir.transpose();
+        ++climbed;
+      }
+    }
+  }
+  EXPECT_GT(scanned, 1000);  // premise: both regimes ran
+  EXPECT_GT(climbed, 1000);
 }
 
 TEST(Support, RandomSpherePolytopes) {
@@ -221,7 +275,8 @@ TEST(Support, RandomCubeClouds) {
   for (const int n : {10, 100, 1000, 10000}) {
     SCOPED_TRACE("cube cloud n=" + std::to_string(n));
     Points pts;
-    for (int i = 0; i < n; ++i) pts.emplace_back(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    for (int i = 0; i < n; ++i)
+      pts.emplace_back(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
     const ConvexPolytope p(pts);
     compare_random_directions(p, rng, 2000, tally);
     compare_face_normals(p, false, tally);
@@ -237,7 +292,8 @@ TEST(Support, IntegerGridPolytopesExactPlateaus) {
   for (const int g : {1, 2, 4, 10}) {
     for (int rep = 0; rep < 3; ++rep) {
       Points pts;
-      for (int i = 0; i < 300; ++i) pts.emplace_back(uniform_int(rng, -g, g), uniform_int(rng, -g, g), uniform_int(rng, -g, g));
+      for (int i = 0; i < 300; ++i)
+        pts.emplace_back(uniform_int(rng, -g, g), uniform_int(rng, -g, g), uniform_int(rng, -g, g));
       const ConvexPolytope p(pts);
       ASSERT_EQ(p.dimension(), 3);
       compare_face_normals(p, true, tally);
@@ -256,7 +312,8 @@ TEST(Support, IntegerGridPolytopesExactPlateaus) {
 TEST(Support, BoxesWithFaceGrids) {
   Rng rng(104);
   Tally tally;
-  for (const Vec3& half : {Vec3(1, 1, 1), Vec3(4, 0.5, 0.125), Vec3(0x1p-40, 0x1p-38, 0x1p-41), Vec3(0x1p60, 1, 0x1p30)}) {
+  for (const Vec3& half : {Vec3(1, 1, 1), Vec3(4, 0.5, 0.125), Vec3(0x1p-40, 0x1p-38, 0x1p-41),
+                           Vec3(0x1p60, 1, 0x1p30)}) {
     const ConvexPolytope p(box_with_face_grids(half, 6));
     ASSERT_EQ(p.vertex_count(), 8);
     for (int axis = 0; axis < 3; ++axis) {
@@ -317,7 +374,8 @@ TEST(Support, TiltedPlateausAlongRoundedNormals) {
     for (int f = 0; f < p.face_count(); ++f) {
       if (p.face(f).size() < 40) continue;
       const auto c = p.face(f);
-      const Vec3 n = (p.vertex(c[1]) - p.vertex(c[0])).cross(p.vertex(c[2]) - p.vertex(c[0]));  // exact: integers
+      const Vec3 n = (p.vertex(c[1]) - p.vertex(c[0]))
+                         .cross(p.vertex(c[2]) - p.vertex(c[0]));  // exact: integers
       const Vec3 dir = n / n.norm();
       for (int hint = 0; hint < p.vertex_count(); ++hint) compare(p, dir, hint, false, tally);
     }
@@ -348,7 +406,9 @@ TEST(Support, PolygonsSegmentsAndPoints) {
       EXPECT_EQ(support_hill_climb(p, Vec3(0, 0, -1), hint), hint);  // all tie: stay
     }
     compare_random_directions(p, rng, 500, tally);
-    for (int i = 0; i < 200; ++i) compare(p, Vec3(uniform_int(rng, -3, 3), uniform_int(rng, -3, 3), 1), i % p.vertex_count(), true, tally);
+    for (int i = 0; i < 200; ++i)
+      compare(p, Vec3(uniform_int(rng, -3, 3), uniform_int(rng, -3, 3), 1), i % p.vertex_count(),
+              true, tally);
   }
   {
     // An exactly tilted polygon: integer combinations of integer vectors.
@@ -392,7 +452,8 @@ TEST(Support, WarmHintAlongRotatingDirection) {
   int hint = 0;
   for (int i = 0; i < 5000; ++i) {
     const double angle = 1e-3 * i;
-    const Vec3 dir(std::cos(angle), std::sin(angle) * std::cos(0.3 * angle), std::sin(angle) * std::sin(0.3 * angle));
+    const Vec3 dir(std::cos(angle), std::sin(angle) * std::cos(0.3 * angle),
+                   std::sin(angle) * std::sin(0.3 * angle));
     compare(p, dir, hint, true, tally);
     hint = support_hill_climb(p, dir, hint);
   }
