@@ -26,15 +26,12 @@ constexpr int kMaxWalkFaces = 32;
 
 constexpr std::size_t at(int i) { return static_cast<std::size_t>(i); }
 
-bool face_holds(const ConvexPolytope& poly, int f, std::int32_t v) {
-  const auto verts = poly.face(f);
-  return std::find(verts.begin(), verts.end(), v) != verts.end();
-}
-
+// Whether face f holds ids[first..m) (its vertex list looked up once).
 bool face_holds_all(const ConvexPolytope& poly, int f, const std::array<std::int32_t, 4>& ids,
-                    int m) {
-  for (int i = 0; i < m; ++i) {
-    if (!face_holds(poly, f, ids[at(i)])) return false;
+                    int m, int first = 0) {
+  const auto verts = poly.face(f);
+  for (int i = first; i < m; ++i) {
+    if (std::find(verts.begin(), verts.end(), ids[at(i)]) == verts.end()) return false;
   }
   return true;
 }
@@ -54,7 +51,8 @@ int face_containing(const ConvexPolytope& poly, const std::array<std::int32_t, 4
   double best_alignment = 0.0;
   for (auto k = at(offsets[v0]); k < at(offsets[v0 + 1]); ++k) {
     const int f = left[k];
-    if (f < 0 || !face_holds_all(poly, f, ids, m)) continue;
+    // f is left of an edge out of ids[0]: it holds ids[0].
+    if (f < 0 || !face_holds_all(poly, f, ids, m, 1)) continue;
     if (best < 0) {
       best = f;
       if (poly.dimension() == 3) break;
@@ -289,23 +287,33 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
     }
     return best;
   };
+  // nearest_drop of the set as it is (ids and order), once evaluated: rule
+  // 1's last evaluation is what the drops below would compute again (at
+  // four vertices, four triangle distances) until the set or its order
+  // changes. -1: not known.
+  int known_drop = -1;
   const auto drop = [&](int j) {
     --m;
     ids[at(j)] = ids[at(m)];
     rel[at(j)] = rel[at(m)];
+    known_drop = -1;
+  };
+  const auto drop_nearest = [&] {
+    double g = 0.0;
+    drop(known_drop >= 0 ? known_drop : nearest_drop(g));
   };
 
   // Rule 1.
   while (m > 1) {
     double g = 0.0;
     const int j = nearest_drop(g);
-    if (!(g <= band2)) break;
+    if (!(g <= band2)) {
+      known_drop = j;
+      break;
+    }
     drop(j);
   }
-  if (m == 4) {
-    double g = 0.0;
-    drop(nearest_drop(g));
-  }
+  if (m == 4) drop_nearest();
 
   // Rules 2 and 3.
   bool walked = false;
@@ -314,6 +322,7 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
       for (int i = j; i > 0 && ids[at(i - 1)] > ids[at(i)]; --i) {
         std::swap(ids[at(i - 1)], ids[at(i)]);
         std::swap(rel[at(i - 1)], rel[at(i)]);
+        known_drop = -1;  // the gaps depend on the order (rounding)
       }
     }
     Feature f;
@@ -350,8 +359,7 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
           return *held;
       }
     }
-    double g = 0.0;
-    drop(nearest_drop(g));
+    drop_nearest();
   }
 }
 
