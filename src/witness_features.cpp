@@ -41,11 +41,42 @@ bool face_holds_all(const ConvexPolytope& poly, int f, const std::array<std::int
 // none. In a solid two faces share at most an edge, so the face holding a
 // diagonal or three vertices is unique; a polygon has two, one per side:
 // the one facing `outward`.
+//
+// On a solid whose faces are all triangles (points in general position:
+// the common case) the search needs no face but at most two: two vertices
+// share a face only when adjacent, and a face holding ids[0], u and w is the
+// triangle left of ids[0] -> u (its third vertex w) or left of ids[0] -> w.
+// The answer is the general search's: the first of those two faces in
+// ids[0]'s adjacency order that holds them all, or none.
 int face_containing(const ConvexPolytope& poly, const std::array<std::int32_t, 4>& ids, int m,
                     const Vec3& outward) {
   const auto offsets = poly.adjacency_offsets();
   const auto left = poly.adjacency_faces();
   const auto v0 = at(ids[0]);
+  if (poly.dimension() == 3 && (m == 2 || m == 3) &&
+      poly.face_vertices().size() == 3 * at(poly.face_count())) {
+    const auto nbrs = poly.adjacency();
+    const auto position = [&](std::int32_t v) {  // of the edge ids[0] -> v; -1: not adjacent
+      for (auto k = at(offsets[v0]); k < at(offsets[v0 + 1]); ++k) {
+        if (nbrs[k] == v) return static_cast<std::ptrdiff_t>(k);
+      }
+      return std::ptrdiff_t{-1};
+    };
+    const std::ptrdiff_t k1 = position(ids[1]);
+    if (k1 < 0) return -1;
+    if (m == 2) {
+      // Adjacent: the two faces on the edge (the callers take the edge
+      // before they look for a face). The general search below.
+    } else {
+      const std::ptrdiff_t k2 = position(ids[2]);
+      if (k2 < 0) return -1;
+      for (const std::ptrdiff_t k : {std::min(k1, k2), std::max(k1, k2)}) {
+        const int f = left[static_cast<std::size_t>(k)];
+        if (f >= 0 && face_holds_all(poly, f, ids, m, 1)) return f;
+      }
+      return -1;
+    }
+  }
   int best = -1;
   bool best_aligned = false;  // best_alignment computed (only when another face competes)
   double best_alignment = 0.0;
