@@ -49,6 +49,8 @@ constexpr std::size_t kGrainSize = 32;
 // chunk's place in the output), in the order of a sequential loop.
 constexpr std::size_t kBoxChunk = 512;
 constexpr std::size_t kCloseChunk = 1024;
+// Candidate pairs per chunk of the merge that carries the caches over.
+constexpr std::size_t kCarryChunk = 1024;
 
 // Rounding slack of a world box, in units of u times the body's magnitude
 // bound |t|_inf + sqrt(3) scale: 64 for the contact band of the accuracy
@@ -177,6 +179,7 @@ struct Scene::Impl {
   std::vector<ClosePair> results;          // parallel to pairs
   std::vector<std::size_t> chunk_close;    // close pairs per chunk of pairs, then their offsets
   std::vector<int> chunk_queries;          // convex queries per chunk of pairs
+  std::vector<int> chunk_warm;             // warm pairs per chunk of carry_caches
   std::vector<ClosePair> close;
   SceneStats stats;
 
@@ -382,34 +385,53 @@ struct Scene::Impl {
   // Makes `list` (sorted by key, the states of the last call's candidates)
   // the states of `keys` (sorted): a pair that stays keeps its state, a new
   // one starts from its state in `donor` (sorted too; may be null) when it
-  // has one there, else cold. Returns how many are warm.
+  // has one there, else cold. Returns how many are warm. On threads, in
+  // fixed chunks of keys, each starting its merge where its first key falls
+  // in `list` and `donor` (each old state moves to one key at most, so the
+  // chunks touch disjoint states): the merge moved 16,000 states of about
+  // 250 bytes per step at 10,000 bodies, on one thread while the other
+  // waited.
   int carry_caches(const std::vector<std::uint64_t>& keys, std::vector<PairState>& list,
-                   const std::vector<PairState>* donor) {
+                   const std::vector<PairState>* donor, int threads) {
     next_pairs.resize(keys.size());
-    int warm = 0;
-    std::size_t old = 0;
-    std::size_t given = 0;
-    for (std::size_t k = 0; k < keys.size(); ++k) {
-      const std::uint64_t key = keys[k];
-      while (old < list.size() && list[old].key < key) ++old;
-      PairState& next = next_pairs[k];
-      if (old < list.size() && list[old].key == key) {
-        next = std::move(list[old]);
-        ++warm;
-        continue;
-      }
-      if (donor != nullptr) {
-        while (given < donor->size() && (*donor)[given].key < key) ++given;
-        if (given < donor->size() && (*donor)[given].key == key) {
-          next = (*donor)[given];
-          ++warm;
-          continue;
-        }
-      }
-      next.reset();
-      next.key = key;
-    }
+    const auto by_key = [](const PairState& p, std::uint64_t k) { return p.key < k; };
+    chunk_warm.assign(detail::chunk_count(keys.size(), kCarryChunk), 0);
+    detail::parallel_chunks(
+        keys.size(), kCarryChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+          int warm = 0;
+          auto old = static_cast<std::size_t>(
+              std::lower_bound(list.begin(), list.end(), keys[begin], by_key) - list.begin());
+          std::size_t given = 0;
+          if (donor != nullptr) {
+            given = static_cast<std::size_t>(
+                std::lower_bound(donor->begin(), donor->end(), keys[begin], by_key) -
+                donor->begin());
+          }
+          for (std::size_t k = begin; k < end; ++k) {
+            const std::uint64_t key = keys[k];
+            while (old < list.size() && list[old].key < key) ++old;
+            PairState& next = next_pairs[k];
+            if (old < list.size() && list[old].key == key) {
+              next = std::move(list[old]);
+              ++warm;
+              continue;
+            }
+            if (donor != nullptr) {
+              while (given < donor->size() && (*donor)[given].key < key) ++given;
+              if (given < donor->size() && (*donor)[given].key == key) {
+                next = (*donor)[given];
+                ++warm;
+                continue;
+              }
+            }
+            next.reset();
+            next.key = key;
+          }
+          chunk_warm[c] = warm;
+        });
     list.swap(next_pairs);
+    int warm = 0;
+    for (const int w : chunk_warm) warm += w;
     return warm;
   }
 
@@ -734,7 +756,7 @@ std::span<const ClosePair> Scene::step() {
   s.finder->find_pairs(s.boxes, s.candidates, threads);
   const int filtered = s.filter_candidates(s.candidates);
   s.drop_removed(s.pairs, s.removed_since_step);
-  const int warm = s.carry_caches(s.candidates, s.pairs, nullptr);
+  const int warm = s.carry_caches(s.candidates, s.pairs, nullptr, threads);
 
   const std::size_t n = s.pairs.size();
   s.results.resize(n);
@@ -825,7 +847,7 @@ std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   const int filtered = s.filter_candidates(s.sweep_candidates);
   s.drop_removed(s.sweep_pairs, s.removed_since_sweep);
   s.drop_removed(s.pairs, s.removed_since_step);
-  const int warm = s.carry_caches(s.sweep_candidates, s.sweep_pairs, &s.pairs);
+  const int warm = s.carry_caches(s.sweep_candidates, s.sweep_pairs, &s.pairs, threads);
 
   // The time of impact of each candidate, the pairs not separated gathered
   // in pair order (each chunk into its own list, joined in chunk order).
