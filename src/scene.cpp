@@ -142,8 +142,8 @@ struct Scene::Impl {
     double reach = 0.0;    // shape->padded.radius(): how far the body reaches beyond its core
     bool general = false;  // rounded, padded or a mesh: its pairs take the Body query
     Pose pose;
-    Pose end;                                                      // the end pose of the next sweep
-    std::array<std::int32_t, 6> hints = {-1, -1, -1, -1, -1, -1};  // support_box
+    Pose end;                // the end pose of the next sweep
+    detail::BoxHints hints;  // support_box's
     CollisionFilter filter;
     bool live = false;
   };
