@@ -39,16 +39,22 @@ namespace {
 
 using detail::Aabb;
 
-// Smallest index range a narrow-phase task runs: a tracked query costs about
-// 0.1 to 0.3 us, a TBB task about 1 us to schedule (as in batch.cpp).
+// Smallest index range a sweep's task runs (its time of impact queries): a
+// tracked query costs about 0.1 to 0.3 us, a TBB task about 1 us to
+// schedule (as in batch.cpp).
 constexpr std::size_t kGrainSize = 32;
 
-// Fixed chunks (parallel_ranges.h) of the step's other parallel loops: the
-// world boxes (six warm hill climbs each, a fraction of a microsecond) and
-// the gathering of the close pairs (a count per chunk, then a copy to the
-// chunk's place in the output), in the order of a sequential loop.
+// Fixed chunks (parallel_ranges.h) of the step's parallel loops: the world
+// boxes (six warm hill climbs each, a fraction of a microsecond) and the
+// narrow phase with the gathering of the close pairs, in the order of a
+// sequential loop.
 constexpr std::size_t kBoxChunk = 512;
-constexpr std::size_t kCloseChunk = 1024;
+// Fixed chunks of the narrow phase (candidate pairs): a chunk answers its
+// pairs and counts its close ones, then copies them to their place. At a
+// few tenths of a microsecond per tracked query, 256 pairs are a task of
+// tens of microseconds, and 16,000 candidates (10,000 bodies) make 63 of
+// them, which TBB deals out to the threads as they finish.
+constexpr std::size_t kNarrowChunk = 256;
 // Candidate pairs per chunk of the merge that carries the caches over.
 constexpr std::size_t kCarryChunk = 1024;
 
@@ -758,38 +764,36 @@ std::span<const ClosePair> Scene::step() {
   s.drop_removed(s.pairs, s.removed_since_step);
   const int warm = s.carry_caches(s.candidates, s.pairs, nullptr, threads);
 
+  // The narrow phase and the close pairs in pair order. On one thread, the
+  // close answers go straight to the output. On threads, in fixed chunks of
+  // pairs: each chunk answers its pairs into their result slots and counts
+  // its close ones, the offsets follow, and each chunk copies its close
+  // answers to its place (the count rides on the answering pass, which has
+  // the answers at hand, instead of a pass of its own over every slot).
   const std::size_t n = s.pairs.size();
-  s.results.resize(n);
-  const auto run_range = [&s](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) s.results[k] = s.query(s.pairs[k]);
-  };
-  if (threads == 1 || n < 2 * kGrainSize) {
-    run_range(0, n);
-  } else {
-    detail::parallel_ranges(n, kGrainSize, threads, run_range);
-  }
-
-  // The close pairs in pair order. On threads, each chunk counts its own,
-  // the offsets follow, and each chunk copies its pairs to its place.
   const double margin = s.options.margin;
-  const std::size_t chunks = detail::chunk_count(n, kCloseChunk);
+  const std::size_t chunks = detail::chunk_count(n, kNarrowChunk);
   int convex_queries = 0;
   if (threads == 1 || chunks < 2) {
     s.close.clear();
     for (std::size_t k = 0; k < n; ++k) {
-      convex_queries += s.results[k].result.pairs_tested;
-      if (is_close(s.results[k].result, margin)) s.close.push_back(s.results[k]);
+      const ClosePair p = s.query(s.pairs[k]);
+      convex_queries += p.result.pairs_tested;
+      if (is_close(p.result, margin)) s.close.push_back(p);
     }
   } else {
+    s.results.resize(n);
     s.chunk_close.assign(chunks, 0);
     s.chunk_queries.assign(chunks, 0);
-    detail::parallel_chunks(n, kCloseChunk, threads,
+    detail::parallel_chunks(n, kNarrowChunk, threads,
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t count = 0;
                               int queries = 0;
                               for (std::size_t k = begin; k < end; ++k) {
-                                count += is_close(s.results[k].result, margin) ? 1 : 0;
-                                queries += s.results[k].result.pairs_tested;
+                                ClosePair& p = s.results[k];
+                                p = s.query(s.pairs[k]);
+                                count += is_close(p.result, margin) ? 1 : 0;
+                                queries += p.result.pairs_tested;
                               }
                               s.chunk_close[c] = count;
                               s.chunk_queries[c] = queries;
@@ -797,7 +801,7 @@ std::span<const ClosePair> Scene::step() {
     std::size_t total = 0;
     for (std::size_t& c : s.chunk_close) total += std::exchange(c, total);
     s.close.resize(total);
-    detail::parallel_chunks(n, kCloseChunk, threads,
+    detail::parallel_chunks(n, kNarrowChunk, threads,
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t at = s.chunk_close[c];
                               for (std::size_t k = begin; k < end; ++k) {
