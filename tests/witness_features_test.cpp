@@ -136,5 +136,57 @@ TEST(WitnessFeatures, FaceLookupMatchesTheCachedFaceAndABruteForce) {
   EXPECT_GT(no_face, 1000);
 }
 
+// witness_feature's inline path for two vertices that are not adjacent on a
+// solid of triangles, without rule 3's walk (an overlapping answer's
+// features), against the general rule it stands for
+// (witness_feature_of_vertices): the same feature for random pairs and
+// points, in both orders, and for ties (a centrally symmetric hull, the
+// point at its centre: a vertex and its opposite are equally far).
+TEST(WitnessFeatures, NonAdjacentPairInlineIsTheGeneralRule) {
+  Rng rng(2024);
+  int checked = 0;
+  int ties = 0;
+  for (int trial = 0; trial < 8; ++trial) {
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 10 + 12 * trial; ++i) {
+      const Vec3 p = random_unit(rng);
+      pts.push_back(p);
+      if (trial % 2 == 1) pts.push_back(-p);  // centrally symmetric
+    }
+    const ConvexPolytope poly(pts);
+    ASSERT_EQ(poly.face_vertices().size(), 3 * std::size_t(poly.face_count()));
+    const double band = detail::witness_band(poly.scale());
+    for (int k = 0; k < 400; ++k) {
+      const auto u = static_cast<std::int32_t>(rng() % std::uint64_t(poly.vertex_count()));
+      const auto w = static_cast<std::int32_t>(rng() % std::uint64_t(poly.vertex_count()));
+      const auto nbrs = poly.neighbors(u);
+      if (u == w || std::find(nbrs.begin(), nbrs.end(), w) != nbrs.end()) continue;
+      const double t = uniform(rng, 0.0, 1.0);
+      Vec3 point = (1.0 - t) * poly.vertex(u) + t * poly.vertex(w);
+      if (trial % 2 == 1 && k % 4 == 0 && (poly.vertex(u) + poly.vertex(w)).norm() == 0.0) {
+        point = Vec3::Zero();  // u and w opposite: a tie
+        ++ties;
+      }
+      for (const std::array<std::int32_t, 2> ids :
+           {std::array<std::int32_t, 2>{u, w}, std::array<std::int32_t, 2>{w, u}}) {
+        const Feature inline_path = detail::witness_feature(
+            poly, ids, band, -1,
+            [&] {
+              return detail::WitnessPoint{point, Vec3::UnitX()};
+            },
+            /*locate=*/false);
+        const Feature general =
+            detail::witness_feature_of_vertices(poly, ids, point, band, Vec3::UnitX(), -1, false);
+        SCOPED_TRACE(testing::Message()
+                     << "trial " << trial << ", ids " << ids[0] << " " << ids[1]);
+        EXPECT_TRUE(same(inline_path, general));
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 2000);
+  EXPECT_GT(ties, 0);
+}
+
 }  // namespace
 }  // namespace proxima
