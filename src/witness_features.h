@@ -99,21 +99,6 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
       return f;
     }
     if (hull_edge(poly, id[0], id[1], f)) return f;
-    // Not adjacent, on a solid whose faces are all triangles: no face holds
-    // both, and without rule 3's walk (an intersecting answer) the general
-    // path drops the one farther from the point (rule 1's nearest drop, on
-    // the ids in ascending order: a tie keeps the larger id). The tracked
-    // overlapping query's common case, at the general path's arithmetic.
-    if (!locate && poly.dimension() == 3 &&
-        poly.face_vertices().size() == 3 * static_cast<std::size_t>(poly.face_count())) {
-      const bool first_lower = id[0] < id[1];
-      const double d_lower = first_lower ? d0 : d1;
-      const double d_upper = first_lower ? d1 : d0;
-      const std::int32_t lower = std::min(id[0], id[1]);
-      const std::int32_t upper = std::max(id[0], id[1]);
-      f.vertices = {d_lower < d_upper ? lower : upper, -1, -1};
-      return f;
-    }
   }
   // Three distinct ids on a solid at ordinary magnitudes that the previous
   // answer's face holds, the tracked face case: rules 1 and 2 inline. The

@@ -136,13 +136,15 @@ TEST(WitnessFeatures, FaceLookupMatchesTheCachedFaceAndABruteForce) {
   EXPECT_GT(no_face, 1000);
 }
 
-// witness_feature's inline path for two vertices that are not adjacent on a
-// solid of triangles, without rule 3's walk (an overlapping answer's
-// features), against the general rule it stands for
-// (witness_feature_of_vertices): the same feature for random pairs and
-// points, in both orders, and for ties (a centrally symmetric hull, the
-// point at its centre: a vertex and its opposite are equally far).
-TEST(WitnessFeatures, NonAdjacentPairInlineIsTheGeneralRule) {
+// The shortcut for two vertices that are not adjacent on a solid of
+// triangles, without rule 3's walk (an overlapping answer's features),
+// against the rules it stands for (those of a longer id list, where the
+// shortcut does not apply: the same two ids with one repeated, which the
+// rules reduce to the two): the same feature for random pairs and points,
+// in both orders, through witness_feature and witness_feature_of_vertices,
+// and for ties (a centrally symmetric hull, the point at its centre: a
+// vertex and its opposite are equally far).
+TEST(WitnessFeatures, NonAdjacentPairShortcutIsTheGeneralRule) {
   Rng rng(2024);
   int checked = 0;
   int ties = 0;
@@ -175,11 +177,15 @@ TEST(WitnessFeatures, NonAdjacentPairInlineIsTheGeneralRule) {
               return detail::WitnessPoint{point, Vec3::UnitX()};
             },
             /*locate=*/false);
-        const Feature general =
+        const Feature shortcut =
             detail::witness_feature_of_vertices(poly, ids, point, band, Vec3::UnitX(), -1, false);
+        const std::array<std::int32_t, 3> repeated = {ids[0], ids[1], ids[0]};
+        const Feature general = detail::witness_feature_of_vertices(poly, repeated, point, band,
+                                                                    Vec3::UnitX(), -1, false);
         SCOPED_TRACE(testing::Message()
                      << "trial " << trial << ", ids " << ids[0] << " " << ids[1]);
         EXPECT_TRUE(same(inline_path, general));
+        EXPECT_TRUE(same(shortcut, general));
         ++checked;
       }
     }
