@@ -50,11 +50,20 @@ constexpr std::size_t kGrainSize = 32;
 // sequential loop.
 constexpr std::size_t kBoxChunk = 512;
 // Fixed chunks of the narrow phase (candidate pairs): a chunk answers its
-// pairs and counts its close ones, then copies them to their place. At a
-// few tenths of a microsecond per tracked query, 256 pairs are a task of
-// tens of microseconds, and 16,000 candidates (10,000 bodies) make 63 of
-// them, which TBB deals out to the threads as they finish.
-constexpr std::size_t kNarrowChunk = 256;
+// pairs and counts its close ones, then copies them to their place. About
+// 64 chunks per step, so that TBB, dealing them out to the threads as they
+// finish, leaves at most a small fraction of the step to one thread at the
+// end, and of 32 to 256 pairs: at a few tenths of a microsecond per tracked
+// query, tasks of 10 to 100 microseconds against about 1 to schedule.
+// 16,000 candidates (10,000 bodies) make 64 chunks of 250, 1,500 (1,000
+// bodies) 47 of 32. The size depends on the candidate count only, never on
+// the threads: the output is in pair order whatever it is.
+constexpr std::size_t kNarrowChunkMin = 32;
+constexpr std::size_t kNarrowChunkMax = 256;
+constexpr std::size_t kNarrowChunks = 64;
+std::size_t narrow_chunk(std::size_t pairs) {
+  return std::clamp(pairs / kNarrowChunks, kNarrowChunkMin, kNarrowChunkMax);
+}
 // Candidate pairs per chunk of the merge that carries the caches over.
 constexpr std::size_t kCarryChunk = 1024;
 
@@ -772,7 +781,8 @@ std::span<const ClosePair> Scene::step() {
   // the answers at hand, instead of a pass of its own over every slot).
   const std::size_t n = s.pairs.size();
   const double margin = s.options.margin;
-  const std::size_t chunks = detail::chunk_count(n, kNarrowChunk);
+  const std::size_t chunk = narrow_chunk(n);
+  const std::size_t chunks = detail::chunk_count(n, chunk);
   int convex_queries = 0;
   if (threads == 1 || chunks < 2) {
     s.close.clear();
@@ -785,7 +795,7 @@ std::span<const ClosePair> Scene::step() {
     s.results.resize(n);
     s.chunk_close.assign(chunks, 0);
     s.chunk_queries.assign(chunks, 0);
-    detail::parallel_chunks(n, kNarrowChunk, threads,
+    detail::parallel_chunks(n, chunk, threads,
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t count = 0;
                               int queries = 0;
@@ -801,7 +811,7 @@ std::span<const ClosePair> Scene::step() {
     std::size_t total = 0;
     for (std::size_t& c : s.chunk_close) total += std::exchange(c, total);
     s.close.resize(total);
-    detail::parallel_chunks(n, kNarrowChunk, threads,
+    detail::parallel_chunks(n, chunk, threads,
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t at = s.chunk_close[c];
                               for (std::size_t k = begin; k < end; ++k) {
