@@ -106,8 +106,7 @@ void broad_phase(benchmark::State& state, BroadPhase kind, BoxKind box_kind) {
   auto finder = detail::make_pair_finder(kind);
   for (int i = 0; i < n; ++i) finder->add(i);
   std::vector<detail::Aabb> boxes(static_cast<std::size_t>(n));
-  std::vector<std::array<std::int32_t, 6>> hints(static_cast<std::size_t>(n),
-                                                 {-1, -1, -1, -1, -1, -1});
+  std::vector<detail::BoxHints> hints(static_cast<std::size_t>(n));
   std::vector<std::uint64_t> pairs;
   const auto compute_boxes = [&] {
     for (std::size_t i = 0; i < boxes.size(); ++i) {

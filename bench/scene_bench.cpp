@@ -61,6 +61,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -98,7 +99,55 @@ struct Options {
   FclSolver fcl_solver = FclSolver::libccd;
   FclBoxes fcl_boxes = FclBoxes::fcl;
   std::string out_dir = "out";
-  int threads = 1;  // the second scene's threads; 1: no second scene
+  int threads = 1;    // the second scene's threads; 1: no second scene
+  bool hash = false;  // print a hash of every close pair's whole answer, per size
+};
+
+// FNV-1a over the bytes of every field of a close pair's answer (ids, status,
+// distance, bounds, points, normal, features, depth and its bounds,
+// iterations, second algorithm, pieces, triangles): two builds whose hashes
+// agree over a run gave bit-identical answers (--hash; a change that must not
+// alter any answer is checked with it).
+class AnswerHash {
+ public:
+  void add(const ClosePair& p) {
+    const CompoundResult& r = p.result;
+    value(p.a);
+    value(p.b);
+    value(p.triangle_a);
+    value(p.triangle_b);
+    value(r.status);
+    for (const double x :
+         {r.distance, r.lower_bound, r.depth, r.depth_lower_bound, r.depth_upper_bound}) {
+      value(x);
+    }
+    for (const Vec3* v : {&r.point_a, &r.point_b, &r.normal}) {
+      for (int i = 0; i < 3; ++i) value((*v)[i]);
+    }
+    for (const Feature* f : {&r.feature_a, &r.feature_b}) {
+      value(f->type);
+      for (const std::int32_t v : f->vertices) value(v);
+      value(f->face);
+    }
+    value(r.iterations);
+    value(r.second_algorithm);
+    value(r.piece_a);
+    value(r.piece_b);
+    value(r.pairs_tested);
+    ++pairs_;
+  }
+  std::uint64_t hash() const { return hash_; }
+  std::uint64_t pairs() const { return pairs_; }
+
+ private:
+  template <class T>
+  void value(const T& v) {
+    unsigned char bytes[sizeof(T)];
+    std::memcpy(bytes, &v, sizeof(T));
+    for (const unsigned char c : bytes) hash_ = (hash_ ^ c) * 0x100000001b3ull;
+  }
+  std::uint64_t hash_ = 0xcbf29ce484222325ull;
+  std::uint64_t pairs_ = 0;
 };
 
 // CPU time of the calling thread, in ns (see the file header).
@@ -203,6 +252,8 @@ struct SizeResult {
   Series proxima_wall;            // the 1-thread scene, wall time
   Series proxima_threads_wall;    // the --threads scene, wall time
   int thread_mismatch_steps = 0;  // steps where the two scenes' close pairs differ
+  AnswerHash answers;             // the 1-thread scene's close pairs over all steps
+  AnswerHash threaded_answers;    // the --threads scene's
   PairSetDifference total;        // summed over the compared steps
   int compared_steps = 0;
   double setup_seconds = 0.0;
@@ -293,6 +344,12 @@ SizeResult run_size(int n, const Options& options) {
                    x.result.point_b == y.result.point_b;
           });
       if (!same) ++r.thread_mismatch_steps;
+      if (options.hash) {
+        for (const ClosePair& p : threaded_pairs) r.threaded_answers.add(p);
+      }
+    }
+    if (options.hash) {
+      for (const ClosePair& p : pairs) r.answers.add(p);
     }
     int intersecting = 0;
     reference.clear();
@@ -374,6 +431,20 @@ void print_size(const SizeResult& r, const Options& options) {
               << "meaningful on an idle machine only); close pairs identical in "
               << r.steps - r.thread_mismatch_steps << " of " << r.steps << " steps\n";
   }
+  if (options.hash) {
+    char line[160];
+    std::snprintf(line, sizeof(line), "  answers hash: %016llx over %llu close pairs",
+                  static_cast<unsigned long long>(r.answers.hash()),
+                  static_cast<unsigned long long>(r.answers.pairs()));
+    std::cout << line;
+    if (!r.proxima_threads_wall.ms.empty()) {
+      std::snprintf(line, sizeof(line), "; %d threads: %016llx over %llu", options.threads,
+                    static_cast<unsigned long long>(r.threaded_answers.hash()),
+                    static_cast<unsigned long long>(r.threaded_answers.pairs()));
+      std::cout << line;
+    }
+    std::cout << "\n";
+  }
   const double proxima_median = quantile(r.proxima.first_ms(common_steps), 0.5);
   const double fcl_median = quantile(r.fcl.ms, 0.5);
   const double ratio = proxima_median > 0.0 ? fcl_median / proxima_median : 0.0;
@@ -452,7 +523,7 @@ bool write_csv(const std::vector<SizeResult>& results, const Options& options) {
 void usage(std::ostream& out) {
   out << "usage: scene_bench [--bodies N[,N...]]... [--steps S] [--quick] [--seed K]\n"
          "                   [--fcl-budget SECONDS] [--fcl-solver libccd|gjk]\n"
-         "                   [--fcl-boxes fcl|tight] [--threads T] [--out DIR]\n"
+         "                   [--fcl-boxes fcl|tight] [--threads T] [--hash] [--out DIR]\n"
          "  --bodies      scene sizes, repeatable or comma-separated (default 1000,10000)\n"
          "  --steps       steps per size (default 1000; --quick: 50)\n"
          "  --fcl-budget  FCL stops after this much CPU time per size (default 240)\n"
@@ -462,6 +533,8 @@ void usage(std::ostream& out) {
          "  --threads     a second proxima scene with T narrow-phase threads (0: all cores)\n"
          "                on the same steps, wall time beside the 1-thread scene's, and the\n"
          "                ratio (default 1: no second scene)\n"
+         "  --hash        print a hash of every close pair's whole answer over the steps\n"
+         "                (bit-identical answers between two builds: same hash)\n"
          "  --out         directory of the CSV files (default out; \"\" writes none)\n"
          "example: scene_bench --bodies 1000 --steps 200\n"
          "         scene_bench --quick --threads 2     (1 against 2 threads, wall time)\n";
@@ -546,6 +619,8 @@ bool parse(int argc, char** argv, Options& o) {
         std::cerr << "scene_bench: --threads wants an integer in [0, 1024], got '" << v << "'\n";
         return false;
       }
+    } else if (arg == "--hash") {
+      o.hash = true;
     } else if (arg == "--out" && value(v)) {
       o.out_dir = v;
     } else {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include "parallel_ranges.h"
 #include "proxima/support.h"
@@ -565,17 +566,74 @@ Aabb sphere_box(const ConvexPolytope& body, const Pose& pose) {
   return {(center.array() - r).matrix(), (center.array() + r).matrix()};
 }
 
-Aabb support_box(const ConvexPolytope& body, const Pose& pose, std::array<std::int32_t, 6>& hints) {
+namespace {
+
+// The rounding of one computed dot product d.x of a direction (|d| within
+// rounding of 1: a rotation's row) with a vertex (|x| <= sqrt(3) scale) is
+// below 3 u |d| |x| (the standard bound for a sum of three products); in
+// units of u sqrt(3) scale, with room to spare.
+constexpr double kDotErrorUlps = 8.0;
+
+// Magnitudes between which the certificate's squares and differences stay
+// far from overflow and underflow; outside, no certificate (every call
+// climbs).
+constexpr double kCertifiedScaleMin = 0x1p-400;
+constexpr double kCertifiedScaleMax = 0x1p400;
+
+// The allowance of vertex v as the support in direction d (v the climb's
+// answer, v_dot its computed dot product): how far (Euclidean) another
+// direction d' may be from d with no neighbour's computed dot product
+// exceeding v's, so that the climb from v at d' stays at v.
+//
+// Why. For a neighbour w, let g be the computed gap v_dot - d.w and e the
+// bound on one dot product's rounding. Exactly, d.(v - w) >= g - 2e - u g
+// (the two dots and the subtraction), so d'.(v - w) = d.(v - w) +
+// (d' - d).(v - w) >= g - 2e - u g - |d' - d| |v - w|, and the computed d'.w
+// cannot exceed the computed d'.v while that stays above 2e:
+// |d' - d| < (g - 4e - u g) / |v - w|. The least of these over the
+// neighbours, shrunk by 2^-30 for its own rounding and that of the caller's
+// |d' - d|^2. -1 when a neighbour leaves no margin (a plateau: coplanar
+// neighbours tie); infinite for a vertex without neighbours.
+double allowance_of(const ConvexPolytope& body, const Vec3& d, std::int32_t v, double v_dot) {
+  const double scale = body.scale();
+  if (!(scale > kCertifiedScaleMin && scale < kCertifiedScaleMax)) return -1.0;
+  const Vec3* vertices = body.vertices().data();
+  const Vec3& x = vertices[v];
+  const double e = kDotErrorUlps * kUnitRoundoff * std::sqrt(3.0) * scale;
+  double least = std::numeric_limits<double>::infinity();
+  for (const std::int32_t w : body.neighbors(v)) {
+    const double gap = v_dot - d.dot(vertices[w]);
+    const double margin = gap - 4.0 * e - kUnitRoundoff * gap;
+    if (!(margin > 0.0)) return -1.0;
+    const double length2 = (vertices[w] - x).squaredNorm();
+    if (!(length2 > 0.0)) return -1.0;  // an edge too short to square
+    least = std::min(least, margin / std::sqrt(length2));
+  }
+  return least * (1.0 - 0x1p-30);
+}
+}  // namespace
+
+Aabb support_box(const ConvexPolytope& body, const Pose& pose, BoxHints& hints) {
   Aabb box;
   for (int k = 0; k < 3; ++k) {
     // World axis k seen from the body: row k of the rotation.
-    const Vec3 dir = pose.rotation.row(k).transpose();
-    const auto hi = static_cast<std::size_t>(2 * k);
-    const auto lo = hi + 1;
-    hints[hi] = support_hill_climb(body, dir, hints[hi]);
-    hints[lo] = support_hill_climb(body, -dir, hints[lo]);
-    box.hi[k] = pose.translation[k] + dir.dot(body.vertex(hints[hi]));
-    box.lo[k] = pose.translation[k] + dir.dot(body.vertex(hints[lo]));
+    const Vec3 row = pose.rotation.row(k).transpose();
+    for (int side = 0; side < 2; ++side) {
+      const auto i = static_cast<std::size_t>(2 * k + side);
+      const Vec3 dir = side == 0 ? row : Vec3(-row);
+      const std::int32_t hint = hints.vertex[i];
+      const double allowance = hints.allowance[i];
+      const bool held = hint >= 0 && hint < body.vertex_count() && allowance >= 0.0 &&
+                        (dir - hints.direction[i]).squaredNorm() < allowance * allowance;
+      if (!held) {
+        const std::int32_t v = support_hill_climb(body, dir, hint);
+        hints.vertex[i] = v;
+        hints.direction[i] = dir;
+        hints.allowance[i] = allowance_of(body, dir, v, dir.dot(body.vertex(v)));
+      }
+    }
+    box.hi[k] = pose.translation[k] + row.dot(body.vertex(hints.vertex[2 * k]));
+    box.lo[k] = pose.translation[k] + row.dot(body.vertex(hints.vertex[2 * k + 1]));
   }
   return box;
 }

@@ -77,6 +77,26 @@ std::unique_ptr<PairFinder> make_pair_finder(BroadPhase kind);
 //   updates.
 // Neither adds any slack: the caller inflates for rounding and margin.
 Aabb sphere_box(const ConvexPolytope& body, const Pose& pose);
-Aabb support_box(const ConvexPolytope& body, const Pose& pose, std::array<std::int32_t, 6>& hints);
+
+// What support_box keeps of a body from one call to the next, per world
+// direction (+x, -x, +y, -y, +z, -z): the support vertex found (the next
+// climb's hint), the body-frame direction of the climb that found it, and
+// how far a direction may be from that one (Euclidean) with the vertex
+// still the climb's answer (no neighbour's dot product can exceed its own,
+// rounding included; -1: no such certificate). A default BoxHints is cold.
+struct BoxHints {
+  std::array<std::int32_t, 6> vertex = {-1, -1, -1, -1, -1, -1};
+  std::array<Vec3, 6> direction = {Vec3::Zero(), Vec3::Zero(), Vec3::Zero(),
+                                   Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  std::array<double, 6> allowance = {-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
+};
+
+// The same box as hill climbing from hints.vertex (support_hill_climb in
+// each direction: the same vertices, the same box to the bit), but a
+// direction within its certificate's allowance of the last climb's skips
+// the climb: the vertex is its answer. The rotations of a coherent scene
+// (0.01 rad per step in scene_bench) keep most directions inside for many
+// steps.
+Aabb support_box(const ConvexPolytope& body, const Pose& pose, BoxHints& hints);
 
 }  // namespace proxima::detail

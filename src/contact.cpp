@@ -8,6 +8,7 @@
 
 #include <algorithm>
 
+#include "gjk_contact.h"
 #include "proxima/gjk.h"
 
 namespace proxima {
@@ -44,7 +45,8 @@ void classify_contact(const ConvexPolytope& a, const ConvexPolytope& b, const Po
     contact_cache.hint_b = cache.hint_b;
     contact_cache.vertices_a = cache.contact_a;
     contact_cache.vertices_b = cache.contact_b;
-    contact = enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, contact_cache);
+    // Its witness features would be dropped with it: not computed.
+    contact = detail::enhanced_gjk_contact(a, b, b_in_a, options, contact_tolerance, contact_cache);
     cache.contact_a = contact_cache.vertices_a;
     cache.contact_b = contact_cache.vertices_b;
     result.second_algorithm = true;

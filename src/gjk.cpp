@@ -79,11 +79,13 @@ constexpr double kGapUlps = 16.0;
 // `deep` receives the contact classification's tetrahedron around the origin
 // when it certifies intersection (classify_contact). `cached_face_a` and
 // `cached_face_b` are a previous answer's witness faces (-1 for none).
+// `witnesses` false leaves the features default (vertex -1): for a caller
+// that keeps only the status, iterations and simplex (the contact unit).
 template <class Support>
 DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
                        double contact_tolerance, Simplex& simplex, int iterations, Vec3 direction,
                        Support& support, Points& deep, std::int32_t cached_face_a = -1,
-                       std::int32_t cached_face_b = -1) {
+                       std::int32_t cached_face_b = -1, bool witnesses = true) {
   const double tol = contact_tolerance * frame.inv_unit;
   double lower = 0.0;  // certified lower bound, scaled units
   double w_max2 = 0.0;
@@ -225,6 +227,7 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
                         : direction;
   }
   result.status = status;
+  if (!witnesses) return result;
   // The witness features by the rule all algorithms share
   // (witness_features.h), A's in A's frame, B's in B's.
   const double witness_band = detail::witness_band(frame.magnitude);
@@ -278,9 +281,11 @@ DistanceResult gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
   return run_gjk(frame, options, contact_tolerance, simplex, 1, direction, support, deep);
 }
 
-DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b,
-                                     const Pose& b_in_a, const DistanceOptions& options,
-                                     double contact_tolerance, DistanceCache& cache) {
+namespace {
+
+DistanceResult run_enhanced_gjk(const ConvexPolytope& a, const ConvexPolytope& b,
+                                const Pose& b_in_a, const DistanceOptions& options,
+                                double contact_tolerance, DistanceCache& cache, bool witnesses) {
   const GjkFrame frame(a, b, b_in_a);
   const auto valid = [](std::int32_t id, int count) { return id >= 0 && id < count; };
   HillClimbSupport support{frame, valid(cache.hint_a, a.vertex_count()) ? cache.hint_a : 0,
@@ -309,8 +314,9 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   }
 
   Points deep;
-  const DistanceResult result = run_gjk(frame, options, contact_tolerance, simplex, iterations,
-                                        direction, support, deep, cache.face_a, cache.face_b);
+  const DistanceResult result =
+      run_gjk(frame, options, contact_tolerance, simplex, iterations, direction, support, deep,
+              cache.face_a, cache.face_b, witnesses);
   // run_gjk reduced `simplex` in place to the final one. An intersection
   // certified by a tetrahedron around the origin caches that tetrahedron
   // instead: while the bodies overlap by more than the band, the next query
@@ -330,6 +336,20 @@ DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolyto
   cache.face_a = result.feature_a.face;
   cache.face_b = result.feature_b.face;
   return result;
+}
+
+}  // namespace
+
+DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b,
+                                     const Pose& b_in_a, const DistanceOptions& options,
+                                     double contact_tolerance, DistanceCache& cache) {
+  return run_enhanced_gjk(a, b, b_in_a, options, contact_tolerance, cache, true);
+}
+
+DistanceResult detail::enhanced_gjk_contact(const ConvexPolytope& a, const ConvexPolytope& b,
+                                            const Pose& b_in_a, const DistanceOptions& options,
+                                            double contact_tolerance, DistanceCache& cache) {
+  return run_enhanced_gjk(a, b, b_in_a, options, contact_tolerance, cache, false);
 }
 
 }  // namespace proxima

@@ -39,16 +39,33 @@ namespace {
 
 using detail::Aabb;
 
-// Smallest index range a narrow-phase task runs: a tracked query costs about
-// 0.1 to 0.3 us, a TBB task about 1 us to schedule (as in batch.cpp).
+// Smallest index range a sweep's task runs (its time of impact queries): a
+// tracked query costs about 0.1 to 0.3 us, a TBB task about 1 us to
+// schedule (as in batch.cpp).
 constexpr std::size_t kGrainSize = 32;
 
-// Fixed chunks (parallel_ranges.h) of the step's other parallel loops: the
-// world boxes (six warm hill climbs each, a fraction of a microsecond) and
-// the gathering of the close pairs (a count per chunk, then a copy to the
-// chunk's place in the output), in the order of a sequential loop.
+// Fixed chunks (parallel_ranges.h) of the step's parallel loops: the world
+// boxes (six warm hill climbs each, a fraction of a microsecond) and the
+// narrow phase with the gathering of the close pairs, in the order of a
+// sequential loop.
 constexpr std::size_t kBoxChunk = 512;
-constexpr std::size_t kCloseChunk = 1024;
+// Fixed chunks of the narrow phase (candidate pairs): a chunk answers its
+// pairs and counts its close ones, then copies them to their place. About
+// 64 chunks per step, so that TBB, dealing them out to the threads as they
+// finish, leaves at most a small fraction of the step to one thread at the
+// end, and of 32 to 256 pairs: at a few tenths of a microsecond per tracked
+// query, tasks of 10 to 100 microseconds against about 1 to schedule.
+// 16,000 candidates (10,000 bodies) make 64 chunks of 250, 1,500 (1,000
+// bodies) 47 of 32. The size depends on the candidate count only, never on
+// the threads: the output is in pair order whatever it is.
+constexpr std::size_t kNarrowChunkMin = 32;
+constexpr std::size_t kNarrowChunkMax = 256;
+constexpr std::size_t kNarrowChunks = 64;
+std::size_t narrow_chunk(std::size_t pairs) {
+  return std::clamp(pairs / kNarrowChunks, kNarrowChunkMin, kNarrowChunkMax);
+}
+// Candidate pairs per chunk of the merge that carries the caches over.
+constexpr std::size_t kCarryChunk = 1024;
 
 // Rounding slack of a world box, in units of u times the body's magnitude
 // bound |t|_inf + sqrt(3) scale: 64 for the contact band of the accuracy
@@ -140,8 +157,8 @@ struct Scene::Impl {
     double reach = 0.0;    // shape->padded.radius(): how far the body reaches beyond its core
     bool general = false;  // rounded, padded or a mesh: its pairs take the Body query
     Pose pose;
-    Pose end;                                                      // the end pose of the next sweep
-    std::array<std::int32_t, 6> hints = {-1, -1, -1, -1, -1, -1};  // support_box
+    Pose end;                // the end pose of the next sweep
+    detail::BoxHints hints;  // support_box's
     CollisionFilter filter;
     bool live = false;
   };
@@ -177,6 +194,7 @@ struct Scene::Impl {
   std::vector<ClosePair> results;          // parallel to pairs
   std::vector<std::size_t> chunk_close;    // close pairs per chunk of pairs, then their offsets
   std::vector<int> chunk_queries;          // convex queries per chunk of pairs
+  std::vector<int> chunk_warm;             // warm pairs per chunk of carry_caches
   std::vector<ClosePair> close;
   SceneStats stats;
 
@@ -382,34 +400,53 @@ struct Scene::Impl {
   // Makes `list` (sorted by key, the states of the last call's candidates)
   // the states of `keys` (sorted): a pair that stays keeps its state, a new
   // one starts from its state in `donor` (sorted too; may be null) when it
-  // has one there, else cold. Returns how many are warm.
+  // has one there, else cold. Returns how many are warm. On threads, in
+  // fixed chunks of keys, each starting its merge where its first key falls
+  // in `list` and `donor` (each old state moves to one key at most, so the
+  // chunks touch disjoint states): the merge moved 16,000 states of about
+  // 250 bytes per step at 10,000 bodies, on one thread while the other
+  // waited.
   int carry_caches(const std::vector<std::uint64_t>& keys, std::vector<PairState>& list,
-                   const std::vector<PairState>* donor) {
+                   const std::vector<PairState>* donor, int threads) {
     next_pairs.resize(keys.size());
-    int warm = 0;
-    std::size_t old = 0;
-    std::size_t given = 0;
-    for (std::size_t k = 0; k < keys.size(); ++k) {
-      const std::uint64_t key = keys[k];
-      while (old < list.size() && list[old].key < key) ++old;
-      PairState& next = next_pairs[k];
-      if (old < list.size() && list[old].key == key) {
-        next = std::move(list[old]);
-        ++warm;
-        continue;
-      }
-      if (donor != nullptr) {
-        while (given < donor->size() && (*donor)[given].key < key) ++given;
-        if (given < donor->size() && (*donor)[given].key == key) {
-          next = (*donor)[given];
-          ++warm;
-          continue;
-        }
-      }
-      next.reset();
-      next.key = key;
-    }
+    const auto by_key = [](const PairState& p, std::uint64_t k) { return p.key < k; };
+    chunk_warm.assign(detail::chunk_count(keys.size(), kCarryChunk), 0);
+    detail::parallel_chunks(
+        keys.size(), kCarryChunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+          int warm = 0;
+          auto old = static_cast<std::size_t>(
+              std::lower_bound(list.begin(), list.end(), keys[begin], by_key) - list.begin());
+          std::size_t given = 0;
+          if (donor != nullptr) {
+            given = static_cast<std::size_t>(
+                std::lower_bound(donor->begin(), donor->end(), keys[begin], by_key) -
+                donor->begin());
+          }
+          for (std::size_t k = begin; k < end; ++k) {
+            const std::uint64_t key = keys[k];
+            while (old < list.size() && list[old].key < key) ++old;
+            PairState& next = next_pairs[k];
+            if (old < list.size() && list[old].key == key) {
+              next = std::move(list[old]);
+              ++warm;
+              continue;
+            }
+            if (donor != nullptr) {
+              while (given < donor->size() && (*donor)[given].key < key) ++given;
+              if (given < donor->size() && (*donor)[given].key == key) {
+                next = (*donor)[given];
+                ++warm;
+                continue;
+              }
+            }
+            next.reset();
+            next.key = key;
+          }
+          chunk_warm[c] = warm;
+        });
     list.swap(next_pairs);
+    int warm = 0;
+    for (const int w : chunk_warm) warm += w;
     return warm;
   }
 
@@ -734,40 +771,39 @@ std::span<const ClosePair> Scene::step() {
   s.finder->find_pairs(s.boxes, s.candidates, threads);
   const int filtered = s.filter_candidates(s.candidates);
   s.drop_removed(s.pairs, s.removed_since_step);
-  const int warm = s.carry_caches(s.candidates, s.pairs, nullptr);
+  const int warm = s.carry_caches(s.candidates, s.pairs, nullptr, threads);
 
+  // The narrow phase and the close pairs in pair order. On one thread, the
+  // close answers go straight to the output. On threads, in fixed chunks of
+  // pairs: each chunk answers its pairs into their result slots and counts
+  // its close ones, the offsets follow, and each chunk copies its close
+  // answers to its place (the count rides on the answering pass, which has
+  // the answers at hand, instead of a pass of its own over every slot).
   const std::size_t n = s.pairs.size();
-  s.results.resize(n);
-  const auto run_range = [&s](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) s.results[k] = s.query(s.pairs[k]);
-  };
-  if (threads == 1 || n < 2 * kGrainSize) {
-    run_range(0, n);
-  } else {
-    detail::parallel_ranges(n, kGrainSize, threads, run_range);
-  }
-
-  // The close pairs in pair order. On threads, each chunk counts its own,
-  // the offsets follow, and each chunk copies its pairs to its place.
   const double margin = s.options.margin;
-  const std::size_t chunks = detail::chunk_count(n, kCloseChunk);
+  const std::size_t chunk = narrow_chunk(n);
+  const std::size_t chunks = detail::chunk_count(n, chunk);
   int convex_queries = 0;
   if (threads == 1 || chunks < 2) {
     s.close.clear();
     for (std::size_t k = 0; k < n; ++k) {
-      convex_queries += s.results[k].result.pairs_tested;
-      if (is_close(s.results[k].result, margin)) s.close.push_back(s.results[k]);
+      const ClosePair p = s.query(s.pairs[k]);
+      convex_queries += p.result.pairs_tested;
+      if (is_close(p.result, margin)) s.close.push_back(p);
     }
   } else {
+    s.results.resize(n);
     s.chunk_close.assign(chunks, 0);
     s.chunk_queries.assign(chunks, 0);
-    detail::parallel_chunks(n, kCloseChunk, threads,
+    detail::parallel_chunks(n, chunk, threads,
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t count = 0;
                               int queries = 0;
                               for (std::size_t k = begin; k < end; ++k) {
-                                count += is_close(s.results[k].result, margin) ? 1 : 0;
-                                queries += s.results[k].result.pairs_tested;
+                                ClosePair& p = s.results[k];
+                                p = s.query(s.pairs[k]);
+                                count += is_close(p.result, margin) ? 1 : 0;
+                                queries += p.result.pairs_tested;
                               }
                               s.chunk_close[c] = count;
                               s.chunk_queries[c] = queries;
@@ -775,7 +811,7 @@ std::span<const ClosePair> Scene::step() {
     std::size_t total = 0;
     for (std::size_t& c : s.chunk_close) total += std::exchange(c, total);
     s.close.resize(total);
-    detail::parallel_chunks(n, kCloseChunk, threads,
+    detail::parallel_chunks(n, chunk, threads,
                             [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
                               std::size_t at = s.chunk_close[c];
                               for (std::size_t k = begin; k < end; ++k) {
@@ -825,7 +861,7 @@ std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   const int filtered = s.filter_candidates(s.sweep_candidates);
   s.drop_removed(s.sweep_pairs, s.removed_since_sweep);
   s.drop_removed(s.pairs, s.removed_since_step);
-  const int warm = s.carry_caches(s.sweep_candidates, s.sweep_pairs, &s.pairs);
+  const int warm = s.carry_caches(s.sweep_candidates, s.sweep_pairs, &s.pairs, threads);
 
   // The time of impact of each candidate, the pairs not separated gathered
   // in pair order (each chunk into its own list, joined in chunk order).

@@ -26,15 +26,12 @@ constexpr int kMaxWalkFaces = 32;
 
 constexpr std::size_t at(int i) { return static_cast<std::size_t>(i); }
 
-bool face_holds(const ConvexPolytope& poly, int f, std::int32_t v) {
-  const auto verts = poly.face(f);
-  return std::find(verts.begin(), verts.end(), v) != verts.end();
-}
-
+// Whether face f holds ids[first..m) (its vertex list looked up once).
 bool face_holds_all(const ConvexPolytope& poly, int f, const std::array<std::int32_t, 4>& ids,
-                    int m) {
-  for (int i = 0; i < m; ++i) {
-    if (!face_holds(poly, f, ids[at(i)])) return false;
+                    int m, int first = 0) {
+  const auto verts = poly.face(f);
+  for (int i = first; i < m; ++i) {
+    if (std::find(verts.begin(), verts.end(), ids[at(i)]) == verts.end()) return false;
   }
   return true;
 }
@@ -44,17 +41,49 @@ bool face_holds_all(const ConvexPolytope& poly, int f, const std::array<std::int
 // none. In a solid two faces share at most an edge, so the face holding a
 // diagonal or three vertices is unique; a polygon has two, one per side:
 // the one facing `outward`.
+//
+// On a solid whose faces are all triangles (points in general position:
+// the common case) the search needs no face but at most two: two vertices
+// share a face only when adjacent, and a face holding ids[0], u and w is the
+// triangle left of ids[0] -> u (its third vertex w) or left of ids[0] -> w.
+// The answer is the general search's: the first of those two faces in
+// ids[0]'s adjacency order that holds them all, or none.
 int face_containing(const ConvexPolytope& poly, const std::array<std::int32_t, 4>& ids, int m,
                     const Vec3& outward) {
   const auto offsets = poly.adjacency_offsets();
   const auto left = poly.adjacency_faces();
   const auto v0 = at(ids[0]);
+  if (poly.dimension() == 3 && (m == 2 || m == 3) &&
+      poly.face_vertices().size() == 3 * at(poly.face_count())) {
+    const auto nbrs = poly.adjacency();
+    const auto position = [&](std::int32_t v) {  // of the edge ids[0] -> v; -1: not adjacent
+      for (auto k = at(offsets[v0]); k < at(offsets[v0 + 1]); ++k) {
+        if (nbrs[k] == v) return static_cast<std::ptrdiff_t>(k);
+      }
+      return std::ptrdiff_t{-1};
+    };
+    const std::ptrdiff_t k1 = position(ids[1]);
+    if (k1 < 0) return -1;
+    if (m == 2) {
+      // Adjacent: the two faces on the edge (the callers take the edge
+      // before they look for a face). The general search below.
+    } else {
+      const std::ptrdiff_t k2 = position(ids[2]);
+      if (k2 < 0) return -1;
+      for (const std::ptrdiff_t k : {std::min(k1, k2), std::max(k1, k2)}) {
+        const int f = left[static_cast<std::size_t>(k)];
+        if (f >= 0 && face_holds_all(poly, f, ids, m, 1)) return f;
+      }
+      return -1;
+    }
+  }
   int best = -1;
   bool best_aligned = false;  // best_alignment computed (only when another face competes)
   double best_alignment = 0.0;
   for (auto k = at(offsets[v0]); k < at(offsets[v0 + 1]); ++k) {
     const int f = left[k];
-    if (f < 0 || !face_holds_all(poly, f, ids, m)) continue;
+    // f is left of an edge out of ids[0]: it holds ids[0].
+    if (f < 0 || !face_holds_all(poly, f, ids, m, 1)) continue;
     if (best < 0) {
       best = f;
       if (poly.dimension() == 3) break;
@@ -256,6 +285,26 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
   const View view(poly, point);
   const double scaled_band = band * view.inverse_unit;
   const double band2 = scaled_band * scaled_band;
+  // Two vertices farther than the band from the point and not adjacent, on
+  // a solid whose faces are all triangles, for an overlapping answer (no
+  // walk): no face holds both, so the rules below drop the one farther from
+  // the point (rule 1's nearest drop on the ids in ascending order: a tie
+  // keeps the larger id). The tracked overlapping query's common case, at
+  // the same arithmetic, without the searches.
+  if (!locate && id.size() == 2 && id[0] != id[1] && poly.dimension() == 3 &&
+      poly.face_vertices().size() == 3 * at(poly.face_count())) {
+    const std::int32_t lower = std::min(id[0], id[1]);
+    const std::int32_t upper = std::max(id[0], id[1]);
+    const double d_lower = view.at(lower).squaredNorm();
+    const double d_upper = view.at(upper).squaredNorm();
+    const auto nbrs = poly.neighbors(lower);
+    if (d_lower > band2 && d_upper > band2 &&
+        std::find(nbrs.begin(), nbrs.end(), upper) == nbrs.end()) {
+      Feature f;
+      f.vertices = {d_lower < d_upper ? lower : upper, -1, -1};
+      return f;
+    }
+  }
   // The distinct ids (a GJK simplex repeats a vertex of one body).
   // with their positions relative to the point.
   std::array<std::int32_t, 4> ids;
@@ -289,23 +338,33 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
     }
     return best;
   };
+  // nearest_drop of the set as it is (ids and order), once evaluated: rule
+  // 1's last evaluation is what the drops below would compute again (at
+  // four vertices, four triangle distances) until the set or its order
+  // changes. -1: not known.
+  int known_drop = -1;
   const auto drop = [&](int j) {
     --m;
     ids[at(j)] = ids[at(m)];
     rel[at(j)] = rel[at(m)];
+    known_drop = -1;
+  };
+  const auto drop_nearest = [&] {
+    double g = 0.0;
+    drop(known_drop >= 0 ? known_drop : nearest_drop(g));
   };
 
   // Rule 1.
   while (m > 1) {
     double g = 0.0;
     const int j = nearest_drop(g);
-    if (!(g <= band2)) break;
+    if (!(g <= band2)) {
+      known_drop = j;
+      break;
+    }
     drop(j);
   }
-  if (m == 4) {
-    double g = 0.0;
-    drop(nearest_drop(g));
-  }
+  if (m == 4) drop_nearest();
 
   // Rules 2 and 3.
   bool walked = false;
@@ -314,6 +373,7 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
       for (int i = j; i > 0 && ids[at(i - 1)] > ids[at(i)]; --i) {
         std::swap(ids[at(i - 1)], ids[at(i)]);
         std::swap(rel[at(i - 1)], rel[at(i)]);
+        known_drop = -1;  // the gaps depend on the order (rounding)
       }
     }
     Feature f;
@@ -350,8 +410,7 @@ Feature witness_feature_of_vertices(const ConvexPolytope& poly, std::span<const 
           return *held;
       }
     }
-    double g = 0.0;
-    drop(nearest_drop(g));
+    drop_nearest();
   }
 }
 

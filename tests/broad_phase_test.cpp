@@ -10,9 +10,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "proxima/support.h"
 #include "support/generators.h"
 
 namespace proxima {
@@ -216,7 +218,7 @@ TEST(WorldBox, SupportBoxIsTheBoxOfThePlacedVerticesAndInsideTheSphereBox) {
                                  ? test::points_in_cube(rng, test::uniform_int(rng, 20, 200))
                                  : test::points_on_sphere(rng, test::uniform_int(rng, 20, 200));
     const ConvexPolytope body(pts);
-    std::array<std::int32_t, 6> hints = {-1, -1, -1, -1, -1, -1};
+    detail::BoxHints hints;
     Pose pose(test::random_quaternion(rng), Vec3(test::uniform(rng, -50, 50), 3.0, -7.0));
     for (int step = 0; step < 3; ++step) {
       const Aabb box = detail::support_box(body, pose, hints);
@@ -235,6 +237,72 @@ TEST(WorldBox, SupportBoxIsTheBoxOfThePlacedVerticesAndInsideTheSphereBox) {
       pose = Pose(Mat3(test::random_small_rotation(rng, 0.05) * pose.rotation), pose.translation);
     }
   }
+}
+
+// support_box skips a direction's hill climb while the direction stays
+// within its certificate's allowance (broad_phase.h). Its slow, obvious
+// twin: the six plain climbs (support_hill_climb) from the same hints. Along
+// slow turns (most directions skip) and fast ones (most climb), on hulls of
+// points on a sphere and in a cube, boxes (plateaus: coplanar neighbours
+// tie, no certificate), flat polygons and scales 1e-90 to 1e90 (under the
+// test main's floating-point traps), the vertices and the box are the
+// twin's, bit for bit, step after step.
+TEST(WorldBox, SupportBoxSkipsOnlyClimbsThatWouldStay) {
+  Rng rng(17);
+  long skipped = 0;
+  long directions = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    test::Points pts;
+    switch (trial % 4) {
+      case 0:
+        pts = test::points_on_sphere(rng, test::uniform_int(rng, 20, 200));
+        break;
+      case 1:
+        pts = test::points_in_cube(rng, test::uniform_int(rng, 20, 200));
+        break;
+      case 2:
+        for (int i = 0; i < 8; ++i)
+          pts.emplace_back(i & 1 ? 1.0 : -1.0, i & 2 ? 0.5 : -0.5, i & 4 ? 2.0 : -2.0);
+        break;
+      default:
+        pts = test::points_on_sphere(rng, test::uniform_int(rng, 8, 40));
+        for (Vec3& p : pts) p.z() = 0.0;  // a polygon
+    }
+    const double scale = trial % 5 == 4 ? (trial % 10 == 4 ? 1e-90 : 1e90) : 1.0;
+    const ConvexPolytope body(test::scaled(pts, scale));
+    const double turn = trial % 3 == 0 ? 0.3 : 0.005;
+    detail::BoxHints hints;
+    std::array<std::int32_t, 6> twin = {-1, -1, -1, -1, -1, -1};
+    Pose pose(test::random_quaternion(rng), scale * Vec3(test::uniform(rng, -50, 50), 3.0, -7.0));
+    // An axis-aligned start for the boxes: their faces' neighbours tie.
+    if (trial % 4 == 2) pose = Pose::from_translation(pose.translation);
+    for (int step = 0; step < 40; ++step) {
+      const detail::BoxHints before = hints;
+      const Aabb box = detail::support_box(body, pose, hints);
+      Aabb expected;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 dir = pose.rotation.row(k).transpose();
+        const auto hi = static_cast<std::size_t>(2 * k);
+        twin[hi] = support_hill_climb(body, dir, twin[hi]);
+        twin[hi + 1] = support_hill_climb(body, -dir, twin[hi + 1]);
+        expected.hi[k] = pose.translation[k] + dir.dot(body.vertex(twin[hi]));
+        expected.lo[k] = pose.translation[k] + dir.dot(body.vertex(twin[hi + 1]));
+      }
+      SCOPED_TRACE(testing::Message() << "trial " << trial << ", step " << step);
+      EXPECT_EQ(hints.vertex, twin);
+      EXPECT_EQ(box.lo, expected.lo);
+      EXPECT_EQ(box.hi, expected.hi);
+      for (std::size_t i = 0; i < 6; ++i) {
+        skipped += step > 0 && hints.direction[i] == before.direction[i] ? 1 : 0;
+        directions += step > 0 ? 1 : 0;
+      }
+      pose = Pose(Mat3(test::random_small_rotation(rng, turn) * pose.rotation),
+                  pose.translation + scale * Vec3(0.01, 0.0, 0.0));
+    }
+  }
+  // Both paths ran often.
+  EXPECT_GT(skipped, directions / 4);
+  EXPECT_LT(skipped, directions * 3 / 4);
 }
 
 }  // namespace

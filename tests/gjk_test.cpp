@@ -26,6 +26,7 @@
 #include <random>
 #include <vector>
 
+#include "../src/gjk_contact.h"
 #include "proxima/distance.h"
 #include "support/exact_oracle.h"
 
@@ -679,6 +680,48 @@ TEST(EnhancedGjk, MatchesClassicAlongAMotion) {
   // The warm start pays: about a quarter of classic GJK's support
   // evaluations here (a cold Enhanced GJK would need as many as classic).
   EXPECT_LT(2 * enhanced_iterations, classic_iterations);
+}
+
+// The contact unit's Enhanced GJK (detail::enhanced_gjk_contact) is
+// enhanced_gjk_distance without the witness features: along the same motion
+// in and out of contact, each with its own tracking cache, every field but
+// the features is bit for bit the same, and so is every cache field but the
+// faces, step after step (a difference would let the two drift apart).
+TEST(EnhancedGjk, ContactVariantIsTheQueryWithoutWitnessFeatures) {
+  Rng rng(2718);
+  const ConvexPolytope a(sphere_points(rng, 150, 1.0));
+  const ConvexPolytope b(sphere_points(rng, 80, 0.6));
+  DistanceCache full_cache;
+  DistanceCache contact_cache;
+  int intersecting = 0;
+  const int steps = 300;
+  for (int k = 0; k < steps; ++k) {
+    const double s = 2.0 * M_PI * k / steps;
+    const double radius = 1.5 + 0.5 * std::cos(5.0 * s);
+    const Pose b_in_a(Mat3(Eigen::AngleAxisd(3.0 * s, Vec3(3, 1, 2).normalized())),
+                      Vec3(radius * std::cos(s), 0.2 * std::sin(3.0 * s), radius * std::sin(s)));
+    const double tol = contact_band(a, b, b_in_a);
+    const DistanceResult full = enhanced_gjk_distance(a, b, b_in_a, gjk_options(), tol, full_cache);
+    const DistanceResult lean =
+        detail::enhanced_gjk_contact(a, b, b_in_a, gjk_options(), tol, contact_cache);
+    SCOPED_TRACE(testing::Message() << "step " << k);
+    EXPECT_EQ(lean.status, full.status);
+    EXPECT_EQ(lean.distance, full.distance);
+    EXPECT_EQ(lean.lower_bound, full.lower_bound);
+    EXPECT_EQ(lean.point_a, full.point_a);
+    EXPECT_EQ(lean.point_b, full.point_b);
+    EXPECT_EQ(lean.normal, full.normal);
+    EXPECT_EQ(lean.iterations, full.iterations);
+    EXPECT_EQ(lean.feature_a.vertices[0], -1);
+    EXPECT_EQ(lean.feature_b.vertices[0], -1);
+    EXPECT_EQ(contact_cache.vertices_a, full_cache.vertices_a);
+    EXPECT_EQ(contact_cache.vertices_b, full_cache.vertices_b);
+    EXPECT_EQ(contact_cache.hint_a, full_cache.hint_a);
+    EXPECT_EQ(contact_cache.hint_b, full_cache.hint_b);
+    EXPECT_EQ(contact_cache.face_a, -1);
+    intersecting += full.status == Status::intersecting;
+  }
+  EXPECT_GE(intersecting, 30);
 }
 
 // With the pose unchanged, the cached simplex is already the answer: one
