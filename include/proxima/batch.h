@@ -28,7 +28,9 @@
 // TBB's global one, all cores; a caller inside its own tbb::task_arena keeps
 // its limit). `threads == 1` runs every query in the calling thread.
 // `threads > 1` runs in a dedicated arena of that many threads (the calling
-// thread among them).
+// thread among them), created by a calling thread's first such call and
+// kept for its next ones; each loop runs under the caller's floating-point
+// settings of that moment.
 #pragma once
 
 #include <span>

@@ -80,7 +80,8 @@ struct SceneOptions {
   // faster than sweep and prune (one sorted axis) at 1,000 and 10,000 bodies.
   BroadPhase broad_phase = BroadPhase::dynamic_aabb_tree;
   // Narrow-phase threads: 1 runs in the caller's thread, 0 in the caller's
-  // TBB arena, n > 1 in a dedicated arena (as distance_batch).
+  // TBB arena, n > 1 in a dedicated arena, kept per calling thread (as
+  // distance_batch).
   int threads = 1;
 };
 
