@@ -125,33 +125,48 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // B's pose in A's frame, pose_a^-1 pose_b, formed directly (the transpose
 // is the inverse of a rotation under the pose contract).
 //
-// With SSE2, two entries at a time: column j of R_a^T R_b (or R_a^T d) is
-// sum_k (R_a row k) * v_k for v = column j of R_b (or d), and the first two
-// entries of each row of R_a are a pair of lanes. Eigen's 3x3 product
-// vectorizes each length-3 dot product with horizontal adds instead: 127
-// instructions per query against about 90 here (callgrind,
-// bench/tracked_instructions).
+// With SSE2, two columns at a time: entry i of columns j and j' of
+// R_a^T [R_b | d] is ((R_a(0,i) v_0 + R_a(1,i) v_1) + R_a(2,i) v_2) for
+// the pair v_k = (column j, column j') entry k, so the columns (0, 1) of R_b
+// and (2, d) share the nine broadcast entries of R_a, each multiplied once
+// per pair of outputs. The rounding is the scalar product's, term by term.
+// Eigen's 3x3 product vectorizes each length-3 dot product with horizontal
+// adds instead: 127 instructions per query; the rows of R_a paired in
+// lanes, one column at a time: about 90; the columns paired: 11 fewer
+// (callgrind, bench/tracked_instructions translation 64).
 [[gnu::always_inline]] inline Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
-  const Vec3 d = pose_b.translation - pose_a.translation;
 #if defined(__SSE2__)
   const double* ra = pose_a.rotation.data();  // column-major: R_a(k, i) = ra[3 i + k]
   const double* rb = pose_b.rotation.data();
-  const __m128d row0 = _mm_loadh_pd(_mm_load_sd(ra + 0), ra + 3);  // (R_a(0,0), R_a(0,1))
-  const __m128d row1 = _mm_loadh_pd(_mm_load_sd(ra + 1), ra + 4);
-  const __m128d row2 = _mm_loadh_pd(_mm_load_sd(ra + 2), ra + 5);
-  // R_a^T v into out[0..2]: the first two entries paired, the third alone.
-  const auto apply_transpose = [&](const double* v, double* out) {
-    const __m128d top = _mm_add_pd(
-        _mm_add_pd(_mm_mul_pd(row0, _mm_set1_pd(v[0])), _mm_mul_pd(row1, _mm_set1_pd(v[1]))),
-        _mm_mul_pd(row2, _mm_set1_pd(v[2])));
-    _mm_storeu_pd(out, top);
-    out[2] = ra[6] * v[0] + ra[7] * v[1] + ra[8] * v[2];
-  };
+  const double* ta = pose_a.translation.data();
+  const double* tb = pose_b.translation.data();
+  // d = t_b - t_a, entries 0 and 1 in a pair, entry 2 alone.
+  const __m128d d01 = _mm_sub_pd(_mm_loadu_pd(tb), _mm_loadu_pd(ta));
+  const __m128d d2 = _mm_sub_sd(_mm_load_sd(tb + 2), _mm_load_sd(ta + 2));
+  // Entry k of columns 0 and 1 of R_b, and of column 2 of R_b and d.
+  const __m128d v01[3] = {_mm_loadh_pd(_mm_load_sd(rb + 0), rb + 3),
+                          _mm_loadh_pd(_mm_load_sd(rb + 1), rb + 4),
+                          _mm_loadh_pd(_mm_load_sd(rb + 2), rb + 5)};
+  const __m128d v2d[3] = {_mm_unpacklo_pd(_mm_load_sd(rb + 6), d01), _mm_loadl_pd(d01, rb + 7),
+                          _mm_unpacklo_pd(_mm_load_sd(rb + 8), d2)};
   Pose b_in_a;  // written in place (the returned object itself)
-  for (int j = 0; j < 3; ++j) apply_transpose(rb + 3 * j, b_in_a.rotation.data() + 3 * j);
-  apply_transpose(d.data(), b_in_a.translation.data());
+  double* out = b_in_a.rotation.data();
+  double* out_t = b_in_a.translation.data();
+  for (int i = 0; i < 3; ++i) {
+    const __m128d c0 = _mm_set1_pd(ra[3 * i]), c1 = _mm_set1_pd(ra[3 * i + 1]),
+                  c2 = _mm_set1_pd(ra[3 * i + 2]);
+    const __m128d e01 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(c0, v01[0]), _mm_mul_pd(c1, v01[1])),
+                                   _mm_mul_pd(c2, v01[2]));
+    const __m128d e2d = _mm_add_pd(_mm_add_pd(_mm_mul_pd(c0, v2d[0]), _mm_mul_pd(c1, v2d[1])),
+                                   _mm_mul_pd(c2, v2d[2]));
+    _mm_storel_pd(out + i, e01);      // (i, 0)
+    _mm_storeh_pd(out + 3 + i, e01);  // (i, 1)
+    _mm_storel_pd(out + 6 + i, e2d);  // (i, 2)
+    _mm_storeh_pd(out_t + i, e2d);    // translation i
+  }
   return b_in_a;
 #else
+  const Vec3 d = pose_b.translation - pose_a.translation;
   return {Mat3(pose_a.rotation.transpose() * pose_b.rotation),
           Vec3(pose_a.rotation.transpose() * d)};
 #endif
@@ -194,49 +209,15 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 #endif
 }
 
-// The query for poses under the contract, with the caller's cache or a cold
-// one.
-[[gnu::always_inline]] inline DistanceResult distance_in_frame(
-    const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
-    const DistanceOptions& options, DistanceCache& c) {
-  // Both tolerances finite and >= 0, and at least one iteration: on the
-  // bits first (sign clear and exponent below all ones in both, so in their
-  // or), the exact test only when that fails (-0.0 is accepted there).
-  if (((std::bit_cast<std::uint64_t>(options.relative_tolerance) |
-        std::bit_cast<std::uint64_t>(options.absolute_tolerance)) >= 0x7ff0000000000000ULL) ||
-      options.max_iterations < 1) [[unlikely]] {
-    check_options(options);
-  }
-
-  // The contact band 64 u R + Ae, first with a cheap bound on R. A distance
-  // found inside that band but above 0 may still be outside the band of the
-  // exact R; then the exact R is computed and the query resumed from its own
-  // cache with the exact band, so that "separated" means d > 64 u R exactly.
-  const double r_bound = magnitude_bounds(a, pose_a, b, pose_b);
-  if (!(r_bound <= kMaxMagnitude)) [[unlikely]] {
-    char what[200];
-    std::snprintf(
-        what, sizeof what,
-        "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
-        "beyond the supported %.3g where differences of coordinates may overflow",
-        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
-        kMaxMagnitude);
-    throw InvalidInput(what);
-  }
-  const Pose b_in_a = relative_pose(pose_a, pose_b);
-  const double band_bound = contact_band(r_bound, options.absolute_tolerance);
-
-  // A pair that was penetrating: the tracked depth first, and when it
-  // certifies the overlap, its answer without the algorithm's
-  // (src/signed_distance.cpp).
-  if (c.penetration) [[unlikely]] {
-    DistanceResult overlap;
-    if (detail::tracked_overlap(a, b, b_in_a, options, band_bound, c, overlap)) {
-      to_world(pose_a, overlap);
-      return overlap;
-    }
-  }
-  DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
+// The end of a query after its algorithm's answer `result` (A's frame, the
+// cheap contact band `band_bound`): the exact band where it matters, the
+// signed distance, the world frame. In place, so that distance() builds the
+// answer in its caller's return slot (below).
+[[gnu::always_inline]] inline void finish_query(const ConvexPolytope& a, const Pose& pose_a,
+                                                const ConvexPolytope& b, const Pose& pose_b,
+                                                const Pose& b_in_a, const DistanceOptions& options,
+                                                double band_bound, DistanceCache& c,
+                                                DistanceResult& result) {
   // Most contacts (overlapping bodies) end with a distance of a few
   // roundings: inside the band of a lower bound on R taken from the cached
   // features and support hints, where the exact R could not change the
@@ -270,6 +251,73 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   }
   // Back to the world frame, in place.
   to_world(pose_a, result);
+}
+
+// The query of a pair that was penetrating: the tracked depth first, and
+// when it certifies the overlap, its answer without the algorithm's
+// (src/signed_distance.cpp). Out of line, so that the common path returns
+// one object only (below).
+[[gnu::noinline]] DistanceResult penetrating_query(const ConvexPolytope& a, const Pose& pose_a,
+                                                   const ConvexPolytope& b, const Pose& pose_b,
+                                                   const Pose& b_in_a,
+                                                   const DistanceOptions& options,
+                                                   double band_bound, DistanceCache& c) {
+  DistanceResult overlap;
+  if (detail::tracked_overlap(a, b, b_in_a, options, band_bound, c, overlap)) {
+    to_world(pose_a, overlap);
+    return overlap;
+  }
+  DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
+  finish_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c, result);
+  return result;
+}
+
+// The query for poses under the contract, with the caller's cache or a cold
+// one. Its one named result is the caller's return slot itself (NRVO): with
+// the penetrating pair's answer a second named object here, the algorithm
+// wrote a local that was then copied out, field by field, and to_world's
+// stores went through the stack (about 40 instructions a query, callgrind,
+// bench/tracked_instructions).
+[[gnu::always_inline]] inline DistanceResult distance_in_frame(
+    const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
+    const DistanceOptions& options, DistanceCache& c) {
+  // Both tolerances finite and >= 0, and at least one iteration: on the
+  // bits first (sign clear and exponent below all ones in both, so in their
+  // or), the exact test only when that fails (-0.0 is accepted there).
+  if (((std::bit_cast<std::uint64_t>(options.relative_tolerance) |
+        std::bit_cast<std::uint64_t>(options.absolute_tolerance)) >= 0x7ff0000000000000ULL) ||
+      options.max_iterations < 1) [[unlikely]] {
+    check_options(options);
+  }
+
+  // The contact band 64 u R + Ae, first with a cheap bound on R. A distance
+  // found inside that band but above 0 may still be outside the band of the
+  // exact R; then the exact R is computed and the query resumed from its own
+  // cache with the exact band, so that "separated" means d > 64 u R exactly
+  // (finish_query).
+  const double r_bound = magnitude_bounds(a, pose_a, b, pose_b);
+  if (!(r_bound <= kMaxMagnitude)) [[unlikely]] {
+    char what[200];
+    std::snprintf(
+        what, sizeof what,
+        "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
+        "beyond the supported %.3g where differences of coordinates may overflow",
+        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
+        kMaxMagnitude);
+    throw InvalidInput(what);
+  }
+  const Pose b_in_a = relative_pose(pose_a, pose_b);
+  const double band_bound = contact_band(r_bound, options.absolute_tolerance);
+
+  // One initialization from either call, not two returns: GCC 12 elides
+  // the copy of a named result only when every return names it.
+  const bool penetrating = static_cast<bool>(c.penetration);
+  DistanceResult result =
+      penetrating ? penetrating_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c)
+                  : run(a, b, b_in_a, options, band_bound, c);
+  if (!penetrating) [[likely]] {
+    finish_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c, result);
+  }
   return result;
 }
 
