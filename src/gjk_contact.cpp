@@ -45,24 +45,52 @@ constexpr int kMaxContactEdges = 3 * kMaxContactFaces;
 // A), so its centroid is more than h_f/4 > r/2 from every face: one whose
 // centroid is within tol/2 of a face cannot hold the origin deeper than tol,
 // and is refused (the lowest double), as a flat one is.
+namespace {
+
+// One face (pi, pj, pk) of origin_depth's tetrahedron of centroid `inner`,
+// oriented outwards by it: the origin's depth below the face's plane in
+// `depth`, or false when the face is refused (flat, or the centroid within
+// tol/2 of it; origin_depth says why).
+[[gnu::always_inline]] inline bool face_depth(const Vec3& pi, const Vec3& pj, const Vec3& pk,
+                                              const Vec3& inner, double tol, double& depth) {
+  Vec3 nrm = face_normal(pj - pi, pk - pi).n;
+  double side = nrm.dot(pi - inner);
+  if (side < 0.0) {
+    nrm = -nrm;
+    side = -side;
+  }
+  const double len = nrm.norm();
+  if (!(side > 0.0) || !(len > 0.0) || !(side > 0.5 * tol * len)) return false;
+  depth = (nrm / len).dot(pi);
+  return true;
+}
+
+}  // namespace
+
 double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3, double tol) {
   const std::array<const Vec3*, 4> p = {&p0, &p1, &p2, &p3};
   const Vec3 inner = 0.25 * (p0 + p1 + p2 + p3);
   double depth = std::numeric_limits<double>::max();
   for (const auto& f : kOppositeFace) {
-    const Vec3& pi = *p[idx(f[0])];
-    Vec3 nrm = face_normal(*p[idx(f[1])] - pi, *p[idx(f[2])] - pi).n;
-    double side = nrm.dot(pi - inner);
-    if (side < 0.0) {
-      nrm = -nrm;
-      side = -side;
-    }
-    const double len = nrm.norm();
-    if (!(side > 0.0) || !(len > 0.0) || !(side > 0.5 * tol * len))
+    double face = 0.0;
+    if (!face_depth(*p[idx(f[0])], *p[idx(f[1])], *p[idx(f[2])], inner, tol, face))
       return std::numeric_limits<double>::lowest();
-    depth = std::min(depth, (nrm / len).dot(pi));
+    depth = std::min(depth, face);
   }
   return depth;
+}
+
+bool origin_deeper_than(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3,
+                        double tol) {
+  const Vec3 inner = 0.25 * (p0 + p1 + p2 + p3);
+  // origin_depth's faces in its order; a face at depth <= tol makes the
+  // minimum <= tol, and a refused one makes it the lowest double, so either
+  // ends the test. A NaN depth, which std::min skips there, is skipped here.
+  double face = 0.0;
+  return face_depth(p1, p2, p3, inner, tol, face) && !(face <= tol) &&
+         face_depth(p0, p2, p3, inner, tol, face) && !(face <= tol) &&
+         face_depth(p0, p1, p3, inner, tol, face) && !(face <= tol) &&
+         face_depth(p0, p1, p2, inner, tol, face) && !(face <= tol);
 }
 
 // ---------------------------------------------------------------------------
@@ -179,7 +207,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
         // stalled answers stopped being called separated and reached the
         // contact classification
         // (ForeignCache.FlatContactTetrahedronDoesNotCertifyIntersection).
-        if (!(origin_depth(p[0], p[1], p[2], p[3], tol) > tol)) return Status::touching;
+        if (!origin_deeper_than(p[0], p[1], p[2], p[3], tol)) return Status::touching;
         deep = {sp[0], sp[1], sp[2], sp[3]};
         return Status::intersecting;
       }
@@ -263,7 +291,7 @@ bool encloses_origin_deeply(const ConvexPolytope& a, const ConvexPolytope& b, co
   const detail::GjkFrame frame(a, b, b_in_a);
   const double tol = std::max(contact_tolerance, 0.0) * frame.inv_unit;
   const auto w = [&](std::size_t k) { return frame.point(ids_a[k], ids_b[k]).w; };
-  return detail::origin_depth(w(0), w(1), w(2), w(3), tol) > tol;
+  return detail::origin_deeper_than(w(0), w(1), w(2), w(3), tol);
 }
 
 }  // namespace proxima

@@ -20,6 +20,12 @@ namespace proxima::detail {
 // intersection.
 double origin_depth(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3, double tol);
 
+// origin_depth(p0, p1, p2, p3, tol) > tol, the same decision on the same
+// arithmetic, face by face: it stops at the first face that decides
+// against. The certificate of a tracked overlapping pair
+// (encloses_origin_deeply).
+bool origin_deeper_than(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3, double tol);
+
 // Touching, intersecting or iteration_cap for a solved simplex whose closest
 // point is within tol of the origin (gjk_contact.cpp). Its support
 // evaluations count in `iterations`. When it certifies intersection, `deep`

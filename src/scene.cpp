@@ -317,18 +317,25 @@ struct Scene::Impl {
     return p;
   }
 
-  ClosePair query(PairState& state) const {
+  // The answer of pair `state` written into `p`, every field of it: the
+  // narrow phase answers into its output slots, so that no answer of about
+  // 280 bytes is built and then copied.
+  void query_into(PairState& state, ClosePair& p) const {
     const BodyId ia = detail::pair_first(state.key);
     const BodyId ib = detail::pair_second(state.key);
     const Body& a = bodies[slot(ia)];
     const Body& b = bodies[slot(ib)];
     if (a.general || b.general) {
-      return body_answer(ia, a, ib, b,
-                         distance(a.shape->padded, a.pose, b.shape->padded, b.pose,
-                                  options.distance, &state.body.get()));
+      p = body_answer(ia, a, ib, b,
+                      distance(a.shape->padded, a.pose, b.shape->padded, b.pose, options.distance,
+                               &state.body.get()));
+      return;
     }
-    ClosePair p{ia, ib, {}};
     if (a.convex && b.convex) {
+      p.a = ia;
+      p.b = ib;
+      p.triangle_a = -1;
+      p.triangle_b = -1;
       static_cast<DistanceResult&>(p.result) =
           // The stored poses were checked by add and set_pose.
           detail::distance_of_rigid_poses(*a.convex, a.pose, *b.convex, b.pose, options.distance,
@@ -336,10 +343,16 @@ struct Scene::Impl {
       p.result.piece_a = 0;
       p.result.piece_b = 0;
       p.result.pairs_tested = 1;
-      return p;
+      return;
     }
-    p.result =
-        distance(*a.compound, a.pose, *b.compound, b.pose, options.distance, &state.compound);
+    p = ClosePair{
+        ia, ib,
+        distance(*a.compound, a.pose, *b.compound, b.pose, options.distance, &state.compound)};
+  }
+
+  ClosePair query(PairState& state) const {
+    ClosePair p;
+    query_into(state, p);
     return p;
   }
 
@@ -787,9 +800,10 @@ std::span<const ClosePair> Scene::step() {
   if (threads == 1 || chunks < 2) {
     s.close.clear();
     for (std::size_t k = 0; k < n; ++k) {
-      const ClosePair p = s.query(s.pairs[k]);
+      ClosePair& p = s.close.emplace_back();
+      s.query_into(s.pairs[k], p);
       convex_queries += p.result.pairs_tested;
-      if (is_close(p.result, margin)) s.close.push_back(p);
+      if (!is_close(p.result, margin)) s.close.pop_back();
     }
   } else {
     s.results.resize(n);
@@ -801,7 +815,7 @@ std::span<const ClosePair> Scene::step() {
                               int queries = 0;
                               for (std::size_t k = begin; k < end; ++k) {
                                 ClosePair& p = s.results[k];
-                                p = s.query(s.pairs[k]);
+                                s.query_into(s.pairs[k], p);
                                 count += is_close(p.result, margin) ? 1 : 0;
                                 queries += p.result.pairs_tested;
                               }

@@ -31,14 +31,8 @@ Reduction single(const Points& p, int i) {
 // of a plane it is 1e-13 from. Splitting each product into its rounded value
 // and its exact error (Dekker's two-product) gives a*b - c*d to a few u of
 // itself. It costs several plain products, so it is used only for faces
-// thinner than kThinFaceSine2.
+// thinner than kThinFaceSine2 (simplex_solver.h).
 // ---------------------------------------------------------------------------
-
-// sin^2 of the angle between a face's edges below which its normal is
-// recomputed accurately: at sin >= 1/8 the plain cross product's direction
-// error is at most ~16 u, which moves a height over the face by ~16 u R,
-// inside the 64 u R band; thinner faces would exceed it.
-constexpr double kThinFaceSine2 = 1.0 / 64.0;
 
 // a * b == p + e exactly (no overflow at the unit's scale). With a hardware
 // fused multiply-add the error is one instruction; otherwise Veltkamp's
@@ -73,9 +67,7 @@ double difference_of_products(double a, double b, double c, double d) {
 }
 }  // namespace
 
-FaceNormal face_normal(const Vec3& e1, const Vec3& e2) {
-  const Vec3 n = e1.cross(e2);
-  if (!(n.squaredNorm() < kThinFaceSine2 * e1.squaredNorm() * e2.squaredNorm())) return {n, false};
+FaceNormal accurate_face_normal(const Vec3& e1, const Vec3& e2) {
   return {Vec3(difference_of_products(e1.y(), e2.z(), e1.z(), e2.y()),
                difference_of_products(e1.z(), e2.x(), e1.x(), e2.z()),
                difference_of_products(e1.x(), e2.y(), e1.y(), e2.x())),

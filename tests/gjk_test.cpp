@@ -724,6 +724,44 @@ TEST(EnhancedGjk, ContactVariantIsTheQueryWithoutWitnessFeatures) {
   EXPECT_GE(intersecting, 30);
 }
 
+// The tracked overlap's certificate (detail::origin_deeper_than, behind
+// encloses_origin_deeply) is origin_depth(...) > tol face by face, stopping
+// at the first face that decides against: the same decision on every
+// tetrahedron, around the origin or not, flat or shallow, at tolerances
+// around its depth (a face test that differed from origin_depth's, or an
+// early exit on the wrong side of the tolerance, makes it differ).
+TEST(ContactCertificate, OriginDeeperThanIsOriginDepthAboveTheTolerance) {
+  Rng rng(1414);
+  int deep = 0;
+  int shallow = 0;
+  int refused = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    std::array<Vec3, 4> p;
+    for (Vec3& x : p) x = uniform(rng, 0.1, 2.0) * random_unit(rng);
+    if (trial % 5 == 0) {
+      // Nearly flat: the fourth point a little off the plane of the others.
+      const Vec3 n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+      p[3] = (p[0] + p[1] + p[2]) / 3.0 + uniform(rng, -1e-9, 1e-9) * n +
+             0.3 * uniform(rng, -1.0, 1.0) * (p[1] - p[0]);
+    }
+    const double exact = detail::origin_depth(p[0], p[1], p[2], p[3], 0.0);
+    const double tol = trial % 3 == 0   ? 0.0
+                       : trial % 3 == 1 ? uniform(rng, 0.0, 0.5)
+                                        : std::max(0.0, exact * uniform(rng, 0.5, 1.5));
+    const double depth = detail::origin_depth(p[0], p[1], p[2], p[3], tol);
+    const bool expected = depth > tol;
+    EXPECT_EQ(detail::origin_deeper_than(p[0], p[1], p[2], p[3], tol), expected)
+        << "trial " << trial << " depth " << depth << " tol " << tol;
+    deep += expected;
+    shallow += !expected && depth != std::numeric_limits<double>::lowest();
+    refused += depth == std::numeric_limits<double>::lowest();
+  }
+  // The set holds each kind of answer.
+  EXPECT_GE(deep, 500);
+  EXPECT_GE(shallow, 500);
+  EXPECT_GE(refused, 500);
+}
+
 // With the pose unchanged, the cached simplex is already the answer: one
 // support evaluation confirms it.
 TEST(EnhancedGjk, RepeatedQueryConfirmsInOneIteration) {
