@@ -121,9 +121,13 @@ struct VertexSet {
     return size == o.size &&
            std::equal(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), o.ids.begin());
   }
+  // A plain loop (std::find's unrolled one costs more: S holds a few
+  // vertices).
   bool has(std::int32_t v) const {
-    return std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
-           ids.begin() + static_cast<std::ptrdiff_t>(size);
+    for (std::size_t k = 0; k < size; ++k) {
+      if (ids[k] == v) return true;
+    }
+    return false;
   }
 };
 
@@ -167,19 +171,31 @@ double cone_margin(const ConvexPolytope& body, const VertexSet& set, const Vec3&
   // Each edge's ratio on its own and the smallest kept: no chain of
   // divisions through a running margin (that chain, not the arithmetic,
   // was the cost of a step). A falling edge (rise < 0) ends it at 0.
-  double margin = 1.0;
+  // The ratios squared, rise^2 / length^2 where length^2 is in range, one
+  // root at the end: no root per edge. rise <= length, so rise^2 does not
+  // overflow; a square in the subnormals may be rounded up, so squares
+  // below 2^-900 (margins below 2^-450) count as no margin.
+  double margin2 = 1.0;
+  const Vec3 d = sign * direction;
   for (std::size_t k = 0; k < set.size; ++k) {
     const Vec3& q = body.vertex(set.ids[k]);
     for (const std::int32_t y : body.neighbors(set.ids[k])) {
       if (set.has(y)) continue;
       const Vec3 edge = q - body.vertex(y);
-      const double rise = sign * direction.dot(edge);
+      const double rise = d.dot(edge);
       if (rise < 0.0) return 0.0;
-      const double length = fast_norm(edge);
-      margin = std::min(margin, length > 0.0 ? rise / length : 1.0);
+      const double length2 = edge.squaredNorm();
+      if (length2 >= std::numeric_limits<double>::min() && length2 < 0x1p1000) [[likely]] {
+        margin2 = std::min(margin2, rise * rise / length2);
+      } else {
+        const double length = edge.stableNorm();
+        const double ratio = length > 0.0 ? rise / length : 1.0;
+        margin2 = std::min(margin2, ratio * ratio);
+      }
     }
   }
-  return margin * kConeMarginShrink;
+  if (!(margin2 >= 0x1p-900)) return 0.0;
+  return std::sqrt(margin2) * kConeMarginShrink;
 }
 
 // The witness feature's plane of one body at one step. Its value, rate and
@@ -230,22 +246,26 @@ class FeaturePlane {
   // before a neighbour of S may overtake it: the smallest margin of the
   // header comment, a hair inside, >= 0. The margin loop, O(|S| degree
   // |S|), runs on the first call only.
-  double margin() {
-    if (margin_ >= 0.0) return margin_;
-    // From the kept margin while it is at least half of what it was.
-    if (memo_->margin > 0.0 && memo_->set.same(set_)) {
+  // `need`: the margin that would not limit the caller's step; a kept
+  // margin that reaches it is as good as a fresh one there.
+  double margin(double need) {
+    if (fresh_ || margin_ >= need) return margin_;
+    // From the kept margin while it is at least half of what it was, or
+    // while it does not limit the step.
+    if (margin_ < 0.0 && memo_->margin > 0.0 && memo_->set.same(set_)) {
       const double kept = memo_->margin - fast_norm(direction_ - memo_->direction) - kMarginSlack;
-      if (kept >= 0.5 * memo_->margin) {
-        margin_ = kept;
-        return margin_;
-      }
+      if (kept >= 0.0) margin_ = kept;
+      if (kept >= 0.5 * memo_->margin || kept >= need) return margin_;
     }
     margin_ = fresh_margin();
+    fresh_ = true;
     *memo_ = {set_, direction_, margin_};
     return margin_;
   }
-  // The span: unbounded without a turn.
-  double span() { return turn_ > 0.0 ? margin() / turn_ : std::numeric_limits<double>::infinity(); }
+  // The span, for a step of `step` (unbounded without a turn).
+  double span(double step) {
+    return turn_ > 0.0 ? margin(step * turn_) / turn_ : std::numeric_limits<double>::infinity();
+  }
 
   const VertexSet& set() const { return set_; }
 
@@ -260,6 +280,7 @@ class FeaturePlane {
   PlaneBound bound_;
   MarginMemo* memo_;
   double margin_ = -1.0;  // not computed yet
+  bool fresh_ = false;    // margin_ is cone_margin's own (else kept or none)
 };
 
 // The first time in [0, span] at which a gap gap0 closing at `rate` with
@@ -756,12 +777,17 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     // A's top along n, and B's bottom as -(min along n): both rising at
     // `rate` at most bring them closer. The hull's and the ball's planes
     // have no span limit and no acceleration.
-    const PlaneBound top_a[2] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
-                                 {n.dot(pa.apply(a.centroid())) + a.bounding_radius(),
-                                  va.dot(n) + turn_a * ha.lever, 0.0, inf}};
-    const PlaneBound bottom_b[2] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
-                                    {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()),
-                                     -vb.dot(n) + turn_b * hb.lever, 0.0, inf}};
+    // The balls' centers along n as the hull's vertices: n.t + (R^T n).c.
+    const double along_a = n.dot(pa.translation), along_b = n.dot(pb.translation);
+    const double speed_a = va.dot(n), speed_b = vb.dot(n);
+    const PlaneBound top_a[2] = {
+        {hull.top_a, speed_a + turn_a * reach_a, 0.0, inf},
+        {along_a + hull.direction_a.dot(a.centroid()) + a.bounding_radius(),
+         speed_a + turn_a * ha.lever, 0.0, inf}};
+    const PlaneBound bottom_b[2] = {
+        {-hull.bottom_b, -speed_b + turn_b * reach_b, 0.0, inf},
+        {-(along_b + hull.direction_b.dot(b.centroid()) - b.bounding_radius()),
+         -speed_b + turn_b * hb.lever, 0.0, inf}};
     SafeStep best = lower_bound_step(r.lower_bound - band, target, any_speed);
     // The step of planes x and y without their span limit, or 0 when their
     // gap is already closed.
@@ -782,8 +808,9 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     }
     if (best.never) return best;
     const double horizon = 1.0 - t;
-    const Vec3 origin_a = pa.apply(ha.origin);
-    const Vec3 origin_b = pb.apply(hb.origin);
+    // The reference points (a convex body's is its pose's translation).
+    const Vec3 origin_a = ha.local != nullptr ? pa.apply(ha.origin) : pa.translation;
+    const Vec3 origin_b = hb.local != nullptr ? pb.apply(hb.origin) : pb.translation;
     // The plane through two edges (edge_pair_step): an edge-edge contact
     // closes at its true rate, at second order. Before the feature planes,
     // whose spans it then mostly spares.
@@ -803,8 +830,8 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     const PlaneBound& fb = feature_b.bound();
     const auto with_span = [&](double step, FeaturePlane* x, FeaturePlane* y) {
       if (!(step > best.step)) return;
-      if (x != nullptr) step = std::min(step, x->span());
-      if (y != nullptr) step = std::min(step, y->span());
+      if (x != nullptr) step = std::min(step, x->span(step));
+      if (y != nullptr) step = std::min(step, y->span(step));
       take(step);
     };
     with_span(unlimited(fa, fb), &feature_a, &feature_b);
@@ -820,7 +847,8 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     // shows (toi_bench, N = 8: 3.3 us with them everywhere, 3.1 us so).
     const auto fixed = [&](double step, FeaturePlane& moving) {
       if (!(step > best.step)) return;
-      if (relative_turn > 0.0) step = std::min(step, moving.margin() / relative_turn);
+      if (relative_turn > 0.0)
+        step = std::min(step, moving.margin(step * relative_turn) / relative_turn);
       take(step);
     };
     if (r.feature_a.type == FeatureType::face) {
