@@ -209,7 +209,7 @@ class FeaturePlane {
   FeaturePlane(const ConvexPolytope& body, const Pose& pose, const Vec3& origin,
                const VertexSet& set, const Vec3& n, const Vec3& direction, double sign,
                const Vec3& v, const Vec3& w, double turn, MarginMemo& memo)
-      : body_(&body), set_(set), direction_(direction), sign_(sign), turn_(turn), memo_(&memo) {
+      : body_(&body), set_(&set), direction_(direction), sign_(sign), turn_(turn), memo_(&memo) {
     // Vertex q at r = R (q - o) from the reference point (o, `origin`, the
     // reference point in the hull's frame): n.(x) = n.t + (R^T n).q, and
     // its rotation part moves along n at (w x r).n = r.(n x w) =
@@ -252,14 +252,14 @@ class FeaturePlane {
     if (fresh_ || margin_ >= need) return margin_;
     // From the kept margin while it is at least half of what it was, or
     // while it does not limit the step.
-    if (margin_ < 0.0 && memo_->margin > 0.0 && memo_->set.same(set_)) {
+    if (margin_ < 0.0 && memo_->margin > 0.0 && memo_->set.same(*set_)) {
       const double kept = memo_->margin - fast_norm(direction_ - memo_->direction) - kMarginSlack;
       if (kept >= 0.0) margin_ = kept;
       if (kept >= 0.5 * memo_->margin || kept >= need) return margin_;
     }
     margin_ = fresh_margin();
     fresh_ = true;
-    *memo_ = {set_, direction_, margin_};
+    *memo_ = {*set_, direction_, margin_};
     return margin_;
   }
   // The span, for a step of `step` (unbounded without a turn).
@@ -267,13 +267,13 @@ class FeaturePlane {
     return turn_ > 0.0 ? margin(step * turn_) / turn_ : std::numeric_limits<double>::infinity();
   }
 
-  const VertexSet& set() const { return set_; }
+  const VertexSet& set() const { return *set_; }
 
  private:
-  double fresh_margin() const { return cone_margin(*body_, set_, direction_, sign_); }
+  double fresh_margin() const { return cone_margin(*body_, *set_, direction_, sign_); }
 
   const ConvexPolytope* body_;
-  VertexSet set_;
+  const VertexSet* set_;  // the caller's, outliving the plane
   Vec3 direction_;
   double sign_;
   double turn_;
@@ -552,10 +552,11 @@ class Sweep {
     const Eigen::AngleAxisd turn(Mat3(m.end.rotation * m.start.rotation.transpose()));
     angle_ = turn.angle();
     axis_ = turn.axis();
-    Mat3 k;
-    k << 0.0, -axis_.z(), axis_.y(), axis_.z(), 0.0, -axis_.x(), -axis_.y(), axis_.x(), 0.0;
-    k_r0_ = k * m.start.rotation;
-    kk_r0_ = k * k_r0_;
+    // K x = axis x x, column by column.
+    for (int j = 0; j < 3; ++j) {
+      k_r0_.col(j) = axis_.cross(m.start.rotation.col(j));
+      kk_r0_.col(j) = axis_.cross(Vec3(k_r0_.col(j)));
+    }
   }
   Pose at(double t) const {
     if (t <= 0.0) return motion_.start;
@@ -646,6 +647,9 @@ namespace {
 // Both motions under the pose contract (re-orthonormalized where the
 // contract allows it).
 Sweep checked_sweep(const Motion& m, const char* start, const char* end) {
+  // Both ends' check at once (the common case), else each end's own.
+  if (detail::are_rigid(m.start, m.end)) [[likely]]
+    return Sweep(m);
   return Sweep(Motion{checked_pose(m.start, start), checked_pose(m.end, end)});
 }
 
@@ -862,10 +866,12 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     }
     // The pairs with a feature's plane: its span (costly) only where the
     // step before the span limit beats the best so far.
-    FeaturePlane feature_a(a, pa, ha.origin, feature_set(a, r.feature_a, hull.vertex_a), n,
-                           hull.direction_a, 1.0, va, wa, turn_a, memo_a);
-    FeaturePlane feature_b(b, pb, hb.origin, feature_set(b, r.feature_b, hull.vertex_b), n,
-                           hull.direction_b, -1.0, vb, wb, turn_b, memo_b);
+    const VertexSet set_a = feature_set(a, r.feature_a, hull.vertex_a);
+    const VertexSet set_b = feature_set(b, r.feature_b, hull.vertex_b);
+    FeaturePlane feature_a(a, pa, ha.origin, set_a, n, hull.direction_a, 1.0, va, wa, turn_a,
+                           memo_a);
+    FeaturePlane feature_b(b, pb, hb.origin, set_b, n, hull.direction_b, -1.0, vb, wb, turn_b,
+                           memo_b);
     const PlaneBound& fa = feature_a.bound();
     const PlaneBound& fb = feature_b.bound();
     const auto with_span = [&](double step, FeaturePlane* x, FeaturePlane* y) {
