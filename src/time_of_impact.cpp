@@ -108,22 +108,30 @@ constexpr std::size_t kMaxFeatureVertices = 16;
 struct VertexSet {
   std::array<std::int32_t, kMaxFeatureVertices + 4> ids;  // the first `size` only
   std::size_t size = 0;
+  // Bit v mod 64 set for each vertex v of S: a vertex whose bit is clear
+  // is not in S (the common answer of has(), without the loop).
+  std::uint64_t bits = 0;
+  static std::uint64_t bit(std::int32_t v) {
+    return std::uint64_t{1} << (static_cast<std::uint32_t>(v) & 63u);
+  }
   // A vertex known not to be in S yet (a face's own, distinct, into an
   // empty S).
-  void push(std::int32_t v) { ids[size++] = v; }
-  void add(std::int32_t v) {
-    if (v < 0 || std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
-                     ids.begin() + static_cast<std::ptrdiff_t>(size))
-      return;
+  void push(std::int32_t v) {
     ids[size++] = v;
+    bits |= bit(v);
+  }
+  void add(std::int32_t v) {
+    if (v < 0 || has(v)) return;
+    push(v);
   }
   bool same(const VertexSet& o) const {
     return size == o.size &&
            std::equal(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), o.ids.begin());
   }
-  // A plain loop (std::find's unrolled one costs more: S holds a few
-  // vertices).
+  // The bit first, then a plain loop (std::find's unrolled one costs more:
+  // S holds a few vertices).
   bool has(std::int32_t v) const {
+    if ((bits & bit(v)) == 0) return false;
     for (std::size_t k = 0; k < size; ++k) {
       if (ids[k] == v) return true;
     }
