@@ -153,6 +153,24 @@ VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int su
   return set;
 }
 
+// feature_set of the last step, kept while the witness feature and the
+// support vertex stay (near a contact they do from step to step).
+struct FeatureSetMemo {
+  Feature feature;
+  int support = -1;  // -1: none yet
+  VertexSet set;
+
+  const VertexSet& of(const ConvexPolytope& body, const Feature& f, int s) {
+    if (s != support || f.type != feature.type || f.face != feature.face ||
+        f.vertices != feature.vertices) {
+      set = feature_set(body, f, s);
+      feature = f;
+      support = s;
+    }
+    return set;
+  }
+};
+
 // A feature margin computed at an earlier step, kept for the next ones:
 // each edge's ratio sign d.(q - y) / |q - y| is 1-Lipschitz in the unit
 // direction d, and so is their minimum, so for the same vertex set the
@@ -811,6 +829,7 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
   // standard at these poses (the rounding of the query's coordinates).
   const double relative_turn = fast_norm(wa - wb);
   MarginMemo memo_a, memo_b;
+  FeatureSetMemo sets_a, sets_b;
   EdgePairs edge_pairs;
   edge_pairs.turn_a = fast_norm(wa);
   edge_pairs.turn_b = fast_norm(wb);
@@ -874,8 +893,8 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     }
     // The pairs with a feature's plane: its span (costly) only where the
     // step before the span limit beats the best so far.
-    const VertexSet set_a = feature_set(a, r.feature_a, hull.vertex_a);
-    const VertexSet set_b = feature_set(b, r.feature_b, hull.vertex_b);
+    const VertexSet& set_a = sets_a.of(a, r.feature_a, hull.vertex_a);
+    const VertexSet& set_b = sets_b.of(b, r.feature_b, hull.vertex_b);
     FeaturePlane feature_a(a, pa, ha.origin, set_a, n, hull.direction_a, 1.0, va, wa, turn_a,
                            memo_a);
     FeaturePlane feature_b(b, pb, hb.origin, set_b, n, hull.direction_b, -1.0, vb, wb, turn_b,
