@@ -108,22 +108,34 @@ constexpr std::size_t kMaxFeatureVertices = 16;
 struct VertexSet {
   std::array<std::int32_t, kMaxFeatureVertices + 4> ids;  // the first `size` only
   std::size_t size = 0;
+  // Bit v mod 64 set for each vertex v of S: a vertex whose bit is clear
+  // is not in S (the common answer of has(), without the loop).
+  std::uint64_t bits = 0;
+  static std::uint64_t bit(std::int32_t v) {
+    return std::uint64_t{1} << (static_cast<std::uint32_t>(v) & 63u);
+  }
   // A vertex known not to be in S yet (a face's own, distinct, into an
   // empty S).
-  void push(std::int32_t v) { ids[size++] = v; }
-  void add(std::int32_t v) {
-    if (v < 0 || std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
-                     ids.begin() + static_cast<std::ptrdiff_t>(size))
-      return;
+  void push(std::int32_t v) {
     ids[size++] = v;
+    bits |= bit(v);
+  }
+  void add(std::int32_t v) {
+    if (v < 0 || has(v)) return;
+    push(v);
   }
   bool same(const VertexSet& o) const {
     return size == o.size &&
            std::equal(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), o.ids.begin());
   }
+  // The bit first, then a plain loop (std::find's unrolled one costs more:
+  // S holds a few vertices).
   bool has(std::int32_t v) const {
-    return std::find(ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(size), v) !=
-           ids.begin() + static_cast<std::ptrdiff_t>(size);
+    if ((bits & bit(v)) == 0) return false;
+    for (std::size_t k = 0; k < size; ++k) {
+      if (ids[k] == v) return true;
+    }
+    return false;
   }
 };
 
@@ -140,6 +152,24 @@ VertexSet feature_set(const ConvexPolytope& body, const Feature& feature, int su
   set.add(support);
   return set;
 }
+
+// feature_set of the last step, kept while the witness feature and the
+// support vertex stay (near a contact they do from step to step).
+struct FeatureSetMemo {
+  Feature feature;
+  int support = -1;  // -1: none yet
+  VertexSet set;
+
+  const VertexSet& of(const ConvexPolytope& body, const Feature& f, int s) {
+    if (s != support || f.type != feature.type || f.face != feature.face ||
+        f.vertices != feature.vertices) {
+      set = feature_set(body, f, s);
+      feature = f;
+      support = s;
+    }
+    return set;
+  }
+};
 
 // A feature margin computed at an earlier step, kept for the next ones:
 // each edge's ratio sign d.(q - y) / |q - y| is 1-Lipschitz in the unit
@@ -167,19 +197,31 @@ double cone_margin(const ConvexPolytope& body, const VertexSet& set, const Vec3&
   // Each edge's ratio on its own and the smallest kept: no chain of
   // divisions through a running margin (that chain, not the arithmetic,
   // was the cost of a step). A falling edge (rise < 0) ends it at 0.
-  double margin = 1.0;
+  // The ratios squared, rise^2 / length^2 where length^2 is in range, one
+  // root at the end: no root per edge. rise <= length, so rise^2 does not
+  // overflow; a square in the subnormals may be rounded up, so squares
+  // below 2^-900 (margins below 2^-450) count as no margin.
+  double margin2 = 1.0;
+  const Vec3 d = sign * direction;
   for (std::size_t k = 0; k < set.size; ++k) {
     const Vec3& q = body.vertex(set.ids[k]);
     for (const std::int32_t y : body.neighbors(set.ids[k])) {
       if (set.has(y)) continue;
       const Vec3 edge = q - body.vertex(y);
-      const double rise = sign * direction.dot(edge);
+      const double rise = d.dot(edge);
       if (rise < 0.0) return 0.0;
-      const double length = fast_norm(edge);
-      margin = std::min(margin, length > 0.0 ? rise / length : 1.0);
+      const double length2 = edge.squaredNorm();
+      if (length2 >= std::numeric_limits<double>::min() && length2 < 0x1p1000) [[likely]] {
+        margin2 = std::min(margin2, rise * rise / length2);
+      } else {
+        const double length = edge.stableNorm();
+        const double ratio = length > 0.0 ? rise / length : 1.0;
+        margin2 = std::min(margin2, ratio * ratio);
+      }
     }
   }
-  return margin * kConeMarginShrink;
+  if (!(margin2 >= 0x1p-900)) return 0.0;
+  return std::sqrt(margin2) * kConeMarginShrink;
 }
 
 // The witness feature's plane of one body at one step. Its value, rate and
@@ -193,7 +235,7 @@ class FeaturePlane {
   FeaturePlane(const ConvexPolytope& body, const Pose& pose, const Vec3& origin,
                const VertexSet& set, const Vec3& n, const Vec3& direction, double sign,
                const Vec3& v, const Vec3& w, double turn, MarginMemo& memo)
-      : body_(&body), set_(set), direction_(direction), sign_(sign), turn_(turn), memo_(&memo) {
+      : body_(&body), set_(&set), direction_(direction), sign_(sign), turn_(turn), memo_(&memo) {
     // Vertex q at r = R (q - o) from the reference point (o, `origin`, the
     // reference point in the hull's frame): n.(x) = n.t + (R^T n).q, and
     // its rotation part moves along n at (w x r).n = r.(n x w) =
@@ -230,36 +272,41 @@ class FeaturePlane {
   // before a neighbour of S may overtake it: the smallest margin of the
   // header comment, a hair inside, >= 0. The margin loop, O(|S| degree
   // |S|), runs on the first call only.
-  double margin() {
-    if (margin_ >= 0.0) return margin_;
-    // From the kept margin while it is at least half of what it was.
-    if (memo_->margin > 0.0 && memo_->set.same(set_)) {
+  // `need`: the margin that would not limit the caller's step; a kept
+  // margin that reaches it is as good as a fresh one there.
+  double margin(double need) {
+    if (fresh_ || margin_ >= need) return margin_;
+    // From the kept margin while it is at least half of what it was, or
+    // while it does not limit the step.
+    if (margin_ < 0.0 && memo_->margin > 0.0 && memo_->set.same(*set_)) {
       const double kept = memo_->margin - fast_norm(direction_ - memo_->direction) - kMarginSlack;
-      if (kept >= 0.5 * memo_->margin) {
-        margin_ = kept;
-        return margin_;
-      }
+      if (kept >= 0.0) margin_ = kept;
+      if (kept >= 0.5 * memo_->margin || kept >= need) return margin_;
     }
     margin_ = fresh_margin();
-    *memo_ = {set_, direction_, margin_};
+    fresh_ = true;
+    *memo_ = {*set_, direction_, margin_};
     return margin_;
   }
-  // The span: unbounded without a turn.
-  double span() { return turn_ > 0.0 ? margin() / turn_ : std::numeric_limits<double>::infinity(); }
+  // The span, for a step of `step` (unbounded without a turn).
+  double span(double step) {
+    return turn_ > 0.0 ? margin(step * turn_) / turn_ : std::numeric_limits<double>::infinity();
+  }
 
-  const VertexSet& set() const { return set_; }
+  const VertexSet& set() const { return *set_; }
 
  private:
-  double fresh_margin() const { return cone_margin(*body_, set_, direction_, sign_); }
+  double fresh_margin() const { return cone_margin(*body_, *set_, direction_, sign_); }
 
   const ConvexPolytope* body_;
-  VertexSet set_;
+  const VertexSet* set_;  // the caller's, outliving the plane
   Vec3 direction_;
   double sign_;
   double turn_;
   PlaneBound bound_;
   MarginMemo* memo_;
   double margin_ = -1.0;  // not computed yet
+  bool fresh_ = false;    // margin_ is cone_margin's own (else kept or none)
 };
 
 // The first time in [0, span] at which a gap gap0 closing at `rate` with
@@ -477,6 +524,46 @@ double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origi
   return std::min(step, span);
 }
 
+// sin x and cos x for x in [0, pi/2], the range of a sweep's half angle
+// (angle <= pi, 0 < t < 1): Taylor polynomials on [0, pi/4], their
+// truncation below 1e-19 there, and the cofunctions of pi/2 - x above it
+// (pi/2 - x exact by Sterbenz with pi/2's head, then its tail added). A
+// few ulps, as the library's; a quarter of glibc's sincos's instructions
+// (its argument reduction covers every double), one pair per body and
+// step. Outside the range: std::sin and std::cos.
+void sin_cos_quadrant(double x, double& sine, double& cosine) {
+  constexpr double kHalfPiHead = 1.5707963267948966;
+  constexpr double kHalfPiTail = 6.123233995736766e-17;
+  if (!(x >= 0.0 && x <= kHalfPiHead)) {
+    sine = std::sin(x);
+    cosine = std::cos(x);
+    return;
+  }
+  const bool high = x > 0.5 * kHalfPiHead;
+  const double y = high ? (kHalfPiHead - x) + kHalfPiTail : x;
+  const double z = y * y;
+  // sin y = y (1 - z/3! + z^2/5! - ... + z^8/17!), cos y = 1 - z/2! + ... + z^9/18!.
+  const double s =
+      y + y * z *
+              (-1.0 / 6 +
+               z * (1.0 / 120 + z * (-1.0 / 5040 +
+                                     z * (1.0 / 362880 + z * (-1.0 / 39916800 +
+                                                              z * (1.0 / 6227020800 +
+                                                                   z * (-1.0 / 1307674368000 +
+                                                                        z / 355687428096000)))))));
+  const double c =
+      1.0 +
+      z * (-0.5 + z * (1.0 / 24 +
+                       z * (-1.0 / 720 +
+                            z * (1.0 / 40320 +
+                                 z * (-1.0 / 3628800 +
+                                      z * (1.0 / 479001600 + z * (-1.0 / 87178291200 +
+                                                                  z * (1.0 / 20922789888000 -
+                                                                       z / 6402373705728000))))))));
+  sine = high ? c : s;
+  cosine = high ? s : c;
+}
+
 // A motion with its turn precomputed (Motion::at would convert the rotation
 // to an angle and an axis on every call; a time of impact takes poses at a
 // dozen times). The turn by phi = t angle about the unit axis k is
@@ -491,10 +578,11 @@ class Sweep {
     const Eigen::AngleAxisd turn(Mat3(m.end.rotation * m.start.rotation.transpose()));
     angle_ = turn.angle();
     axis_ = turn.axis();
-    Mat3 k;
-    k << 0.0, -axis_.z(), axis_.y(), axis_.z(), 0.0, -axis_.x(), -axis_.y(), axis_.x(), 0.0;
-    k_r0_ = k * m.start.rotation;
-    kk_r0_ = k * k_r0_;
+    // K x = axis x x, column by column.
+    for (int j = 0; j < 3; ++j) {
+      k_r0_.col(j) = axis_.cross(m.start.rotation.col(j));
+      kk_r0_.col(j) = axis_.cross(Vec3(k_r0_.col(j)));
+    }
   }
   Pose at(double t) const {
     if (t <= 0.0) return motion_.start;
@@ -502,8 +590,8 @@ class Sweep {
     Pose p;
     if (angle_ > 0.0) {
       const double half = 0.5 * t * angle_;
-      const double s = std::sin(half);
-      const double c = std::cos(half);
+      double s, c;
+      sin_cos_quadrant(half, s, c);
       p.rotation = motion_.start.rotation + (2.0 * s * c) * k_r0_ + (2.0 * s * s) * kk_r0_;
     } else {
       p.rotation = motion_.start.rotation;
@@ -585,6 +673,9 @@ namespace {
 // Both motions under the pose contract (re-orthonormalized where the
 // contract allows it).
 Sweep checked_sweep(const Motion& m, const char* start, const char* end) {
+  // Both ends' check at once (the common case), else each end's own.
+  if (detail::are_rigid(m.start, m.end)) [[likely]]
+    return Sweep(m);
   return Sweep(Motion{checked_pose(m.start, start), checked_pose(m.end, end)});
 }
 
@@ -738,6 +829,7 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
   // standard at these poses (the rounding of the query's coordinates).
   const double relative_turn = fast_norm(wa - wb);
   MarginMemo memo_a, memo_b;
+  FeatureSetMemo sets_a, sets_b;
   EdgePairs edge_pairs;
   edge_pairs.turn_a = fast_norm(wa);
   edge_pairs.turn_b = fast_norm(wb);
@@ -756,12 +848,17 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     // A's top along n, and B's bottom as -(min along n): both rising at
     // `rate` at most bring them closer. The hull's and the ball's planes
     // have no span limit and no acceleration.
-    const PlaneBound top_a[2] = {{hull.top_a, va.dot(n) + turn_a * reach_a, 0.0, inf},
-                                 {n.dot(pa.apply(a.centroid())) + a.bounding_radius(),
-                                  va.dot(n) + turn_a * ha.lever, 0.0, inf}};
-    const PlaneBound bottom_b[2] = {{-hull.bottom_b, -vb.dot(n) + turn_b * reach_b, 0.0, inf},
-                                    {-(n.dot(pb.apply(b.centroid())) - b.bounding_radius()),
-                                     -vb.dot(n) + turn_b * hb.lever, 0.0, inf}};
+    // The balls' centers along n as the hull's vertices: n.t + (R^T n).c.
+    const double along_a = n.dot(pa.translation), along_b = n.dot(pb.translation);
+    const double speed_a = va.dot(n), speed_b = vb.dot(n);
+    const PlaneBound top_a[2] = {
+        {hull.top_a, speed_a + turn_a * reach_a, 0.0, inf},
+        {along_a + hull.direction_a.dot(a.centroid()) + a.bounding_radius(),
+         speed_a + turn_a * ha.lever, 0.0, inf}};
+    const PlaneBound bottom_b[2] = {
+        {-hull.bottom_b, -speed_b + turn_b * reach_b, 0.0, inf},
+        {-(along_b + hull.direction_b.dot(b.centroid()) - b.bounding_radius()),
+         -speed_b + turn_b * hb.lever, 0.0, inf}};
     SafeStep best = lower_bound_step(r.lower_bound - band, target, any_speed);
     // The step of planes x and y without their span limit, or 0 when their
     // gap is already closed.
@@ -782,8 +879,9 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     }
     if (best.never) return best;
     const double horizon = 1.0 - t;
-    const Vec3 origin_a = pa.apply(ha.origin);
-    const Vec3 origin_b = pb.apply(hb.origin);
+    // The reference points (a convex body's is its pose's translation).
+    const Vec3 origin_a = ha.local != nullptr ? pa.apply(ha.origin) : pa.translation;
+    const Vec3 origin_b = hb.local != nullptr ? pb.apply(hb.origin) : pb.translation;
     // The plane through two edges (edge_pair_step): an edge-edge contact
     // closes at its true rate, at second order. Before the feature planes,
     // whose spans it then mostly spares.
@@ -795,16 +893,18 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     }
     // The pairs with a feature's plane: its span (costly) only where the
     // step before the span limit beats the best so far.
-    FeaturePlane feature_a(a, pa, ha.origin, feature_set(a, r.feature_a, hull.vertex_a), n,
-                           hull.direction_a, 1.0, va, wa, turn_a, memo_a);
-    FeaturePlane feature_b(b, pb, hb.origin, feature_set(b, r.feature_b, hull.vertex_b), n,
-                           hull.direction_b, -1.0, vb, wb, turn_b, memo_b);
+    const VertexSet& set_a = sets_a.of(a, r.feature_a, hull.vertex_a);
+    const VertexSet& set_b = sets_b.of(b, r.feature_b, hull.vertex_b);
+    FeaturePlane feature_a(a, pa, ha.origin, set_a, n, hull.direction_a, 1.0, va, wa, turn_a,
+                           memo_a);
+    FeaturePlane feature_b(b, pb, hb.origin, set_b, n, hull.direction_b, -1.0, vb, wb, turn_b,
+                           memo_b);
     const PlaneBound& fa = feature_a.bound();
     const PlaneBound& fb = feature_b.bound();
     const auto with_span = [&](double step, FeaturePlane* x, FeaturePlane* y) {
       if (!(step > best.step)) return;
-      if (x != nullptr) step = std::min(step, x->span());
-      if (y != nullptr) step = std::min(step, y->span());
+      if (x != nullptr) step = std::min(step, x->span(step));
+      if (y != nullptr) step = std::min(step, y->span(step));
       take(step);
     };
     with_span(unlimited(fa, fb), &feature_a, &feature_b);
@@ -820,7 +920,8 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     // shows (toi_bench, N = 8: 3.3 us with them everywhere, 3.1 us so).
     const auto fixed = [&](double step, FeaturePlane& moving) {
       if (!(step > best.step)) return;
-      if (relative_turn > 0.0) step = std::min(step, moving.margin() / relative_turn);
+      if (relative_turn > 0.0)
+        step = std::min(step, moving.margin(step * relative_turn) / relative_turn);
       take(step);
     };
     if (r.feature_a.type == FeatureType::face) {
