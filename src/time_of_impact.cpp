@@ -23,6 +23,51 @@
 #include "proxima/support.h"
 
 namespace proxima {
+
+namespace detail {
+
+// sin x and cos x for x in [0, pi/2], the range of a sweep's half angle
+// (angle <= pi, 0 < t < 1): Taylor polynomials on [0, pi/4], their
+// truncation below 1e-19 there, and the cofunctions of pi/2 - x above it
+// (pi/2 - x exact by Sterbenz with pi/2's head, then its tail added). A
+// few ulps, as the library's; a quarter of glibc's sincos's instructions
+// (its argument reduction covers every double), one pair per body and
+// step. Outside the range: std::sin and std::cos.
+void sin_cos_quadrant(double x, double& sine, double& cosine) {
+  constexpr double kHalfPiHead = 1.5707963267948966;
+  constexpr double kHalfPiTail = 6.123233995736766e-17;
+  if (!(x >= 0.0 && x <= kHalfPiHead)) {
+    sine = std::sin(x);
+    cosine = std::cos(x);
+    return;
+  }
+  const bool high = x > 0.5 * kHalfPiHead;
+  const double y = high ? (kHalfPiHead - x) + kHalfPiTail : x;
+  const double z = y * y;
+  // sin y = y (1 - z/3! + z^2/5! - ... + z^8/17!), cos y = 1 - z/2! + ... + z^9/18!.
+  const double s =
+      y + y * z *
+              (-1.0 / 6 +
+               z * (1.0 / 120 + z * (-1.0 / 5040 +
+                                     z * (1.0 / 362880 + z * (-1.0 / 39916800 +
+                                                              z * (1.0 / 6227020800 +
+                                                                   z * (-1.0 / 1307674368000 +
+                                                                        z / 355687428096000)))))));
+  const double c =
+      1.0 +
+      z * (-0.5 + z * (1.0 / 24 +
+                       z * (-1.0 / 720 +
+                            z * (1.0 / 40320 +
+                                 z * (-1.0 / 3628800 +
+                                      z * (1.0 / 479001600 + z * (-1.0 / 87178291200 +
+                                                                  z * (1.0 / 20922789888000 -
+                                                                       z / 6402373705728000))))))));
+  sine = high ? c : s;
+  cosine = high ? s : c;
+}
+
+}  // namespace detail
+
 namespace {
 
 bool finite(const Vec3& v) { return v.allFinite(); }
@@ -524,46 +569,6 @@ double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origi
   return std::min(step, span);
 }
 
-// sin x and cos x for x in [0, pi/2], the range of a sweep's half angle
-// (angle <= pi, 0 < t < 1): Taylor polynomials on [0, pi/4], their
-// truncation below 1e-19 there, and the cofunctions of pi/2 - x above it
-// (pi/2 - x exact by Sterbenz with pi/2's head, then its tail added). A
-// few ulps, as the library's; a quarter of glibc's sincos's instructions
-// (its argument reduction covers every double), one pair per body and
-// step. Outside the range: std::sin and std::cos.
-void sin_cos_quadrant(double x, double& sine, double& cosine) {
-  constexpr double kHalfPiHead = 1.5707963267948966;
-  constexpr double kHalfPiTail = 6.123233995736766e-17;
-  if (!(x >= 0.0 && x <= kHalfPiHead)) {
-    sine = std::sin(x);
-    cosine = std::cos(x);
-    return;
-  }
-  const bool high = x > 0.5 * kHalfPiHead;
-  const double y = high ? (kHalfPiHead - x) + kHalfPiTail : x;
-  const double z = y * y;
-  // sin y = y (1 - z/3! + z^2/5! - ... + z^8/17!), cos y = 1 - z/2! + ... + z^9/18!.
-  const double s =
-      y + y * z *
-              (-1.0 / 6 +
-               z * (1.0 / 120 + z * (-1.0 / 5040 +
-                                     z * (1.0 / 362880 + z * (-1.0 / 39916800 +
-                                                              z * (1.0 / 6227020800 +
-                                                                   z * (-1.0 / 1307674368000 +
-                                                                        z / 355687428096000)))))));
-  const double c =
-      1.0 +
-      z * (-0.5 + z * (1.0 / 24 +
-                       z * (-1.0 / 720 +
-                            z * (1.0 / 40320 +
-                                 z * (-1.0 / 3628800 +
-                                      z * (1.0 / 479001600 + z * (-1.0 / 87178291200 +
-                                                                  z * (1.0 / 20922789888000 -
-                                                                       z / 6402373705728000))))))));
-  sine = high ? c : s;
-  cosine = high ? s : c;
-}
-
 // A motion with its turn precomputed (Motion::at would convert the rotation
 // to an angle and an axis on every call; a time of impact takes poses at a
 // dozen times). The turn by phi = t angle about the unit axis k is
@@ -591,7 +596,7 @@ class Sweep {
     if (angle_ > 0.0) {
       const double half = 0.5 * t * angle_;
       double s, c;
-      sin_cos_quadrant(half, s, c);
+      detail::sin_cos_quadrant(half, s, c);
       p.rotation = motion_.start.rotation + (2.0 * s * c) * k_r0_ + (2.0 * s * s) * kk_r0_;
     } else {
       p.rotation = motion_.start.rotation;
