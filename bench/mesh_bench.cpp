@@ -25,8 +25,8 @@
 // triangle pair with the closed-form kernel), on K poses of each kind.
 // Then: mesh against convex (env against the hull of rob along the motion,
 // cold and tracked; the same hull as a closed mesh, mesh against mesh; FCL
-// BVHModel<OBBRSS> against fcl::Convexd of the same hull), the exact triangle-triangle kernel's time, and the build of a
-// ~10^6-triangle mesh (time, bytes against the raw vertices + triangles).
+// BVHModel<OBBRSS> against fcl::Convexd of the same hull), the exact triangle-triangle kernel's
+// time, and the build of a ~10^6-triangle mesh (time, bytes against the raw vertices + triangles).
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/distance.h>
 #include <proxima/closest_point.h>
@@ -62,20 +62,6 @@ struct MeshFile {
 MeshFile load(const std::string& path) {
   proxima::PointCloud cloud = proxima::read_points(path);
   return {std::move(cloud.points), std::move(cloud.triangles)};
-}
-
-template <class BV>
-std::shared_ptr<fcl::BVHModel<BV>> fcl_model(const MeshFile& m) {
-  auto model = std::make_shared<fcl::BVHModel<BV>>();
-  std::vector<fcl::Vector3d> v(m.vertices.begin(), m.vertices.end());
-  std::vector<fcl::Triangle> t;
-  for (const auto& tri : m.triangles)
-    t.emplace_back(static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
-                   static_cast<std::size_t>(tri[2]));
-  model->beginModel();
-  model->addSubModel(v, t);
-  model->endModel();
-  return model;
 }
 
 fcl::Transform3d to_fcl(const Pose& p) {
@@ -213,10 +199,12 @@ int main(int argc, char** argv) {
   std::printf("rob: %d vertices, %d triangles, closed %d, %zu degenerate, %zu components\n",
               rob.vertex_count(), rob.triangle_count(), rob.is_closed() ? 1 : 0,
               rob.degenerate_triangles().size(), rob.component_vertices().size());
-  const auto env_obbrss = fcl_model<fcl::OBBRSSd>(env_file);
-  const auto rob_obbrss = fcl_model<fcl::OBBRSSd>(rob_file);
-  const auto env_rss = fcl_model<fcl::RSSd>(env_file);
-  const auto rob_rss = fcl_model<fcl::RSSd>(rob_file);
+  const auto env_obbrss =
+      proxima::bench::fcl_mesh<fcl::OBBRSSd>(env_file.vertices, env_file.triangles);
+  const auto rob_obbrss =
+      proxima::bench::fcl_mesh<fcl::OBBRSSd>(rob_file.vertices, rob_file.triangles);
+  const auto env_rss = proxima::bench::fcl_mesh<fcl::RSSd>(env_file.vertices, env_file.triangles);
+  const auto rob_rss = proxima::bench::fcl_mesh<fcl::RSSd>(rob_file.vertices, rob_file.triangles);
 
   std::mt19937_64 rng(20261125);
   std::vector<Pose> random_poses;

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "panda_arm.h"
+#include "peers/fcl_convex.h"
 
 #ifndef PROXIMA_PANDA_MESH_DIR
 #define PROXIMA_PANDA_MESH_DIR "examples/data/panda"
@@ -57,25 +58,6 @@ double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-template <class BV>
-std::shared_ptr<fcl::BVHModel<BV>> fcl_mesh(const proxima::TriangleMesh& m) {
-  auto model = std::make_shared<fcl::BVHModel<BV>>();
-  std::vector<fcl::Vector3d> v(m.vertices().begin(), m.vertices().end());
-  std::vector<fcl::Triangle> t;
-  for (const auto& tri : m.triangles()) t.emplace_back(tri[0], tri[1], tri[2]);
-  model->beginModel();
-  model->addSubModel(v, t);
-  model->endModel();
-  return model;
-}
-
-fcl::Transform3d to_fcl(const proxima::Pose& p) {
-  fcl::Transform3d tf = fcl::Transform3d::Identity();
-  tf.linear() = p.rotation;
-  tf.translation() = p.translation;
-  return tf;
 }
 
 struct Agreement {
@@ -104,8 +86,10 @@ int run(int repeat, int referee_count, const std::string& mesh_dir) {
     meshes.push_back(std::make_shared<const proxima::TriangleMesh>(proxima::load_mesh(path).mesh));
     triangles += meshes.back()->triangle_count();
     closed += meshes.back()->is_closed() ? 1 : 0;
-    fcl_obbrss.push_back(fcl_mesh<fcl::OBBRSSd>(*meshes.back()));
-    fcl_rss.push_back(fcl_mesh<fcl::RSSd>(*meshes.back()));
+    fcl_obbrss.push_back(proxima::bench::fcl_mesh<fcl::OBBRSSd>(meshes.back()->vertices(),
+                                                                meshes.back()->triangles()));
+    fcl_rss.push_back(
+        proxima::bench::fcl_mesh<fcl::RSSd>(meshes.back()->vertices(), meshes.back()->triangles()));
   }
   std::vector<std::pair<int, int>> pairs;  // the non-adjacent pairs
   for (int a = 0; a < kBodies; ++a)
@@ -158,7 +142,7 @@ int run(int repeat, int referee_count, const std::string& mesh_dir) {
       for (int s : {fcl_obb, fcl_r}) {
         const auto start = Clock::now();
         std::array<fcl::Transform3d, kBodies> tf;
-        for (int i = 0; i < kBodies; ++i) tf[i] = to_fcl(pose[i]);
+        for (int i = 0; i < kBodies; ++i) tf[i] = proxima::bench::fcl_transform(pose[i]);
         for (std::size_t k = 0; k < pairs.size(); ++k) {
           const auto [a, b] = pairs[k];
           fcl::DistanceResultd result;

@@ -72,6 +72,18 @@
 
 namespace {
 
+// FCL's conservative advancement with its libccd solver, linear motion,
+// proxima's iteration cap and a time tolerance of 1e-6.
+fcl::ContinuousCollisionRequestd fcl_ca_request() {
+  fcl::ContinuousCollisionRequestd request;
+  request.ccd_motion_type = fcl::CCDM_LINEAR;
+  request.ccd_solver_type = fcl::CCDC_CONSERVATIVE_ADVANCEMENT;
+  request.gjk_solver_type = fcl::GST_LIBCCD;
+  request.num_max_iterations = 256;
+  request.toc_err = 1e-6;
+  return request;
+}
+
 using proxima::ConvexPolytope;
 using proxima::Motion;
 using proxima::Pose;
@@ -213,20 +225,6 @@ void compound_section(int count) {
   }
 }
 
-// FCL's BVHModel<OBBRSS> of a mesh's vertices and triangles.
-std::shared_ptr<fcl::BVHModel<fcl::OBBRSSd>> fcl_mesh(const proxima::PointCloud& m) {
-  auto model = std::make_shared<fcl::BVHModel<fcl::OBBRSSd>>();
-  std::vector<fcl::Vector3d> v(m.points.begin(), m.points.end());
-  std::vector<fcl::Triangle> t;
-  for (const auto& tri : m.triangles)
-    t.emplace_back(static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
-                   static_cast<std::size_t>(tri[2]));
-  model->beginModel();
-  model->addSubModel(v, t);
-  model->endModel();
-  return model;
-}
-
 void mesh_section(int count, const std::string& dir) {
   const std::string env_path = dir + "/env.obj", rob_path = dir + "/rob.obj";
   if (!std::filesystem::exists(env_path) || !std::filesystem::exists(rob_path)) {
@@ -238,7 +236,7 @@ void mesh_section(int count, const std::string& dir) {
   const proxima::Body mesh(proxima::TriangleMesh(env.points, env.triangles));
   const ConvexPolytope hull(rob.points);
   const proxima::Body convex(hull);
-  const auto fmesh = fcl_mesh(env);
+  const auto fmesh = proxima::bench::fcl_mesh<fcl::OBBRSSd>(env.points, env.triangles);
   const auto fhull = proxima::bench::fcl_convex(hull, "toi_bench: rob hull");
   std::printf(
       "\n# meshes: env.obj (%d triangles, fixed) against the hull of rob.obj (%d vertices), %d "
@@ -283,12 +281,7 @@ void mesh_section(int count, const std::string& dir) {
     const bool ours_hit = r.status == proxima::ImpactStatus::contact;
     contacts += ours_hit ? 1 : 0;
 
-    fcl::ContinuousCollisionRequestd request;
-    request.ccd_motion_type = fcl::CCDM_LINEAR;
-    request.ccd_solver_type = fcl::CCDC_CONSERVATIVE_ADVANCEMENT;
-    request.gjk_solver_type = fcl::GST_LIBCCD;
-    request.num_max_iterations = 256;
-    request.toc_err = 1e-6;
+    const fcl::ContinuousCollisionRequestd request = fcl_ca_request();
     fcl::ContinuousCollisionResultd result;
     fcl_ns.push_back(best_of_three_ns([&] {
       result = fcl::ContinuousCollisionResultd();
@@ -351,12 +344,7 @@ int main(int argc, char** argv) {
         steps += r.iterations;
       }
 
-      fcl::ContinuousCollisionRequestd request;
-      request.ccd_motion_type = fcl::CCDM_LINEAR;
-      request.ccd_solver_type = fcl::CCDC_CONSERVATIVE_ADVANCEMENT;
-      request.gjk_solver_type = fcl::GST_LIBCCD;
-      request.num_max_iterations = 256;
-      request.toc_err = 1e-6;
+      const fcl::ContinuousCollisionRequestd request = fcl_ca_request();
       fcl::ContinuousCollisionResultd result;
       fcl_ns.push_back(best_of_three_ns([&] {
         result = fcl::ContinuousCollisionResultd();

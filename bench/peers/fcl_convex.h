@@ -7,10 +7,12 @@
 // (fcl_peer.h and fcl_scene.h keep FCL out of their users' builds).
 #pragma once
 
+#include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/convex.h>
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -49,6 +51,24 @@ inline fcl::Transform3d fcl_transform(const Pose& pose) {
   tf.linear() = pose.rotation;
   tf.translation() = pose.translation;
   return tf;
+}
+
+// FCL's BVHModel<BV> of a triangle mesh: the same vertices and triangles
+// (`triangles` a range of three vertex indices each).
+template <class BV, class Triangles>
+std::shared_ptr<fcl::BVHModel<BV>> fcl_mesh(std::span<const Vec3> vertices,
+                                            const Triangles& triangles) {
+  auto model = std::make_shared<fcl::BVHModel<BV>>();
+  std::vector<fcl::Vector3d> v(vertices.begin(), vertices.end());
+  std::vector<fcl::Triangle> t;
+  t.reserve(triangles.size());
+  for (const auto& tri : triangles)
+    t.emplace_back(static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
+                   static_cast<std::size_t>(tri[2]));
+  model->beginModel();
+  model->addSubModel(v, t);
+  model->endModel();
+  return model;
 }
 
 }  // namespace proxima::bench
