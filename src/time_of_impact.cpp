@@ -978,6 +978,20 @@ class PosesAt {
   std::pair<Pose, Pose> poses_;
 };
 
+// One step of the bounds' advancement below, from t by gap / speed: t
+// itself when the gap is within `close_enough` (the bounds are close: where
+// they are is still a lower bound), infinity when nothing closes or the
+// step passes t_end, the next time (> t) otherwise.
+[[gnu::always_inline]] inline double advance_by_gap(double t, double gap, double close_enough,
+                                                    double speed, double t_end) {
+  if (!(gap > close_enough)) return t;
+  const double never = std::numeric_limits<double>::infinity();
+  if (!(speed > 0.0)) return never;
+  const double next = t + gap / speed;
+  if (!(next < t_end)) return never;
+  return next > t ? next : t;
+}
+
 // The earliest time in [t, t_end] at which balls ba (moving with body A)
 // and bb (with B) can come within `target` of each other, or infinity when
 // they cannot before t_end: conservative advancement on the balls' gap
@@ -1002,11 +1016,8 @@ class PosesAt {
     const double band =
         contact_band(std::max(xa.cwiseAbs().maxCoeff(), xb.cwiseAbs().maxCoeff()) + radii);
     const double gap = fast_norm(xb - xa) - radii - target - band;
-    if (!(gap > kBallCloseEnough * radii)) return t;
-    if (!(speed > 0.0)) return never;
-    const double next = t + gap / speed;
-    if (!(next < t_end)) return never;
-    if (!(next > t)) return t;
+    const double next = advance_by_gap(t, gap, kBallCloseEnough * radii, speed, t_end);
+    if (!(next > t && next < never)) return next;
     t = next;
   }
   return t;
@@ -1075,11 +1086,8 @@ double earliest_contact(PosesAt& poses, const Vec3& speeds, const Bound& ba, con
         std::max({magnitude, x.cwiseAbs().maxCoeff(), ps.translation.cwiseAbs().maxCoeff()}) +
         shape.ball.radius + other.radius);
     const double gap = d - other.radius - target - band;
-    if (!(gap > kBallCloseEnough * other.radius)) return t;
-    if (!(speed > 0.0)) return never;
-    const double next = t + gap / speed;
-    if (!(next < t_end)) return never;
-    if (!(next > t)) return t;
+    const double next = advance_by_gap(t, gap, kBallCloseEnough * other.radius, speed, t_end);
+    if (!(next > t && next < never)) return next;
     t = next;
   }
   return t;
