@@ -49,6 +49,15 @@ double distance_at(const ConvexPolytope& a, const Motion& ma, const ConvexPolyto
   return distance(a, ma.at(t), b, mb.at(t)).distance;
 }
 
+// A distance answer at the reported time of contact (a fresh query's, or
+// the result's own) within the target separation and its tolerance, up to
+// 1e-9 of rounding.
+template <class Answer>
+void expect_within_target(const Answer& at, const ImpactOptions& options) {
+  EXPECT_GE(at.signed_distance(), options.target_separation - 1e-9);
+  EXPECT_LE(at.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+}
+
 // The guarantee of time_of_impact checked against `samples` evenly spaced
 // times: no sample before the reported t within the target (minus a
 // rounding margin), the reported t not after the first sample within it,
@@ -261,8 +270,7 @@ TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {
       ++contacts;
       steps += r.iterations;
       const DistanceResult at = distance(a, r.pose_a, b, r.pose_b);
-      EXPECT_GE(at.signed_distance(), options.target_separation - 1e-9);
-      EXPECT_LE(at.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+      expect_within_target(at, options);
     }
     check_against_sampling(a, ma, b, mb, options, r, 2000);
   }
@@ -356,8 +364,7 @@ TEST(TimeOfImpact, TurningBarsCrossingEdgeOnNeverOvershoot) {
         edge_steps += r.iterations;
       }
       const DistanceResult at = distance(a, r.pose_a, b, r.pose_b);
-      EXPECT_GE(at.signed_distance(), options.target_separation - 1e-9);
-      EXPECT_LE(at.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+      expect_within_target(at, options);
     }
     check_against_sampling(a, ma, b, mb, options, r, 4000);
   }
@@ -711,8 +718,7 @@ TEST(TimeOfImpact, CompoundsPrunedAnswerIsTheEarliestOfEveryPiecePair) {
     if (got.status == ImpactStatus::separated) continue;
     EXPECT_NEAR(got.t, want.t, 1e-6);
     const BodyDistance at = distance(a, got.pose_a, b, got.pose_b);
-    EXPECT_GE(at.signed_distance(), options.target_separation - 1e-9);
-    EXPECT_LE(at.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+    expect_within_target(at, options);
     EXPECT_EQ(got.piece_a, at.piece_a);
     EXPECT_EQ(got.piece_b, at.piece_b);
     contacts += got.status == ImpactStatus::contact ? 1 : 0;
@@ -975,8 +981,7 @@ TEST(TimeOfImpact, MeshPrunedAnswerIsTheEarliestOfEveryTriangle) {
     ASSERT_EQ(r.status, ImpactStatus::contact);
     ++contacts;
     EXPECT_NEAR(r.t, every, 1e-6);
-    EXPECT_GE(r.at_t.signed_distance(), options.target_separation - 1e-9);
-    EXPECT_LE(r.at_t.signed_distance(), options.target_separation + options.tolerance + 1e-9);
+    expect_within_target(r.at_t, options);
     // piece_a: the closest triangle at t, as far from the rock as the mesh.
     ASSERT_GE(r.piece_a, 0);
     ASSERT_LT(r.piece_a, mesh->triangle_count());
