@@ -15,6 +15,8 @@
 #   fig3_rotation.png      paper fig. 3: time per query against the rotational
 #                          speed, tracking where the system has it
 #   cold.png               cold queries against the vertex count, log-log
+#   overlap.png            the signed distance through contact (B sweeping
+#                          through A), against the vertex count, log-log
 #   robustness.png         answers within the accuracy standard, per system
 import csv
 import os
@@ -35,6 +37,7 @@ COLOURS = {
     "FCL libccd scaled": "#8c564b",
     "FCL GJK": "#9467bd",
     "Bullet GJK": "#ff7f0e",
+    "FCL libccd signed": "#bcbd22",
 }
 ORDER = list(COLOURS)
 
@@ -184,6 +187,13 @@ def main():
         "number of vertices per body",
         "Cold queries: random poses, no coherence",
         os.path.join(out, "cold.png"),
+    )
+    systems_figure(
+        read_csv(os.path.join(out, "overlap.csv")),
+        "n",
+        "number of vertices per body",
+        "Signed distance through contact: B sweeps through A (dashed: with tracking)",
+        os.path.join(out, "overlap.png"),
     )
     robustness_figure(robustness, os.path.join(out, "robustness.png"))
     return 0

@@ -87,7 +87,7 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
     SCOPED_TRACE("every file");
     for (const char* name :
          {"robustness.csv", "robustness_failures.csv", "translation.csv", "rotation.csv",
-          "cold.csv", "targets.csv", "tracking_modes.csv", "run.csv"}) {
+          "cold.csv", "overlap.csv", "targets.csv", "tracking_modes.csv", "run.csv"}) {
       EXPECT_TRUE(fs::exists(dir / name)) << name;
       EXPECT_FALSE(read_csv(dir / name).empty() && std::string(name) != "robustness_failures.csv")
           << name;
@@ -139,6 +139,26 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
       EXPECT_EQ(systems, kSystems) << name;
     }
     EXPECT_EQ(log.str().find("WARNING"), std::string::npos) << log.str();
+  }
+  {
+    SCOPED_TRACE("overlap sweep: the signed distance, proxima tracked and cold and both peers");
+    std::set<std::pair<std::string, bool>> configurations;
+    for (const auto& row : read_csv(dir / "overlap.csv")) {
+      configurations.insert({row.at("system"), row.at("tracking") == "1"});
+      EXPECT_GT(std::stod(row.at("median_ns")), 0.0) << row.at("system");
+      EXPECT_GE(std::stoi(row.at("repetitions")), 5);
+      // B overlaps A on most of the sweep (about three quarters of it from
+      // N = 64; 8 points span a smaller hull): a system that answered the
+      // distance (0 when overlapping) instead would have a mean >= 0.
+      EXPECT_LT(std::stod(row.at("mean_distance")), 0.0)
+          << row.at("system") << " N " << row.at("n");
+    }
+    const std::set<std::pair<std::string, bool>> expected = {{"proxima hybrid", true},
+                                                             {"proxima hybrid", false},
+                                                             {"FCL libccd signed", false},
+                                                             {"Bullet GJK", false}};
+    EXPECT_EQ(configurations, expected);
+    EXPECT_NE(log.str().find("tracked flat in N"), std::string::npos) << log.str();
   }
   fs::remove_all(dir);
 }

@@ -110,7 +110,12 @@ enum class SystemKind : std::uint8_t {
   fcl_libccd,
   fcl_libccd_scaled,
   fcl_indep,
-  bullet
+  bullet,
+  // Part 5 only (the signed distance): the hybrid answering the signed
+  // distance, FCL's libccd with enable_signed_distance. Bullet's adapter
+  // answers it already (its EPA's negative distance).
+  hybrid_signed,
+  fcl_libccd_signed
 };
 // FCL's libccd solver twice: with FCL's default absolute tolerance (what a
 // user gets) and with the same tolerance relative to the query's scale (the
@@ -122,7 +127,8 @@ constexpr std::array<SystemKind, 7> kSystems = {
 
 bool is_peer(SystemKind k) {
   return k == SystemKind::fcl_libccd || k == SystemKind::fcl_libccd_scaled ||
-         k == SystemKind::fcl_indep || k == SystemKind::bullet;
+         k == SystemKind::fcl_indep || k == SystemKind::bullet ||
+         k == SystemKind::fcl_libccd_signed;
 }
 
 std::unique_ptr<DistanceSystem> make_system(SystemKind k, const ConvexPolytope& a,
@@ -142,6 +148,10 @@ std::unique_ptr<DistanceSystem> make_system(SystemKind k, const ConvexPolytope& 
       return std::make_unique<FclPeer>(a, b, FclSolver::indep);
     case SystemKind::bullet:
       return std::make_unique<BulletPeer>(a, b);
+    case SystemKind::hybrid_signed:
+      return std::make_unique<ProximaSystem>(a, b, Algorithm::hybrid, true);
+    case SystemKind::fcl_libccd_signed:
+      return std::make_unique<FclPeer>(a, b, FclSolver::libccd_signed);
   }
   return nullptr;
 }
@@ -668,14 +678,18 @@ struct TimingRow {
 std::vector<TimingRow> time_configs(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const std::vector<Pose>& pa, const std::vector<Pose>& pb,
                                     const std::vector<Config>& configs, int reps, double x) {
+  // The systems the configurations name, each built once.
+  std::vector<SystemKind> kinds;
   std::vector<std::unique_ptr<DistanceSystem>> systems;
-  for (const SystemKind k : kSystems) {
-    systems.push_back(make_system(k, a, b));
+  for (const Config& c : configs) {
+    if (std::find(kinds.begin(), kinds.end(), c.kind) != kinds.end()) continue;
+    kinds.push_back(c.kind);
+    systems.push_back(make_system(c.kind, a, b));
     systems.back()->load_poses(pa, pb);
   }
   auto system_of = [&](SystemKind k) -> DistanceSystem& {
-    return *systems[static_cast<std::size_t>(std::find(kSystems.begin(), kSystems.end(), k) -
-                                             kSystems.begin())];
+    return *systems[static_cast<std::size_t>(std::find(kinds.begin(), kinds.end(), k) -
+                                             kinds.begin())];
   };
   const double n = static_cast<double>(pa.size());
   std::vector<std::vector<double>> times(configs.size());
@@ -748,12 +762,14 @@ std::string config_label(const TimingRow& r) {
 // distance; 1e-4 leaves room and still catches a wrong frame or body.
 constexpr double kChecksumAgreement = 1e-4;
 
+// `scale`: a floor for the reference (part 5's mean signed distance may be
+// near 0 by cancellation; its bodies' size stands in).
 void check_agreement(const std::vector<TimingRow>& rows, const std::string& where,
-                     std::ostream& out) {
+                     std::ostream& out, double scale = 0.0) {
   if (rows.empty()) return;
   const double ref = rows.front().mean_distance;
   for (const TimingRow& r : rows) {
-    if (!(std::abs(r.mean_distance - ref) <= kChecksumAgreement * std::abs(ref))) {
+    if (!(std::abs(r.mean_distance - ref) <= kChecksumAgreement * std::max(std::abs(ref), scale))) {
       out << "    WARNING (" << where << "): " << config_label(r) << " mean distance "
           << exact_text(r.mean_distance) << " differs from " << rows.front().system << "'s "
           << exact_text(ref) << "\n";
@@ -793,6 +809,7 @@ void print_timing(const std::vector<TimingRow>& rows, const std::string& x_name,
     if (n.rfind("proxima ", 0) == 0) n = n.substr(8);
     if (n == "Enhanced GJK") n = "EGJK";
     if (n == "FCL libccd scaled") n = "libccd 64uR";  // fits the column
+    if (n == "FCL libccd signed") n = "libccd EPA";
     return n + (tracking ? " trk" : "");
   };
   const std::size_t w = 13;
@@ -917,6 +934,86 @@ std::vector<TimingRow> run_cold(const PaperOptions& options, std::ostream& out) 
     out.flush();
   }
   return rows;
+}
+
+// Part 5: the signed distance through contact (issue 10), the overlap
+// sweep of bench/penetration_peers made part of the report: A, N points on
+// the unit sphere, at the origin; B, N points on a sphere of radius 0.8,
+// turned once, its centre moved along a line through A's from -2.4 to 2.4
+// in `steps` equal steps (1.6e-3 in the full run, the paper's translation
+// step): apart, then overlapping for about three quarters of the way
+// (|s| < 1.8), then apart again. Every system answers the signed distance
+// (minus the penetration depth when overlapping): proxima with tracking
+// (one DistanceCache) and cold, FCL's libccd with enable_signed_distance
+// (EPA), Bullet's GJK with its EPA penetration solver. Their accuracy
+// against the exact oracle is bench/penetration_peers' (make results).
+std::vector<int> overlap_sizes(bool quick) {
+  if (quick) return {8, 64, 512};
+  return {8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
+}
+
+std::vector<Config> overlap_configs() {
+  return {{SystemKind::hybrid_signed, true},
+          {SystemKind::hybrid_signed, false},
+          {SystemKind::fcl_libccd_signed, false},
+          {SystemKind::bullet, false}};
+}
+
+std::vector<TimingRow> run_overlap(const PaperOptions& options, std::ostream& out) {
+  const int steps = options.quick ? 1000 : 3000;
+  const double half_length = 2.4;
+  std::vector<TimingRow> rows;
+  for (const int n : overlap_sizes(options.quick)) {
+    const auto t0 = Clock::now();
+    Rng rng(9000 + static_cast<std::uint64_t>(n));
+    const ConvexPolytope a(points_on_sphere(rng, n));
+    const ConvexPolytope b(points_on_sphere(rng, n, 0.8));
+    const Mat3 rb = random_rotation(rng);
+    const Vec3 dir = Vec3(1.0, 0.3, -0.2).normalized();
+    std::vector<Pose> pa(static_cast<std::size_t>(steps)), pb;
+    for (int k = 0; k < steps; ++k) {
+      const double s = -half_length + 2 * half_length * k / (steps - 1);
+      pb.emplace_back(rb, Vec3(s * dir + Vec3(0.01, 0.02, -0.03)));
+    }
+    std::vector<TimingRow> r = time_configs(a, b, pa, pb, overlap_configs(), kRepetitions, n);
+    check_agreement(r, "overlap N=" + std::to_string(n), out, 1.0);
+    rows.insert(rows.end(), r.begin(), r.end());
+    out << "    N = " << pad(std::to_string(n), 4) << ": " << fixed(seconds_since(t0), 1) << " s\n";
+    out.flush();
+  }
+  return rows;
+}
+
+// Issue 10's speed targets that the overlap sweep measures (its "overlapping
+// <= 2x separated" needs the two halves apart: bench/penetration_peers).
+void print_overlap_targets(const std::vector<TimingRow>& rows, std::ostream& out) {
+  out << "  (libccd EPA: FCL's GST_LIBCCD with enable_signed_distance; Bullet GJK: its "
+         "btGjkPairDetector with\n"
+         "   the btGjkEpaPenetrationDepthSolver, as in the other parts; accuracy: "
+         "bench/penetration_peers)\n";
+  out << "  issue 10's targets on this sweep (best peer / proxima; tracked flat: largest N / "
+         "N = 8):\n";
+  std::vector<double> xs;
+  for (const TimingRow& r : rows)
+    if (std::find(xs.begin(), xs.end(), r.x) == xs.end()) xs.push_back(r.x);
+  for (const double x : xs) {
+    const TimingRow* tracked = find_row(rows, x, "proxima hybrid", true);
+    const TimingRow* cold = find_row(rows, x, "proxima hybrid", false);
+    if (tracked == nullptr || cold == nullptr) continue;
+    const double peer = fastest_peer(rows, x);
+    const double t = peer / tracked->median_ns, c = peer / cold->median_ns;
+    out << "    N = " << pad(fixed(x, 0), 5) << "  " << (t >= 10.0 ? "MET    " : "MISSED ")
+        << "tracked >= 10x: " << pad(fixed(t, 1) + "x", 7) << "   "
+        << (c >= 3.0 ? "MET    " : "MISSED ") << "cold >= 3x: " << fixed(c, 2) << "x\n";
+  }
+  const TimingRow* first = find_row(rows, xs.front(), "proxima hybrid", true);
+  const TimingRow* last = find_row(rows, xs.back(), "proxima hybrid", true);
+  if (first != nullptr && last != nullptr) {
+    const double flat = last->median_ns / first->median_ns;
+    out << "    " << (flat <= 1.5 ? "MET    " : "MISSED ")
+        << "tracked flat in N (<= 1.5x): " << fixed(flat, 1) << "x (N = " << fixed(xs.back(), 0)
+        << " against " << fixed(xs.front(), 0) << ")\n";
+  }
 }
 
 // ===========================================================================
@@ -1171,25 +1268,31 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
          "R of their hulls,"
          " status separated iff d* > 64 u R\n";
 
-  out << "\n[1/4] robustness (paper section 6, experiments 1 and 2), exact reference: kernels on "
+  out << "\n[1/5] robustness (paper section 6, experiments 1 and 2), exact reference: kernels on "
          "cpp_rational, "
          "certified\n";
   const RobustnessResult robust = run_robustness(options, out);
   print_robustness(robust, out);
 
-  out << "\n[2/4] timing, paper figures 1-2: translation tracking, N vertices per body, "
+  out << "\n[2/5] timing, paper figures 1-2: translation tracking, N vertices per body, "
       << (options.quick ? 2000 : 10000) << " steps\n";
   const std::vector<TimingRow> translation = run_translation(options, out);
   print_timing(translation, "N", true, out);
 
-  out << "\n[3/4] timing, paper figure 3: rotation, 50 points per body, "
+  out << "\n[3/5] timing, paper figure 3: rotation, 50 points per body, "
       << (options.quick ? 2000 : 10000) << " steps, tracking where the system has it\n";
   const std::vector<TimingRow> rotation = run_rotation(options, out);
   print_timing(rotation, "omega", true, out);
 
-  out << "\n[4/4] timing: cold queries, random poses, no coherence\n";
+  out << "\n[4/5] timing: cold queries, random poses, no coherence\n";
   const std::vector<TimingRow> cold = run_cold(options, out);
   print_timing(cold, "N", false, out);
+
+  out << "\n[5/5] timing: the signed distance through contact, B (radius 0.8) sweeping through A, "
+      << (options.quick ? 1000 : 3000) << " steps, overlapping on about 3/4 of them\n";
+  const std::vector<TimingRow> overlap = run_overlap(options, out);
+  print_timing(overlap, "N", true, out);
+  print_overlap_targets(overlap, out);
 
   const std::vector<Target> targets =
       evaluate_targets(robust, translation, rotation, cold, options.quick);
@@ -1206,6 +1309,7 @@ int run_paper(const PaperOptions& options, std::ostream& out) {
   ok = write_file(dir / "translation.csv", timing_csv(translation, "n"), out) && ok;
   ok = write_file(dir / "rotation.csv", timing_csv(rotation, "omega"), out) && ok;
   ok = write_file(dir / "cold.csv", timing_csv(cold, "n"), out) && ok;
+  ok = write_file(dir / "overlap.csv", timing_csv(overlap, "n"), out) && ok;
   ok = write_file(dir / "targets.csv", targets_csv(targets), out) && ok;
   ok = write_file(dir / "tracking_modes.csv", tracking_csv(), out) && ok;
   ok = write_file(dir / "run.csv", run_csv(options.quick, seconds_since(start), load_at_start),

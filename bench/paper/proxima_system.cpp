@@ -8,8 +8,9 @@
 
 namespace proxima::bench {
 
-ProximaSystem::ProximaSystem(const ConvexPolytope& a, const ConvexPolytope& b, Algorithm algorithm)
-    : a_(a), b_(b) {
+ProximaSystem::ProximaSystem(const ConvexPolytope& a, const ConvexPolytope& b, Algorithm algorithm,
+                             bool signed_distance)
+    : a_(a), b_(b), signed_(signed_distance) {
   options_.algorithm = algorithm;
 }
 
@@ -51,7 +52,7 @@ SystemAnswer ProximaSystem::query(std::size_t i, bool tracking) {
                    tracking && has_tracking() ? &cache_ : nullptr);
   SystemAnswer answer;
   answer.answered = true;
-  answer.distance = last_.distance;
+  answer.distance = signed_ ? last_.signed_distance() : last_.distance;
   answer.point_a = last_.point_a;
   answer.point_b = last_.point_b;
   answer.separated = last_.status == Status::separated;
@@ -62,12 +63,13 @@ double ProximaSystem::run_all(bool tracking) {
   cache_.reset();
   double sum = 0.0;
   const std::size_t n = poses_a_.size();
-  if (tracking && has_tracking()) {
+  DistanceCache* cache = tracking && has_tracking() ? &cache_ : nullptr;
+  if (signed_) {
     for (std::size_t i = 0; i < n; ++i)
-      sum += distance(a_, poses_a_[i], b_, poses_b_[i], options_, &cache_).distance;
+      sum += distance(a_, poses_a_[i], b_, poses_b_[i], options_, cache).signed_distance();
   } else {
     for (std::size_t i = 0; i < n; ++i)
-      sum += distance(a_, poses_a_[i], b_, poses_b_[i], options_, nullptr).distance;
+      sum += distance(a_, poses_a_[i], b_, poses_b_[i], options_, cache).distance;
   }
   return sum;
 }

@@ -8,7 +8,9 @@
 //                 simplex and hill-climbing hints).
 //   gjk           classic GJK, brute-force support, always cold.
 // Options are the library defaults (relative tolerance 1e-12, absolute 0).
-// Without tracking every query gets a null cache: cold.
+// Without tracking every query gets a null cache: cold. With
+// `signed_distance`, answers (and run_all's sum) carry the signed distance
+// (minus the penetration depth when overlapping) instead of the distance.
 #pragma once
 
 #include <vector>
@@ -22,7 +24,8 @@ namespace proxima::bench {
 class ProximaSystem final : public DistanceSystem {
  public:
   // The polytopes must outlive the system (it keeps references).
-  ProximaSystem(const ConvexPolytope& a, const ConvexPolytope& b, Algorithm algorithm);
+  ProximaSystem(const ConvexPolytope& a, const ConvexPolytope& b, Algorithm algorithm,
+                bool signed_distance = false);
 
   std::string name() const override;
   bool has_tracking() const override;
@@ -40,6 +43,7 @@ class ProximaSystem final : public DistanceSystem {
   const ConvexPolytope& a_;
   const ConvexPolytope& b_;
   DistanceOptions options_;
+  bool signed_ = false;
   DistanceCache cache_;
   DistanceResult last_;
   std::vector<Pose> poses_a_;

@@ -71,6 +71,7 @@ struct FclPeer::Impl {
       : solver(s), a(fcl_convex(pa, "FclPeer: body a")), b(fcl_convex(pb, "FclPeer: body b")) {
     request.enable_nearest_points = true;
     request.gjk_solver_type = s == FclSolver::indep ? fcl::GST_INDEP : fcl::GST_LIBCCD;
+    request.enable_signed_distance = s == FclSolver::libccd_signed;
     for (const Vec3& v : pa.vertices()) radius_a = std::max(radius_a, v.norm());
     for (const Vec3& v : pb.vertices()) radius_b = std::max(radius_b, v.norm());
     tracking_solver.gjk_tolerance = request.distance_tolerance;
@@ -113,6 +114,8 @@ std::string FclPeer::name() const {
       return "FCL libccd";
     case FclSolver::libccd_scaled:
       return "FCL libccd scaled";
+    case FclSolver::libccd_signed:
+      return "FCL libccd signed";
     case FclSolver::indep:
       break;
   }

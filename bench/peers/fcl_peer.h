@@ -7,15 +7,14 @@
 //   query         fcl::distance(geometry, transform, geometry, transform,
 //                 request, result), one fresh DistanceResult per query.
 //   request       enable_nearest_points = true, enable_signed_distance =
-//                 false, rel_err = abs_err = 0, distance_tolerance = 1e-6
-//                 (FCL's default), gjk_solver_type GST_LIBCCD or GST_INDEP;
-//                 FclSolver::libccd_scaled: GST_LIBCCD with distance_tolerance
-//                 = kFclScaledTolerance x R (64 u R) per pose pair, R = max over both
-//                 bodies of |translation| + largest vertex norm (the scale of
-//                 the query), so that the solver stops at the same relative
-//                 accuracy at every scale (issue 9: FCL's absolute 1e-6 is
-//                 meaningless for bodies of size 1e-23 and too strict at 1e39;
-//                 comparing with it measures a default, not the algorithm).
+//                 false (true for FclSolver::libccd_signed), rel_err = abs_err = 0,
+//                 distance_tolerance = 1e-6 (FCL's default), gjk_solver_type GST_LIBCCD or
+//                 GST_INDEP; FclSolver::libccd_scaled: GST_LIBCCD with distance_tolerance =
+//                 kFclScaledTolerance x R (64 u R) per pose pair, R = max over both bodies of
+//                 |translation| + largest vertex norm (the scale of the query), so that the solver
+//                 stops at the same relative accuracy at every scale (issue 9: FCL's absolute 1e-6
+//                 is meaningless for bodies of size 1e-23 and too strict at 1e39; comparing with it
+//                 measures a default, not the algorithm).
 //   tracking      GST_INDEP only: one GJKSolver_indep kept for the whole
 //                 sequence with enableCachedGuess(true), its shapeDistance
 //                 called for the Convex pair (what fcl::distance calls after
@@ -33,7 +32,12 @@
 
 namespace proxima::bench {
 
-enum class FclSolver { libccd, libccd_scaled, indep };
+// libccd_signed: GST_LIBCCD with enable_signed_distance (FCL's penetration
+// depth by libccd's EPA for overlapping pairs: min_distance negative), for
+// the signed-distance experiment. (GST_INDEP with enable_signed_distance
+// aborts on an internal assert for overlapping Convex pairs in FCL 0.7:
+// bench/penetration_peers.cpp.)
+enum class FclSolver { libccd, libccd_scaled, indep, libccd_signed };
 
 // The relative tolerance of FclSolver::libccd_scaled: the absolute term of
 // proxima's accuracy standard, 64 u R (DESIGN.md), so that libccd is asked
