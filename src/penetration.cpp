@@ -873,7 +873,7 @@ bool same_face(const MinkowskiFaceId& x, const MinkowskiFaceId& y) {
 
 // Builds the result from the winning candidate and the supporting regions
 // along its normal n: A's simplices `ta`, B's `tb`.
-PenetrationResult finish_with_regions(const Query& q, const Candidate& best, double lower_scaled,
+[[gnu::always_inline]] inline PenetrationResult finish_with_regions(const Query& q, const Candidate& best, double lower_scaled,
                                       int candidates, bool tracked, std::span<const Feature> ta,
                                       std::span<const Feature> tb) {
   PenetrationResult r;
@@ -937,15 +937,21 @@ PenetrationResult finish_with_regions(const Query& q, const Candidate& best, dou
 // or null) keeps the supporting regions of the answer's direction: a
 // tracked answer along the same face of A - B (same id, same normal: B
 // only translated) reads them instead of walking the hulls again.
+// Without a cache (cold queries): the regions on the stack, out of line so
+// that the tracked path's frame does not hold their buffer.
+[[gnu::noinline]] PenetrationResult finish_untracked(const Query& q, const Candidate& best,
+                                                     double lower_scaled, int candidates,
+                                                     bool tracked) {
+  std::array<std::byte, 2048> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  std::pmr::vector<Feature> ta(&memory), tb(&memory);
+  support_regions(q, best, &memory, ta, tb);
+  return finish_with_regions(q, best, lower_scaled, candidates, tracked, ta, tb);
+}
+
 PenetrationResult finish(const Query& q, const Candidate& best, double lower_scaled, int candidates,
                          bool tracked, PenetrationCache::Witnesses* memo = nullptr) {
-  if (memo == nullptr) {
-    std::array<std::byte, 2048> buffer;
-    std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
-    std::pmr::vector<Feature> ta(&memory), tb(&memory);
-    support_regions(q, best, &memory, ta, tb);
-    return finish_with_regions(q, best, lower_scaled, candidates, tracked, ta, tb);
-  }
+  if (memo == nullptr) return finish_untracked(q, best, lower_scaled, candidates, tracked);
   if (memo->a.empty() || !same_face(memo->id, best.id) || memo->normal != best.normal)
     remember_regions(q, best, *memo);
   return finish_with_regions(q, best, lower_scaled, candidates, tracked, memo->a, memo->b);
