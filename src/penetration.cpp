@@ -873,9 +873,9 @@ bool same_face(const MinkowskiFaceId& x, const MinkowskiFaceId& y) {
 
 // Builds the result from the winning candidate and the supporting regions
 // along its normal n: A's simplices `ta`, B's `tb`.
-[[gnu::always_inline]] inline PenetrationResult finish_with_regions(const Query& q, const Candidate& best, double lower_scaled,
-                                      int candidates, bool tracked, std::span<const Feature> ta,
-                                      std::span<const Feature> tb) {
+[[gnu::always_inline]] inline PenetrationResult finish_with_regions(
+    const Query& q, const Candidate& best, double lower_scaled, int candidates, bool tracked,
+    std::span<const Feature> ta, std::span<const Feature> tb) {
   PenetrationResult r;
   r.candidates = candidates;
   r.tracked = tracked;
