@@ -262,12 +262,14 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
                                                    const Pose& b_in_a,
                                                    const DistanceOptions& options,
                                                    double band_bound, DistanceCache& c) {
-  DistanceResult overlap;
-  if (detail::tracked_overlap(a, b, b_in_a, options, band_bound, c, overlap)) {
-    to_world(pose_a, overlap);
-    return overlap;
+  // One named result (NRVO, as distance_in_frame): the tracked answer is
+  // built in the caller's slot, not copied there.
+  DistanceResult result;
+  if (detail::tracked_overlap(a, b, b_in_a, options, band_bound, c, result)) [[likely]] {
+    to_world(pose_a, result);
+    return result;
   }
-  DistanceResult result = run(a, b, b_in_a, options, band_bound, c);
+  result = run(a, b, b_in_a, options, band_bound, c);
   finish_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c, result);
   return result;
 }
@@ -310,8 +312,11 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
   // One initialization from either call, not two returns: GCC 12 elides
-  // the copy of a named result only when every return names it.
-  const bool penetrating = static_cast<bool>(c.penetration);
+  // the copy of a named result only when every return names it. A pair
+  // whose last depth was not penetrating (one that overlapped once and
+  // separated since) takes the common path: the tracked depth would not be
+  // tried for it.
+  const bool penetrating = detail::overlap_trackable(options, c);
   DistanceResult result =
       penetrating ? penetrating_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c)
                   : run(a, b, b_in_a, options, band_bound, c);

@@ -773,22 +773,22 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
 // its support vertex v: the vertices whose value is within `tie` of v's,
 // found by a walk over the adjacency (the region is connected: it is a face
 // of the hull thickened by rounding), as simplices to search for witness
-// points: every face all of whose vertices are in the region (fan
-// triangles), else every edge in it, else v. Nearly coplanar faces (a
-// polygon whose doubles are not exactly planar, a coplanar face-face
-// contact) are all in, so the witness is found wherever it is.
-struct Simplex {
-  std::array<int, 3> v = {-1, -1, -1};
-  FeatureType type = FeatureType::vertex;
-  int face = -1;
-};
-
-// The lists live in `memory` (finish's buffer on the stack: a tracked
-// query's regions are a face and a vertex, and six heap allocations were
-// a tenth of it at N = 8).
-template <class PointOf>
-std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d,
-                                         int v, double tie, std::pmr::memory_resource* memory) {
+// points, appended to `out`: every face all of whose vertices are in the
+// region (fan triangles), else every edge in it, else v. Nearly coplanar
+// faces (a polygon whose doubles are not exactly planar, a coplanar
+// face-face contact) are all in, so the witness is found wherever it is.
+// The walk's lists live in `memory` (a buffer on the stack: six heap
+// allocations were a tenth of a tracked query at N = 8).
+template <class PointOf, class Out>
+void support_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d, int v, double tie,
+                    std::pmr::memory_resource* memory, Out& out) {
+  const auto simplex = [](FeatureType type, int v0, int v1, int v2, int face) {
+    Feature f;
+    f.type = type;
+    f.vertices = {v0, v1, v2};
+    f.face = face;
+    return f;
+  };
   const double top = d.dot(point(v));
   const auto in = [&](int w) { return d.dot(point(w)) >= top - tie; };
   std::pmr::vector<int> region({v}, memory);
@@ -796,19 +796,17 @@ std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& p
   for (std::size_t head = 0; head < region.size(); ++head)
     for (const std::int32_t w : poly.neighbors(region[head]))
       if (std::find(region.begin(), region.end(), w) == region.end() && in(w)) region.push_back(w);
-  std::pmr::vector<Simplex> out(memory);
   // A vertex, or an edge (the BFS joined its two ends along it): no face
   // has all its vertices in (what the general case below finds, without
   // evaluating the faces around it).
   if (region.size() == 1) {
-    out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
-    return out;
+    out.push_back(simplex(FeatureType::vertex, v, -1, -1, -1));
+    return;
   }
   if (region.size() == 2) {
-    out.push_back({{std::min(region[0], region[1]), std::max(region[0], region[1]), -1},
-                   FeatureType::edge,
-                   -1});
-    return out;
+    out.push_back(simplex(FeatureType::edge, std::min(region[0], region[1]),
+                          std::max(region[0], region[1]), -1, -1));
+    return;
   }
   // A face's vertices are all within the tie exactly when they are all in
   // the region: its boundary runs along hull edges, so they are connected
@@ -816,6 +814,7 @@ std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& p
   const auto in_region = [&](int w) {
     return std::find(region.begin(), region.end(), w) != region.end();
   };
+  const std::size_t first = out.size();
   std::pmr::vector<int> faces_seen(memory);
   const auto faces = poly.adjacency_faces();
   for (const int x : region) {
@@ -831,38 +830,52 @@ std::pmr::vector<Simplex> support_region(const ConvexPolytope& poly, PointOf&& p
       for (const std::int32_t w : cycle) all = all && in_region(w);
       if (!all) continue;
       for (std::size_t i = 1; i + 1 < cycle.size(); ++i)
-        out.push_back({{cycle[0], cycle[i], cycle[i + 1]}, FeatureType::face, f});
+        out.push_back(simplex(FeatureType::face, cycle[0], cycle[i], cycle[i + 1], f));
     }
   }
-  if (!out.empty()) return out;
+  if (out.size() > first) return;
   for (const int x : region)
     for (const std::int32_t w : poly.neighbors(x))
-      if (x < w && in_region(w)) out.push_back({{x, w, -1}, FeatureType::edge, -1});
-  if (!out.empty()) return out;
-  out.push_back({{v, -1, -1}, FeatureType::vertex, -1});
-  return out;
+      if (x < w && in_region(w)) out.push_back(simplex(FeatureType::edge, x, w, -1, -1));
+  if (out.size() > first) return;
+  out.push_back(simplex(FeatureType::vertex, v, -1, -1, -1));
 }
 
-Feature to_feature(const Simplex& s) {
-  Feature f;
-  f.type = s.type;
-  f.face = s.face;
-  f.vertices = {s.v[0], s.v[1], s.v[2]};
-  return f;
+// The supporting regions of the winning candidate: A's along its normal n,
+// B's along -n, appended to `ta` and `tb`.
+template <class Out>
+void support_regions(const Query& q, const Candidate& best, std::pmr::memory_resource* memory,
+                     Out& ta, Out& tb) {
+  const double tie = kTieUlps * kUnitRoundoff;
+  support_region(
+      q.a, [&](int i) { return q.point_a(i); }, best.normal, best.support_a, tie, memory, ta);
+  support_region(
+      q.b, [&](int j) { return q.point_b(j); }, Vec3(-best.normal), best.support_b, tie, memory,
+      tb);
 }
 
-Simplex to_simplex(const Feature& f) { return {f.vertices, f.type, f.face}; }
+// A tracking cache's regions for the winning candidate, walked again
+// (out of line: its buffer is not paid for by the queries that read them).
+[[gnu::noinline]] void remember_regions(const Query& q, const Candidate& best,
+                                        PenetrationCache::Witnesses& memo) {
+  std::array<std::byte, 1024> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  memo.id = best.id;
+  memo.normal = best.normal;
+  memo.a.clear();
+  memo.b.clear();
+  support_regions(q, best, &memory, memo.a, memo.b);
+}
 
 bool same_face(const MinkowskiFaceId& x, const MinkowskiFaceId& y) {
   return x.kind == y.kind && x.a0 == y.a0 && x.a1 == y.a1 && x.b0 == y.b0 && x.b1 == y.b1;
 }
 
-// Builds the result from the winning candidate. `memo` (a tracking cache's,
-// or null) keeps the supporting features of the answer's direction: a
-// tracked answer along the same face of A - B (same id, same normal: B
-// only translated) reads them instead of walking the hulls again.
-PenetrationResult finish(const Query& q, const Candidate& best, double lower_scaled, int candidates,
-                         bool tracked, PenetrationCache::Witnesses* memo = nullptr) {
+// Builds the result from the winning candidate and the supporting regions
+// along its normal n: A's simplices `ta`, B's `tb`.
+[[gnu::always_inline]] inline PenetrationResult finish_with_regions(
+    const Query& q, const Candidate& best, double lower_scaled, int candidates, bool tracked,
+    std::span<const Feature> ta, std::span<const Feature> tb) {
   PenetrationResult r;
   r.candidates = candidates;
   r.tracked = tracked;
@@ -871,58 +884,39 @@ PenetrationResult finish(const Query& q, const Candidate& best, double lower_sca
   const Vec3& n = best.normal;
   const double value = best.value;  // scaled
   r.normal = n;
-  // Witnesses: the supporting features along n (A) and -n (B), and a pair
-  // of their points that differ by value * n: the closest points of
-  // feature A and feature B moved by value * n.
-  const double tie = kTieUlps * kUnitRoundoff;
-  std::array<std::byte, 2048> buffer;
-  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
-  std::pmr::vector<Simplex> ta(&memory), tb(&memory);
-  if (memo != nullptr && !memo->a.empty() && same_face(memo->id, best.id) && memo->normal == n) {
-    for (const Feature& f : memo->a) ta.push_back(to_simplex(f));
-    for (const Feature& f : memo->b) tb.push_back(to_simplex(f));
-  } else {
-    ta = support_region(
-        q.a, [&](int i) { return q.point_a(i); }, n, best.support_a, tie, &memory);
-    tb = support_region(
-        q.b, [&](int j) { return q.point_b(j); }, Vec3(-n), best.support_b, tie, &memory);
-    if (memo != nullptr) {
-      memo->id = best.id;
-      memo->normal = n;
-      memo->a.clear();
-      memo->b.clear();
-      for (const Simplex& x : ta) memo->a.push_back(to_feature(x));
-      for (const Simplex& x : tb) memo->b.push_back(to_feature(x));
-    }
-  }
+  // Witnesses: a pair of points of the supporting features that differ by
+  // value * n: the closest points of feature A and feature B moved by
+  // value * n (the first least pair of simplices).
   const Vec3 shift = std::max(value, 0.0) * n;
   ClosestPoints<double> closest;
   closest.point_a = closest.point_b = Vec3::Zero();
   closest.distance_squared = std::numeric_limits<double>::infinity();
-  Simplex best_ta, best_tb;
-  for (const Simplex& s : ta) {
+  const Feature* best_ta = nullptr;
+  const Feature* best_tb = nullptr;
+  for (const Feature& s : ta) {
     Vec3 pa[3];
-    int na = 0;
-    for (; na < 3 && s.v[static_cast<std::size_t>(na)] >= 0; ++na)
-      pa[na] = q.point_a(s.v[static_cast<std::size_t>(na)]);
-    for (const Simplex& t : tb) {
+    const int na = s.vertex_count();
+    for (int i = 0; i < na; ++i) pa[i] = q.point_a(s.vertices[static_cast<std::size_t>(i)]);
+    for (const Feature& t : tb) {
       Vec3 pb[3];
-      int nb = 0;
-      for (; nb < 3 && t.v[static_cast<std::size_t>(nb)] >= 0; ++nb)
-        pb[nb] = q.point_b(t.v[static_cast<std::size_t>(nb)]) + shift;
+      const int nb = t.vertex_count();
+      for (int j = 0; j < nb; ++j)
+        pb[j] = q.point_b(t.vertices[static_cast<std::size_t>(j)]) + shift;
       const ClosestPoints<double> c = closest_points<double>(pa, na, pb, nb);
       if (c.distance_squared < closest.distance_squared) {
         closest = c;
-        best_ta = s;
-        best_tb = t;
+        best_ta = &s;
+        best_tb = &t;
       }
     }
   }
   const double residual = std::sqrt(closest.distance_squared) * q.unit;
   r.point_a = closest.point_a * q.unit;
   r.point_b = (closest.point_b - shift) * q.unit;
-  r.feature_a = to_feature(best_ta);
-  r.feature_b = to_feature(best_tb);
+  if (best_ta != nullptr) {
+    r.feature_a = *best_ta;
+    r.feature_b = *best_tb;
+  }
   const double depth = value * q.unit;
   if (depth < -band || residual > band) {
     // Separated: a plane separates them (depth < 0), or the supporting
@@ -937,6 +931,30 @@ PenetrationResult finish(const Query& q, const Candidate& best, double lower_sca
   r.upper_bound = r.depth;
   r.lower_bound = std::max(0.0, std::min(lower_scaled, value) * q.unit - contact_band(q.magnitude));
   return r;
+}
+
+// Builds the result from the winning candidate. `memo` (a tracking cache's,
+// or null) keeps the supporting regions of the answer's direction: a
+// tracked answer along the same face of A - B (same id, same normal: B
+// only translated) reads them instead of walking the hulls again.
+// Without a cache (cold queries): the regions on the stack, out of line so
+// that the tracked path's frame does not hold their buffer.
+[[gnu::noinline]] PenetrationResult finish_untracked(const Query& q, const Candidate& best,
+                                                     double lower_scaled, int candidates,
+                                                     bool tracked) {
+  std::array<std::byte, 2048> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  std::pmr::vector<Feature> ta(&memory), tb(&memory);
+  support_regions(q, best, &memory, ta, tb);
+  return finish_with_regions(q, best, lower_scaled, candidates, tracked, ta, tb);
+}
+
+PenetrationResult finish(const Query& q, const Candidate& best, double lower_scaled, int candidates,
+                         bool tracked, PenetrationCache::Witnesses* memo = nullptr) {
+  if (memo == nullptr) return finish_untracked(q, best, lower_scaled, candidates, tracked);
+  if (memo->a.empty() || !same_face(memo->id, best.id) || memo->normal != best.normal)
+    remember_regions(q, best, *memo);
+  return finish_with_regions(q, best, lower_scaled, candidates, tracked, memo->a, memo->b);
 }
 
 // Both hulls of dimension <= 1 with no crossing edges (points, parallel or

@@ -137,11 +137,8 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
 bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                      const DistanceOptions& options, double band, DistanceCache& cache,
                      DistanceResult& result) {
+  if (!overlap_trackable(options, cache)) return false;
   PenetrationCache* depth_cache = cache.penetration.get();
-  if (depth_cache == nullptr || depth_cache->last_status != PenetrationStatus::penetrating ||
-      !options.penetration || options.algorithm != Algorithm::hybrid) {
-    return false;
-  }
   PenetrationResult p;
   if (!penetration_depth_tracked(a, b, b_in_a, *depth_cache, p) ||
       p.status != PenetrationStatus::penetrating || !(p.lower_bound > band)) {

@@ -6,6 +6,7 @@
 // by distance() after its algorithm answered.
 #pragma once
 
+#include "proxima/penetration.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
@@ -23,8 +24,18 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
                             const DistanceOptions& options, DistanceCache& cache,
                             DistanceResult& result);
 
+// Whether tracked_overlap may answer for the pair: its last depth was
+// penetrating, with options.penetration and the hybrid. Inline: distance()
+// asks it of every query, and a pair that overlapped once and separated
+// since pays only this test (not a call that fails).
+inline bool overlap_trackable(const DistanceOptions& options, const DistanceCache& cache) {
+  const PenetrationCache* depth_cache = cache.penetration.get();
+  return depth_cache != nullptr && depth_cache->last_status == PenetrationStatus::penetrating &&
+         options.penetration && options.algorithm == Algorithm::hybrid;
+}
+
 // Before distance()'s algorithm runs: for a pair whose last depth was
-// penetrating (options.penetration, the hybrid), the tracked depth alone
+// penetrating (overlap_trackable), the tracked depth alone
 // (penetration_depth_tracked). When it certifies an overlap deeper than
 // `band` (distance()'s contact band, at least the exact one), `result` is
 // the intersecting answer the algorithm and finish_signed_distance would

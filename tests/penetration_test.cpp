@@ -12,6 +12,7 @@
 #include "support/exact_oracle.h"
 #include "support/generators.h"
 #include "support/penetration_oracle.h"
+#include "support/same_bits.h"
 
 namespace proxima::test {
 namespace {
@@ -671,6 +672,56 @@ TEST(PenetrationTracking, WitnessFeaturesOfBoxesTranslatedAndTurned) {
     }
   }
   EXPECT_GE(penetrating, 1000);
+}
+
+// The twin of the witness regions a tracked answer reads from its cache
+// (PenetrationCache::witnesses, read in place by finish) against the walk
+// a cold query makes: whenever a tracked answer has the cold one's face of
+// A - B, normal and depth, bit for bit, its witness points and features are
+// the cold ones bit for bit (the same regions searched in the same order).
+// Points on spheres (a face and a vertex, or two edges) and boxes (faces
+// of two fan triangles, coplanar ties), B swept through A and back.
+TEST(PenetrationTracking, WitnessesReadFromTheCacheAreTheColdOnesBitForBit) {
+  int compared = 0, queries = 0;
+  for (const int n : {8, 20, 64, 0}) {
+    for (int trial = 0; trial < 3; ++trial) {
+      Rng rng(static_cast<std::uint64_t>(n * 53 + trial + 7));
+      const Points a = n > 0 ? points_on_sphere(rng, n)
+                             : box(Vec3(uniform(rng, 0.3, 1), uniform(rng, 0.3, 1), 0.5));
+      const Points b_local = n > 0 ? points_on_sphere(rng, n, 0.8)
+                                   : box(Vec3(uniform(rng, 0.1, 0.4), 0.3, uniform(rng, 0.1, 0.4)));
+      const ConvexPolytope pa(a), pb(b_local);
+      const Mat3 rotation = n > 0 ? random_rotation(rng) : Mat3::Identity();
+      const Vec3 dir = random_unit_vector(rng);
+      PenetrationCache cache;
+      const int steps = 400;
+      for (int i = 0; i < steps; ++i) {
+        const double phase = static_cast<double>(i) / steps;
+        const double s = phase < 0.5 ? -2.0 + 8.0 * phase : 6.0 - 8.0 * phase;
+        const Pose pose(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+        const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+        PenetrationCache fresh;
+        const PenetrationResult cold = penetration_depth(pa, pb, pose, fresh);
+        ++queries;
+        if (!r.tracked || r.status != PenetrationStatus::penetrating ||
+            r.face.kind != cold.face.kind || r.face.a0 != cold.face.a0 ||
+            r.face.a1 != cold.face.a1 || r.face.b0 != cold.face.b0 || r.face.b1 != cold.face.b1 ||
+            !same_bits(r.normal, cold.normal) || !same_bits(r.depth, cold.depth))
+          continue;
+        ++compared;
+        const std::string where = "n " + std::to_string(n) + ", trial " + std::to_string(trial) +
+                                  ", step " + std::to_string(i);
+        ASSERT_TRUE(same_bits(r.point_a, cold.point_a)) << where;
+        ASSERT_TRUE(same_bits(r.point_b, cold.point_b)) << where;
+        ASSERT_TRUE(same_feature(r.feature_a, cold.feature_a)) << where;
+        ASSERT_TRUE(same_feature(r.feature_b, cold.feature_b)) << where;
+        ASSERT_EQ(r.status, cold.status) << where;
+      }
+    }
+  }
+  // Most penetrating answers are compared (the sweeps overlap about half
+  // of their poses).
+  EXPECT_GE(compared, queries / 4);
 }
 
 // The tracked query searches a tree over the cached faces' normals with

@@ -413,6 +413,41 @@ TEST(SignedDistanceTracking, OverlapCertifiedByTheTrackedDepthIsTheFullAnswer) {
   EXPECT_GE(overlapping, 600);
 }
 
+// A pair that overlapped once keeps its depth's state; once it separates,
+// distance() answers it as it answers a pair that never overlapped (the
+// tracked depth is not tried: overlap_trackable, src/signed_distance.h).
+// Along sweeps through and back, every separated or touching answer of the
+// cache is bit for bit the answer of a copy of it without the depth's
+// state.
+TEST(SignedDistanceTracking, SeparatedAfterAnOverlapAnswersAsIfItNeverOverlapped) {
+  Rng rng(41);
+  int compared = 0;
+  for (int body = 0; body < 4; ++body) {
+    const ConvexPolytope a(points_on_sphere(rng, 8 + 20 * body)), b(points_on_sphere(rng, 12, 0.7));
+    const Vec3 dir = random_unit_vector(rng);
+    const Quat q = random_quaternion(rng);
+    const Pose pa(random_quaternion(rng), random_unit_vector(rng));
+    DistanceCache cache;
+    constexpr int kSteps = 600;
+    const double step = 5.0 / (kSteps / 3);
+    for (int i = 0; i <= kSteps; ++i) {
+      // Through, back and through again: separated poses after overlaps.
+      const int k = i % (2 * (kSteps / 3));
+      const double s = k <= kSteps / 3 ? -2.5 + step * k : 2.5 - step * (k - kSteps / 3);
+      const Pose pb = pa * Pose(q, s * dir);
+      DistanceCache without_state = cache;
+      without_state.penetration = PenetrationState{};
+      const bool had_state = static_cast<bool>(cache.penetration);
+      const DistanceResult r = distance(a, pa, b, pb, {}, &cache);
+      if (r.status == Status::intersecting || !had_state) continue;
+      const DistanceResult twin = distance(a, pa, b, pb, {}, &without_state);
+      ASSERT_TRUE(same_answer(r, twin)) << body << " step " << i;
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, 400);
+}
+
 TEST(SignedDistanceCache, StateIsAllocatedOnTheFirstOverlapAndCopiedDeeply) {
   const ConvexPolytope a(cube(1.0)), b(cube(1.0));
   DistanceCache cache;
