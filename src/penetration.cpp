@@ -1389,14 +1389,16 @@ bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationRes
 // The margin of an expansion or of an enumeration after a translation
 // outgrew the cache (PenetrationCache::prune_margin): twice the last one,
 // at least this many of B's last steps and a small fraction of the bodies'
-// radii, at most half of them (a B that jumps keeps pruning). Doubling:
-// measured on bench/penetration_peers' sweep (B through A and back, 6000
-// steps), a margin of 8 steps that did not grow expanded 77 times a pass
-// at N = 4096, each 100 to 3000 groups whose bounds had just passed the
-// best value (the faces of A - B all near it when B nears A's centre),
-// 4 us a query amortized against 2.3 us with the doubling (6 expansions,
-// the last one keeping every face).
-constexpr double kMarginSteps = 8.0;
+// radii, at most half of them (a B that jumps keeps pruning). Measured on
+// bench/penetration_peers' sweep (B through A and back, 6000 steps of
+// 1.6e-3, one cache a pass; /work/wt/pen.cpp, medians of 9 passes, ns a
+// query amortized, N = 512 / 4096): 8 steps that did not grow expanded 77
+// times a pass at N = 4096, each 100 to 3000 groups whose bounds had just
+// passed the best value (all the faces of A - B are near it when B nears
+// A's centre): about 7000 ns; doubling from 8 steps: 784 / 4819; from 32
+// steps: 777 / 4262 (the re-enumerations with a doubling margin before
+// the expansions: 785 / 4203).
+constexpr double kMarginSteps = 32.0;
 
 double translation_margin(const ConvexPolytope& a, const ConvexPolytope& b,
                           const PenetrationCache& cache, const Pose& b_in_a) {
