@@ -1525,8 +1525,8 @@ bool expand(Query& q, PenetrationCache& cache, const Pose& b_in_a, double best, 
 // The tracked query, expanding the pruned groups a translation reached
 // (at most twice: the second search certifies unless rounding decided a
 // group at the threshold). False when the cache needs an enumeration: the
-// groups were not recorded, or too many were reached; then `margin` is the
-// one to enumerate with.
+// groups were not recorded (or two expansions did not certify); then
+// `margin` is the one to enumerate with.
 bool track_or_expand(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationResult& out,
                      double& margin) {
   double best = 0.0;

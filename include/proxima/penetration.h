@@ -126,8 +126,8 @@ struct PenetrationResult {
   Feature feature_a;
   Feature feature_b;
   // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
-  // crossing edge pairs) for a cold query; faces and tree nodes visited
-  // for a tracked one.
+  // crossing edge pairs) for a cold query; faces and tree nodes visited,
+  // and faces an expansion evaluated, for a tracked one.
   int candidates = 0;
   // True when the cache certified the answer (no enumeration of M).
   bool tracked = false;
