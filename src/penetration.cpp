@@ -106,6 +106,14 @@ bool arcs_may_cross(const Arc& x, const Arc& y) {
   return true;
 }
 
+// The elements an expansion of pruned groups enumerates again
+// (Query::only, PenetrationCache::Bound): faces of A, faces of B, and
+// edges of A as (v, w), w = -1 for all the edges (v, w) at v with v < w.
+struct Subset {
+  std::vector<int> faces_a, faces_b;
+  std::vector<std::array<int, 2>> edges_a;
+};
+
 // The query in scaled units: A's vertices times s, B's mapped by b_in_a and
 // times s (s a power of two near 1 / R, exact), normals unchanged.
 struct Query {
@@ -133,6 +141,8 @@ struct Query {
   double pruned = std::numeric_limits<double>::infinity();  // least lower bound of a pruned face
   // Where pruned groups are recorded (PenetrationCache::bounds), or null.
   std::vector<PenetrationCache::Bound>* bounds_out = nullptr;
+  // The candidate loops visit only these elements (an expansion), or all.
+  const Subset* only = nullptr;
   double prune_margin = 0.0;  // faces within this of the bound are kept (scaled)
   // Points of A and of B (scaled, A's frame): the supports of the best
   // candidate so far (see pruned_by).
@@ -413,14 +423,19 @@ Candidate evaluate_face(const Query& q, const MinkowskiFaceId& id) {
 // in the angle, where the balls leave the gap between the hulls'
 // circumradius and inradius. The face that realizes the depth has a lower
 // bound at most the depth, so it is never pruned.
+// `kind`, `i`, `j`: the group's element (PenetrationCache::Bound).
 template <class Cone>
-bool pruned_by(Query& q, double lower, Cone&& cone) {
+bool pruned_by(Query& q, double lower, PenetrationCache::Group kind, int i, int j, Cone&& cone) {
   if (!q.prune || !(lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff))
     return false;
   q.pruned = std::min(q.pruned, lower);
   if (q.bounds_out != nullptr) {
     PenetrationCache::Bound b = cone();
     b.lower = lower * q.unit;
+    b.anchor = q.translation * q.unit;
+    b.kind = kind;
+    b.i = i;
+    b.j = j;
     q.bounds_out->push_back(b);
   }
   return true;
@@ -507,7 +522,10 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   std::vector<std::int32_t>& near_b = q.near_b;
   std::vector<std::int32_t> near_a;
   int hint_b = 0;
-  for (int f = 0; f < q.a.face_count(); ++f) {
+  const int count_a =
+      q.only != nullptr ? static_cast<int>(q.only->faces_a.size()) : q.a.face_count();
+  for (int k = 0; k < count_a; ++k) {
+    const int f = q.only != nullptr ? q.only->faces_a[static_cast<std::size_t>(k)] : k;
     const auto i = static_cast<std::size_t>(f);
     if (q.prune) {
       const Vec3 af = q.point_a(q.a.face(f)[0]);
@@ -516,7 +534,7 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       if (pruned_by(q,
                     std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
                              face_lower(n, error, af - q.reference_b, q.reach)),
-                    [&] {
+                    PenetrationCache::Group::face_a, f, -1, [&] {
                       return PenetrationCache::Bound{n, error + kConeSlack, 0.0};
                     }))
         continue;
@@ -532,7 +550,10 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
     keep(q, c, out);
   }
   int hint_a = 0;
-  for (int g = 0; g < q.b.face_count(); ++g) {
+  const int count_b =
+      q.only != nullptr ? static_cast<int>(q.only->faces_b.size()) : q.b.face_count();
+  for (int k = 0; k < count_b; ++k) {
+    const int g = q.only != nullptr ? q.only->faces_b[static_cast<std::size_t>(k)] : k;
     const auto i = static_cast<std::size_t>(g);
     if (q.prune) {
       // In B's frame (scaled): with n = -(R m), b_g = R b'_g + t and x' =
@@ -546,7 +567,7 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       if (pruned_by(q,
                     std::max(face_lower(m, error, bg - q.centroid_a_in_b, q.reach) + q.inradius_a,
                              face_lower(m, error, bg - q.reference_a_in_b, q.reach)),
-                    [&] {
+                    PenetrationCache::Group::face_b, g, -1, [&] {
                       return PenetrationCache::Bound{-(q.rotation * m), error + kConeSlack, 0.0};
                     }))
         continue;
@@ -624,10 +645,16 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   const auto faces_a = q.a.adjacency_faces();
   // Every edge of A once, as ConvexPolytope::edges() lists them (v < w, in
   // adjacency order), with the face to its left from the slot.
-  for (int v = 0; v < q.a.vertex_count(); ++v) {
+  // In an expansion (Query::only) an item is all the edges at a vertex
+  // (only_w = -1) or one edge.
+  const int items =
+      q.only != nullptr ? static_cast<int>(q.only->edges_a.size()) : q.a.vertex_count();
+  for (int item = 0; item < items; ++item) {
+    const int v = q.only != nullptr ? q.only->edges_a[static_cast<std::size_t>(item)][0] : item;
+    const int only_w = q.only != nullptr ? q.only->edges_a[static_cast<std::size_t>(item)][1] : -1;
     const auto slot_begin = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v)]);
     const auto slot_end = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v) + 1]);
-    if (q.prune && solid_a) {
+    if (q.prune && solid_a && only_w < 0) {
       // All edges at v at once: the faces to the left of v -> w over its
       // neighbours w are all the faces around v, so both faces of every
       // edge at v; the bound below (the per-edge one, with the least over
@@ -671,12 +698,12 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
       if (all && slot_begin < slot_end &&
           pruned_by(
               q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity),
-              cone))
+              PenetrationCache::Group::vertex_a, v, -1, cone))
         continue;
     }
     for (std::size_t at = slot_begin; at < slot_end; ++at) {
       const int w_end = adjacency_a[at];
-      if (!(v < w_end)) continue;
+      if (!(v < w_end) || (only_w >= 0 && w_end != only_w)) continue;
       const std::array<int, 2> e = {v, w_end};
       const int l = q.a.dimension() >= 2 ? faces_a[at] : -1;
       const int r = q.a.dimension() >= 2 ? left_face(q.a, w_end, v) : -1;
@@ -694,7 +721,7 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
         const double lower =
             std::max(m >= 0.0 ? m + q.inradius_b : -kInfinity, m2 >= 0.0 ? m2 : -kInfinity);
-        if (pruned_by(q, lower, [&] {
+        if (pruned_by(q, lower, PenetrationCache::Group::edge_a, v, w_end, [&] {
               return cone_of_arc(sa.normals[il], sa.error[il], sa.normals[ir], sa.error[ir]);
             }))
           continue;
@@ -708,11 +735,12 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
           lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
           lower2 = std::min(lower2, arc_minimum(xs[static_cast<std::size_t>(i)], w2));
         }
-        if (pruned_by(q, std::max(lower + q.inradius_b, lower2), [&] {
-              // A solid's one arc; a polygon's or a segment's half or
-              // whole circle: anywhere.
-              return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
-            }))
+        if (pruned_by(q, std::max(lower + q.inradius_b, lower2), PenetrationCache::Group::edge_a, v,
+                      w_end, [&] {
+                        // A solid's one arc; a polygon's or a segment's half or
+                        // whole circle: anywhere.
+                        return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
+                      }))
           continue;
       }
       for (int i = 0; i < nx; ++i) {
@@ -996,10 +1024,13 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
 }
 
 // B's translation since the enumeration: delta = t - t_enumeration and its
-// length (computed in the query's unit: no overflow, no underflow).
+// length (computed in the query's unit: no overflow, no underflow); t and
+// the unit for the groups, each anchored at its own translation.
 struct Moved {
   Vec3 delta;
   double length;
+  Vec3 t = Vec3::Zero();
+  double inverse = 1.0, unit = 1.0;
 };
 
 // The value at B's translation t of a cached face: its offset at the
@@ -1008,13 +1039,15 @@ struct Moved {
 double entry_value(const PenetrationCache::Facet& f, const Moved& m) {
   return f.enumerated_offset - f.normal.dot(m.delta);
 }
-// A lower bound at t on the values of a pruned group's faces: each normal
-// n has n.delta <= c.delta + spread |delta| (|n - c| <= spread) and
-// <= |delta| (unit), plus the rounding of c.delta (|c| <= 1) and of the
-// sums, a few u of |delta|.
+// A lower bound at t on the values of a pruned group's faces: with delta
+// = t - its anchor (correctly rounded: within u |delta|), each normal n has
+// n.delta <= c.delta + spread |delta| (|n - c| <= spread) and <= |delta|
+// (unit), plus the rounding of c.delta (|c| <= 1) and of the sums, a few
+// u of |delta|.
 double entry_value(const PenetrationCache::Bound& b, const Moved& m) {
-  return b.lower - std::min(m.length, b.center.dot(m.delta) + b.spread * m.length) -
-         0x1p-44 * m.length;
+  const Vec3 delta = m.t - b.anchor;
+  const double length = (delta * m.inverse).norm() * m.unit;
+  return b.lower - std::min(length, b.center.dot(delta) + b.spread * length) - 0x1p-44 * length;
 }
 const Vec3& entry_normal(const PenetrationCache::Facet& f) { return f.normal; }
 const Vec3& entry_normal(const PenetrationCache::Bound& b) { return b.center; }
@@ -1088,15 +1121,51 @@ void split_node(std::vector<Entry>& entries, std::vector<PenetrationCache::Node>
 }
 
 // The tree's root over all entries (the searches split it), anchored at
-// B's translation t.
+// B's translation t; their count.
 template <class Entry>
-void build_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache::Node>& nodes,
-                const Vec3& t, const Moved& moved) {
+std::int32_t build_tree(const std::vector<Entry>& entries,
+                        std::vector<PenetrationCache::Node>& nodes, const Vec3& t,
+                        const Moved& moved) {
   nodes.clear();
-  if (entries.empty()) return;
+  if (entries.empty()) return 0;
   nodes.reserve(4 * entries.size() / PenetrationCache::kLeaf + 2);
   nodes.resize(1);
   make_node(entries, nodes, 0, 0, static_cast<int>(entries.size()), t, moved);
+  return static_cast<std::int32_t>(entries.size());
+}
+
+// The forest over entries (PenetrationCache::roots): one tree over all
+// when there is none (or when the nodes left behind by merges outnumber
+// the live ones: a tree split to its leaves has about 2 n / kLeaf nodes).
+template <class Entry>
+void ensure_forest(const std::vector<Entry>& entries, std::vector<PenetrationCache::Node>& nodes,
+                   std::vector<std::int32_t>& roots, const Vec3& t, const Moved& moved) {
+  if (!roots.empty() && nodes.size() <= 8 * entries.size() / PenetrationCache::kLeaf + 256) return;
+  roots.clear();
+  if (build_tree(entries, nodes, t, moved) > 0) roots.push_back(0);
+}
+
+// A tree over entries[begin, end) (appended by an expansion) added to the
+// forest, then merged with the tree before it (one new root over both
+// runs, contiguous) while that one is at most twice as large.
+template <class Entry>
+void add_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache::Node>& nodes,
+              std::vector<std::int32_t>& roots, int begin, const Vec3& t, const Moved& moved) {
+  const int end = static_cast<int>(entries.size());
+  if (roots.empty() || begin >= end) return;  // the next search builds the whole forest
+  const auto size = [&](std::int32_t r) {
+    const PenetrationCache::Node& n = nodes[static_cast<std::size_t>(r)];
+    return n.end - n.begin;
+  };
+  int first = begin;
+  while (!roots.empty() && size(roots.back()) <= 2 * (end - first)) {
+    first = nodes[static_cast<std::size_t>(roots.back())].begin;
+    roots.pop_back();
+  }
+  const auto at = static_cast<std::int32_t>(nodes.size());
+  nodes.emplace_back();
+  make_node(entries, nodes, at, first, end, t, moved);
+  roots.push_back(at);
 }
 
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
@@ -1109,6 +1178,8 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     // last one's faces are certified by the scalar `pruned` alone.
     cache->bounds.clear();
     cache->bound_nodes.clear();
+    cache->bound_roots.clear();
+    cache->expanded = 0;
     cache->bounded = false;
     if (record) q.bounds_out = &cache->bounds;
   }
@@ -1165,6 +1236,8 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     cache->enumerated_translation = b_in_a.translation;
     cache->pruned = q.pruned * q.unit;
     cache->bounded = record;
+    cache->expanded = 0;
+    ++cache->enumerations;
     // B's rotation may have changed: its supporting features with it.
     cache->witnesses.a.clear();
     cache->witnesses.b.clear();
@@ -1172,6 +1245,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     // enumerates every query, never pays for it); until then `last` is the
     // answer's face.
     cache->nodes.clear();
+    cache->roots.clear();
     cache->last = cache->facets[static_cast<std::size_t>(best - candidates.begin())];
   }
   return r;
@@ -1193,7 +1267,8 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
 // moved, and only one node's gain per level of the tree is ever chained).
 // A node not split yet is split when the search enters it.
 // The same search over the pruned groups (PenetrationCache::Bound), from
-// the faces' best value, finds whether any group's bound is below it.
+// the faces' best value, finds whether any group's bound is below it; with
+// `found` set, it collects every entry below `best` instead (best fixed).
 template <class Entry>
 struct TreeSearch {
   std::vector<Entry>& entries;
@@ -1204,6 +1279,7 @@ struct TreeSearch {
   double best = 0.0;
   Entry winner;
   int work = 0;
+  std::vector<int>* found = nullptr;
 
   // A lower bound at t on the values of the faces under node `at` (its
   // bound, or after entering it the least found).
@@ -1233,8 +1309,12 @@ struct TreeSearch {
         ++work;
         least = std::min(least, value);
         if (value < best) {
-          best = value;
-          winner = f;
+          if (found != nullptr) {
+            found->push_back(i);
+          } else {
+            best = value;
+            winner = f;
+          }
         }
       }
     } else {
@@ -1257,22 +1337,32 @@ struct TreeSearch {
   }
 };
 
+// At most this many cached faces are searched one by one, without their
+// tree: measured on bench/penetration_peers' sweep with a warm cache
+// (every face found), N = 8 (43 faces): 151 ns a query against 164 with
+// the tree; N = 64 (407 faces): 383 against 229.
+constexpr std::size_t kScanFacets = 64;
+
+// B's translation since the enumeration, for the cached faces and groups.
+Moved moved_since(const Query& q, const PenetrationCache& cache, const Pose& b_in_a) {
+  const Vec3 delta = b_in_a.translation - cache.enumerated_translation;
+  return {delta, (delta * q.inverse).norm() * q.unit, b_in_a.translation, q.inverse, q.unit};
+}
+
 // The tracked query (a cache of this pair at B's rotation): the least of
 // the cached faces' values, certified against the pruned ones. True with
 // the answer in `out`; false when a pruned group may be nearer now (then
-// `moved` is B's translation since the enumeration), `cache.last` the best
-// cached face.
+// `best` is the least cached value, `cache.last` its face). `extra`: work
+// of an expansion before it, counted in the answer's candidates.
 bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationResult& out,
-           double& moved_length) {
+           double& best_out, int extra = 0) {
   // M is the reference's M translated by -(t - t_ref): the cached facets
   // are all of its facets but the pruned ones, each offset moved by
   // -n.(t - t_ref).
   const double slack = kValueSlackUlps * kUnitRoundoff * q.magnitude;
-  const Moved moved{
-      b_in_a.translation - cache.enumerated_translation,
-      ((b_in_a.translation - cache.enumerated_translation) * q.inverse).norm() * q.unit};
-  moved_length = moved.length;
-  if (cache.nodes.empty()) build_tree(cache.facets, cache.nodes, b_in_a.translation, moved);
+  const Moved moved = moved_since(q, cache, b_in_a);
+  const bool scan = cache.facets.size() <= kScanFacets;
+  if (!scan) ensure_forest(cache.facets, cache.nodes, cache.roots, b_in_a.translation, moved);
   TreeSearch<PenetrationCache::Facet> search{cache.facets,
                                              cache.nodes,
                                              b_in_a.translation,
@@ -1282,25 +1372,38 @@ bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationRes
                                              entry_value(cache.last, moved),
                                              cache.last,
                                              1};
-  search.visit(0, search.bound(cache.nodes[0]));
+  if (scan) {
+    for (const PenetrationCache::Facet& g : cache.facets) {
+      const double value = entry_value(g, moved);
+      if (value < search.best) {
+        search.best = value;
+        search.winner = g;
+      }
+    }
+    search.work += static_cast<int>(cache.facets.size());
+  } else {
+    for (const std::int32_t r : cache.roots)
+      search.visit(r, search.bound(cache.nodes[static_cast<std::size_t>(r)]));
+  }
   const double best = search.best;
   const PenetrationCache::Facet& f = search.winner;
-  int work = search.work;
+  int work = search.work + extra;
   cache.last = f;
+  best_out = best;
   // The pruned faces: no group's bound below the best (searched on their
-  // tree), or when they were not recorded, their least bound at the
+  // forest), or when they were not recorded, their least bound at the
   // enumeration less the distance moved since.
   bool certified = false;
   if (!cache.bounded) {
     certified = best <= cache.pruned - moved.length;
-  } else if (cache.bounds.empty()) {
-    certified = true;
   } else {
-    if (cache.bound_nodes.empty())
-      build_tree(cache.bounds, cache.bound_nodes, b_in_a.translation, moved);
+    ensure_forest(cache.bounds, cache.bound_nodes, cache.bound_roots, b_in_a.translation, moved);
     TreeSearch<PenetrationCache::Bound> check{
         cache.bounds, cache.bound_nodes, b_in_a.translation, moved, q.inverse, q.unit, best, {}, 0};
-    check.visit(0, check.bound(cache.bound_nodes[0]));
+    for (std::size_t k = 0; k < cache.bound_roots.size() && !(check.best < best); ++k) {
+      const std::int32_t r = cache.bound_roots[k];
+      check.visit(r, check.bound(cache.bound_nodes[static_cast<std::size_t>(r)]));
+    }
     certified = !(check.best < best);
     work += check.work;
   }
@@ -1319,6 +1422,146 @@ bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationRes
   return true;
 }
 
+// The margin of an expansion or of an enumeration after a translation
+// outgrew the cache (PenetrationCache::prune_margin): twice the last one,
+// at least this many of B's last steps and a small fraction of the bodies'
+// radii, at most half of them (a B that jumps keeps pruning). Measured on
+// bench/penetration_peers' sweep (B through A and back, 6000 steps of
+// 1.6e-3, one cache a pass; /work/wt/pen.cpp, medians of 9 passes, ns a
+// query amortized, N = 512 / 4096): 8 steps that did not grow expanded 77
+// times a pass at N = 4096, each 100 to 3000 groups whose bounds had just
+// passed the best value (all the faces of A - B are near it when B nears
+// A's centre): about 7000 ns; doubling from 8 steps: 784 / 4819; from 32
+// steps: 777 / 4262 (the re-enumerations with a doubling margin before
+// the expansions: 785 / 4203).
+constexpr double kMarginSteps = 32.0;
+
+double translation_margin(const ConvexPolytope& a, const ConvexPolytope& b,
+                          const PenetrationCache& cache, const Pose& b_in_a) {
+  const double radii = a.bounding_radius() + b.bounding_radius();
+  const double step = (b_in_a.translation - cache.previous_translation).norm();
+  return std::min(std::max({2.0 * cache.prune_margin, kMarginSteps * step, 0x1p-10 * radii}),
+                  0.5 * radii);
+}
+
+// Expands the pruned groups whose bound at B's translation is below `best`
+// (the least cached value) plus `margin`: each is enumerated alone at this
+// pose, by the enumeration's own loops (Query::only), pruned against the
+// best value with the margin, its faces added to the cache (their offsets
+// moved back to the enumeration's translation: value + n.(t -
+// t_enumeration), as a cached face's) and its own pruned groups recorded,
+// anchored here; the group itself is dropped (lower +infinity). Then every
+// group's bound is at least the best value again, up to the faces found.
+// An expansion costs at most what an enumeration would (it tests the
+// groups it expands, the enumeration all of them, and evaluates no face
+// twice), so it is never refused; the false return (nothing changed) is
+// for no group below the threshold. The work (faces evaluated) in
+// `work`.
+bool expand(Query& q, PenetrationCache& cache, const Pose& b_in_a, double best, double margin,
+            int& work) {
+  const Moved moved = moved_since(q, cache, b_in_a);
+  const double threshold = best + margin;
+  std::vector<int> failing;
+  ensure_forest(cache.bounds, cache.bound_nodes, cache.bound_roots, b_in_a.translation, moved);
+  TreeSearch<PenetrationCache::Bound> collect{cache.bounds,
+                                              cache.bound_nodes,
+                                              b_in_a.translation,
+                                              moved,
+                                              q.inverse,
+                                              q.unit,
+                                              threshold,
+                                              {},
+                                              0,
+                                              &failing};
+  for (const std::int32_t r : cache.bound_roots)
+    collect.visit(r, collect.bound(cache.bound_nodes[static_cast<std::size_t>(r)]));
+  if (failing.empty()) return false;
+  Subset subset;
+  for (const int i : failing) {
+    PenetrationCache::Bound& g = cache.bounds[static_cast<std::size_t>(i)];
+    switch (g.kind) {
+      case PenetrationCache::Group::face_a:
+        subset.faces_a.push_back(g.i);
+        break;
+      case PenetrationCache::Group::face_b:
+        subset.faces_b.push_back(g.i);
+        break;
+      case PenetrationCache::Group::vertex_a:
+        subset.edges_a.push_back({g.i, -1});
+        break;
+      case PenetrationCache::Group::edge_a:
+        subset.edges_a.push_back({g.i, g.j});
+        break;
+    }
+    g.lower = kInfinity;
+  }
+  // In the enumeration's order (its hints for the other hull's supports
+  // follow neighbouring faces).
+  std::sort(subset.faces_a.begin(), subset.faces_a.end());
+  std::sort(subset.faces_b.begin(), subset.faces_b.end());
+  std::sort(subset.edges_a.begin(), subset.edges_a.end());
+  cache.expanded += static_cast<std::int32_t>(failing.size());
+  std::vector<PenetrationCache::Bound> fresh;
+  q.use_shapes(cache.shapes);
+  q.prune = true;
+  q.bound = best * q.inverse;
+  q.set_references(cache.last.support_a, cache.last.support_b);
+  q.prune_margin = margin * q.inverse;
+  q.bounds_out = &fresh;
+  q.only = &subset;
+  std::vector<Candidate> found;
+  add_face_candidates(q, found);
+  if (!subset.edges_a.empty()) add_edge_candidates_walk(q, found);
+  q.only = nullptr;
+  q.bounds_out = nullptr;
+  const Vec3 since = b_in_a.translation - cache.enumerated_translation;
+  const int old_facets = static_cast<int>(cache.facets.size());
+  const int old_bounds = static_cast<int>(cache.bounds.size());
+  for (const Candidate& c : found)
+    cache.facets.push_back(
+        {c.id, c.normal, c.value * q.unit + c.normal.dot(since), c.support_a, c.support_b});
+  cache.bounds.insert(cache.bounds.end(), fresh.begin(), fresh.end());
+  work = static_cast<int>(found.size());
+  ++cache.expansions;
+  // The new entries get trees of their own in the forests; the groups are
+  // compacted (and their forest built again by the next search) when the
+  // expanded ones are half of them.
+  add_tree(cache.facets, cache.nodes, cache.roots, old_facets, b_in_a.translation, moved);
+  if (2 * static_cast<std::size_t>(cache.expanded) > cache.bounds.size()) {
+    std::erase_if(cache.bounds,
+                  [](const PenetrationCache::Bound& g) { return g.lower == kInfinity; });
+    cache.expanded = 0;
+    cache.bound_nodes.clear();
+    cache.bound_roots.clear();
+  } else {
+    add_tree(cache.bounds, cache.bound_nodes, cache.bound_roots, old_bounds, b_in_a.translation,
+             moved);
+  }
+  return true;
+}
+
+// The tracked query, expanding the pruned groups a translation reached
+// (at most twice: the second search certifies unless rounding decided a
+// group at the threshold). False when the cache needs an enumeration: the
+// groups were not recorded (or two expansions did not certify); then
+// `margin` is the one to enumerate with.
+bool track_or_expand(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationResult& out,
+                     double& margin) {
+  double best = 0.0;
+  if (track(q, cache, b_in_a, out, best)) return true;
+  margin = translation_margin(q.a, q.b, cache, b_in_a);
+  cache.prune_margin = margin;
+  if (!cache.bounded) return false;
+  int work = 0;
+  for (int round = 0; round < 2; ++round) {
+    int more = 0;
+    if (!expand(q, cache, b_in_a, best, margin, more)) return false;
+    work += more;
+    if (track(q, cache, b_in_a, out, best, work)) return true;
+  }
+  return false;
+}
+
 bool same_pair(const PenetrationCache& cache, const ConvexPolytope& a, const ConvexPolytope& b) {
   return cache.a == &a && cache.b == &b && cache.fingerprint == fingerprint(a, b);
 }
@@ -1331,14 +1574,11 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
     cache.reset();
   } else if (!cache.facets.empty() && cache.rotation == b_in_a.rotation) {
     PenetrationResult r;
-    double moved = 0.0;
-    if (track(q, cache, b_in_a, r, moved)) return r;
-    // The pruned faces may be nearer now: enumerate again, keeping more of
-    // them for the translations to come (twice the distance moved since the
-    // enumeration, and at least twice the last margin). Capped at half the
-    // bodies' radii: a B that jumps keeps pruning.
-    cache.prune_margin = std::min(std::max(2.0 * cache.prune_margin, 2.0 * moved),
-                                  0.5 * (a.bounding_radius() + b.bounding_radius()));
+    double margin = 0.0;
+    if (track_or_expand(q, cache, b_in_a, r, margin)) return r;
+    // The pruned faces were not recorded, or too many are nearer now:
+    // enumerate again, keeping the faces within the margin.
+    cache.prune_margin = margin;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
@@ -1368,6 +1608,7 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
                                     const Pose& b_in_a, PenetrationCache& cache) {
   PenetrationResult r = depth(a, b, b_in_a, cache);
   cache.last_status = r.status;
+  cache.previous_translation = b_in_a.translation;
   return r;
 }
 
@@ -1376,8 +1617,10 @@ bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b,
   if (cache.facets.empty() || !same_pair(cache, a, b) || cache.rotation != b_in_a.rotation)
     return false;
   Query q(a, b, b_in_a);
-  double moved = 0.0;
-  if (!track(q, cache, b_in_a, out, moved)) return false;
+  double margin = 0.0;
+  const bool certified = track_or_expand(q, cache, b_in_a, out, margin);
+  cache.previous_translation = b_in_a.translation;
+  if (!certified) return false;
   cache.last_status = out.status;
   return true;
 }

@@ -757,6 +757,74 @@ TEST(PenetrationTracking, RandomWalkMatchesBruteForceThroughReAnchors) {
   EXPECT_GE(tracked, steps / 2);
 }
 
+// A translation that reaches pruned groups expands just them
+// (PenetrationCache::Bound's element, enumerated alone at the new pose)
+// instead of enumerating A - B again. B (128 points) swept through A (512
+// points) and back in 400 steps, its rotation fixed: every answer, from
+// a cache grown by expansions whose faces are anchored at the
+// enumeration's translation and whose groups at their own, equals the
+// slow twin's, and its bounds bracket it.
+TEST(PenetrationTracking, ExpandedCacheMatchesBruteForceOnALongSweep) {
+  Rng rng(512);
+  const Points a = points_on_sphere(rng, 512);
+  const Points b_local = points_on_sphere(rng, 128, 0.8);
+  const ConvexPolytope pa(a), pb(b_local);
+  const Mat3 rotation = random_rotation(rng);
+  const Vec3 dir = random_unit_vector(rng);
+  PenetrationCache cache;
+  const int steps = 400;
+  int penetrating = 0;
+  for (int i = 0; i < steps; ++i) {
+    const double phase = static_cast<double>(i) / steps;
+    const double s = phase < 0.5 ? -2.2 + 8.8 * phase : 6.6 - 8.8 * phase;
+    const Pose pose(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+    const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult slow_twin = penetration_depth_brute_force(pa, pb, pose);
+    const double tol = kContactBandUlps * kUnitRoundoff * 2.0;
+    ASSERT_EQ(r.status, slow_twin.status) << i;
+    ASSERT_NEAR(r.depth, slow_twin.depth, kRel * slow_twin.depth + tol) << i;
+    ASSERT_LE(r.lower_bound, slow_twin.depth + tol) << i;
+    ASSERT_GE(r.upper_bound, slow_twin.depth - tol) << i;
+    penetrating += r.status == PenetrationStatus::penetrating;
+  }
+  EXPECT_GE(penetrating, steps / 2);
+  EXPECT_GE(cache.expansions, 1);
+}
+
+// The expansions replace the enumerations: on bench/penetration_peers'
+// sweep (512 points each, B of radius 0.8 through A and back, steps of
+// 4e-3), the cache enumerated 6 times a pass before them (the margin
+// doubling at each, the last keeping 3348 faces), now twice: cold, and
+// once to record the pruned groups (a cold enumeration does not).
+TEST(PenetrationTracking, TranslationsExpandInsteadOfEnumerating) {
+  Rng rng(512 * 7919 + 1);
+  const Points a = points_on_sphere(rng, 512);
+  const Points b_local = points_on_sphere(rng, 512, 0.8);
+  const ConvexPolytope pa(a), pb(b_local);
+  const Vec3 dir = Vec3(1.0, 0.3, -0.2).normalized();
+  const Mat3 rotation =
+      Quat(Eigen::AngleAxisd(0.7, Vec3(0.2, -1.0, 0.4).normalized())).toRotationMatrix();
+  PenetrationCache cache;
+  const int steps = 2400;
+  int untracked = 0;
+  for (int i = 0; i < steps; ++i) {
+    const double phase = static_cast<double>(i) / steps;
+    const double s = phase < 0.5 ? -2.4 + 9.6 * phase : 7.2 - 9.6 * phase;
+    const Pose pose(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+    const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+    if (i % 16 == 0) {
+      PenetrationCache fresh;
+      const PenetrationResult cold = penetration_depth(pa, pb, pose, fresh);
+      ASSERT_EQ(r.status, cold.status) << i;
+      ASSERT_NEAR(r.depth, cold.depth, kRel * cold.depth + 1e-14) << i;
+    }
+    untracked += !r.tracked;
+  }
+  EXPECT_LE(untracked, 2);
+  EXPECT_GE(cache.expansions, 3);
+  EXPECT_EQ(cache.enumerations, 2);
+}
+
 TEST(PenetrationTracking, RotationAndForeignCachesAreNeverWrong) {
   Rng rng(18);
   const Points a1 = points_on_sphere(rng, 60), b1 = points_on_sphere(rng, 40, 0.5);

@@ -126,8 +126,8 @@ struct PenetrationResult {
   Feature feature_a;
   Feature feature_b;
   // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
-  // crossing edge pairs) for a cold query; faces and tree nodes visited
-  // for a tracked one.
+  // crossing edge pairs) for a cold query; faces and tree nodes visited,
+  // and faces an expansion evaluated, for a tracked one.
   int candidates = 0;
   // True when the cache certified the answer (no enumeration of M).
   bool tracked = false;
@@ -160,8 +160,13 @@ struct PenetrationResult {
 // enumeration with a ball around their normals, so that it moves with B
 // like a face (its value now is at least lower - (c.delta + spread
 // |delta|)) and sits in a second tree searched the same way: the answer is
-// certified when no Bound is below it, and only a B that moved towards a
-// pruned group's normals enumerates again. A rotated B enumerates again.
+// certified when no Bound is below it. A B that moved towards pruned
+// groups expands them: each is enumerated alone at the new pose (pruned
+// against the best value, its own pruned parts kept as new groups), its
+// faces join the cache, and the search certifies again. A rotated B
+// enumerates again; so does the first translation after a cold
+// enumeration (which records no groups: a caller querying cold every time
+// would pay for them).
 struct PenetrationCache {
   struct Facet {
     MinkowskiFaceId id;
@@ -187,12 +192,20 @@ struct PenetrationCache {
   };
   // A group of faces of A - B the enumeration pruned: their outward unit
   // normals lie within `spread` of `center` (spread 2: anywhere), and
-  // `lower` bounds their values h_A(n) + h_B(-n) from below at the
-  // enumeration's translation of B (A's units).
+  // `lower` bounds their values h_A(n) + h_B(-n) from below at B's
+  // translation `anchor` (A's units): the enumeration's, or an
+  // expansion's. `kind` and `i`, `j` name the element of the enumeration
+  // it stands for, so that it can be expanded alone: a face i of A, a face
+  // i of B, the edges (i, w) at a vertex i of A with i < w, or the edge
+  // (i, j) of A (i < j).
+  enum class Group : std::uint8_t { face_a, face_b, vertex_a, edge_a };
   struct Bound {
     Vec3 center = Vec3::Zero();
     double spread = 2.0;
     double lower = 0.0;
+    Vec3 anchor = Vec3::Zero();
+    Group kind = Group::face_a;
+    std::int32_t i = -1, j = -1;
   };
   // Faces at most this many to a leaf.
   static constexpr int kLeaf = 8;
@@ -204,28 +217,45 @@ struct PenetrationCache {
   // B's rotation, and its translation at the enumeration.
   Mat3 rotation = Mat3::Zero();
   Vec3 enumerated_translation = Vec3::Zero();
-  // All faces of A - B found, in tree order, and the tree.
+  // All faces of A - B found, in tree order, and a forest over them: the
+  // trees' roots in nodes, each over a run of facets (the enumeration's,
+  // then each expansion's, merged with the run before it when that run is
+  // at most twice as long: a few trees, each entry rebuilt into a new tree
+  // O(log) times); empty until the first search builds one over all.
   std::vector<Facet> facets;
   std::vector<Node> nodes;
+  std::vector<std::int32_t> roots;
   // The facet of the last answer (a copy: the tree reorders facets while
   // it is built, lazily, by the searches that descend into it).
   Facet last;
-  // The faces the enumeration pruned (not in facets): their groups and a
-  // tree over them like `nodes` (built by the first tracked query), when
-  // recorded (`bounded`: only by an enumeration after a translation
-  // outgrew the cached faces; a cold one or one for a B that turned does
-  // not record them: a caller querying cold, or a rotating B, enumerates
-  // every query), and
-  // in any case their least lower bound at the enumeration's translation
-  // (+infinity when none), the certificate when they are not recorded.
+  // The faces the enumeration and the expansions pruned (not in facets):
+  // their groups and a forest over them like the facets' (built by the
+  // first tracked query), when recorded (`bounded`: only by an
+  // enumeration after a translation outgrew the cached faces, and by the
+  // expansions after it; a cold one or one for a B that turned does not
+  // record them: a caller querying cold, or a rotating B, enumerates every
+  // query), an expanded group staying with lower +infinity until the
+  // groups are compacted (`expanded` counts them); and in any case the
+  // enumeration's least lower bound at its translation (+infinity when
+  // none), the certificate when they are not recorded.
   std::vector<Bound> bounds;
   std::vector<Node> bound_nodes;
+  std::vector<std::int32_t> bound_roots;
+  std::int32_t expanded = 0;
   bool bounded = false;
   double pruned = 0.0;
-  // Faces within this of the first upper bound are kept by the enumeration
-  // even where a lower bound would prune them: it grows while B translates
-  // past it (so that tracking finds them cached) and halves when B turns.
+  // Faces within this of the best value are kept by an enumeration or an
+  // expansion even where a lower bound would prune them, and the groups
+  // within it of the best value are expanded: a few steps of B (so that
+  // the next queries find them cached); halves when B turns.
   double prune_margin = 0.0;
+  // B's translation at the last query with this cache (its step sets the
+  // margin).
+  Vec3 previous_translation = Vec3::Zero();
+  // Work done with this cache: full enumerations of A - B, and
+  // expansions of pruned groups (a translation towards them).
+  std::int64_t enumerations = 0;
+  std::int64_t expansions = 0;
   // What the query needs of each hull whatever the pose, in its own frame:
   // face normals and the radius of a ball about the centroid inside it.
   // A normal is first a fast one (a triangle's rounded cross product,
@@ -274,12 +304,12 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
 
 // The tracked query alone: when `cache` holds this pair's faces of A - B
 // at B's rotation and certifies their least value without enumerating
-// again (the translation-only path of penetration_depth), fills `out` with
-// the answer penetration_depth would give and returns true; else returns
-// false, `out` and the answer's cache state unchanged (the tree's bounds
-// may have been tightened), and the caller decides whether the depth is
-// wanted (distance() asks it first for a pair that was penetrating, and
-// skips its own algorithm when the depth certifies the overlap).
+// again (the translation-only path of penetration_depth, expansions of
+// pruned groups included), fills `out` with the answer penetration_depth
+// would give and returns true; else returns false, `out` and the answer's
+// cache state unchanged (the tree's bounds may have been tightened, faces
+// added), and the caller decides whether the depth is wanted (distance() asks it first for a pair
+// that was penetrating, and skips its own algorithm when the depth certifies the overlap).
 bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                                PenetrationCache& cache, PenetrationResult& out);
 
