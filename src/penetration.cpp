@@ -63,13 +63,22 @@ namespace proxima {
 namespace {
 
 // A sign value s = p.k (p unit) with |s| <= kArcTolerance |k| counts as
-// zero, and zeros never reject a pair. face_plane's normals are within
-// about 16 u per face vertex of the exact ones (polytope.cpp, kSliverRatio)
-// and the scaled edge vectors within a few u: a true crossing whose signs
-// are decided wrongly by rounding is always kept. Pairs kept by it that do
+// zero, and zeros never reject a pair. The arcs' endpoints are face
+// normals within kArcNormalError of the exact ones (face_plane's, about
+// 16 u per face vertex: polytope.cpp, kSliverRatio; or fast ones) and the
+// scaled edge vectors within a few u: a true crossing whose signs are
+// decided wrongly by rounding is always kept. Pairs kept by it that do
 // not cross cost one evaluation each and cannot lower the minimum (step 2
 // above). Pinned by PenetrationDegenerate.* (parallel and coplanar edges).
 constexpr double kArcTolerance = 1e-12;
+
+// The largest error bound of a fast face normal (Query::fast_normals) that
+// an arc's endpoint takes instead of face_plane's: 128 u, about 1/70 of
+// kArcTolerance and near face_plane's own bound for a triangle (48 u). A
+// well-shaped triangle's bound is about 45 u (equilateral); thinner ones
+// pay for face_plane. Saves face_plane on every face whose arcs the walk
+// reads but that it never evaluates (at N = 8, 4 faces of 24 are).
+constexpr double kArcNormalError = 128.0 * kUnitRoundoff;
 
 // Slack on a value computed in double, in units of u times the scaled
 // magnitude (about 1 after scaling): the dot product of a unit normal with
@@ -83,12 +92,6 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 constexpr double kTieUlps = 64.0;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-// Hulls of at most this many faces get face_plane's normals at once
-// (Query::fast_normals). Measured on the cold sweep of
-// bench/penetration_peers' poses: fast normals first made N = 8 (12
-// faces) 7% slower and N = 64 (124 faces) 10% faster.
-constexpr std::size_t kFastNormalsMinFaces = 32;
 
 struct Arc {
   Vec3 p, q;         // unit endpoints
@@ -166,12 +169,13 @@ struct Query {
   Vec3 point_b(int j) const { return rotation * (b.vertex(j) * inverse) + translation; }
 
   // Points the query at the hulls' normals and inradii in `shapes`,
-  // computed first when they are not (or not for these hulls).
-  void use_shapes(PenetrationCache::Shapes& shapes) {
+  // computed first when they are not (or not for these hulls): fast ones
+  // unless `fast` is false (the slow twin: face_plane's only).
+  void use_shapes(PenetrationCache::Shapes& shapes, bool fast) {
     if (shapes.a.normals.size() != static_cast<std::size_t>(a.face_count()) ||
         shapes.b.normals.size() != static_cast<std::size_t>(b.face_count())) {
-      fast_normals(a, shapes.a);
-      fast_normals(b, shapes.b);
+      fast_normals(a, shapes.a, fast);
+      fast_normals(b, shapes.b, fast);
     }
     shapes_a = &shapes.a;
     shapes_b = &shapes.b;
@@ -192,15 +196,17 @@ struct Query {
   // the unit normal is within 16 u |p||q| / |c| of the exact one, plus the
   // normalization's rounding; kept with twice that bound (|p||q| read as
   // (|p|^2 + |q|^2) / 2, no square root) when |c| >= 2^-10 |p||q| (an
-  // angle above 0.06 degree), else, and for faces of more
-  // vertices, face_plane's (error 0); face_plane's for all faces of a
-  // small hull (at most kFastNormalsMinFaces faces: the query evaluates
-  // most of them, so fast normals would be computed twice). The inradius:
+  // angle above 0.06 degree), else, for faces of more vertices and when
+  // `fast` is false, face_plane's (error 0). Small hulls too: a cold query
+  // evaluates few of their faces (4 of 24 at N = 8 in
+  // bench/penetration_bench's Cold), and one face_plane costs several fast
+  // normals. The inradius:
   // the least over the faces of n.(v - centroid) less the normal's error
   // and the rounding times twice the bounding radius (>= |v - centroid|),
   // then less 64 u R; 0 for a flat hull (its two faces' planes hold the
   // centroid).
-  static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out) {
+  static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out,
+                           bool fast) {
     const auto count = static_cast<std::size_t>(poly.face_count());
     out.normals.resize(count);
     out.error.resize(count);
@@ -213,7 +219,7 @@ struct Query {
     double r = std::numeric_limits<double>::infinity();
     for (std::size_t f = 0; f < count; ++f) {
       const auto cycle = poly.face(static_cast<int>(f));
-      if (cycle.size() == 3 && count > kFastNormalsMinFaces) {
+      if (fast && cycle.size() == 3) {
         const Vec3 v0 = poly.vertex(cycle[0]) * s.inverse;
         const Vec3 p = poly.vertex(cycle[1]) * s.inverse - v0;
         const Vec3 q = poly.vertex(cycle[2]) * s.inverse - v0;
@@ -259,6 +265,17 @@ struct Query {
   Vec3 normal_a(int f) const { return exact_normal(a, *shapes_a, f); }
   // Of -B, in A's frame.
   Vec3 normal_b(int g) const { return -(rotation * exact_normal(b, *shapes_b, g)); }
+
+  // A face's normal for its edges' Gauss-map arcs: the stored one when
+  // within kArcNormalError of the exact one (face_plane's has error 0),
+  // else face_plane's.
+  static const Vec3& arc_normal(const ConvexPolytope& poly, PenetrationCache::HullNormals& h,
+                                int f) {
+    const auto i = static_cast<std::size_t>(f);
+    return h.error[i] <= kArcNormalError ? h.normals[i] : exact_normal(poly, h, f);
+  }
+  Vec3 arc_normal_a(int f) const { return arc_normal(a, *shapes_a, f); }
+  Vec3 arc_normal_b(int g) const { return -(rotation * arc_normal(b, *shapes_b, g)); }
 };
 
 // The face to the left of the directed edge v -> w, or -1.
@@ -311,7 +328,7 @@ int arcs_of_a(const Query& q, int v, int w, int l, int r, std::array<Arc, 4>& ou
   const Vec3 k = q.point_a(w) - q.point_a(v);
   if (dim == 3 || dim == 2) {
     if (l < 0 || r < 0) return 0;
-    return edge_arcs(dim, k, q.normal_a(l), q.normal_a(r), false, out);
+    return edge_arcs(dim, k, q.arc_normal_a(l), q.arc_normal_a(r), false, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), false, out);
 }
@@ -327,7 +344,7 @@ int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
     const int l = left_face(q.b, v, w);
     const int r = left_face(q.b, w, v);
     if (l < 0 || r < 0) return 0;
-    return edge_arcs(dim, k, q.normal_b(l), q.normal_b(r), true, out);
+    return edge_arcs(dim, k, q.arc_normal_b(l), q.arc_normal_b(r), true, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), true, out);
 }
@@ -1085,7 +1102,7 @@ void build_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache:
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
   PenetrationCache::Shapes local;
-  q.use_shapes(cache != nullptr ? cache->shapes : local);
+  q.use_shapes(cache != nullptr ? cache->shapes : local, walk);
   if (cache != nullptr) {
     // Filled by this enumeration; until the cache is written below, the
     // last one's faces are certified by the scalar `pruned` alone.

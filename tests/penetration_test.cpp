@@ -521,6 +521,53 @@ TEST(PenetrationTwins, GridsWithCoplanarFacesAndRotationSweep) {
   }
 }
 
+TEST(PenetrationTwins, SmallHullsWithFastArcNormalsMatchBruteForce) {
+  // Hulls of 4 to 18 points (the cold query's fast face normals serve their
+  // Gauss-map arcs when within 128 u of the exact ones, face_plane's
+  // otherwise; the slow twin reads face_plane's only): round, boxy and
+  // flattened (thin triangles, whose fast normals are too loose for the
+  // arcs) bodies, turned and overlapping by any amount. Counts both kinds
+  // of normal among the arcs' faces, so that the set holds both.
+  Rng rng(23);
+  int fast_normals = 0, loose_normals = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const auto shape = [&](double radius) {
+      const int n = uniform_int(rng, 4, 18);
+      switch (trial % 4) {
+        case 0:
+          return points_on_sphere(rng, n, radius);
+        case 1:
+          return points_in_cube(rng, n, radius);
+        case 2:
+          return transformed(points_on_sphere(rng, n, radius),
+                             Mat3(Vec3(1.0, 1.0, 1e-3).asDiagonal()), Vec3::Zero());
+        default:
+          return transformed(points_in_cube(rng, n, radius),
+                             Mat3(Vec3(1.0, 0.05, 0.05).asDiagonal()), Vec3::Zero());
+      }
+    };
+    const Points a = shape(1.0), b = shape(0.7);
+    const Pose pose(random_quaternion(rng), uniform(rng, 0.0, 1.6) * random_unit_vector(rng));
+    const ConvexPolytope pa(a), pb(b);
+    PenetrationCache cache;
+    const PenetrationResult rf = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult rs = penetration_depth_brute_force(pa, pb, pose);
+    const double tol =
+        kContactBandUlps * kUnitRoundoff * std::max(pa.scale(), magnitude_bound(pose, pb.scale()));
+    EXPECT_EQ(rf.status, rs.status) << trial;
+    EXPECT_NEAR(rf.depth, rs.depth, kRel * rs.depth + tol) << trial;
+    EXPECT_LE(rf.candidates, rs.candidates) << trial;
+    for (const PenetrationCache::HullNormals* h : {&cache.shapes.a, &cache.shapes.b}) {
+      for (const double e : h->error) {
+        fast_normals += e > 0.0 && e <= 128 * kUnitRoundoff;
+        loose_normals += e > 128 * kUnitRoundoff;
+      }
+    }
+  }
+  EXPECT_GT(fast_normals, 1000);
+  EXPECT_GT(loose_normals, 100);
+}
+
 TEST(PenetrationDegenerate, LongThinTriangleThroughABox) {
   // Jolt's long thin triangle: a triangle 100 long and 1e-3 wide cutting
   // through a box; the depth is set by the box, not by the triangle's
