@@ -141,9 +141,11 @@ struct Query {
   // candidate so far (see pruned_by).
   Vec3 reference_a = Vec3::Zero();
   Vec3 reference_b = Vec3::Zero();
-  // Per vertex v of A (empty until a face of A is evaluated): B's support
+  // The enumeration's scratch lists (solve_cold's buffer on the stack).
+  std::pmr::memory_resource* memory = std::pmr::get_default_resource();
+  // Per vertex v of A (null until a face of A is evaluated): B's support
   // found for the last face through v evaluated, or -1 (a hint).
-  std::vector<std::int32_t> near_b;
+  std::int32_t* near_b = nullptr;
   // centroid_a and reference_a in B's frame (scaled): R^T (x - t).
   Vec3 centroid_a_in_b = Vec3::Zero();
   Vec3 reference_a_in_b = Vec3::Zero();
@@ -337,16 +339,20 @@ int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
   return arcs_of_a(q, v, w, left_face(q.a, v, w), left_face(q.a, w, v), out);
 }
 
-int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+// The arcs of -B's edge v -> w, whose left and right faces are l and r
+// (left_face's; read only for dimensions 2 and 3).
+int arcs_of_b(const Query& q, int v, int w, int l, int r, std::array<Arc, 4>& out) {
   const int dim = q.b.dimension();
   const Vec3 k = q.point_b(w) - q.point_b(v);
   if (dim == 3 || dim == 2) {
-    const int l = left_face(q.b, v, w);
-    const int r = left_face(q.b, w, v);
     if (l < 0 || r < 0) return 0;
     return edge_arcs(dim, k, q.arc_normal_b(l), q.arc_normal_b(r), true, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), true, out);
+}
+
+int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+  return arcs_of_b(q, v, w, left_face(q.b, v, w), left_face(q.b, w, v), out);
 }
 
 bool edges_may_cross(const std::array<Arc, 4>& xs, int nx, const std::array<Arc, 4>& ys, int ny) {
@@ -468,7 +474,9 @@ PenetrationCache::Bound cone_of_arc(const Vec3& p, double ep, const Vec3& q, dou
   return {c, spread, 0.0};
 }
 
-void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
+using Candidates = std::pmr::vector<Candidate>;
+
+void keep(Query& q, const Candidate& c, Candidates& out) {
   out.push_back(c);
   if (c.value < q.bound) {
     q.bound = c.value;
@@ -485,7 +493,7 @@ void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
 // a half circle that the side is unclear, kClearMiddle) both n and -n are
 // added (each an upper bound).
 void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
-                        int b1, const std::array<Arc, 4>& yb, int nb, std::vector<Candidate>& out) {
+                        int b1, const std::array<Arc, 4>& yb, int nb, Candidates& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
   const Vec3& ea = xa[0].k;
   const Vec3& eb = yb[0].k;
@@ -513,7 +521,15 @@ double face_lower(const Vec3& m, double error, const Vec3& w, double reach) {
 // Appends every face candidate (faces of A, faces of B), the ones that
 // pruned_by leaves. The pruning test reads the fast normals; a face kept
 // is evaluated along its exact one.
-void add_face_candidates(Query& q, std::vector<Candidate>& out) {
+// A list of n hints in q.memory, all -1.
+std::int32_t* new_hints(const Query& q, int n) {
+  std::int32_t* hints =
+      std::pmr::polymorphic_allocator<std::int32_t>(q.memory).allocate(static_cast<std::size_t>(n));
+  std::fill_n(hints, n, -1);
+  return hints;
+}
+
+void add_face_candidates(Query& q, Candidates& out) {
   const PenetrationCache::HullNormals& sa = *q.shapes_a;
   const PenetrationCache::HullNormals& sb = *q.shapes_b;
   // Hints for the other hull's support: the last one found for a face
@@ -521,8 +537,8 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   // climb from it is short; the previous face's, in index order, can be
   // anywhere: at N = 4096 an enumeration that keeps many faces spent most
   // of its time climbing). Allocated with the first face evaluated.
-  std::vector<std::int32_t>& near_b = q.near_b;
-  std::vector<std::int32_t> near_a;
+  std::int32_t*& near_b = q.near_b;
+  std::int32_t* near_a = nullptr;
   int hint_b = 0;
   for (int f = 0; f < q.a.face_count(); ++f) {
     const auto i = static_cast<std::size_t>(f);
@@ -539,7 +555,7 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
         continue;
     }
     const auto cycle = q.a.face(f);
-    if (near_b.empty()) near_b.assign(static_cast<std::size_t>(q.a.vertex_count()), -1);
+    if (near_b == nullptr) near_b = new_hints(q, q.a.vertex_count());
     const std::int32_t near = near_b[static_cast<std::size_t>(cycle[0])];
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, near >= 0 ? near : hint_b, -1};
     Candidate c = evaluate_face(q, id);
@@ -569,7 +585,7 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
         continue;
     }
     const auto cycle = q.b.face(g);
-    if (near_a.empty()) near_a.assign(static_cast<std::size_t>(q.b.vertex_count()), -1);
+    if (near_a == nullptr) near_a = new_hints(q, q.b.vertex_count());
     const std::int32_t near = near_a[static_cast<std::size_t>(cycle[0])];
     MinkowskiFaceId id{MinkowskiFace::vertex_face, near >= 0 ? near : hint_a, -1, g, -1};
     Candidate c = evaluate_face(q, id);
@@ -593,7 +609,7 @@ double arc_minimum(const Arc& arc, const Vec3& w) {
 }
 
 // Brute force over all edge pairs.
-void add_edge_candidates_brute_force(Query& q, std::vector<Candidate>& out) {
+void add_edge_candidates_brute_force(Query& q, Candidates& out) {
   struct EdgeArcs {
     int v, w, count;
     std::array<Arc, 4> arcs;
@@ -617,10 +633,15 @@ void add_edge_candidates_brute_force(Query& q, std::vector<Candidate>& out) {
         add_edge_candidate(q, x.v, x.w, x.arcs, x.count, y.v, y.w, y.arcs, y.count, out);
 }
 
+// B's arcs by adjacency slot (add_edge_candidates_walk) up to this size
+// come from the query's scratch buffer (solve_cold).
+constexpr std::size_t kScratchArcBytes = 4096;
+
 // The overlay walk: for each arc of A, the chain of B cells it crosses.
-void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
-  std::vector<std::int32_t> chain;  // visited B vertices of the current arc (the queue too)
-  std::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0);
+void add_edge_candidates_walk(Query& q, Candidates& out) {
+  // Visited B vertices of the current arc (the queue too).
+  std::pmr::vector<std::int32_t> chain(q.memory);
+  std::pmr::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0, q.memory);
   int hint = 0;
   std::array<Arc, 4> xs, ys;
   // A solid B's arcs, one per edge, computed once on first use (each is
@@ -628,12 +649,25 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
   // (an arc read backwards is the same arc for the crossing test).
   const bool memo = q.b.dimension() == 3;
   const auto offsets = q.b.adjacency_offsets();
+  const auto adjacency_b = q.b.adjacency();
+  const auto faces_b = q.b.adjacency_faces();
   // Storage only (not value-initialized): with pruning a query reads a
   // few of B's slots, and writing all of them (80 bytes each) was a tenth
   // of a cold query at N = 4096 (page faults of the fresh allocation).
+  // From the scratch buffer when small; else from the heap (the buffer's
+  // next blocks double in size: at N = 512, 240 KB of arcs took a fresh
+  // 512 KB block, and its page faults, every query).
   const std::size_t slots = memo ? q.b.adjacency().size() : 0;
-  const std::unique_ptr<Arc[]> slot_arc = std::make_unique_for_overwrite<Arc[]>(slots);
-  std::vector<char> slot_ready(slots, 0);
+  std::unique_ptr<Arc[]> heap_arcs;
+  Arc* slot_arc = nullptr;
+  if (slots * sizeof(Arc) <= kScratchArcBytes) {
+    slot_arc = std::pmr::polymorphic_allocator<Arc>(q.memory).allocate(slots);
+    std::uninitialized_default_construct_n(slot_arc, slots);
+  } else {
+    heap_arcs = std::make_unique_for_overwrite<Arc[]>(slots);
+    slot_arc = heap_arcs.get();
+  }
+  std::pmr::vector<char> slot_ready(slots, 0, q.memory);
   const PenetrationCache::HullNormals& sa = *q.shapes_a;
   const bool solid_a = q.a.dimension() == 3;
   const auto offsets_a = q.a.adjacency_offsets();
@@ -737,7 +771,7 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         // The B cell of direction p: B's support along -p.
         // From the support found for a face through v, when one was
         // evaluated (for a solid A, p is the normal of such a face).
-        const std::int32_t near = q.near_b.empty() ? -1 : q.near_b[static_cast<std::size_t>(v)];
+        const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
         const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), near >= 0 ? near : hint);
         hint = start;
         chain.clear();
@@ -752,9 +786,17 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
             int ny = 0;
             if (memo) {
               if (!slot_ready[slot]) {
-                const int count = arcs_of_b(q, j, k, ys);
-                slot_ready[slot] = count == 1 ? 1 : 2;
+                // Both directions of the edge at once: k -> j's slot (its
+                // left face is j -> k's right one) gets the same arc read
+                // backwards, (q, p, -k), what arcs_of_b gives for it.
+                const auto back = static_cast<std::size_t>(
+                    std::find(adjacency_b.begin() + offsets[static_cast<std::size_t>(k)],
+                              adjacency_b.begin() + offsets[static_cast<std::size_t>(k) + 1], j) -
+                    adjacency_b.begin());
+                const int count = arcs_of_b(q, j, k, faces_b[slot], faces_b[back], ys);
+                slot_ready[slot] = slot_ready[back] = count == 1 ? 1 : 2;
                 slot_arc[slot] = ys[0];
+                slot_arc[back] = {ys[0].q, ys[0].p, -ys[0].k, ys[0].tolerance};
               }
               ny = slot_ready[slot] == 1 ? 1 : 0;
               ys[0] = slot_arc[slot];
@@ -1101,6 +1143,13 @@ void build_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache:
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
+  // The scratch lists (candidates, hints, the walk's marks and B's arcs)
+  // from a buffer on the stack, which holds them all up to about N = 10
+  // (sphere hulls of N vertices; larger ones continue on the heap): eight
+  // heap allocations were a tenth of a cold query at N = 8.
+  std::array<std::byte, 8192> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  q.memory = &memory;
   PenetrationCache::Shapes local;
   q.use_shapes(cache != nullptr ? cache->shapes : local, walk);
   if (cache != nullptr) {
@@ -1125,7 +1174,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     q.bound = first.value;
     q.set_references(first.support_a, first.support_b);
   }
-  std::vector<Candidate> candidates;
+  Candidates candidates(&memory);
   // Every face and crossing for the slow twin; a pruned walk keeps a few
   // hundred at most on the benchmarks' spheres (reserving for all of them,
   // 2 MB at N = 4096, cost an mmap and its page faults per cold query).
