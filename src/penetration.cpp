@@ -491,7 +491,11 @@ void keep(Query& q, const Candidate& c, Candidates& out) {
 // holds n or -n, the one on the side of its middle; a segment's arcs make
 // a whole circle, then -B's arc decides; for two segments (or arcs so near
 // a half circle that the side is unclear, kClearMiddle) both n and -n are
-// added (each an upper bound).
+// added (each an upper bound). Pruning: a0 is in A and b0 in B, so the
+// value h_A(n) + h_B(-n) is at least n.(a0 - b0), the value itself when
+// the pair is a face of A - B (its supports are the edges' points); at
+// N = 8 to 4096, 90 to 99% of the edge pairs the walk evaluated had a
+// value above the bound, each at the cost of two hill climbs.
 void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
                         int b1, const std::array<Arc, 4>& yb, int nb, Candidates& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
@@ -503,12 +507,19 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
   n /= length;
   Vec3 middle = arc_middle(xa, na);
   if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);
+  const auto add = [&](const Vec3& normal) {
+    if (q.prune && pruned_by(q, normal.dot(q.point_a(a0) - q.point_b(b0)), [&] {
+          return PenetrationCache::Bound{normal, kConeSlack, 0.0};
+        }))
+      return;
+    keep(q, evaluate(q, id, normal, a0, b0), out);
+  };
   if (middle.squaredNorm() == 0) {
-    keep(q, evaluate(q, id, n, a0, b0), out);
-    keep(q, evaluate(q, id, -n, a0, b0), out);
+    add(n);
+    add(-n);
     return;
   }
-  keep(q, evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0), out);
+  add(n.dot(middle) < 0 ? Vec3(-n) : n);
 }
 
 // A lower bound on n.w for the exact unit normal n of a face, from its
