@@ -73,12 +73,13 @@ namespace {
 constexpr double kArcTolerance = 1e-12;
 
 // The largest error bound of a fast face normal (Query::fast_normals) that
-// an arc's endpoint takes instead of face_plane's: 128 u, about 1/70 of
-// kArcTolerance and near face_plane's own bound for a triangle (48 u). A
-// well-shaped triangle's bound is about 45 u (equilateral); thinner ones
-// pay for face_plane. Saves face_plane on every face whose arcs the walk
-// reads but that it never evaluates (at N = 8, 4 faces of 24 are).
-constexpr double kArcNormalError = 128.0 * kUnitRoundoff;
+// an arc's endpoint takes instead of face_plane's: 512 u, about 1/17 of
+// kArcTolerance and face_plane's own bound for a face of 32 vertices (16 u
+// per vertex). A well-shaped triangle's bound is about 45 u (equilateral);
+// slivers pay for face_plane. Saves face_plane on every face whose arcs
+// the walk reads but that it never evaluates (at N = 8, 20 of 24 faces;
+// 512 u rather than 128 u: 3% of a cold query at N = 8).
+constexpr double kArcNormalError = 512.0 * kUnitRoundoff;
 
 // Slack on a value computed in double, in units of u times the scaled
 // magnitude (about 1 after scaling): the dot product of a unit normal with
