@@ -633,11 +633,14 @@ void add_face_candidates(Query& q, Candidates& out) {
 // lower bound on it: with n = c1 p + c2 q, c1, c2 >= 0 and
 // 1 <= c1 + c2 <= 1 / cos(alpha / 2), n.w >= m = min(p.w, q.w) when
 // m >= 0 and n.w >= m / cos(alpha / 2) otherwise (cos(alpha / 2) =
-// |p + q| / 2). -infinity for an arc too near a half circle.
-double arc_minimum(const Arc& arc, const Vec3& w) {
-  const double m = std::min(arc.p.dot(w), arc.q.dot(w));
+// |p + q| / 2). -infinity for an arc too near a half circle. The arc's
+// ends within `error` of the exact arc's (fast face normals,
+// kArcNormalError), |w| <= reach: each end's value within error * reach,
+// and the exact cos(alpha / 2) at least |p + q| / 2 - error.
+double arc_minimum(const Arc& arc, const Vec3& w, double error, double reach) {
+  const double m = std::min(arc.p.dot(w), arc.q.dot(w)) - error * reach;
   if (m >= 0.0) return m;
-  const double half_cos = 0.5 * (arc.p + arc.q).norm();
+  const double half_cos = 0.5 * (arc.p + arc.q).norm() - error;
   return half_cos > 1e-3 ? m / half_cos : -std::numeric_limits<double>::infinity();
 }
 
@@ -787,10 +790,18 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
       if (q.prune && nx > 0) {
         const Vec3 w = q.point_a(e[0]) - q.centroid_b;
         const Vec3 w2 = q.point_a(e[0]) - q.reference_b;
+        // The arcs' ends: the faces' normals as arcs_of_a read them (error
+        // 0 once face_plane's), and for a polygon the in-plane normal from
+        // them, normalized (twice the error at most).
+        const double error = l >= 0 && r >= 0
+                                 ? 2.0 * std::max(sa.error[static_cast<std::size_t>(l)],
+                                                  sa.error[static_cast<std::size_t>(r)])
+                                 : 0.0;
         double lower = kInfinity, lower2 = kInfinity;
         for (int i = 0; i < nx; ++i) {
-          lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
-          lower2 = std::min(lower2, arc_minimum(xs[static_cast<std::size_t>(i)], w2));
+          const Arc& x = xs[static_cast<std::size_t>(i)];
+          lower = std::min(lower, arc_minimum(x, w, error, q.reach));
+          lower2 = std::min(lower2, arc_minimum(x, w2, error, q.reach));
         }
         if (pruned_by(q, std::max(lower + q.inradius_b, lower2), [&] {
               // A solid's one arc; a polygon's or a segment's half or
