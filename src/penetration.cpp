@@ -679,6 +679,15 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
   std::pmr::vector<std::int32_t> chain(q.memory);
   std::pmr::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0, q.memory);
   int hint = 0;
+  // A vertex of B near B's support along -n for the normals n near v's
+  // cell of A's Gauss map: the support found for a face through v, else
+  // the last arc's start. The lower bounds read it as a point of B when
+  // the centroid's and the reference's do not prune (a third bound, as
+  // for the faces in add_face_candidates).
+  const auto near_hint = [&](int v) {
+    const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
+    return near >= 0 ? static_cast<int>(near) : hint;
+  };
   std::array<Arc, 4> xs, ys;
   // A solid B's arcs, one per edge, computed once on first use (each is
   // met from several arcs of A), by adjacency slot of either direction
@@ -755,11 +764,19 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
         if (!(spread < kMaxConeChord)) return whole_sphere();
         return PenetrationCache::Bound{c, spread, 0.0};
       };
-      if (all && slot_begin < slot_end &&
-          pruned_by(
-              q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity),
-              cone))
-        continue;
+      double lower =
+          std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity);
+      if (all && slot_begin < slot_end && !above_bound(q, lower)) {
+        // The same with B's point at the hint (near_hint).
+        const Vec3 wh = av - q.point_b(near_hint(v));
+        double mh = kInfinity;
+        for (std::size_t at = slot_begin; at < slot_end; ++at) {
+          const auto i = static_cast<std::size_t>(faces_a[at]);
+          mh = std::min(mh, face_lower(sa.normals[i], sa.error[i], wh, q.reach));
+        }
+        if (mh >= 0.0) lower = std::max(lower, mh);
+      }
+      if (all && slot_begin < slot_end && pruned_by(q, lower, cone)) continue;
     }
     for (std::size_t at = slot_begin; at < slot_end; ++at) {
       const int w_end = adjacency_a[at];
@@ -803,7 +820,16 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
           lower = std::min(lower, arc_minimum(x, w, error, q.reach));
           lower2 = std::min(lower2, arc_minimum(x, w2, error, q.reach));
         }
-        if (pruned_by(q, std::max(lower + q.inradius_b, lower2), [&] {
+        double arc_lower = std::max(lower + q.inradius_b, lower2);
+        if (!above_bound(q, arc_lower)) {
+          const Vec3 wh = q.point_a(e[0]) - q.point_b(near_hint(v));
+          double lower3 = kInfinity;
+          for (int i = 0; i < nx; ++i)
+            lower3 =
+                std::min(lower3, arc_minimum(xs[static_cast<std::size_t>(i)], wh, error, q.reach));
+          arc_lower = std::max(arc_lower, lower3);
+        }
+        if (pruned_by(q, arc_lower, [&] {
               // A solid's one arc; a polygon's or a segment's half or
               // whole circle: anywhere.
               return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
