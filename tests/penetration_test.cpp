@@ -672,13 +672,15 @@ TEST(PenetrationTracking, PrunedGroupsCertifyTranslationsThroughAndBack) {
   EXPECT_GE(tracked, queries * 9 / 10);
 }
 
-// The edge pairs the enumeration prunes by their lower bound n.(a0 - b0)
-// (an edge of A, an edge of B and their arcs' crossing n) are recorded as
-// groups of one normal. B's rotation fixed, its translation a random walk
-// of steps from 1e-3 to 0.6 (so that the cache, re-enumerated after a jump
-// with its pruned groups recorded, meets the next jump): every tracked
-// answer equals a cold one. Each edge pair's normal negated in its group
-// (tried while writing it) gave wrong tracked answers here.
+// The edge pairs a cold (or turned) enumeration prunes by their lower
+// bound n.(a0 - b0) (an edge of A, an edge of B and their arcs' crossing
+// n) leave the cache's faces, and the cache's least pruned bound takes
+// them. B's rotation fixed, its translation a random walk of steps from
+// 1e-3 to 0.6 (so that the cache meets jumps both fresh and after
+// re-enumerations): every tracked answer equals a cold one. Pruning them
+// without telling the cache failed here; recording them as groups of one
+// normal (the enumerations after a translation, tried while writing it),
+// with each group's normal negated, failed here too.
 TEST(PenetrationTracking, PrunedEdgePairsFollowJumps) {
   Rng rng(29);
   int tracked = 0, queries = 0;
