@@ -142,8 +142,10 @@ struct Query {
   // candidate so far (see pruned_by).
   Vec3 reference_a = Vec3::Zero();
   Vec3 reference_b = Vec3::Zero();
-  // The enumeration's scratch lists (solve_cold's buffer on the stack).
-  std::pmr::memory_resource* memory = std::pmr::get_default_resource();
+  // The enumeration's scratch lists (candidates, hints, the walk's marks
+  // and B's arcs): a ScratchScope's buffer while one is open, else null
+  // (add_face_candidates and add_edge_candidates_walk need one).
+  std::pmr::memory_resource* memory = nullptr;
   // Per vertex v of A (null until a face of A is evaluated): B's support
   // found for the last face through v evaluated, or -1 (a hint).
   std::int32_t* near_b = nullptr;
@@ -519,11 +521,14 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
   Vec3 middle = arc_middle(xa, na);
   if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);
   const auto add = [&](const Vec3& normal) {
-    if (q.prune && q.bounds_out == nullptr &&
-        pruned_by(q, normal.dot(q.point_a(a0) - q.point_b(b0)), [&] {
-          return PenetrationCache::Bound{normal, kConeSlack, 0.0};
-        }))
-      return;
+    if (q.bounds_out == nullptr) {
+      // Pruned as pruned_by does when it records no group.
+      const double lower = normal.dot(q.point_a(a0) - q.point_b(b0));
+      if (above_bound(q, lower)) {
+        q.pruned = std::min(q.pruned, lower);
+        return;
+      }
+    }
     keep(q, evaluate(q, id, normal, a0, b0), out);
   };
   if (middle.squaredNorm() == 0) {
@@ -1215,16 +1220,33 @@ void build_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache:
   make_node(entries, nodes, 0, 0, static_cast<int>(entries.size()), t, moved);
 }
 
+// The query's scratch memory (Query::memory) while it lives: a buffer on
+// the stack, which holds an enumeration's lists up to about N = 10 (sphere
+// hulls of N vertices; larger ones continue on the heap, and release it
+// at the end): eight heap allocations were a tenth of a cold query at
+// N = 8. On leaving, the query's pointers into it are cleared.
+class ScratchScope {
+ public:
+  explicit ScratchScope(Query& q) : q_(q), memory_(buffer_.data(), buffer_.size()) {
+    q.memory = &memory_;
+  }
+  ~ScratchScope() {
+    q_.memory = nullptr;
+    q_.near_b = nullptr;
+  }
+  ScratchScope(const ScratchScope&) = delete;
+  ScratchScope& operator=(const ScratchScope&) = delete;
+
+ private:
+  Query& q_;
+  std::array<std::byte, 8192> buffer_;
+  std::pmr::monotonic_buffer_resource memory_;
+};
+
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
-  // The scratch lists (candidates, hints, the walk's marks and B's arcs)
-  // from a buffer on the stack, which holds them all up to about N = 10
-  // (sphere hulls of N vertices; larger ones continue on the heap): eight
-  // heap allocations were a tenth of a cold query at N = 8.
-  std::array<std::byte, 8192> buffer;
-  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
-  q.memory = &memory;
+  ScratchScope scratch(q);
   PenetrationCache::Shapes local;
   q.use_shapes(cache != nullptr ? cache->shapes : local, walk);
   if (cache != nullptr) {
@@ -1249,7 +1271,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     q.bound = first.value;
     q.set_references(first.support_a, first.support_b);
   }
-  Candidates candidates(&memory);
+  Candidates candidates(q.memory);
   // Every face and crossing for the slow twin; a pruned walk keeps a few
   // hundred at most on the benchmarks' spheres (reserving for all of them,
   // 2 MB at N = 4096, cost an mmap and its page faults per cold query).
