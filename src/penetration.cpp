@@ -63,13 +63,23 @@ namespace proxima {
 namespace {
 
 // A sign value s = p.k (p unit) with |s| <= kArcTolerance |k| counts as
-// zero, and zeros never reject a pair. face_plane's normals are within
-// about 16 u per face vertex of the exact ones (polytope.cpp, kSliverRatio)
-// and the scaled edge vectors within a few u: a true crossing whose signs
-// are decided wrongly by rounding is always kept. Pairs kept by it that do
+// zero, and zeros never reject a pair. The arcs' endpoints are face
+// normals within kArcNormalError of the exact ones (face_plane's, about
+// 16 u per face vertex: polytope.cpp, kSliverRatio; or fast ones) and the
+// scaled edge vectors within a few u: a true crossing whose signs are
+// decided wrongly by rounding is always kept. Pairs kept by it that do
 // not cross cost one evaluation each and cannot lower the minimum (step 2
 // above). Pinned by PenetrationDegenerate.* (parallel and coplanar edges).
 constexpr double kArcTolerance = 1e-12;
+
+// The largest error bound of a fast face normal (Query::fast_normals) that
+// an arc's endpoint takes instead of face_plane's: 512 u, about 1/17 of
+// kArcTolerance and face_plane's own bound for a face of 32 vertices (16 u
+// per vertex). A well-shaped triangle's bound is about 45 u (equilateral);
+// slivers pay for face_plane. Saves face_plane on every face whose arcs
+// the walk reads but that it never evaluates (at N = 8, 20 of 24 faces;
+// 512 u rather than 128 u: 3% of a cold query at N = 8).
+constexpr double kArcNormalError = 512.0 * kUnitRoundoff;
 
 // Slack on a value computed in double, in units of u times the scaled
 // magnitude (about 1 after scaling): the dot product of a unit normal with
@@ -83,12 +93,6 @@ constexpr double kValueSlackUlps = kContactBandUlps;
 constexpr double kTieUlps = 64.0;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-// Hulls of at most this many faces get face_plane's normals at once
-// (Query::fast_normals). Measured on the cold sweep of
-// bench/penetration_peers' poses: fast normals first made N = 8 (12
-// faces) 7% slower and N = 64 (124 faces) 10% faster.
-constexpr std::size_t kFastNormalsMinFaces = 32;
 
 struct Arc {
   Vec3 p, q;         // unit endpoints
@@ -148,9 +152,13 @@ struct Query {
   // candidate so far (see pruned_by).
   Vec3 reference_a = Vec3::Zero();
   Vec3 reference_b = Vec3::Zero();
-  // Per vertex v of A (empty until a face of A is evaluated): B's support
+  // The enumeration's scratch lists (candidates, hints, the walk's marks
+  // and B's arcs): a ScratchScope's buffer while one is open, else null
+  // (add_face_candidates and add_edge_candidates_walk need one).
+  std::pmr::memory_resource* memory = nullptr;
+  // Per vertex v of A (null until a face of A is evaluated): B's support
   // found for the last face through v evaluated, or -1 (a hint).
-  std::vector<std::int32_t> near_b;
+  std::int32_t* near_b = nullptr;
   // centroid_a and reference_a in B's frame (scaled): R^T (x - t).
   Vec3 centroid_a_in_b = Vec3::Zero();
   Vec3 reference_a_in_b = Vec3::Zero();
@@ -176,12 +184,13 @@ struct Query {
   Vec3 point_b(int j) const { return rotation * (b.vertex(j) * inverse) + translation; }
 
   // Points the query at the hulls' normals and inradii in `shapes`,
-  // computed first when they are not (or not for these hulls).
-  void use_shapes(PenetrationCache::Shapes& shapes) {
+  // computed first when they are not (or not for these hulls): fast ones
+  // unless `fast` is false (the slow twin: face_plane's only).
+  void use_shapes(PenetrationCache::Shapes& shapes, bool fast) {
     if (shapes.a.normals.size() != static_cast<std::size_t>(a.face_count()) ||
         shapes.b.normals.size() != static_cast<std::size_t>(b.face_count())) {
-      fast_normals(a, shapes.a);
-      fast_normals(b, shapes.b);
+      fast_normals(a, shapes.a, fast);
+      fast_normals(b, shapes.b, fast);
     }
     shapes_a = &shapes.a;
     shapes_b = &shapes.b;
@@ -202,15 +211,17 @@ struct Query {
   // the unit normal is within 16 u |p||q| / |c| of the exact one, plus the
   // normalization's rounding; kept with twice that bound (|p||q| read as
   // (|p|^2 + |q|^2) / 2, no square root) when |c| >= 2^-10 |p||q| (an
-  // angle above 0.06 degree), else, and for faces of more
-  // vertices, face_plane's (error 0); face_plane's for all faces of a
-  // small hull (at most kFastNormalsMinFaces faces: the query evaluates
-  // most of them, so fast normals would be computed twice). The inradius:
+  // angle above 0.06 degree), else, for faces of more vertices and when
+  // `fast` is false, face_plane's (error 0). Small hulls too: a cold query
+  // evaluates few of their faces (4 of 24 at N = 8 in
+  // bench/penetration_bench's Cold), and one face_plane costs several fast
+  // normals. The inradius:
   // the least over the faces of n.(v - centroid) less the normal's error
   // and the rounding times twice the bounding radius (>= |v - centroid|),
   // then less 64 u R; 0 for a flat hull (its two faces' planes hold the
   // centroid).
-  static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out) {
+  static void fast_normals(const ConvexPolytope& poly, PenetrationCache::HullNormals& out,
+                           bool fast) {
     const auto count = static_cast<std::size_t>(poly.face_count());
     out.normals.resize(count);
     out.error.resize(count);
@@ -223,7 +234,7 @@ struct Query {
     double r = std::numeric_limits<double>::infinity();
     for (std::size_t f = 0; f < count; ++f) {
       const auto cycle = poly.face(static_cast<int>(f));
-      if (cycle.size() == 3 && count > kFastNormalsMinFaces) {
+      if (fast && cycle.size() == 3) {
         const Vec3 v0 = poly.vertex(cycle[0]) * s.inverse;
         const Vec3 p = poly.vertex(cycle[1]) * s.inverse - v0;
         const Vec3 q = poly.vertex(cycle[2]) * s.inverse - v0;
@@ -269,6 +280,17 @@ struct Query {
   Vec3 normal_a(int f) const { return exact_normal(a, *shapes_a, f); }
   // Of -B, in A's frame.
   Vec3 normal_b(int g) const { return -(rotation * exact_normal(b, *shapes_b, g)); }
+
+  // A face's normal for its edges' Gauss-map arcs: the stored one when
+  // within kArcNormalError of the exact one (face_plane's has error 0),
+  // else face_plane's.
+  static const Vec3& arc_normal(const ConvexPolytope& poly, PenetrationCache::HullNormals& h,
+                                int f) {
+    const auto i = static_cast<std::size_t>(f);
+    return h.error[i] <= kArcNormalError ? h.normals[i] : exact_normal(poly, h, f);
+  }
+  Vec3 arc_normal_a(int f) const { return arc_normal(a, *shapes_a, f); }
+  Vec3 arc_normal_b(int g) const { return -(rotation * arc_normal(b, *shapes_b, g)); }
 };
 
 // The face to the left of the directed edge v -> w, or -1.
@@ -321,7 +343,7 @@ int arcs_of_a(const Query& q, int v, int w, int l, int r, std::array<Arc, 4>& ou
   const Vec3 k = q.point_a(w) - q.point_a(v);
   if (dim == 3 || dim == 2) {
     if (l < 0 || r < 0) return 0;
-    return edge_arcs(dim, k, q.normal_a(l), q.normal_a(r), false, out);
+    return edge_arcs(dim, k, q.arc_normal_a(l), q.arc_normal_a(r), false, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), false, out);
 }
@@ -330,16 +352,20 @@ int arcs_of_a(const Query& q, int v, int w, std::array<Arc, 4>& out) {
   return arcs_of_a(q, v, w, left_face(q.a, v, w), left_face(q.a, w, v), out);
 }
 
-int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+// The arcs of -B's edge v -> w, whose left and right faces are l and r
+// (left_face's; read only for dimensions 2 and 3).
+int arcs_of_b(const Query& q, int v, int w, int l, int r, std::array<Arc, 4>& out) {
   const int dim = q.b.dimension();
   const Vec3 k = q.point_b(w) - q.point_b(v);
   if (dim == 3 || dim == 2) {
-    const int l = left_face(q.b, v, w);
-    const int r = left_face(q.b, w, v);
     if (l < 0 || r < 0) return 0;
-    return edge_arcs(dim, k, q.normal_b(l), q.normal_b(r), true, out);
+    return edge_arcs(dim, k, q.arc_normal_b(l), q.arc_normal_b(r), true, out);
   }
   return edge_arcs(1, k, Vec3::Zero(), Vec3::Zero(), true, out);
+}
+
+int arcs_of_b(const Query& q, int v, int w, std::array<Arc, 4>& out) {
+  return arcs_of_b(q, v, w, left_face(q.b, v, w), left_face(q.b, w, v), out);
 }
 
 bool edges_may_cross(const std::array<Arc, 4>& xs, int nx, const std::array<Arc, 4>& ys, int ny) {
@@ -441,6 +467,12 @@ bool pruned_by(Query& q, double lower, PenetrationCache::Group kind, int i, int 
   return true;
 }
 
+// Whether pruned_by would prune a group of lower bound `lower` (a cheaper
+// bound first, a dearer one only when that does not prune).
+bool above_bound(const Query& q, double lower) {
+  return q.prune && lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff;
+}
+
 // Balls around a pruned group's normals (PenetrationCache::Bound). Slack
 // on a ball's radius for the roundings of its centre and of the distances
 // to it (a few u each).
@@ -466,7 +498,9 @@ PenetrationCache::Bound cone_of_arc(const Vec3& p, double ep, const Vec3& q, dou
   return {c, spread, 0.0};
 }
 
-void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
+using Candidates = std::pmr::vector<Candidate>;
+
+void keep(Query& q, const Candidate& c, Candidates& out) {
   out.push_back(c);
   if (c.value < q.bound) {
     q.bound = c.value;
@@ -481,9 +515,17 @@ void keep(Query& q, const Candidate& c, std::vector<Candidate>& out) {
 // holds n or -n, the one on the side of its middle; a segment's arcs make
 // a whole circle, then -B's arc decides; for two segments (or arcs so near
 // a half circle that the side is unclear, kClearMiddle) both n and -n are
-// added (each an upper bound).
+// added (each an upper bound). Pruning: a0 is in A and b0 in B, so the
+// value h_A(n) + h_B(-n) is at least n.(a0 - b0), the value itself when
+// the pair is a face of A - B (its supports are the edges' points); at
+// N = 8 to 4096, 90 to 99% of the edge pairs the walk evaluated had a
+// value above the bound, each at the cost of two hill climbs. Not when
+// the pruned groups are recorded (an enumeration after a translation,
+// PenetrationCache::bounds): the tracked queries that follow searched one
+// more group per pair (bench/penetration_bench's TrackedSweep: 15.5
+// candidates a query instead of 14.5, 145 ns instead of 138 at N = 8).
 void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
-                        int b1, const std::array<Arc, 4>& yb, int nb, std::vector<Candidate>& out) {
+                        int b1, const std::array<Arc, 4>& yb, int nb, Candidates& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
   const Vec3& ea = xa[0].k;
   const Vec3& eb = yb[0].k;
@@ -493,12 +535,23 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
   n /= length;
   Vec3 middle = arc_middle(xa, na);
   if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);
+  const auto add = [&](const Vec3& normal) {
+    if (q.bounds_out == nullptr) {
+      // Pruned as pruned_by does when it records no group.
+      const double lower = normal.dot(q.point_a(a0) - q.point_b(b0));
+      if (above_bound(q, lower)) {
+        q.pruned = std::min(q.pruned, lower);
+        return;
+      }
+    }
+    keep(q, evaluate(q, id, normal, a0, b0), out);
+  };
   if (middle.squaredNorm() == 0) {
-    keep(q, evaluate(q, id, n, a0, b0), out);
-    keep(q, evaluate(q, id, -n, a0, b0), out);
+    add(n);
+    add(-n);
     return;
   }
-  keep(q, evaluate(q, id, n.dot(middle) < 0 ? Vec3(-n) : n, a0, b0), out);
+  add(n.dot(middle) < 0 ? Vec3(-n) : n);
 }
 
 // A lower bound on n.w for the exact unit normal n of a face, from its
@@ -511,7 +564,15 @@ double face_lower(const Vec3& m, double error, const Vec3& w, double reach) {
 // Appends every face candidate (faces of A, faces of B), the ones that
 // pruned_by leaves. The pruning test reads the fast normals; a face kept
 // is evaluated along its exact one.
-void add_face_candidates(Query& q, std::vector<Candidate>& out) {
+// A list of n hints in q.memory, all -1.
+std::int32_t* new_hints(const Query& q, int n) {
+  std::int32_t* hints =
+      std::pmr::polymorphic_allocator<std::int32_t>(q.memory).allocate(static_cast<std::size_t>(n));
+  std::fill_n(hints, n, -1);
+  return hints;
+}
+
+void add_face_candidates(Query& q, Candidates& out) {
   const PenetrationCache::HullNormals& sa = *q.shapes_a;
   const PenetrationCache::HullNormals& sb = *q.shapes_b;
   // Hints for the other hull's support: the last one found for a face
@@ -519,8 +580,14 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
   // climb from it is short; the previous face's, in index order, can be
   // anywhere: at N = 4096 an enumeration that keeps many faces spent most
   // of its time climbing). Allocated with the first face evaluated.
-  std::vector<std::int32_t>& near_b = q.near_b;
-  std::vector<std::int32_t> near_a;
+  // A face that the two lower bounds of pruned_by's comment leave gets a
+  // third, the same with the hint's point of the other hull (a point of
+  // it, and near its support along the face's normal, so that the bound
+  // is near the face's value): most faces evaluated had a value above the
+  // bound (bench/penetration_bench's Cold: 186 -> 48 candidates a query
+  // at N = 512, with the edge pairs').
+  std::int32_t*& near_b = q.near_b;
+  std::int32_t* near_a = nullptr;
   int hint_b = 0;
   const int count_a =
       q.only != nullptr ? static_cast<int>(q.only->faces_a.size()) : q.a.face_count();
@@ -528,19 +595,24 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
     const int f = q.only != nullptr ? q.only->faces_a[static_cast<std::size_t>(k)] : k;
     const auto i = static_cast<std::size_t>(f);
     if (q.prune) {
-      const Vec3 af = q.point_a(q.a.face(f)[0]);
+      const auto cycle = q.a.face(f);
+      const Vec3 af = q.point_a(cycle[0]);
       const Vec3& n = sa.normals[i];
       const double error = sa.error[i];
-      if (pruned_by(q,
-                    std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
-                             face_lower(n, error, af - q.reference_b, q.reach)),
-                    PenetrationCache::Group::face_a, f, -1, [&] {
-                      return PenetrationCache::Bound{n, error + kConeSlack, 0.0};
-                    }))
+      double lower = std::max(face_lower(n, error, af - q.centroid_b, q.reach) + q.inradius_b,
+                              face_lower(n, error, af - q.reference_b, q.reach));
+      if (!above_bound(q, lower)) {
+        const std::int32_t near = near_b == nullptr ? -1 : near_b[cycle[0]];
+        lower = std::max(lower,
+                         face_lower(n, error, af - q.point_b(near >= 0 ? near : hint_b), q.reach));
+      }
+      if (pruned_by(q, lower, PenetrationCache::Group::face_a, f, -1, [&] {
+            return PenetrationCache::Bound{n, error + kConeSlack, 0.0};
+          }))
         continue;
     }
     const auto cycle = q.a.face(f);
-    if (near_b.empty()) near_b.assign(static_cast<std::size_t>(q.a.vertex_count()), -1);
+    if (near_b == nullptr) near_b = new_hints(q, q.a.vertex_count());
     const std::int32_t near = near_b[static_cast<std::size_t>(cycle[0])];
     MinkowskiFaceId id{MinkowskiFace::face_vertex, f, -1, near >= 0 ? near : hint_b, -1};
     Candidate c = evaluate_face(q, id);
@@ -561,19 +633,25 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
       // the rotations' roundings.
       const Vec3& m = sb.normals[i];
       const double error = sb.error[i] + 8.0 * kUnitRoundoff;
-      const Vec3 bg = q.b.vertex(q.b.face(g)[0]) * q.inverse;
+      const auto cycle = q.b.face(g);
+      const Vec3 bg = q.b.vertex(cycle[0]) * q.inverse;
+      double lower = std::max(face_lower(m, error, bg - q.centroid_a_in_b, q.reach) + q.inradius_a,
+                              face_lower(m, error, bg - q.reference_a_in_b, q.reach));
+      if (!above_bound(q, lower)) {
+        const std::int32_t near = near_a == nullptr ? -1 : near_a[cycle[0]];
+        const Vec3 hint_in_b =
+            q.rotation_t * (q.point_a(near >= 0 ? near : hint_a) - q.translation);
+        lower = std::max(lower, face_lower(m, error, bg - hint_in_b, q.reach));
+      }
       // The face's normal of A - B is -(R m), within error of it (8 u
       // for the rotation's rounding included).
-      if (pruned_by(q,
-                    std::max(face_lower(m, error, bg - q.centroid_a_in_b, q.reach) + q.inradius_a,
-                             face_lower(m, error, bg - q.reference_a_in_b, q.reach)),
-                    PenetrationCache::Group::face_b, g, -1, [&] {
-                      return PenetrationCache::Bound{-(q.rotation * m), error + kConeSlack, 0.0};
-                    }))
+      if (pruned_by(q, lower, PenetrationCache::Group::face_b, g, -1, [&] {
+            return PenetrationCache::Bound{-(q.rotation * m), error + kConeSlack, 0.0};
+          }))
         continue;
     }
     const auto cycle = q.b.face(g);
-    if (near_a.empty()) near_a.assign(static_cast<std::size_t>(q.b.vertex_count()), -1);
+    if (near_a == nullptr) near_a = new_hints(q, q.b.vertex_count());
     const std::int32_t near = near_a[static_cast<std::size_t>(cycle[0])];
     MinkowskiFaceId id{MinkowskiFace::vertex_face, near >= 0 ? near : hint_a, -1, g, -1};
     Candidate c = evaluate_face(q, id);
@@ -588,16 +666,19 @@ void add_face_candidates(Query& q, std::vector<Candidate>& out) {
 // lower bound on it: with n = c1 p + c2 q, c1, c2 >= 0 and
 // 1 <= c1 + c2 <= 1 / cos(alpha / 2), n.w >= m = min(p.w, q.w) when
 // m >= 0 and n.w >= m / cos(alpha / 2) otherwise (cos(alpha / 2) =
-// |p + q| / 2). -infinity for an arc too near a half circle.
-double arc_minimum(const Arc& arc, const Vec3& w) {
-  const double m = std::min(arc.p.dot(w), arc.q.dot(w));
+// |p + q| / 2). -infinity for an arc too near a half circle. The arc's
+// ends within `error` of the exact arc's (fast face normals,
+// kArcNormalError), |w| <= reach: each end's value within error * reach,
+// and the exact cos(alpha / 2) at least |p + q| / 2 - error.
+double arc_minimum(const Arc& arc, const Vec3& w, double error, double reach) {
+  const double m = std::min(arc.p.dot(w), arc.q.dot(w)) - error * reach;
   if (m >= 0.0) return m;
-  const double half_cos = 0.5 * (arc.p + arc.q).norm();
+  const double half_cos = 0.5 * (arc.p + arc.q).norm() - error;
   return half_cos > 1e-3 ? m / half_cos : -std::numeric_limits<double>::infinity();
 }
 
 // Brute force over all edge pairs.
-void add_edge_candidates_brute_force(Query& q, std::vector<Candidate>& out) {
+void add_edge_candidates_brute_force(Query& q, Candidates& out) {
   struct EdgeArcs {
     int v, w, count;
     std::array<Arc, 4> arcs;
@@ -621,23 +702,50 @@ void add_edge_candidates_brute_force(Query& q, std::vector<Candidate>& out) {
         add_edge_candidate(q, x.v, x.w, x.arcs, x.count, y.v, y.w, y.arcs, y.count, out);
 }
 
+// B's arcs by adjacency slot (add_edge_candidates_walk) up to this size
+// come from the query's scratch buffer (solve_cold).
+constexpr std::size_t kScratchArcBytes = 4096;
+
 // The overlay walk: for each arc of A, the chain of B cells it crosses.
-void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
-  std::vector<std::int32_t> chain;  // visited B vertices of the current arc (the queue too)
-  std::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0);
+void add_edge_candidates_walk(Query& q, Candidates& out) {
+  // Visited B vertices of the current arc (the queue too).
+  std::pmr::vector<std::int32_t> chain(q.memory);
+  std::pmr::vector<char> visited(static_cast<std::size_t>(q.b.vertex_count()), 0, q.memory);
   int hint = 0;
+  // A vertex of B near B's support along -n for the normals n near v's
+  // cell of A's Gauss map: the support found for a face through v, else
+  // the last arc's start. The lower bounds read it as a point of B when
+  // the centroid's and the reference's do not prune (a third bound, as
+  // for the faces in add_face_candidates).
+  const auto near_hint = [&](int v) {
+    const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
+    return near >= 0 ? static_cast<int>(near) : hint;
+  };
   std::array<Arc, 4> xs, ys;
   // A solid B's arcs, one per edge, computed once on first use (each is
   // met from several arcs of A), by adjacency slot of either direction
   // (an arc read backwards is the same arc for the crossing test).
   const bool memo = q.b.dimension() == 3;
   const auto offsets = q.b.adjacency_offsets();
+  const auto adjacency_b = q.b.adjacency();
+  const auto faces_b = q.b.adjacency_faces();
   // Storage only (not value-initialized): with pruning a query reads a
   // few of B's slots, and writing all of them (80 bytes each) was a tenth
   // of a cold query at N = 4096 (page faults of the fresh allocation).
+  // From the scratch buffer when small; else from the heap (the buffer's
+  // next blocks double in size: at N = 512, 240 KB of arcs took a fresh
+  // 512 KB block, and its page faults, every query).
   const std::size_t slots = memo ? q.b.adjacency().size() : 0;
-  const std::unique_ptr<Arc[]> slot_arc = std::make_unique_for_overwrite<Arc[]>(slots);
-  std::vector<char> slot_ready(slots, 0);
+  std::unique_ptr<Arc[]> heap_arcs;
+  Arc* slot_arc = nullptr;
+  if (slots * sizeof(Arc) <= kScratchArcBytes) {
+    slot_arc = std::pmr::polymorphic_allocator<Arc>(q.memory).allocate(slots);
+    std::uninitialized_default_construct_n(slot_arc, slots);
+  } else {
+    heap_arcs = std::make_unique_for_overwrite<Arc[]>(slots);
+    slot_arc = heap_arcs.get();
+  }
+  std::pmr::vector<char> slot_ready(slots, 0, q.memory);
   const PenetrationCache::HullNormals& sa = *q.shapes_a;
   const bool solid_a = q.a.dimension() == 3;
   const auto offsets_a = q.a.adjacency_offsets();
@@ -695,10 +803,20 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         if (!(spread < kMaxConeChord)) return whole_sphere();
         return PenetrationCache::Bound{c, spread, 0.0};
       };
+      double lower =
+          std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity);
+      if (all && slot_begin < slot_end && !above_bound(q, lower)) {
+        // The same with B's point at the hint (near_hint).
+        const Vec3 wh = av - q.point_b(near_hint(v));
+        double mh = kInfinity;
+        for (std::size_t at = slot_begin; at < slot_end; ++at) {
+          const auto i = static_cast<std::size_t>(faces_a[at]);
+          mh = std::min(mh, face_lower(sa.normals[i], sa.error[i], wh, q.reach));
+        }
+        if (mh >= 0.0) lower = std::max(lower, mh);
+      }
       if (all && slot_begin < slot_end &&
-          pruned_by(
-              q, std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity),
-              PenetrationCache::Group::vertex_a, v, -1, cone))
+          pruned_by(q, lower, PenetrationCache::Group::vertex_a, v, -1, cone))
         continue;
     }
     for (std::size_t at = slot_begin; at < slot_end; ++at) {
@@ -730,17 +848,33 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
       if (q.prune && nx > 0) {
         const Vec3 w = q.point_a(e[0]) - q.centroid_b;
         const Vec3 w2 = q.point_a(e[0]) - q.reference_b;
+        // The arcs' ends: the faces' normals as arcs_of_a read them (error
+        // 0 once face_plane's), and for a polygon the in-plane normal from
+        // them, normalized (twice the error at most).
+        const double error = l >= 0 && r >= 0
+                                 ? 2.0 * std::max(sa.error[static_cast<std::size_t>(l)],
+                                                  sa.error[static_cast<std::size_t>(r)])
+                                 : 0.0;
         double lower = kInfinity, lower2 = kInfinity;
         for (int i = 0; i < nx; ++i) {
-          lower = std::min(lower, arc_minimum(xs[static_cast<std::size_t>(i)], w));
-          lower2 = std::min(lower2, arc_minimum(xs[static_cast<std::size_t>(i)], w2));
+          const Arc& x = xs[static_cast<std::size_t>(i)];
+          lower = std::min(lower, arc_minimum(x, w, error, q.reach));
+          lower2 = std::min(lower2, arc_minimum(x, w2, error, q.reach));
         }
-        if (pruned_by(q, std::max(lower + q.inradius_b, lower2), PenetrationCache::Group::edge_a, v,
-                      w_end, [&] {
-                        // A solid's one arc; a polygon's or a segment's half or
-                        // whole circle: anywhere.
-                        return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
-                      }))
+        double arc_lower = std::max(lower + q.inradius_b, lower2);
+        if (!above_bound(q, arc_lower)) {
+          const Vec3 wh = q.point_a(e[0]) - q.point_b(near_hint(v));
+          double lower3 = kInfinity;
+          for (int i = 0; i < nx; ++i)
+            lower3 =
+                std::min(lower3, arc_minimum(xs[static_cast<std::size_t>(i)], wh, error, q.reach));
+          arc_lower = std::max(arc_lower, lower3);
+        }
+        if (pruned_by(q, arc_lower, PenetrationCache::Group::edge_a, v, w_end, [&] {
+              // A solid's one arc; a polygon's or a segment's half or
+              // whole circle: anywhere.
+              return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
+            }))
           continue;
       }
       for (int i = 0; i < nx; ++i) {
@@ -748,7 +882,7 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
         // The B cell of direction p: B's support along -p.
         // From the support found for a face through v, when one was
         // evaluated (for a solid A, p is the normal of such a face).
-        const std::int32_t near = q.near_b.empty() ? -1 : q.near_b[static_cast<std::size_t>(v)];
+        const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
         const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), near >= 0 ? near : hint);
         hint = start;
         chain.clear();
@@ -763,9 +897,17 @@ void add_edge_candidates_walk(Query& q, std::vector<Candidate>& out) {
             int ny = 0;
             if (memo) {
               if (!slot_ready[slot]) {
-                const int count = arcs_of_b(q, j, k, ys);
-                slot_ready[slot] = count == 1 ? 1 : 2;
+                // Both directions of the edge at once: k -> j's slot (its
+                // left face is j -> k's right one) gets the same arc read
+                // backwards, (q, p, -k), what arcs_of_b gives for it.
+                const auto back = static_cast<std::size_t>(
+                    std::find(adjacency_b.begin() + offsets[static_cast<std::size_t>(k)],
+                              adjacency_b.begin() + offsets[static_cast<std::size_t>(k) + 1], j) -
+                    adjacency_b.begin());
+                const int count = arcs_of_b(q, j, k, faces_b[slot], faces_b[back], ys);
+                slot_ready[slot] = slot_ready[back] = count == 1 ? 1 : 2;
                 slot_arc[slot] = ys[0];
+                slot_arc[back] = {ys[0].q, ys[0].p, -ys[0].k, ys[0].tolerance};
               }
               ny = slot_ready[slot] == 1 ? 1 : 0;
               ys[0] = slot_arc[slot];
@@ -1168,11 +1310,35 @@ void add_tree(const std::vector<Entry>& entries, std::vector<PenetrationCache::N
   roots.push_back(at);
 }
 
+// The query's scratch memory (Query::memory) while it lives: a buffer on
+// the stack, which holds an enumeration's lists up to about N = 10 (sphere
+// hulls of N vertices; larger ones continue on the heap, and release it
+// at the end): eight heap allocations were a tenth of a cold query at
+// N = 8. On leaving, the query's pointers into it are cleared.
+class ScratchScope {
+ public:
+  explicit ScratchScope(Query& q) : q_(q), memory_(buffer_.data(), buffer_.size()) {
+    q.memory = &memory_;
+  }
+  ~ScratchScope() {
+    q_.memory = nullptr;
+    q_.near_b = nullptr;
+  }
+  ScratchScope(const ScratchScope&) = delete;
+  ScratchScope& operator=(const ScratchScope&) = delete;
+
+ private:
+  Query& q_;
+  std::array<std::byte, 8192> buffer_;
+  std::pmr::monotonic_buffer_resource memory_;
+};
+
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
+  ScratchScope scratch(q);
   PenetrationCache::Shapes local;
-  q.use_shapes(cache != nullptr ? cache->shapes : local);
+  q.use_shapes(cache != nullptr ? cache->shapes : local, walk);
   if (cache != nullptr) {
     // Filled by this enumeration; until the cache is written below, the
     // last one's faces are certified by the scalar `pruned` alone.
@@ -1197,7 +1363,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     q.bound = first.value;
     q.set_references(first.support_a, first.support_b);
   }
-  std::vector<Candidate> candidates;
+  Candidates candidates(q.memory);
   // Every face and crossing for the slow twin; a pruned walk keeps a few
   // hundred at most on the benchmarks' spheres (reserving for all of them,
   // 2 MB at N = 4096, cost an mmap and its page faults per cold query).
@@ -1502,14 +1668,16 @@ bool expand(Query& q, PenetrationCache& cache, const Pose& b_in_a, double best, 
   std::sort(subset.edges_a.begin(), subset.edges_a.end());
   cache.expanded += static_cast<std::int32_t>(failing.size());
   std::vector<PenetrationCache::Bound> fresh;
-  q.use_shapes(cache.shapes);
+  // The enumeration's loops keep their lists in the query's scratch memory.
+  ScratchScope scratch(q);
+  q.use_shapes(cache.shapes, true);
   q.prune = true;
   q.bound = best * q.inverse;
   q.set_references(cache.last.support_a, cache.last.support_b);
   q.prune_margin = margin * q.inverse;
   q.bounds_out = &fresh;
   q.only = &subset;
-  std::vector<Candidate> found;
+  Candidates found(q.memory);
   add_face_candidates(q, found);
   if (!subset.edges_a.empty()) add_edge_candidates_walk(q, found);
   q.only = nullptr;

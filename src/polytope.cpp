@@ -342,32 +342,46 @@ constexpr double kPlaneResidual = 8.0;
 
 Plane ConvexPolytope::face_plane(int f) const {
   const auto cycle = face(f);
+  const std::size_t n = cycle.size();
   double max_abs = 0.0;
   for (const Index v : cycle) max_abs = std::max(max_abs, vertex(v).cwiseAbs().maxCoeff());
   const int exponent = magnitude_exponent(max_abs);
   const auto local = [&](std::size_t i) { return times_pow2(vertex(cycle[i]), -exponent); };
   const Vec3 origin = local(0);
+  // p_i = local(i) - origin, with p_0 = p_n = 0 exactly (x - x): each edge's
+  // end is the next edge's start, so each p_i and its norm are computed once
+  // (penetration depth computes every face's plane of a small hull per cold
+  // query: bench/penetration_bench's Cold).
   Vec3 normal = Vec3::Zero();
   Vec3 sum = Vec3::Zero();
   double magnitude_sum = 0.0;
-  for (std::size_t i = 0; i < cycle.size(); ++i) {
-    const Vec3 p = local(i) - origin;
-    const Vec3 q = local((i + 1) % cycle.size()) - origin;
+  Vec3 p = Vec3::Zero();
+  double p_norm = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool last = i + 1 == n;
+    const Vec3 q = last ? Vec3::Zero() : Vec3(local(i + 1) - origin);
+    const double q_norm = last ? 0.0 : q.norm();
     normal += p.cross(q);
     sum += p;
-    magnitude_sum += p.norm() * q.norm();
+    magnitude_sum += p_norm * q_norm;
+    p = q;
+    p_norm = q_norm;
   }
-  const Vec3 mean = origin + sum / static_cast<double>(cycle.size());
+  const Vec3 mean = origin + sum / static_cast<double>(n);
   // Conditioning: the rounded Newell sum is off by about u sum |p_i||p_i+1|
   // (each cross product's error). When that bound exceeds kSliverRatio per
   // vertex times the normal (a sliver: nearly collinear vertices, which the
   // exact hull of rounded data keeps as faces), or when a vertex of the face
   // is farther than kPlaneResidual u from the resulting plane (coordinates
   // here are below 1), the normal is taken exactly instead.
-  bool exact = !(magnitude_sum <= kSliverRatio * static_cast<double>(cycle.size()) * normal.norm());
+  const double newell_length = normal.norm();
+  bool exact = !(magnitude_sum <= kSliverRatio * static_cast<double>(n) * newell_length);
+  Vec3 unit = Vec3::UnitZ();
   if (!exact) {
-    const Vec3 unit = normal.normalized();
-    for (std::size_t i = 0; i < cycle.size() && !exact; ++i) {
+    if (!(newell_length > 0.0))
+      return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
+    unit = normal / newell_length;
+    for (std::size_t i = 0; i < n && !exact; ++i) {
       exact = !(std::abs(unit.dot(local(i) - mean)) <= kPlaneResidual * kEpsilon);
     }
   }
@@ -381,26 +395,30 @@ Plane ConvexPolytope::face_plane(int f) const {
     // orientation, to a relative error of a few u, however thin the face.
     std::size_t ib = 1;
     double best = -1.0;
-    for (std::size_t i = 1; i < cycle.size(); ++i) {
+    for (std::size_t i = 1; i < n; ++i) {
       const double d = (local(i) - origin).squaredNorm();
       if (d > best) best = d, ib = i;
     }
     const Vec3 line = local(ib) - origin;
     std::size_t ic = ib == 1 ? 2 : 1;
     best = -1.0;
-    for (std::size_t i = 1; i < cycle.size(); ++i) {
+    for (std::size_t i = 1; i < n; ++i) {
       if (i == ib) continue;
       const double d = line.cross(local(i) - origin).squaredNorm();
       if (d > best) best = d, ic = i;
     }
     normal = exact_triangle_normal(vertex(cycle[0]), vertex(cycle[std::min(ib, ic)]),
                                    vertex(cycle[std::max(ib, ic)]));
+    const double length = normal.norm();
+    if (!(length > 0.0))
+      return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
+    unit = normal / length;
   }
-  const double length = normal.norm();
-  if (!(length > 0.0))
-    return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
-  normal /= length;
-  return {normal, std::ldexp(normal.dot(mean), exponent)};
+  // The offset scaled back by a power of two: a product, exact or rounded
+  // once like ldexp, while the factor is a normal double.
+  const double offset = unit.dot(mean);
+  return {unit, exponent >= -1022 && exponent <= 1023 ? offset * detail::pow2(exponent)
+                                                      : std::ldexp(offset, exponent)};
 }
 
 std::vector<std::int32_t> ConvexPolytope::face_offsets() const {

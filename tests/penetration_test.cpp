@@ -522,6 +522,53 @@ TEST(PenetrationTwins, GridsWithCoplanarFacesAndRotationSweep) {
   }
 }
 
+TEST(PenetrationTwins, SmallHullsWithFastArcNormalsMatchBruteForce) {
+  // Hulls of 4 to 18 points (the cold query's fast face normals serve their
+  // Gauss-map arcs when within 512 u of the exact ones, face_plane's
+  // otherwise; the slow twin reads face_plane's only): round, boxy and
+  // flattened (thin triangles, whose fast normals are too loose for the
+  // arcs) bodies, turned and overlapping by any amount. Counts both kinds
+  // of normal among the arcs' faces, so that the set holds both.
+  Rng rng(23);
+  int fast_normals = 0, loose_normals = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const auto shape = [&](double radius) {
+      const int n = uniform_int(rng, 4, 18);
+      switch (trial % 4) {
+        case 0:
+          return points_on_sphere(rng, n, radius);
+        case 1:
+          return points_in_cube(rng, n, radius);
+        case 2:
+          return transformed(points_on_sphere(rng, n, radius),
+                             Mat3(Vec3(1.0, 1.0, 1e-3).asDiagonal()), Vec3::Zero());
+        default:
+          return transformed(points_in_cube(rng, n, radius),
+                             Mat3(Vec3(1.0, 0.05, 0.05).asDiagonal()), Vec3::Zero());
+      }
+    };
+    const Points a = shape(1.0), b = shape(0.7);
+    const Pose pose(random_quaternion(rng), uniform(rng, 0.0, 1.6) * random_unit_vector(rng));
+    const ConvexPolytope pa(a), pb(b);
+    PenetrationCache cache;
+    const PenetrationResult rf = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult rs = penetration_depth_brute_force(pa, pb, pose);
+    const double tol =
+        kContactBandUlps * kUnitRoundoff * std::max(pa.scale(), magnitude_bound(pose, pb.scale()));
+    EXPECT_EQ(rf.status, rs.status) << trial;
+    EXPECT_NEAR(rf.depth, rs.depth, kRel * rs.depth + tol) << trial;
+    EXPECT_LE(rf.candidates, rs.candidates) << trial;
+    for (const PenetrationCache::HullNormals* h : {&cache.shapes.a, &cache.shapes.b}) {
+      for (const double e : h->error) {
+        fast_normals += e > 0.0 && e <= 512 * kUnitRoundoff;
+        loose_normals += e > 512 * kUnitRoundoff;
+      }
+    }
+  }
+  EXPECT_GT(fast_normals, 1000);
+  EXPECT_GT(loose_normals, 100);
+}
+
 TEST(PenetrationDegenerate, LongThinTriangleThroughABox) {
   // Jolt's long thin triangle: a triangle 100 long and 1e-3 wide cutting
   // through a box; the depth is set by the box, not by the triangle's
@@ -624,6 +671,45 @@ TEST(PenetrationTracking, PrunedGroupsCertifyTranslationsThroughAndBack) {
   // Most queries are certified by the cache (not a check of the groups'
   // soundness, which the comparison above is: that B's moves reach them).
   EXPECT_GE(tracked, queries * 9 / 10);
+}
+
+// The edge pairs a cold (or turned) enumeration prunes by their lower
+// bound n.(a0 - b0) (an edge of A, an edge of B and their arcs' crossing
+// n) leave the cache's faces, and the cache's least pruned bound takes
+// them. B's rotation fixed, its translation a random walk of steps from
+// 1e-3 to 0.6 (so that the cache meets jumps both fresh and after
+// re-enumerations): every tracked answer equals a cold one. Pruning them
+// without telling the cache failed here; recording them as groups of one
+// normal (the enumerations after a translation, tried while writing it),
+// with each group's normal negated, failed here too.
+TEST(PenetrationTracking, PrunedEdgePairsFollowJumps) {
+  Rng rng(29);
+  int tracked = 0, queries = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int n = uniform_int(rng, 6, 24);
+    const Points a = trial % 2 == 0 ? points_on_sphere(rng, n) : points_in_cube(rng, n, 0.7);
+    const Points b_local =
+        trial % 3 == 0 ? points_in_cube(rng, n, 0.5) : points_on_sphere(rng, n, 0.6);
+    const ConvexPolytope pa(a), pb(b_local);
+    const Mat3 rotation = random_rotation(rng);
+    PenetrationCache cache;
+    Vec3 t = 0.3 * random_unit_vector(rng);
+    for (int i = 0; i < 200; ++i) {
+      t += log_uniform(rng, 1e-3, 0.6) * random_unit_vector(rng);
+      if (t.norm() > 1.2) t *= 1.2 / t.norm();
+      const Pose pose(rotation, t);
+      const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+      PenetrationCache fresh;
+      const PenetrationResult cold = penetration_depth(pa, pb, pose, fresh);
+      const double tol = kContactBandUlps * kUnitRoundoff * 2.0;
+      ASSERT_EQ(r.status, cold.status) << "trial " << trial << ", step " << i;
+      ASSERT_NEAR(r.depth, cold.depth, kRel * cold.depth + tol)
+          << "trial " << trial << ", step " << i;
+      tracked += r.tracked;
+      ++queries;
+    }
+  }
+  EXPECT_GE(tracked, queries / 10);
 }
 
 // A tracked answer along the same face of A - B reuses the supporting

@@ -259,8 +259,9 @@ struct PenetrationCache {
   // What the query needs of each hull whatever the pose, in its own frame:
   // face normals and the radius of a ball about the centroid inside it.
   // A normal is first a fast one (a triangle's rounded cross product,
-  // within error[f] of the exact unit normal), good for pruning; a face
-  // the query evaluates, or whose Gauss-map arc it tests, gets
+  // within error[f] of the exact unit normal), good for pruning and, when
+  // error[f] is within 512 u, for the Gauss-map arcs; a face the query
+  // evaluates, or whose arc it tests with a larger error, gets
   // ConvexPolytope::face_plane's (exact[f] set, error 0), once.
   struct HullNormals {
     std::vector<Vec3> normals;
