@@ -762,14 +762,21 @@ std::string config_label(const TimingRow& r) {
 // distance; 1e-4 leaves room and still catches a wrong frame or body.
 constexpr double kChecksumAgreement = 1e-4;
 
+// Part 5's: the EPA solvers' depths are off by up to a few percent on some
+// poses (bench/penetration_peers counts them against the exact oracle;
+// Bullet's mean over the sweep was 6e-4 below proxima's at N = 1024 to
+// 4096); an adapter that answered the distance instead of the signed
+// distance would be off by more than the mean itself.
+constexpr double kSignedChecksumAgreement = 1e-2;
+
 // `scale`: a floor for the reference (part 5's mean signed distance may be
 // near 0 by cancellation; its bodies' size stands in).
 void check_agreement(const std::vector<TimingRow>& rows, const std::string& where,
-                     std::ostream& out, double scale = 0.0) {
+                     std::ostream& out, double scale = 0.0, double agreement = kChecksumAgreement) {
   if (rows.empty()) return;
   const double ref = rows.front().mean_distance;
   for (const TimingRow& r : rows) {
-    if (!(std::abs(r.mean_distance - ref) <= kChecksumAgreement * std::max(std::abs(ref), scale))) {
+    if (!(std::abs(r.mean_distance - ref) <= agreement * std::max(std::abs(ref), scale))) {
       out << "    WARNING (" << where << "): " << config_label(r) << " mean distance "
           << exact_text(r.mean_distance) << " differs from " << rows.front().system << "'s "
           << exact_text(ref) << "\n";
@@ -976,7 +983,7 @@ std::vector<TimingRow> run_overlap(const PaperOptions& options, std::ostream& ou
       pb.emplace_back(rb, Vec3(s * dir + Vec3(0.01, 0.02, -0.03)));
     }
     std::vector<TimingRow> r = time_configs(a, b, pa, pb, overlap_configs(), kRepetitions, n);
-    check_agreement(r, "overlap N=" + std::to_string(n), out, 1.0);
+    check_agreement(r, "overlap N=" + std::to_string(n), out, 1.0, kSignedChecksumAgreement);
     rows.insert(rows.end(), r.begin(), r.end());
     out << "    N = " << pad(std::to_string(n), 4) << ": " << fixed(seconds_since(t0), 1) << " s\n";
     out.flush();
