@@ -462,6 +462,20 @@ TEST(PenetrationRegression, NeedleOfWidthOneUlpOnAPlate) {
 // ---------------------------------------------------------------------------
 // The fast algorithm against its slow twin on larger bodies.
 
+// The fast query (with `cache`) against the slow twin at one pose: the same
+// status, the depth within the standard's relative term plus the contact
+// band, and no more candidates evaluated than the twin's.
+void expect_fast_matches_slow(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& pose,
+                              PenetrationCache& cache, int trial) {
+  const PenetrationResult rf = penetration_depth(pa, pb, pose, cache);
+  const PenetrationResult rs = penetration_depth_brute_force(pa, pb, pose);
+  const double tol =
+      kContactBandUlps * kUnitRoundoff * std::max(pa.scale(), magnitude_bound(pose, pb.scale()));
+  EXPECT_EQ(rf.status, rs.status) << trial;
+  EXPECT_NEAR(rf.depth, rs.depth, kRel * rs.depth + tol) << trial;
+  EXPECT_LE(rf.candidates, rs.candidates) << trial;
+}
+
 TEST(PenetrationTwins, WalkMatchesBruteForce) {
   Rng rng(16);
   for (int trial = 0; trial < 40; ++trial) {
@@ -472,13 +486,7 @@ TEST(PenetrationTwins, WalkMatchesBruteForce) {
     const Pose pose(random_quaternion(rng), uniform(rng, 0.0, 1.4) * random_unit_vector(rng));
     const ConvexPolytope pa(a), pb(b_local);
     PenetrationCache cache;
-    const PenetrationResult rf = penetration_depth(pa, pb, pose, cache);
-    const PenetrationResult rs = penetration_depth_brute_force(pa, pb, pose);
-    const double tol =
-        kContactBandUlps * kUnitRoundoff * std::max(pa.scale(), magnitude_bound(pose, pb.scale()));
-    EXPECT_EQ(rf.status, rs.status) << trial;
-    EXPECT_NEAR(rf.depth, rs.depth, kRel * rs.depth + tol) << trial;
-    EXPECT_LE(rf.candidates, rs.candidates) << trial;
+    expect_fast_matches_slow(pa, pb, pose, cache, trial);
   }
 }
 
@@ -551,13 +559,7 @@ TEST(PenetrationTwins, SmallHullsWithFastArcNormalsMatchBruteForce) {
     const Pose pose(random_quaternion(rng), uniform(rng, 0.0, 1.6) * random_unit_vector(rng));
     const ConvexPolytope pa(a), pb(b);
     PenetrationCache cache;
-    const PenetrationResult rf = penetration_depth(pa, pb, pose, cache);
-    const PenetrationResult rs = penetration_depth_brute_force(pa, pb, pose);
-    const double tol =
-        kContactBandUlps * kUnitRoundoff * std::max(pa.scale(), magnitude_bound(pose, pb.scale()));
-    EXPECT_EQ(rf.status, rs.status) << trial;
-    EXPECT_NEAR(rf.depth, rs.depth, kRel * rs.depth + tol) << trial;
-    EXPECT_LE(rf.candidates, rs.candidates) << trial;
+    expect_fast_matches_slow(pa, pb, pose, cache, trial);
     for (const PenetrationCache::HullNormals* h : {&cache.shapes.a, &cache.shapes.b}) {
       for (const double e : h->error) {
         fast_normals += e > 0.0 && e <= 512 * kUnitRoundoff;
