@@ -637,6 +637,15 @@ TEST(PenetrationTracking, SweepThroughAndBackIsContinuousAndMatchesCold) {
 // edges at a vertex) with a lower bound and a ball around their normals
 // (PenetrationCache::Bound), which move with B like faces, so that a
 // tracked query re-enumerates only when B moved towards a pruned group.
+// Pose i of `steps` of B sweeping through A and back: its centre from -2
+// to 2 along `dir` and back (off the line by a small fixed offset), its
+// rotation fixed.
+Pose through_and_back(int i, int steps, const Mat3& rotation, const Vec3& dir) {
+  const double phase = static_cast<double>(i) / steps;
+  const double s = phase < 0.5 ? -2.0 + 8.0 * phase : 6.0 - 8.0 * phase;
+  return Pose(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+}
+
 // Sweeps of B through A and back on spheres of 8 to 200 points, B's
 // rotation fixed: every tracked answer equals a cold one. Wrong balls
 // (each group's centre negated, its spread 0: tried while writing the
@@ -655,9 +664,7 @@ TEST(PenetrationTracking, PrunedGroupsCertifyTranslationsThroughAndBack) {
       PenetrationCache cache;
       const int steps = 600;
       for (int i = 0; i < steps; ++i) {
-        const double phase = static_cast<double>(i) / steps;
-        const double s = phase < 0.5 ? -2.0 + 8.0 * phase : 6.0 - 8.0 * phase;
-        const Pose pose(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+        const Pose pose = through_and_back(i, steps, rotation, dir);
         const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
         PenetrationCache fresh;
         const PenetrationResult cold = penetration_depth(pa, pb, pose, fresh);
@@ -784,9 +791,7 @@ TEST(PenetrationTracking, WitnessesReadFromTheCacheAreTheColdOnesBitForBit) {
       PenetrationCache cache;
       const int steps = 400;
       for (int i = 0; i < steps; ++i) {
-        const double phase = static_cast<double>(i) / steps;
-        const double s = phase < 0.5 ? -2.0 + 8.0 * phase : 6.0 - 8.0 * phase;
-        const Pose pose(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+        const Pose pose = through_and_back(i, steps, rotation, dir);
         const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
         PenetrationCache fresh;
         const PenetrationResult cold = penetration_depth(pa, pb, pose, fresh);
