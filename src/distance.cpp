@@ -265,7 +265,7 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   // One named result (NRVO, as distance_in_frame): the tracked answer is
   // built in the caller's slot, not copied there.
   DistanceResult result;
-  if (detail::tracked_overlap(a, b, b_in_a, options, band_bound, c, result)) [[likely]] {
+  if (detail::tracked_overlap(a, b, b_in_a, band_bound, c, result)) [[likely]] {
     to_world(pose_a, result);
     return result;
   }

@@ -1743,10 +1743,10 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
   } else if (!cache.facets.empty() && cache.rotation == b_in_a.rotation) {
     PenetrationResult r;
     double margin = 0.0;
+    // Else the pruned faces were not recorded, or too many are nearer now:
+    // enumerate again, keeping the faces within the margin (track_or_expand
+    // set cache.prune_margin to it).
     if (track_or_expand(q, cache, b_in_a, r, margin)) return r;
-    // The pruned faces were not recorded, or too many are nearer now:
-    // enumerate again, keeping the faces within the margin.
-    cache.prune_margin = margin;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:

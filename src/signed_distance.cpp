@@ -135,9 +135,8 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
 }
 
 bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                     const DistanceOptions& options, double band, DistanceCache& cache,
-                     DistanceResult& result) {
-  if (!overlap_trackable(options, cache)) return false;
+                     double band, DistanceCache& cache, DistanceResult& result) {
+  // overlap_trackable(options, cache) holds: distance() chose this path by it.
   PenetrationCache* depth_cache = cache.penetration.get();
   PenetrationResult p;
   if (!penetration_depth_tracked(a, b, b_in_a, *depth_cache, p) ||

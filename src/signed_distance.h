@@ -34,15 +34,14 @@ inline bool overlap_trackable(const DistanceOptions& options, const DistanceCach
          options.penetration && options.algorithm == Algorithm::hybrid;
 }
 
-// Before distance()'s algorithm runs: for a pair whose last depth was
-// penetrating (overlap_trackable), the tracked depth alone
+// Before distance()'s algorithm runs, for a pair that distance() found
+// overlap_trackable (a precondition, not tested again), the tracked depth alone
 // (penetration_depth_tracked). When it certifies an overlap deeper than
 // `band` (distance()'s contact band, at least the exact one), `result` is
 // the intersecting answer the algorithm and finish_signed_distance would
 // give (A's frame; no iterations) and the function returns true; else
 // false, and the pair is not tried again until its depth is penetrating.
 bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                     const DistanceOptions& options, double band, DistanceCache& cache,
-                     DistanceResult& result);
+                     double band, DistanceCache& cache, DistanceResult& result);
 
 }  // namespace proxima::detail
