@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "../src/broad_phase.h"
-#include "proxima/scene.h"
+#include "proxima/scene/scene.h"
 #include "support/random.h"
 
 namespace proxima {

@@ -1,4 +1,4 @@
-// Tests of the scene's pair finders (src/broad_phase.h, private to the
+// Tests of the scene's pair finders (src/scene/broad_phase.h, private to the
 // library): sweep and prune and the dynamic AABB tree against the obvious
 // twin, the closed-box test on every pair, over seeded random box sets that
 // move, grow, lose and gain members between calls. Coordinates are
@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "proxima/support.h"
+#include "proxima/shape/support.h"
 #include "support/generators.h"
 
 namespace proxima {
