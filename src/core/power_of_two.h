@@ -65,6 +65,18 @@ inline double max_abs_coordinate(std::span<const Vec3> pts) {
 // algorithms' squares and cubes.
 inline constexpr int kMaxInverseUnitExponent = 1000;
 
+// magnitude_exponent(magnitude) clamped to [-kMaxInverseUnitExponent,
+// kMaxInverseUnitExponent], so that the scale factor 2^-e and its inverse
+// are both normal doubles: products with them are exact (or underflow,
+// which only lowers a bound) and cost one multiplication, not a call of
+// ldexp per coordinate. For the traversals that scale a whole query
+// (compound and mesh distances); the magnitudes they accept (kMaxMagnitude)
+// keep the scaled ones below 2^20.
+inline int clamped_magnitude_exponent(double magnitude) {
+  return std::clamp(magnitude_exponent(magnitude), -kMaxInverseUnitExponent,
+                    kMaxInverseUnitExponent);
+}
+
 // A unit 2^e near `magnitude` (magnitude < unit <= 2 magnitude) and its
 // exact reciprocal; (1, 1) for a zero or non-finite magnitude.
 struct PowerOfTwoUnit {

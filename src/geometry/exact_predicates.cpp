@@ -37,11 +37,11 @@ namespace {
 // absolute slack kUnderflowSlack covers products that underflowed (each loses
 // at most 2^-1075, later multiplied by factors below 2^302).
 
-constexpr double kEpsilon = 0x1p-53;
+// Shewchuk's epsilon is the unit roundoff u (kUnitRoundoff, core/pose.h).
 // Shewchuk's ccwerrboundA: relative error bound of the rounded orient2d.
-constexpr double kOrient2dErrorBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient2dErrorBound = (3.0 + 16.0 * kUnitRoundoff) * kUnitRoundoff;
 // Shewchuk's o3derrboundA: relative error bound of the rounded orient3d.
-constexpr double kOrient3dErrorBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
+constexpr double kOrient3dErrorBound = (7.0 + 56.0 * kUnitRoundoff) * kUnitRoundoff;
 // Largest coordinate magnitude for which the double filter cannot overflow:
 // differences stay below 2^301 and a product of three below 2^903.
 constexpr double kFilterMaxMagnitude = 0x1p300;

@@ -36,7 +36,8 @@
 // Units. All simplex arithmetic runs on coordinates divided by a power of two
 // near the bodies' magnitude: exact, and it keeps the cubic terms (face
 // normals dotted with points) away from overflow and underflow whatever the
-// scale.#include "proxima/detail/narrowphase/gjk.h"
+// scale.
+#include "proxima/detail/narrowphase/gjk.h"
 
 #include <algorithm>
 #include <array>
@@ -45,6 +46,7 @@
 #include <cstdint>
 #include <span>
 
+#include "core/accuracy.h"
 #include "narrowphase/gjk_contact.h"
 #include "narrowphase/gjk_frame.h"
 #include "narrowphase/simplex_solver.h"
@@ -61,13 +63,11 @@ using detail::Points;
 using detail::Simplex;
 using detail::SupportPoint;
 
-// Rounding slack of the termination test, in units of u * max|w| (the
-// largest simplex point seen, in scaled units): v.w and |v| are sums of
-// products of coordinates of that size and v itself is rebuilt from the
-// simplex points, so the computed gap |v| - v.w/|v| carries an error of a few
-// u max|w|. Below this slack more iterations cannot improve v. Well inside
-// the 64 u R contact band of the accuracy standard (|w| <= 2 sqrt(3) R).
-constexpr double kGapUlps = 16.0;
+// The termination test's rounding slack (core/accuracy.h) is in units of
+// u * max|w| (the largest simplex point seen, in scaled units): v.w and |v|
+// are sums of products of coordinates of that size and v itself is rebuilt
+// from the simplex points (|w| <= 2 sqrt(3) R).
+using detail::kTerminationGapUlps;
 
 // ---------------------------------------------------------------------------
 // The loop shared by both variants.
@@ -116,7 +116,7 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     w_max2 = std::max(w_max2, w.w.squaredNorm());
     lower = std::max(lower, simplex.v.dot(w.w) / v_norm);
     if (v_norm - lower <=
-        options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
+        options.relative_tolerance * v_norm + kTerminationGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
       certified = true;
       break;
     }

@@ -30,6 +30,7 @@
 #include <optional>
 #include <span>
 
+#include "core/accuracy.h"
 #include "core/power_of_two.h"
 #include "narrowphase/witness_features.h"
 #include "proxima/detail/narrowphase/contact.h"
@@ -39,11 +40,9 @@
 namespace proxima {
 namespace {
 
-// Rounding slack of the termination test, in units of u * R: the support
-// values w.a* and w.b* each carry an error of a few u |w| R, so the computed
-// gap d - lower cannot be resolved below this. Well inside the 64 u R of the
-// accuracy standard.
-constexpr double kGapUlps = 16.0;
+// The termination test's rounding slack (core/accuracy.h) is in units of
+// u * R: the support values w.a* and w.b* each carry an error of a few u |w| R.
+using detail::kTerminationGapUlps;
 
 // Range of R (the largest coordinate magnitude in A's frame) in which the
 // algorithm runs on the given coordinates. Squared lengths overflow from
@@ -359,7 +358,7 @@ constexpr double kWitnessFarBands = 64.0;
 bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& x,
                         double far) {
   const double far2 = far * far;
-  return poly.scale() > 0x1p-300 && poly.scale() < 0x1p300 && (f.p[0] - x).squaredNorm() > far2 &&
+  return detail::squares_are_safe(poly.scale()) && (f.p[0] - x).squaredNorm() > far2 &&
          (f.p[1] - x).squaredNorm() > far2;
 }
 
@@ -472,7 +471,7 @@ template <bool kScaled>
     const double wa = w.dot(pa);
     const double wb = w.dot(pb);
     lower = std::max(lower, wb - wa);
-    if (d - lower <= options.relative_tolerance * d + kGapUlps * ulp_r) break;
+    if (d - lower <= options.relative_tolerance * d + kTerminationGapUlps * ulp_r) break;
     if (iterations >= options.max_iterations) {
       result.status = Status::iteration_cap;
       break;

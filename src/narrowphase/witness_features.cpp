@@ -130,7 +130,7 @@ struct View {
   // the point's too.
   View(const ConvexPolytope& p, const Vec3& x) : poly(p), point(x) {
     const double r = p.scale();
-    if (!(r > 0x1p-300 && r < 0x1p300)) {
+    if (!squares_are_safe(r)) {
       inverse_unit = power_of_two_unit(r).inverse;
       scaled = true;
     }

@@ -17,6 +17,14 @@
 
 namespace proxima::detail {
 
+// Hull scales at which the witness rules may square unscaled coordinates:
+// in (2^-300, 2^300) the squared distances between points of the hull stay
+// within (2^-600, 2^600), far from both ends of the doubles' normal range,
+// and so do their products with a band squared. Outside it the general path
+// first divides by a power of two near the scale (power_of_two.h). Pinned
+// by DistanceRegression.ScalesFrom1eMinus300To1e300 (both sides).
+inline bool squares_are_safe(double scale) { return scale > 0x1p-300 && scale < 0x1p300; }
+
 // The closest point whose witness feature is wanted, in poly's frame.
 struct WitnessPoint {
   Vec3 point = Vec3::Zero();
@@ -89,7 +97,7 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
   const WitnessPoint p = describe();
   // Two distinct ids at ordinary magnitudes, the tracked edge case: rules 1
   // and 2 inline (witness_feature_of_vertices applies the same ones).
-  if (id.size() == 2 && id[0] != id[1] && poly.scale() > 0x1p-300 && poly.scale() < 0x1p300) {
+  if (id.size() == 2 && id[0] != id[1] && squares_are_safe(poly.scale())) {
     const double band2 = band * band;
     const double d0 = (poly.vertex(id[0]) - p.point).squaredNorm();
     const double d1 = (poly.vertex(id[1]) - p.point).squaredNorm();
@@ -107,7 +115,7 @@ Feature witness_feature(const ConvexPolytope& poly, std::span<const std::int32_t
   // path, which applies the same rules.
   if (id.size() == 3 && poly.dimension() == 3 && cached_face >= 0 &&
       cached_face < poly.face_count() && id[0] != id[1] && id[1] != id[2] && id[0] != id[2] &&
-      poly.scale() > 0x1p-300 && poly.scale() < 0x1p300) {
+      squares_are_safe(poly.scale())) {
     const Vec3 r0 = poly.vertex(id[0]) - p.point;
     const Vec3 r1 = poly.vertex(id[1]) - p.point;
     const Vec3 r2 = poly.vertex(id[2]) - p.point;

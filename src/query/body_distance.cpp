@@ -17,15 +17,11 @@
 #include <utility>
 #include <vector>
 
+#include "core/accuracy.h"
 #include "proxima/query/distance.h"
 
 namespace proxima {
 namespace {
-
-// The largest coordinate magnitude of a rounded body (core plus radius)
-// accepted: the cores' query's own limit (distance.cpp), so that no sum of
-// radii, signed distance or offset point can overflow.
-constexpr double kMaxMagnitude = 0x1p1018;
 
 // The cores' answer in the world frame as a signed value with its bounds:
 // the distance of the cores (>= 0), or minus their penetration depth when
@@ -115,14 +111,6 @@ Pose relative(const Pose& pose_a, const Pose& pose_b) {
   return checked_pose(pose_a.inverse() * pose_b, "distance: relative pose");
 }
 
-// The largest coordinate magnitude of a polytope's vertices placed at `pose`
-// (the exact R of the accuracy standard). O(N).
-double placed_magnitude(const ConvexPolytope& p, const Pose& pose) {
-  double r = 0.0;
-  for (const Vec3& v : p.vertices()) r = std::max(r, pose.apply(v).cwiseAbs().maxCoeff());
-  return r;
-}
-
 // The pieces (or convex bodies) that gave the answer, placed: the accuracy
 // standard's R is theirs, as for the compound query.
 struct Placed {
@@ -141,8 +129,8 @@ Status rounded_status(double s, const Placed& a, double ra, const Placed& b, dou
                                 magnitude_bound(b.pose, b.polytope->scale()) + rb);
   double band = contact_band(bound, options.absolute_tolerance);
   if (std::abs(s) <= band) {
-    band = contact_band(std::max(placed_magnitude(*a.polytope, a.pose) + ra,
-                                 placed_magnitude(*b.polytope, b.pose) + rb),
+    band = contact_band(std::max(detail::placed_magnitude(a.polytope->vertices(), a.pose) + ra,
+                                 detail::placed_magnitude(b.polytope->vertices(), b.pose) + rb),
                         options.absolute_tolerance);
   }
   return s > band ? Status::separated : s >= -band ? Status::touching : Status::intersecting;
@@ -261,16 +249,17 @@ class DeepestPair {
   }
 
  private:
-  // Whether two spheres (body frames) may meet, with a slack for the
-  // rounding of the placed centers and of the norm: a pair tested more is
-  // only slower.
+  // Whether two spheres (body frames) may meet, with the prune slack
+  // (core/accuracy.h) of the placed centers' and the radii's magnitudes for
+  // the rounding of the centers and of the norm: a pair tested more is only
+  // slower (BodyCompound.DeepestPairIsTheAllPairsTwins).
   bool spheres_meet(const Vec3& center_a, double radius_a, const Vec3& center_b,
                     double radius_b) const {
     const Vec3 ca = pose_a_.apply(center_a);
     const Vec3 cb = pose_b_.apply(center_b);
     const double reach = radius_a + radius_b;
     const double slack =
-        256.0 * kUnitRoundoff * (ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + reach);
+        detail::prune_slack(ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + reach);
     return !((ca - cb).norm() > reach + slack);
   }
 
@@ -341,14 +330,6 @@ BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, con
   // A convex body met a compound as its one-piece wrapper: it has no pieces.
   if (a.kind() == Body::Kind::convex) r.piece_a = -1;
   if (b.kind() == Body::Kind::convex) r.piece_b = -1;
-  return r;
-}
-
-// The largest coordinate magnitude of a mesh's vertices placed at `pose`
-// (the exact R of the accuracy standard). O(V).
-double placed_magnitude(const TriangleMesh& m, const Pose& pose) {
-  double r = 0.0;
-  for (const Vec3& v : m.vertices()) r = std::max(r, pose.apply(v).cwiseAbs().maxCoeff());
   return r;
 }
 
@@ -436,8 +417,8 @@ BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const P
   const Pose place_a = pose_a * ma[best_i].pose;
   const Pose place_b = pose_b * mb[best_j].pose;
   BodyDistance r = offset(c, a, b, [&](double value) {
-    const double reach = std::max(placed_magnitude(*ma[best_i].mesh, place_a) + a.radius(),
-                                  placed_magnitude(*mb[best_j].mesh, place_b) + b.radius());
+    const double reach = std::max(detail::placed_magnitude(ma[best_i].mesh->vertices(), place_a) + a.radius(),
+                                  detail::placed_magnitude(mb[best_j].mesh->vertices(), place_b) + b.radius());
     const double band = contact_band(reach, options.absolute_tolerance);
     return value > band     ? Status::separated
            : value >= -band ? Status::touching
@@ -461,12 +442,12 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
   // distance or the offset points could overflow to infinity).
   for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
     const double reach = magnitude_bound(*pose, body->scale());
-    if (!(reach <= kMaxMagnitude)) {
+    if (!(reach <= detail::kMaxMagnitude)) {
       char message[200];
       std::snprintf(message, sizeof message,
                     "distance: body %s with radius %g reaches coordinates of magnitude %g, beyond "
                     "the supported %g",
-                    name, body->radius(), reach, kMaxMagnitude);
+                    name, body->radius(), reach, detail::kMaxMagnitude);
       throw InvalidInput(message);
     }
   }

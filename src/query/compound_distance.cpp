@@ -21,6 +21,7 @@
 #include <unordered_set>
 #include <utility>
 
+#include "core/accuracy.h"
 #include "core/power_of_two.h"
 #include "proxima/query/distance.h"
 
@@ -28,12 +29,11 @@ namespace proxima {
 
 namespace {
 
-// Slack of a node pair's lower bound, in units of u times the two bodies'
-// world magnitude bounds: the centers in the query frame are a pose product
-// and a transformed point away from the stored doubles (a few u of the
-// translations and coordinates each), and the convex query itself places the
-// pieces through a differently rounded product. 256 u covers both with room.
-constexpr double kPruneSlackUlps = 256.0;
+// The slack of a node pair's lower bound is detail::prune_slack of the
+// larger world magnitude bound (core/accuracy.h): the centers in the query
+// frame are a pose product and a transformed point away from the stored
+// doubles (a few u of the translations and coordinates each), and the convex
+// query itself places the pieces through a differently rounded product.
 // And relative to the bound's own terms (center distance plus radii): the
 // norm and the two subtractions round by at most 4 u of them.
 constexpr double kPruneRelativeUlps = 64.0;
@@ -92,16 +92,15 @@ class Search {
       : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options), cache_(cache) {
     const double magnitude_a = world_magnitude_bound(a, pose_a);
     const double magnitude_b = world_magnitude_bound(b, pose_b);
-    // The factor 2^-e as a double, clamped to [2^-1000, 2^1000] so that it
-    // is a normal number: products with it are exact (or underflow, which
-    // only lowers a bound: never a wrong prune) and cost one multiplication,
-    // not a call of ldexp per coordinate.
-    const int e = std::clamp(magnitude_exponent(std::max(magnitude_a, magnitude_b)), -1000, 1000);
+    // The factor 2^-e as a normal double (clamped_magnitude_exponent): an
+    // underflow in a product with it only lowers a bound, never a wrong prune.
+    const double magnitude = std::max(magnitude_a, magnitude_b);
+    const int e = detail::clamped_magnitude_exponent(magnitude);
     factor_ = std::ldexp(1.0, -e);
     rotation_ = pose_a.rotation.transpose() * pose_b.rotation;
     translation_ =
         pose_a.rotation.transpose() * (factor_ * pose_b.translation - factor_ * pose_a.translation);
-    slack_ = kPruneSlackUlps * kUnitRoundoff * (factor_ * magnitude_a + factor_ * magnitude_b);
+    slack_ = detail::prune_slack(factor_ * magnitude);
     // A near list the caller did not keep sorted is ignored (a binary search
     // on it could miss entries): slower, never wrong.
     if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {

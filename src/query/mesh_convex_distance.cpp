@@ -8,18 +8,17 @@
 #include <cmath>
 #include <limits>
 
+#include "core/accuracy.h"
 #include "proxima/query/distance.h"
 #include "proxima/query/mesh_distance.h"
 
 namespace proxima {
 namespace {
 
-// Slack of a box gap before it prunes, in units of u R: the boxes are
-// rounded outwards (float, stored) or formed from transformed vertices (a
-// few u R each), and the convex query answers within 64 u R of the exact
-// distance; a pruned triangle must be farther than the best in exact
-// arithmetic too.
-constexpr double kPruneSlackUlps = 128.0;
+// The slack of a box gap before it prunes is detail::prune_slack of the
+// query's magnitude (core/accuracy.h): the boxes are rounded outwards
+// (float, stored) or formed from transformed vertices (a few u R each), and
+// the convex query answers within 64 u R of the exact distance.
 
 struct ConvexQuery {
   const TriangleMesh& a;
@@ -57,7 +56,7 @@ ConvexQuery make_query(const TriangleMesh& a, const Pose& pose_a, const ConvexPo
   const double magnitude =
       std::max({magnitude_bound(q.pose_a, a.scale()), magnitude_bound(q.pose_b, b.scale()),
                 a.scale(), magnitude_bound(rel, b.scale())});
-  q.slack = kPruneSlackUlps * kUnitRoundoff * magnitude;
+  q.slack = detail::prune_slack(magnitude);
   q.options.penetration = false;  // the status is all a leaf needs
   return q;
 }

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/accuracy.h"
 #include "core/power_of_two.h"
 #include "geometry/triangle_distance.h"
 #include "proxima/detail/geometry/exact_predicates.h"
@@ -26,13 +27,10 @@ namespace {
 using detail::magnitude_exponent;
 using detail::times_pow2;
 
-// Slack of a node pair's lower bound in the scaled frame (magnitudes about
-// 1), in units of u: the box corners are a float decoded by a power of two
-// (exact) and a rotation plus translation away (a few u each), the gaps a
-// few sums and one square root. Pruning a pair needs its bound to exceed the
-// best distance by this much, so that a pruned pair is farther than the best
-// in exact arithmetic too.
-constexpr double kPruneSlackUlps = 64.0;
+// The slack of a node pair's lower bound is detail::prune_slack of the
+// query's magnitude, in the scaled frame (core/accuracy.h): the box corners
+// are a float decoded by a power of two (exact) and a rotation plus
+// translation away (a few u each), the gaps a few sums and one square root.
 
 // The kernel's own error (rounded points of rounded transformed vertices):
 // a few u R. The reported lower bound is the distance minus this.
@@ -74,13 +72,12 @@ Query make_query(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& 
                  const Pose& pose_b, const DistanceOptions& options) {
   const Pose pa = checked_pose(pose_a, "mesh distance: pose_a");
   const Pose pb = checked_pose(pose_b, "mesh distance: pose_b");
-  if (!is_finite_bits(options.absolute_tolerance) || !(options.absolute_tolerance >= 0.0))
-    throw InvalidInput("mesh distance: absolute_tolerance must be finite and >= 0");
+  detail::check_distance_options(options, "mesh distance: options");
   const Pose rel = pa.inverse() * pb;
   Query q{a, b, rel.rotation, rel.translation, {}, 1.0, 0, 0.0, 0.0, 1.0, 1.0, {}, {}};
   q.magnitude = std::max({magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale()), a.scale(),
                           magnitude_bound(rel, b.scale())});
-  q.exponent = std::clamp(magnitude_exponent(q.magnitude), -1000, 1000);
+  q.exponent = detail::clamped_magnitude_exponent(q.magnitude);
   q.factor = std::ldexp(1.0, -q.exponent);
   q.translation_s = times_pow2(rel.translation, -q.exponent);
   q.band_s = contact_band(std::ldexp(q.magnitude, -q.exponent),
@@ -223,6 +220,18 @@ Triangles prepared(const Vec3& p0, const Vec3& p1, const Vec3& p2, std::int32_t 
 // each coordinate difference rounds once, the squares and sum a few times.
 constexpr double kBoxSlackUlps = 16.0;
 
+// Slack of the planes' bound against a limit (scaled units, magnitudes about
+// 1): a triangle's plane and the other's vertices' offsets from it are a
+// few products and sums, a few u each. Pinned with kBoxSlackUlps by
+// MeshDistanceTraversal.MatchesBruteForceAtAnyScale.
+constexpr double kPlaneSlackUlps = 16.0;
+
+// Relative slack of motion_bound: the norms, the product and the sums round
+// by a few u each, and the bound must stay an upper bound on the motion (a
+// tracked answer is kept only when it held; MeshDistanceTraversal.
+// TrackingGivesTheColdAnswer).
+constexpr double kMotionBoundUlps = 64.0;
+
 // Squared gap between two axis-aligned boxes of the query frame.
 double box_gap_squared(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
   double gap2 = 0.0;
@@ -246,7 +255,7 @@ double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& b
   if (gap2 > box_limit * box_limit) return std::numeric_limits<double>::infinity();
   // The planes' bound, with the slack of its rounding (a few u of the
   // scaled magnitudes, about 1).
-  const double plane_limit = limit + 16.0 * kUnitRoundoff;
+  const double plane_limit = limit + kPlaneSlackUlps * kUnitRoundoff;
   if (plane_separates(a, b, plane_limit) || plane_separates(b, a, plane_limit))
     return std::numeric_limits<double>::infinity();
   // A separating axis through the boxes' centers: along any direction w, the
@@ -381,7 +390,7 @@ double motion_bound(const TriangleMesh& b, const Mat3& r0, const Vec3& t0, const
   const double h = (0.5 * (hi - lo)).stableNorm();
   const Mat3 dr = r1 - r0;
   const double m = dr.norm() * h + (dr * c + (t1 - t0)).stableNorm();
-  return m * (1.0 + 64.0 * kUnitRoundoff);
+  return m * (1.0 + kMotionBoundUlps * kUnitRoundoff);
 }
 
 double b_radius(const TriangleMesh& b) {
@@ -416,7 +425,7 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const T
 MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
                     const Pose& pose_b, const DistanceOptions& options, MeshCache* cache) {
   const Query q = make_query(a, pose_a, b, pose_b, options);
-  const double slack_s = kPruneSlackUlps * kUnitRoundoff;
+  const double slack_s = detail::prune_slack(std::ldexp(q.magnitude, -q.exponent));
   const double unscaled_slack = std::ldexp(slack_s, q.exponent);
   Best best;
   int tested = 0;

@@ -29,6 +29,7 @@
 #include <string>
 #include <utility>
 
+#include "core/accuracy.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
 #include "query/parallel_ranges.h"
@@ -584,15 +585,7 @@ Scene::Scene(const SceneOptions& options) : impl_(std::make_unique<Impl>()) {
                        std::to_string(options.threads));
   }
   const DistanceOptions& d = options.distance;
-  if (!std::isfinite(d.relative_tolerance) || d.relative_tolerance < 0.0 ||
-      !std::isfinite(d.absolute_tolerance) || d.absolute_tolerance < 0.0) {
-    throw InvalidInput(
-        "Scene: options.distance.relative_tolerance and absolute_tolerance must be finite and >= "
-        "0");
-  }
-  if (d.max_iterations < 1) {
-    throw InvalidInput("Scene: options.distance.max_iterations must be at least 1");
-  }
+  detail::check_distance_options(d, "Scene: options.distance");
   impl_->options = options;
   impl_->finder = detail::make_pair_finder(options.broad_phase);
 }

@@ -188,6 +188,16 @@ constexpr std::array<std::array<double, 3>, 8> kRayDirections = {{
     {0.2705078125, 1.0, -0.8876953125},
 }};
 
+// The inside test's slab test against a node's box: the box is widened by
+// kSlabWidening of the mesh's unit (a power of two near its scale), far
+// above the rounding of the box's float coordinates (2^-24 relative) and of
+// the ray's parameters, and each slab's parameter interval by
+// kSlabParameterSlack, above the rounding of the divisions by the ray's
+// direction (a few u). A box kept too many is only a triangle tested more,
+// exactly. Pinned by MeshStatus.ContainsAgreesWithTheBoxOnRaysThroughEdges.
+constexpr double kSlabWidening = 0x1p-20;
+constexpr double kSlabParameterSlack = 0x1p-30;
+
 // Whether p, in the plane of the non-degenerate triangle (a, b, c), lies in
 // the closed triangle: orientations in the projection along the largest
 // component of the normal (an affine bijection of the plane, so the signs
@@ -386,18 +396,18 @@ bool TriangleMesh::contains(const Vec3& p) const {
       const std::int32_t id = stack.back();
       stack.pop_back();
       // Slab test of the segment p + s dq, s in [0, 1], against the box,
-      // widened by a relative 2^-20 of the unit so that rounding never drops
-      // a box the segment touches (triangle tests below are exact).
+      // widened (kSlabWidening, kSlabParameterSlack) so that rounding never
+      // drops a box the segment touches (triangle tests below are exact).
       Vec3 lo, hi;
       box(id, lo, hi);
-      const double widen = 0x1p-20 * unit_;
+      const double widen = kSlabWidening * unit_;
       double s0 = 0.0, s1 = 1.0;
       for (int k = 0; k < 3 && s0 <= s1; ++k) {
         double a = (lo[k] - widen - p[k]) / dq[k];
         double b = (hi[k] + widen - p[k]) / dq[k];
         if (a > b) std::swap(a, b);
-        s0 = std::max(s0, a - 0x1p-30);
-        s1 = std::min(s1, b + 0x1p-30);
+        s0 = std::max(s0, a - kSlabParameterSlack);
+        s1 = std::min(s1, b + kSlabParameterSlack);
       }
       if (s0 > s1) continue;
       const Node& node = nodes_[static_cast<std::size_t>(id)];

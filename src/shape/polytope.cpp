@@ -59,8 +59,6 @@ using detail::projection_axis;
 using detail::segment_ends;
 using detail::times_pow2;
 
-constexpr double kEpsilon = 0x1p-53;
-
 // A built boundary before renumbering: hull vertices as unique-point ids and
 // face cycles over them.
 struct Boundary {
@@ -382,7 +380,7 @@ Plane ConvexPolytope::face_plane(int f) const {
       return {Vec3::UnitZ(), vertex(cycle[0]).z()};  // degenerate face: never built
     unit = normal / newell_length;
     for (std::size_t i = 0; i < n && !exact; ++i) {
-      exact = !(std::abs(unit.dot(local(i) - mean)) <= kPlaneResidual * kEpsilon);
+      exact = !(std::abs(unit.dot(local(i) - mean)) <= kPlaneResidual * kUnitRoundoff);
     }
   }
   if (exact) {
