@@ -238,16 +238,17 @@ TEST(Pose, DistanceOptionsAreCheckedExactly) {
     for (const bool relative : {true, false}) {
       DistanceOptions options;
       (relative ? options.relative_tolerance : options.absolute_tolerance) = x;
-      EXPECT_EQ(message_of([&] { (void)distance(*cube, Pose(), *cube, far, options); }),
-                "distance: options.relative_tolerance and options.absolute_tolerance must be "
-                "finite and >= 0")
+      const std::string field = relative ? "relative_tolerance" : "absolute_tolerance";
+      EXPECT_EQ(message_of([&] { (void)distance(*cube, Pose(), *cube, far, options); })
+                    .rfind("distance: options." + field + " must be finite and >= 0, got ", 0),
+                0u)
           << x;
     }
   }
   DistanceOptions none;
   none.max_iterations = 0;
   EXPECT_EQ(message_of([&] { (void)distance(*cube, Pose(), *cube, far, none); }),
-            "distance: options.max_iterations must be at least 1");
+            "distance: options.max_iterations must be at least 1, got 0");
 }
 
 // are_rigid (both poses in the two SIMD lanes, the check every query pays)
