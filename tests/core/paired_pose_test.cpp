@@ -6,7 +6,7 @@
 // must round as Eigen's products and Pose::apply do: an answer of distance()
 // may not depend on the target, and a change of Eigen's rounding order fails
 // here by name instead of silently moving answers.
-#include "../../src/core/paired_pose.h"
+#include "core/paired_pose.h"
 
 #include <gtest/gtest.h>
 
