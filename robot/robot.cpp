@@ -70,6 +70,31 @@ BoundingSphere sphere_of_points(std::span<const Vec3> points) {
 }
 }  // namespace
 
+BoundingBox bounding_box(const Body& body) {
+  Vec3 low, high;
+  const auto cover = [&](std::span<const Vec3> points) {
+    low = points[0];
+    high = points[0];
+    for (const Vec3& p : points) {
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+  };
+  if (body.kind() == Body::Kind::convex) {
+    cover(body.convex()->vertices());
+  } else if (body.kind() == Body::Kind::mesh) {
+    cover(body.mesh()->vertices());
+  } else {
+    const CompoundBody::Node& root = body.compound()->nodes()[0];
+    low = root.center - Vec3::Constant(root.radius);
+    high = root.center + Vec3::Constant(root.radius);
+  }
+  BoundingBox box{(low + high) / 2, (high - low) / 2};
+  box.half_extents +=
+      Vec3::Constant(kBoundingSphereSlack * (box.center.norm() + box.half_extents.norm()));
+  return box;
+}
+
 BoundingSphere bounding_sphere(const Body& body) {
   BoundingSphere sphere;
   if (body.kind() == Body::Kind::convex) {

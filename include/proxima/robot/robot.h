@@ -102,6 +102,14 @@ struct BoundingSphere {
   double radius = 0.0;
 };
 BoundingSphere bounding_sphere(const Body& body);
+// The box around a body's core in its own frame (axis-aligned there, the
+// same slack), without the body's radius: every point of the body is
+// within body.radius() of it.
+struct BoundingBox {
+  Vec3 center = Vec3::Zero();
+  Vec3 half_extents = Vec3::Zero();
+};
+BoundingBox bounding_box(const Body& body);
 
 // Two robot geometries tested against each other (indices into
 // Robot::geometries(), a < b).

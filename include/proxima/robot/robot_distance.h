@@ -18,11 +18,16 @@
 //
 // Every pair is a tracked distance() (proxima/body.h) whose cache lives in
 // the state: along a trajectory, a pair whose closest features did not
-// change costs one local computation. A pair whose bounding spheres are
-// farther apart than both the margin and the smallest signed distance found
-// so far (in its category: self or environment) is not queried: it cannot
-// be the closest nor within the margin. The answer is that of the slow
-// path, a cold distance() on every pair, within the accuracy standard.
+// change costs one local computation. A pair is not queried when a lower
+// bound on its signed distance exceeds both the margin and the smallest
+// signed distance found so far (in its category: self or environment): it
+// cannot be the closest nor within the margin. The bounds: the bounding
+// spheres' distance (a geometry's sphere against an obstacle's box), and,
+// along a trajectory, the pair's certified lower bound at its last query
+// minus how far any point of either body has moved since (conservative
+// advancement's bound: the centre's displacement plus the rotation's change
+// times the radius). The answer is that of the slow path, a cold distance()
+// on every pair, within the accuracy standard.
 //
 // The gradient of a pair's signed distance s = n . (p_b - p_a) (n the unit
 // normal from A towards B, p_a and p_b the witness points) with respect to
@@ -54,9 +59,11 @@ struct Obstacle {
   Body body;
   Pose pose;
   std::string name;
-  // Bounding sphere in world coordinates (from the body and the pose).
+  // Bounding sphere in world coordinates, and the core's bounding box in
+  // the body's frame (from the body and the pose).
   Vec3 center = Vec3::Zero();
   double radius = 0.0;
+  BoundingBox box;
 };
 
 struct RobotQueryOptions {
@@ -125,6 +132,17 @@ class RobotQueryState {
   std::vector<Pose> link_poses_;
   std::vector<Pose> geometry_poses_;
   std::vector<Vec3> centers_;
+  // Per pair: a lower bound on its signed distance at the last query (the
+  // bookkeeping of conservative advancement, see above), and what it was
+  // measured against.
+  std::vector<double> self_bound_;
+  std::vector<double> environment_bound_;
+  std::vector<Pose> previous_link_poses_;
+  std::vector<double> motion_;  // per geometry, since the last query
+  std::vector<Pose> obstacle_poses_;
+  std::vector<const void*> obstacle_cores_;
+  std::vector<double> obstacle_radii_;
+  std::vector<double> obstacle_motion_;
   std::int32_t last_self_ = -1;
   std::int32_t last_environment_ = -1;
 };
