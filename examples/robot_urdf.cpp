@@ -6,7 +6,7 @@
 // is checked against a cold query (no state), and a mismatch returns 1.
 //
 //   robot_urdf [panda folder]   (default: examples/data/panda)
-#include <proxima/primitives.h>
+#include <proxima/shape/primitives.h>
 #include <proxima/robot/robot_distance.h>
 #include <proxima/robot/urdf.h>
 

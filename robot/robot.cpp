@@ -29,7 +29,17 @@ const char* to_string(JointType type) {
 
 namespace {
 
-std::string quoted(std::string_view name) { return "\"" + std::string(name) + "\""; }
+// Built by appending: GCC 12 warns falsely (-Wrestrict) on "\"" + name +
+// "\"". Not named `quoted`: std::quoted would win overload resolution for a
+// std::string argument (found by argument-dependent lookup).
+std::string in_quotes(std::string_view name) {
+  std::string out;
+  out.reserve(name.size() + 2);
+  out += '"';
+  out += name;
+  out += '"';
+  return out;
+}
 
 std::unordered_map<std::string, std::int32_t> index_names(const std::vector<std::string>& names,
                                                           const std::string& robot,
@@ -37,12 +47,12 @@ std::unordered_map<std::string, std::int32_t> index_names(const std::vector<std:
   std::unordered_map<std::string, std::int32_t> index;
   for (std::size_t i = 0; i < names.size(); ++i) {
     if (names[i].empty()) {
-      throw InvalidInput("robot " + quoted(robot) + ": " + kind + " " + std::to_string(i) +
+      throw InvalidInput("robot " + in_quotes(robot) + ": " + kind + " " + std::to_string(i) +
                          " has no name");
     }
     if (!index.emplace(names[i], static_cast<std::int32_t>(i)).second) {
-      throw InvalidInput("robot " + quoted(robot) + ": two " + kind + "s named " +
-                         quoted(names[i]));
+      throw InvalidInput("robot " + in_quotes(robot) + ": two " + kind + "s named " +
+                         in_quotes(names[i]));
     }
   }
   return index;
@@ -115,7 +125,7 @@ Robot::Robot(RobotDescription description)
       links_(std::move(description.links)),
       joints_(std::move(description.joints)),
       geometries_(std::move(description.geometries)) {
-  const std::string where = "robot " + quoted(name_);
+  const std::string where = "robot " + in_quotes(name_);
   const auto n_links = static_cast<std::int32_t>(links_.size());
   if (n_links == 0) throw InvalidInput(where + ": no links");
   std::vector<std::string> link_names, joint_names;
@@ -130,15 +140,15 @@ Robot::Robot(RobotDescription description)
   std::vector<std::vector<std::int32_t>> child_joints(links_.size());
   for (std::size_t j = 0; j < joints_.size(); ++j) {
     RobotJoint& joint = joints_[j];
-    const std::string at = where + ", joint " + quoted(joint.name);
+    const std::string at = where + ", joint " + in_quotes(joint.name);
     if (joint.parent < 0 || joint.parent >= n_links || joint.child < 0 || joint.child >= n_links) {
       throw InvalidInput(at + ": its parent or child is not a link of the robot");
     }
     if (joint.parent == joint.child) throw InvalidInput(at + ": its parent is its child");
     if (parent_joint[static_cast<std::size_t>(joint.child)] >= 0) {
-      throw InvalidInput(at + ": link " + quoted(links_[static_cast<std::size_t>(joint.child)].name) +
+      throw InvalidInput(at + ": link " + in_quotes(links_[static_cast<std::size_t>(joint.child)].name) +
                          " already has the parent joint " +
-                         quoted(joints_[static_cast<std::size_t>(
+                         in_quotes(joints_[static_cast<std::size_t>(
                                             parent_joint[static_cast<std::size_t>(joint.child)])]
                                     .name));
     }
@@ -171,8 +181,8 @@ Robot::Robot(RobotDescription description)
     if (parent_joint[static_cast<std::size_t>(l)] >= 0) continue;
     if (root_ >= 0) {
       throw InvalidInput(where + ": two root links (no parent joint), " +
-                         quoted(links_[static_cast<std::size_t>(root_)].name) + " and " +
-                         quoted(links_[static_cast<std::size_t>(l)].name));
+                         in_quotes(links_[static_cast<std::size_t>(root_)].name) + " and " +
+                         in_quotes(links_[static_cast<std::size_t>(l)].name));
     }
     root_ = l;
   }
@@ -201,16 +211,16 @@ Robot::Robot(RobotDescription description)
         std::int32_t at = j;
         for (std::size_t hops = 0;; ++hops) {
           const RobotJoint& follower = joints_[static_cast<std::size_t>(at)];
-          const std::string here = where + ", joint " + quoted(follower.name);
+          const std::string here = where + ", joint " + in_quotes(follower.name);
           if (hops > joints_.size()) throw InvalidInput(here + ": its mimic chain is a cycle");
           const auto found = joint_of.find(follower.mimic);
           if (found == joint_of.end()) {
-            throw InvalidInput(here + ": mimics " + quoted(follower.mimic) +
+            throw InvalidInput(here + ": mimics " + in_quotes(follower.mimic) +
                                ", which is not a joint of the robot");
           }
           const RobotJoint& leader = joints_[static_cast<std::size_t>(found->second)];
           if (leader.type == JointType::fixed) {
-            throw InvalidInput(here + ": mimics the fixed joint " + quoted(leader.name));
+            throw InvalidInput(here + ": mimics the fixed joint " + in_quotes(leader.name));
           }
           step.offset = step.multiplier * follower.offset + step.offset;
           step.multiplier *= follower.multiplier;
@@ -227,9 +237,9 @@ Robot::Robot(RobotDescription description)
   if (queue.size() != links_.size()) {
     for (std::int32_t l = 0; l < n_links; ++l) {
       if (l != root_ && parent_step_[static_cast<std::size_t>(l)] < 0) {
-        throw InvalidInput(where + ": link " + quoted(links_[static_cast<std::size_t>(l)].name) +
+        throw InvalidInput(where + ": link " + in_quotes(links_[static_cast<std::size_t>(l)].name) +
                            " is not reached from the root " +
-                           quoted(links_[static_cast<std::size_t>(root_)].name) + " (a cycle)");
+                           in_quotes(links_[static_cast<std::size_t>(root_)].name) + " (a cycle)");
       }
     }
   }
@@ -238,11 +248,11 @@ Robot::Robot(RobotDescription description)
   for (std::size_t g = 0; g < geometries_.size(); ++g) {
     RobotGeometry& geometry = geometries_[g];
     if (geometry.link < 0 || geometry.link >= n_links) {
-      throw InvalidInput(where + ", geometry " + quoted(geometry.name) +
+      throw InvalidInput(where + ", geometry " + in_quotes(geometry.name) +
                          ": its link is not a link of the robot");
     }
     geometry.origin = checked_pose(geometry.origin, [&] {
-      return where + ", geometry " + quoted(geometry.name) + ": origin";
+      return where + ", geometry " + in_quotes(geometry.name) + ": origin";
     });
     link_geometries_[static_cast<std::size_t>(geometry.link)].push_back(
         static_cast<std::int32_t>(g));
@@ -295,8 +305,8 @@ Robot::Robot(RobotDescription description)
     const auto a = link_of.find(first);
     const auto b = link_of.find(second);
     if (a == link_of.end() || b == link_of.end()) {
-      throw InvalidInput(where + ": disabled pair (" + quoted(first) + ", " + quoted(second) +
-                         ") names " + quoted(a == link_of.end() ? first : second) +
+      throw InvalidInput(where + ": disabled pair (" + in_quotes(first) + ", " + in_quotes(second) +
+                         ") names " + in_quotes(a == link_of.end() ? first : second) +
                          ", which is not a link of the robot");
     }
     disable(a->second, b->second);
@@ -336,14 +346,14 @@ std::int32_t Robot::link_index(std::string_view name) const {
   for (std::size_t l = 0; l < links_.size(); ++l) {
     if (links_[l].name == name) return static_cast<std::int32_t>(l);
   }
-  throw InvalidInput("robot " + quoted(name_) + " has no link " + quoted(name));
+  throw InvalidInput("robot " + in_quotes(name_) + " has no link " + in_quotes(name));
 }
 
 std::int32_t Robot::joint_index(std::string_view name) const {
   for (std::size_t j = 0; j < joints_.size(); ++j) {
     if (joints_[j].name == name) return static_cast<std::int32_t>(j);
   }
-  throw InvalidInput("robot " + quoted(name_) + " has no joint " + quoted(name));
+  throw InvalidInput("robot " + in_quotes(name_) + " has no joint " + in_quotes(name));
 }
 
 bool Robot::link_pair_enabled(std::int32_t link_a, std::int32_t link_b) const {
@@ -368,14 +378,14 @@ Pose Robot::joint_motion(const Step& step, double position) const {
 void Robot::forward_kinematics(std::span<const double> q, const Pose& base,
                                std::vector<Pose>& poses) const {
   if (q.size() != variable_joints_.size()) {
-    throw InvalidInput("robot " + quoted(name_) + ": the joint vector has " +
+    throw InvalidInput("robot " + in_quotes(name_) + ": the joint vector has " +
                        std::to_string(q.size()) + " entries, the robot " +
                        std::to_string(variable_joints_.size()) + " variables");
   }
   for (std::size_t v = 0; v < q.size(); ++v) {
     if (!std::isfinite(q[v])) {
-      throw InvalidInput("robot " + quoted(name_) + ": joint " +
-                         quoted(joints_[static_cast<std::size_t>(variable_joints_[v])].name) +
+      throw InvalidInput("robot " + in_quotes(name_) + ": joint " +
+                         in_quotes(joints_[static_cast<std::size_t>(variable_joints_[v])].name) +
                          " (entry " + std::to_string(v) + " of the joint vector) is not finite");
     }
   }

@@ -10,7 +10,7 @@
 #include <limits>
 #include <string>
 
-#include "parallel_ranges.h"
+#include "query/parallel_ranges.h"
 
 namespace proxima {
 

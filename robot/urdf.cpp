@@ -18,7 +18,7 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "proxima/primitives.h"
+#include "proxima/shape/primitives.h"
 
 namespace proxima {
 
@@ -26,7 +26,17 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string quoted(const std::string& s) { return "\"" + s + "\""; }
+// Built by appending: GCC 12 warns falsely (-Wrestrict) on "\"" + name +
+// "\"". Not named `quoted`: std::quoted would win overload resolution for a
+// std::string argument (found by argument-dependent lookup).
+std::string in_quotes(std::string_view name) {
+  std::string out;
+  out.reserve(name.size() + 2);
+  out += '"';
+  out += name;
+  out += '"';
+  return out;
+}
 
 // urdfdom reports a parse failure through console_bridge's log and returns
 // null. The handler collects the errors of one parse, so that the
@@ -159,7 +169,7 @@ Body geometry_body(const urdf::Geometry& geometry, const std::string& where,
       what = mesh.filename;
       const Vec3 scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
       if (!scale.allFinite() || scale.x() == 0 || scale.y() == 0 || scale.z() == 0) {
-        throw InvalidInput(where + ": mesh " + quoted(mesh.filename) + " has a zero or non-finite scale");
+        throw InvalidInput(where + ": mesh " + in_quotes(mesh.filename) + " has a zero or non-finite scale");
       }
       const std::string path = resolve_robot_uri(mesh.filename, base_dir, options.package_dirs);
       return meshes.body(path, scale, as);
@@ -184,7 +194,7 @@ std::string resolve_robot_uri(const std::string& uri, const std::string& base_di
   const auto slash = rest.find('/');
   const std::string package = rest.substr(0, slash);
   const std::string inside = slash == std::string::npos ? "" : rest.substr(slash + 1);
-  if (package.empty()) throw InvalidInput("mesh URI " + quoted(uri) + " names no package");
+  if (package.empty()) throw InvalidInput("mesh URI " + in_quotes(uri) + " names no package");
   for (const std::string& entry : package_dirs) {
     const auto equals = entry.find('=');
     std::error_code error;
@@ -201,7 +211,7 @@ std::string resolve_robot_uri(const std::string& uri, const std::string& base_di
       return (dir / inside).string();
     }
   }
-  throw InvalidInput("mesh URI " + quoted(uri) + ": package " + quoted(package) +
+  throw InvalidInput("mesh URI " + in_quotes(uri) + ": package " + in_quotes(package) +
                      " is not in the package directories (give NAME=DIR or a directory holding "
                      "NAME)");
 }
@@ -226,7 +236,7 @@ RobotDescription read_urdf_string(const std::string& urdf_xml, const std::string
   }
   for (const auto& [link_name, link] : options.link_mesh_as) {
     if (link_of.count(link_name) == 0) {
-      throw InvalidInput(name + ": the mesh mode is given for link " + quoted(link_name) +
+      throw InvalidInput(name + ": the mesh mode is given for link " + in_quotes(link_name) +
                          ", which is not a link of the URDF");
     }
   }
@@ -235,7 +245,7 @@ RobotDescription read_urdf_string(const std::string& urdf_xml, const std::string
     const auto found = model->joints_.find(joint_name);
     if (found == model->joints_.end()) continue;
     const urdf::Joint& source = *found->second;
-    const std::string where = name + ", joint " + quoted(joint_name);
+    const std::string where = name + ", joint " + in_quotes(joint_name);
     RobotJoint joint;
     joint.name = joint_name;
     switch (source.type) {
@@ -289,7 +299,7 @@ RobotDescription read_urdf_string(const std::string& urdf_xml, const std::string
     for (std::size_t c = 0; c < link.collision_array.size(); ++c) {
       const urdf::Collision& collision = *link.collision_array[c];
       const std::string where =
-          name + ", link " + quoted(link_name) + ", collision " + std::to_string(c);
+          name + ", link " + in_quotes(link_name) + ", collision " + std::to_string(c);
       if (!collision.geometry) throw InvalidInput(where + ": no geometry");
       std::string what;
       std::optional<Body> body;

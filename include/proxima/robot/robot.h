@@ -38,8 +38,8 @@
 
 #include <Eigen/Core>
 
-#include "proxima/body.h"
-#include "proxima/types.h"
+#include "proxima/shape/body.h"
+#include "proxima/core/types.h"
 
 namespace proxima {
 

@@ -16,7 +16,7 @@
 //     r.min_signed_distance, r.closest.gradient, r.close_pairs ...
 //   }
 //
-// Every pair is a tracked distance() (proxima/body.h) whose cache lives in
+// Every pair is a tracked distance() (proxima/query/body_distance.h) whose cache lives in
 // the state: along a trajectory, a pair whose closest features did not
 // change costs one local computation. A pair is not queried when a lower
 // bound on its signed distance exceeds both the margin and the smallest
@@ -31,7 +31,7 @@
 //
 // The gradient of a pair's signed distance s = n . (p_b - p_a) (n the unit
 // normal from A towards B, p_a and p_b the witness points) with respect to
-// q is, by the envelope theorem (proxima/signed_distance.h), the motion of
+// q is, by the envelope theorem (proxima/query/signed_distance.h), the motion of
 // the witness points along the normal:
 //   ds/dq = n^T (J_b(p_b) - J_a(p_a)),
 // J the point Jacobians of the links (Robot::point_jacobian), zero for an
@@ -48,7 +48,7 @@
 
 #include <Eigen/Core>
 
-#include "proxima/body.h"
+#include "proxima/query/body_distance.h"
 #include "proxima/robot/robot.h"
 
 namespace proxima {
@@ -88,7 +88,7 @@ struct RobotPairDistance {
   BodyDistance result;  // world frame, A the robot's geometry
   // d signed_distance / d q (length dof) when asked for; empty otherwise,
   // and zero for an overlap whose depth is not computed (a mesh's, see
-  // proxima/body.h), which has no gradient (has_gradient false).
+  // proxima/query/body_distance.h), which has no gradient (has_gradient false).
   Eigen::VectorXd gradient;
   bool has_gradient = false;
   double signed_distance() const { return result.signed_distance(); }

@@ -18,8 +18,8 @@
 //     file (proxima/robot/robot.h says which joints are variables).
 //   - every <collision> of every link, with its <origin>: <box size>,
 //     <sphere radius>, <cylinder radius length> (a prism circumscribing the
-//     cylinder within RobotLoadOptions::cylinder_tolerance, proxima/
-//     primitives.h) and <mesh filename scale> (STL, OBJ, OFF, PLY, through
+//     cylinder within RobotLoadOptions::cylinder_tolerance,
+//     proxima/shape/primitives.h) and <mesh filename scale> (STL, OBJ, OFF, PLY, through
 //     proxima/io.h; the scale applied to the points, a mirroring scale
 //     included). <visual> elements are ignored.
 //   - mesh file names: `package://NAME/rest` (and `package:///NAME/rest`,
