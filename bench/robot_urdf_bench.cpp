@@ -3,17 +3,21 @@
 // smooth trajectory and on random configurations, hulls and meshes, tracked
 // and cold, distance only and with gradients; Talos self-collision; and a
 // batch of 10^4 random configurations on 1 and 2 threads. Each figure is
-// the median of 5 runs, the runs of the variants alternated.
+// the median of 5 runs, the runs of the variants alternated. Single-thread
+// figures are the thread's CPU time (on a shared machine, wall time counts
+// the other processes' turns too); the batch's are wall time, which is what
+// threads shorten.
 //
 //   robot_urdf_bench [robots directory]   (default: ../shared/robots from the
 //                                          repository root)
-#include <proxima/primitives.h>
 #include <proxima/robot/robot_distance.h>
 #include <proxima/robot/urdf.h>
+#include <proxima/shape/primitives.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <numbers>
@@ -74,11 +78,22 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 struct Variant {
   std::string name;
   std::function<void()> run;  // one pass over its configurations
   double per_pass = 1;        // configurations per pass
   std::vector<double> seconds;
+  bool wall = false;  // wall time (threads) instead of the thread's CPU time
 };
 
 // Runs every variant 5 times, alternated, and prints each median in us per
@@ -87,10 +102,9 @@ void run_alternated(std::vector<Variant>& variants) {
   for (Variant& v : variants) v.run();  // warm-up: caches, pages, the mesh wrappers
   for (int repeat = 0; repeat < 5; ++repeat) {
     for (Variant& v : variants) {
-      const auto start = std::chrono::steady_clock::now();
+      const double start = v.wall ? wall_seconds() : cpu_seconds();
       v.run();
-      v.seconds.push_back(
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+      v.seconds.push_back((v.wall ? wall_seconds() : cpu_seconds()) - start);
     }
   }
   for (const Variant& v : variants) {
@@ -118,10 +132,10 @@ std::function<void()> pass(const Robot& robot, const Configs& configs,
     PassStats s;
     for (const std::vector<double>& q : configs) {
       if (!tracked) state.reset();
-      const auto start = std::chrono::steady_clock::now();
-      const proxima::RobotDistances r = proxima::robot_distances(robot, q, obstacles, options, &state);
-      const double seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double start = cpu_seconds();
+      const proxima::RobotDistances r =
+          proxima::robot_distances(robot, q, obstacles, options, &state);
+      const double seconds = cpu_seconds() - start;
       *sink += r.min_signed_distance;
       s.queried += r.pairs_queried;
       (r.min_signed_distance < 0 ? s.colliding : s.free) += 1;
@@ -133,8 +147,9 @@ std::function<void()> pass(const Robot& robot, const Configs& configs,
 }
 
 void print_stats(const std::vector<Variant>& variants, const std::vector<PassStats>& stats) {
-  std::printf("  (last run of each: pairs queried per configuration; us per collision-free / "
-              "colliding configuration)\n");
+  std::printf(
+      "  (last run of each: pairs queried per configuration; us per collision-free / "
+      "colliding configuration)\n");
   for (std::size_t i = 0; i < variants.size(); ++i) {
     const PassStats& s = stats[i];
     std::printf("  %-58s %6.1f pairs  free %8.2f us (%4.0f)  colliding %8.2f us (%4.0f)\n",
@@ -170,10 +185,11 @@ int main(int argc, char** argv) {
 
   const Configs path = smooth_trajectory(panda, 2000, 2026);
   const Configs random = random_configs(panda, 2000, 2027);
-  std::printf("Panda: %d variables, %zu geometries, %zu enabled self pairs + %zu x %zu "
-              "environment pairs\n",
-              panda.dof(), panda.geometries().size(), panda.self_pairs().size(),
-              panda.geometries().size(), obstacles.size());
+  std::printf(
+      "Panda: %d variables, %zu geometries, %zu enabled self pairs + %zu x %zu "
+      "environment pairs\n",
+      panda.dof(), panda.geometries().size(), panda.self_pairs().size(), panda.geometries().size(),
+      obstacles.size());
 
   proxima::RobotQueryOptions distance_only;
   distance_only.margin = 0.05;
@@ -184,28 +200,43 @@ int main(int argc, char** argv) {
   const Configs mesh_path(path.begin(), path.begin() + 200);
   std::vector<Variant> panda_variants = {
       {"hulls, trajectory, tracked, distance only",
-       pass(panda, path, obstacles, distance_only, true, &sink, &queried[0]), 2000.0, {}},
+       pass(panda, path, obstacles, distance_only, true, &sink, &queried[0]),
+       2000.0,
+       {}},
       {"hulls, trajectory, tracked, with gradients (margin 5 cm)",
-       pass(panda, path, obstacles, with_gradients, true, &sink, &queried[1]), 2000.0, {}},
+       pass(panda, path, obstacles, with_gradients, true, &sink, &queried[1]),
+       2000.0,
+       {}},
       {"hulls, trajectory, cold, distance only",
-       pass(panda, path, obstacles, distance_only, false, &sink, &queried[2]), 2000.0, {}},
+       pass(panda, path, obstacles, distance_only, false, &sink, &queried[2]),
+       2000.0,
+       {}},
       {"hulls, random, tracked, distance only",
-       pass(panda, random, obstacles, distance_only, true, &sink, &queried[3]), 2000.0, {}},
+       pass(panda, random, obstacles, distance_only, true, &sink, &queried[3]),
+       2000.0,
+       {}},
       {"hulls, random, cold, distance only",
-       pass(panda, random, obstacles, distance_only, false, &sink, &queried[4]), 2000.0, {}},
+       pass(panda, random, obstacles, distance_only, false, &sink, &queried[4]),
+       2000.0,
+       {}},
       {"hulls, random, tracked, with gradients",
-       pass(panda, random, obstacles, with_gradients, true, &sink, &queried[5]), 2000.0, {}},
+       pass(panda, random, obstacles, with_gradients, true, &sink, &queried[5]),
+       2000.0,
+       {}},
       {"meshes, trajectory (first 200), tracked, distance only",
-       pass(panda_meshes, mesh_path, obstacles, distance_only, true, &sink, &queried[6]), 200.0, {}},
+       pass(panda_meshes, mesh_path, obstacles, distance_only, true, &sink, &queried[6]),
+       200.0,
+       {}},
       {"meshes, trajectory (first 200), cold, distance only",
-       pass(panda_meshes, mesh_path, obstacles, distance_only, false, &sink, &queried[7]), 200.0, {}},
+       pass(panda_meshes, mesh_path, obstacles, distance_only, false, &sink, &queried[7]),
+       200.0,
+       {}},
   };
   run_alternated(panda_variants);
   print_stats(panda_variants, queried);
 
-  const Robot talos =
-      proxima::load_robot(robots + "/robots/talos_data/robots/talos_full_v2.urdf",
-                          robots + "/robots/talos_data/srdf/talos.srdf", options);
+  const Robot talos = proxima::load_robot(robots + "/robots/talos_data/robots/talos_full_v2.urdf",
+                                          robots + "/robots/talos_data/srdf/talos.srdf", options);
   const Configs talos_path = smooth_trajectory(talos, 2000, 2028);
   const Configs talos_random = random_configs(talos, 2000, 2029);
   std::printf("Talos: %d variables, %zu geometries, %zu enabled self pairs\n", talos.dof(),
@@ -214,11 +245,17 @@ int main(int argc, char** argv) {
   std::vector<PassStats> talos_queried(3);
   std::vector<Variant> talos_variants = {
       {"hulls, self, trajectory, tracked",
-       pass(talos, talos_path, {}, talos_options, true, &sink, &talos_queried[0]), 2000.0, {}},
+       pass(talos, talos_path, {}, talos_options, true, &sink, &talos_queried[0]),
+       2000.0,
+       {}},
       {"hulls, self, trajectory, cold",
-       pass(talos, talos_path, {}, talos_options, false, &sink, &talos_queried[1]), 2000.0, {}},
+       pass(talos, talos_path, {}, talos_options, false, &sink, &talos_queried[1]),
+       2000.0,
+       {}},
       {"hulls, self, random, tracked",
-       pass(talos, talos_random, {}, talos_options, true, &sink, &talos_queried[2]), 2000.0, {}},
+       pass(talos, talos_random, {}, talos_options, true, &sink, &talos_queried[2]),
+       2000.0,
+       {}},
   };
   run_alternated(talos_variants);
   print_stats(talos_variants, talos_queried);
@@ -235,14 +272,15 @@ int main(int argc, char** argv) {
   std::printf("Panda batch of 10^4 random configurations (minimum and its gradient):\n");
   std::vector<Variant> batch_variants;
   for (int threads : {1, 2}) {
-    batch_variants.push_back(
-        {std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""),
-         [&panda, &batch, &obstacles, batch_options, threads, &sink] {
-           sink += proxima::robot_distances_batch(panda, batch, obstacles, batch_options, threads)
-                       .min_signed_distance.sum();
-         },
-         10000.0,
-         {}});
+    batch_variants.push_back({std::to_string(threads) + " thread" + (threads > 1 ? "s" : ""),
+                              [&panda, &batch, &obstacles, batch_options, threads, &sink] {
+                                sink += proxima::robot_distances_batch(panda, batch, obstacles,
+                                                                       batch_options, threads)
+                                            .min_signed_distance.sum();
+                              },
+                              10000.0,
+                              {},
+                              true});
   }
   run_alternated(batch_variants);
   std::printf("  speed-up on 2 threads: %.2fx\n",

@@ -41,11 +41,13 @@ std::vector<double> read_q(const Robot& robot, const Json& query) {
   if (it->is_array()) {
     if (it->size() != names.size()) {
       fail("q has " + std::to_string(it->size()) + " entries, the robot " +
-           std::to_string(names.size()) + " joints (" + [&] {
+           std::to_string(names.size()) + " joints (" +
+           [&] {
              std::string list;
              for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
              return list;
-           }() + ")");
+           }() +
+           ")");
     }
     for (std::size_t v = 0; v < names.size(); ++v) q[v] = number((*it)[v], indexed("q", v));
     return q;
@@ -90,8 +92,7 @@ Json pair_json(const Robot& robot, const RobotPairDistance& pair, bool gradients
 
 }  // namespace
 
-int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out,
-              std::ostream& err) {
+int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, std::ostream& err) {
   RobotLoadOptions load;
   load.package_dirs = command.package_dirs;
   std::optional<Robot> robot;

@@ -33,7 +33,6 @@ struct RobotCommand {
 // Exit code: 0 when the robot loaded and every line was read (bad lines
 // included: they are answered), 1 when the robot or the input cannot be
 // read.
-int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out,
-              std::ostream& err);
+int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, std::ostream& err);
 
 }  // namespace proxima::cli

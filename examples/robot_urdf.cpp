@@ -6,9 +6,9 @@
 // is checked against a cold query (no state), and a mismatch returns 1.
 //
 //   robot_urdf [panda folder]   (default: examples/data/panda)
-#include <proxima/shape/primitives.h>
 #include <proxima/robot/robot_distance.h>
 #include <proxima/robot/urdf.h>
+#include <proxima/shape/primitives.h>
 
 #include <cmath>
 #include <cstdio>
@@ -28,7 +28,8 @@ int run(const std::string& dir) {
   options.gradients = true;
   proxima::RobotQueryState state;  // cold; kept along the trajectory
 
-  // From the SRDF's "default" pose, joint 2 leaning forward, joint 6 folding the hand towards link5.
+  // From the SRDF's "default" pose, joint 2 leaning forward, joint 6 folding the hand towards
+  // link5.
   std::vector<double> q = {0, -0.785, 0, -2.356, 0, 1.571, 0.785, 0.01};
   int mismatches = 0;
   for (int step = 0; step < 10; ++step) {
@@ -41,8 +42,9 @@ int run(const std::string& dir) {
     const std::string b =
         r.closest.environment
             ? std::string("the table")
-            : robot.links()[static_cast<std::size_t>(
-                                robot.geometries()[static_cast<std::size_t>(r.closest.geometry_b)].link)]
+            : robot
+                  .links()[static_cast<std::size_t>(
+                      robot.geometries()[static_cast<std::size_t>(r.closest.geometry_b)].link)]
                   .name;
     std::printf("step %d: %.4f m between %s and %s, d/dq6 %.4f\n", step, r.min_signed_distance,
                 robot.links()[static_cast<std::size_t>(a.link)].name.c_str(), b.c_str(),

@@ -130,7 +130,8 @@ void bind_robot(py::module_& m) {
           },
           "The gradient of min_signed_distance (the closest pair's), or None.");
 
-  py::class_<PyRobot>(m, "Robot", R"doc(A robot from its URDF (and SRDF): kinematics and signed distances.
+  py::class_<PyRobot>(m, "Robot",
+                      R"doc(A robot from its URDF (and SRDF): kinematics and signed distances.
 
     robot = proxima.Robot("panda.urdf", srdf="panda.srdf",
                           package_dirs=["example-robot-data=/path/to/example-robot-data"])
@@ -155,8 +156,8 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
              options.cylinder_tolerance = cylinder_tolerance;
              options.exclude_adjacent = exclude_adjacent;
              auto robot = std::make_unique<PyRobot>();
-             robot->robot = std::make_shared<const Robot>(
-                 load_robot(urdf, srdf.value_or(""), options));
+             robot->robot =
+                 std::make_shared<const Robot>(load_robot(urdf, srdf.value_or(""), options));
              return robot;
            }),
            py::arg("urdf"), py::arg("srdf") = py::none(),
@@ -164,53 +165,58 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
            py::arg("link_mesh_as") = std::map<std::string, std::string>{},
            py::arg("cylinder_tolerance") = kDefaultCylinderTolerance,
            py::arg("exclude_adjacent") = true)
-      .def_property_readonly("name", [](const PyRobot& r) { return r.robot->name(); },
-                             "The robot's name (the URDF's <robot name>).")
-      .def_property_readonly("dof", [](const PyRobot& r) { return r.robot->dof(); },
-                             "The length of q.")
-      .def_property_readonly("joint_names",
-                             [](const PyRobot& r) { return r.robot->variable_names(); },
-                             "The joints of q, in its order.")
-      .def_property_readonly("link_names",
-                             [](const PyRobot& r) {
-                               std::vector<std::string> names;
-                               for (const RobotLink& l : r.robot->links()) names.push_back(l.name);
-                               return names;
-                             },
-                             "The links, in the order of forward_kinematics' poses.")
-      .def_property_readonly("geometry_names",
-                             [](const PyRobot& r) {
-                               std::vector<std::string> names;
-                               for (const RobotGeometry& g : r.robot->geometries()) {
-                                 names.push_back(g.name);
-                               }
-                               return names;
-                             },
-                             "Each collision geometry: link/index and its mesh file or primitive.")
-      .def_property_readonly("geometry_links",
-                             [](const PyRobot& r) {
-                               std::vector<std::int32_t> links;
-                               for (const RobotGeometry& g : r.robot->geometries()) {
-                                 links.push_back(g.link);
-                               }
-                               return int32_array(links);
-                             },
-                             "The link (index into link_names) of each geometry.")
-      .def_property_readonly("self_pairs",
-                             [](const PyRobot& r) {
-                               std::vector<std::array<std::int32_t, 2>> rows;
-                               for (const GeometryPair& p : r.robot->self_pairs()) {
-                                 rows.push_back({p.a, p.b});
-                               }
-                               return index_rows(rows);
-                             },
-                             "(P, 2) geometry indices of the enabled self pairs.")
-      .def_property_readonly("lower_limits",
-                             [](const PyRobot& r) { return vector_array(r.robot->lower_limits()); },
-                             "Lower limit of each joint of q (-inf for a continuous joint).")
-      .def_property_readonly("upper_limits",
-                             [](const PyRobot& r) { return vector_array(r.robot->upper_limits()); },
-                             "Upper limit of each joint of q (inf for a continuous joint).")
+      .def_property_readonly(
+          "name", [](const PyRobot& r) { return r.robot->name(); },
+          "The robot's name (the URDF's <robot name>).")
+      .def_property_readonly(
+          "dof", [](const PyRobot& r) { return r.robot->dof(); }, "The length of q.")
+      .def_property_readonly(
+          "joint_names", [](const PyRobot& r) { return r.robot->variable_names(); },
+          "The joints of q, in its order.")
+      .def_property_readonly(
+          "link_names",
+          [](const PyRobot& r) {
+            std::vector<std::string> names;
+            for (const RobotLink& l : r.robot->links()) names.push_back(l.name);
+            return names;
+          },
+          "The links, in the order of forward_kinematics' poses.")
+      .def_property_readonly(
+          "geometry_names",
+          [](const PyRobot& r) {
+            std::vector<std::string> names;
+            for (const RobotGeometry& g : r.robot->geometries()) {
+              names.push_back(g.name);
+            }
+            return names;
+          },
+          "Each collision geometry: link/index and its mesh file or primitive.")
+      .def_property_readonly(
+          "geometry_links",
+          [](const PyRobot& r) {
+            std::vector<std::int32_t> links;
+            for (const RobotGeometry& g : r.robot->geometries()) {
+              links.push_back(g.link);
+            }
+            return int32_array(links);
+          },
+          "The link (index into link_names) of each geometry.")
+      .def_property_readonly(
+          "self_pairs",
+          [](const PyRobot& r) {
+            std::vector<std::array<std::int32_t, 2>> rows;
+            for (const GeometryPair& p : r.robot->self_pairs()) {
+              rows.push_back({p.a, p.b});
+            }
+            return index_rows(rows);
+          },
+          "(P, 2) geometry indices of the enabled self pairs.")
+      .def_property_readonly(
+          "lower_limits", [](const PyRobot& r) { return vector_array(r.robot->lower_limits()); },
+          "Lower limit of each joint of q (-inf for a continuous joint).")
+      .def_property_readonly(
+          "upper_limits", [](const PyRobot& r) { return vector_array(r.robot->upper_limits()); },
+          "Upper limit of each joint of q (inf for a continuous joint).")
       .def(
           "forward_kinematics",
           [](const PyRobot& r, py::handle q, py::handle base) {
@@ -223,8 +229,8 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
           "point_jacobian",
           [](const PyRobot& r, py::handle q, const std::string& link, py::handle point) {
             const std::vector<Pose> poses = r.robot->forward_kinematics(to_q(*r.robot, q));
-            const auto j = r.robot->point_jacobian(poses, r.robot->link_index(link),
-                                                   to_vec3(point, "point"));
+            const auto j =
+                r.robot->point_jacobian(poses, r.robot->link_index(link), to_vec3(point, "point"));
             py::array_t<double> out({py::ssize_t{3}, static_cast<py::ssize_t>(j.cols())});
             auto o = out.mutable_unchecked<2>();
             for (int row = 0; row < 3; ++row) {
@@ -250,7 +256,8 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
           py::arg("obstacles"),
           "The environment: a list of (body, pose) (a Body, ConvexPolytope, CompoundBody or "
           "TriangleMesh and its world pose).")
-      .def("reset", [](PyRobot& r) { r.state.reset(); }, "Forget the per-pair caches (cold).")
+      .def(
+          "reset", [](PyRobot& r) { r.state.reset(); }, "Forget the per-pair caches (cold).")
       .def(
           "distances",
           [](PyRobot& r, py::handle q, double margin, bool gradients, bool self, bool environment,
@@ -260,7 +267,8 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
                                    &r.state);
           },
           py::arg("q"), py::arg("margin") = 0.0, py::arg("gradients") = false,
-          py::arg("include_self") = true, py::arg("include_environment") = true, py::arg("base") = py::none(),
+          py::arg("include_self") = true, py::arg("include_environment") = true,
+          py::arg("base") = py::none(),
           "Signed distances at q: the minimum over self and environment pairs, every pair within "
           "`margin`, and with gradients=True each one's gradient with respect to q (tracked "
           "between calls).")
@@ -289,7 +297,8 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
             return py::make_tuple(minima, g);
           },
           py::arg("q"), py::arg("gradients") = true, py::arg("threads") = 0,
-          py::arg("include_self") = true, py::arg("include_environment") = true, py::arg("base") = py::none(),
+          py::arg("include_self") = true, py::arg("include_environment") = true,
+          py::arg("base") = py::none(),
           "K configurations (K, dof) on the thread pool: (minima (K,), gradients (K, dof) or "
           "None). Row k equals distances(q[k]).min_signed_distance and its gradient.");
 }

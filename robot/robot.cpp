@@ -146,11 +146,12 @@ Robot::Robot(RobotDescription description)
     }
     if (joint.parent == joint.child) throw InvalidInput(at + ": its parent is its child");
     if (parent_joint[static_cast<std::size_t>(joint.child)] >= 0) {
-      throw InvalidInput(at + ": link " + in_quotes(links_[static_cast<std::size_t>(joint.child)].name) +
-                         " already has the parent joint " +
-                         in_quotes(joints_[static_cast<std::size_t>(
-                                            parent_joint[static_cast<std::size_t>(joint.child)])]
-                                    .name));
+      throw InvalidInput(
+          at + ": link " + in_quotes(links_[static_cast<std::size_t>(joint.child)].name) +
+          " already has the parent joint " +
+          in_quotes(
+              joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(joint.child)])]
+                  .name));
     }
     parent_joint[static_cast<std::size_t>(joint.child)] = static_cast<std::int32_t>(j);
     parent_link_[static_cast<std::size_t>(joint.child)] = joint.parent;
@@ -229,7 +230,8 @@ Robot::Robot(RobotDescription description)
         }
         step.variable = variable_of[static_cast<std::size_t>(at)];
       }
-      parent_step_[static_cast<std::size_t>(joint.child)] = static_cast<std::int32_t>(steps_.size());
+      parent_step_[static_cast<std::size_t>(joint.child)] =
+          static_cast<std::int32_t>(steps_.size());
       steps_.push_back(step);
       queue.push_back(joint.child);
     }
@@ -322,14 +324,16 @@ Robot::Robot(RobotDescription description)
 
 std::vector<std::string> Robot::variable_names() const {
   std::vector<std::string> names;
-  for (std::int32_t j : variable_joints_) names.push_back(joints_[static_cast<std::size_t>(j)].name);
+  for (std::int32_t j : variable_joints_)
+    names.push_back(joints_[static_cast<std::size_t>(j)].name);
   return names;
 }
 
 Eigen::VectorXd Robot::lower_limits() const {
   Eigen::VectorXd lower(dof());
   for (int v = 0; v < dof(); ++v) {
-    lower[v] = joints_[static_cast<std::size_t>(variable_joints_[static_cast<std::size_t>(v)])].lower;
+    lower[v] =
+        joints_[static_cast<std::size_t>(variable_joints_[static_cast<std::size_t>(v)])].lower;
   }
   return lower;
 }
@@ -337,7 +341,8 @@ Eigen::VectorXd Robot::lower_limits() const {
 Eigen::VectorXd Robot::upper_limits() const {
   Eigen::VectorXd upper(dof());
   for (int v = 0; v < dof(); ++v) {
-    upper[v] = joints_[static_cast<std::size_t>(variable_joints_[static_cast<std::size_t>(v)])].upper;
+    upper[v] =
+        joints_[static_cast<std::size_t>(variable_joints_[static_cast<std::size_t>(v)])].upper;
   }
   return upper;
 }
@@ -358,7 +363,8 @@ std::int32_t Robot::joint_index(std::string_view name) const {
 
 bool Robot::link_pair_enabled(std::int32_t link_a, std::int32_t link_b) const {
   const auto n = links_.size();
-  return pair_enabled_[static_cast<std::size_t>(link_a) * n + static_cast<std::size_t>(link_b)] != 0;
+  return pair_enabled_[static_cast<std::size_t>(link_a) * n + static_cast<std::size_t>(link_b)] !=
+         0;
 }
 
 Pose Robot::joint_motion(const Step& step, double position) const {
@@ -396,8 +402,9 @@ void Robot::forward_kinematics(std::span<const double> q, const Pose& base,
     Pose& child = poses[static_cast<std::size_t>(step.child)];
     child = poses[static_cast<std::size_t>(step.parent)] * joint.origin;
     if (step.variable >= 0) {
-      child = child * joint_motion(step, step.multiplier * q[static_cast<std::size_t>(step.variable)] +
-                                             step.offset);
+      child =
+          child * joint_motion(step, step.multiplier * q[static_cast<std::size_t>(step.variable)] +
+                                         step.offset);
     }
   }
 }
@@ -433,9 +440,8 @@ void Robot::add_directional_derivative(std::span<const Pose> poses, std::int32_t
     const RobotJoint& joint = joints_[static_cast<std::size_t>(step.joint)];
     const Pose& child = poses[static_cast<std::size_t>(step.child)];
     const Vec3 axis = child.rotation * joint.axis;
-    const Vec3 motion = joint.type == JointType::prismatic
-                            ? axis
-                            : Vec3(axis.cross(point - child.translation));
+    const Vec3 motion =
+        joint.type == JointType::prismatic ? axis : Vec3(axis.cross(point - child.translation));
     gradient[static_cast<std::size_t>(step.variable)] +=
         scale * step.multiplier * direction.dot(motion);
   }

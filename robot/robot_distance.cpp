@@ -67,12 +67,13 @@ void fill_gradient(const Robot& robot, std::span<const Pose> poses, RobotPairDis
   if (!pair.has_gradient) return;
   const std::span<double> g(pair.gradient.data(), static_cast<std::size_t>(pair.gradient.size()));
   const auto& geometries = robot.geometries();
-  robot.add_directional_derivative(poses, geometries[static_cast<std::size_t>(pair.geometry_a)].link,
+  robot.add_directional_derivative(poses,
+                                   geometries[static_cast<std::size_t>(pair.geometry_a)].link,
                                    r.point_a, r.normal, -1.0, g);
   if (!pair.environment) {
-    robot.add_directional_derivative(
-        poses, geometries[static_cast<std::size_t>(pair.geometry_b)].link, r.point_b, r.normal,
-        1.0, g);
+    robot.add_directional_derivative(poses,
+                                     geometries[static_cast<std::size_t>(pair.geometry_b)].link,
+                                     r.point_b, r.normal, 1.0, g);
   }
 }
 
@@ -94,8 +95,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
   const auto& geometries = robot.geometries();
   const auto& pairs = robot.self_pairs();
   const std::size_t n_geometries = geometries.size();
-  if (s.robot_ != &robot || s.obstacles_ != obstacles.size() ||
-      s.self_.size() != pairs.size() || s.motion_.size() != n_geometries) {
+  if (s.robot_ != &robot || s.obstacles_ != obstacles.size() || s.self_.size() != pairs.size() ||
+      s.motion_.size() != n_geometries) {
     s.reset();
     s.robot_ = &robot;
     s.obstacles_ = obstacles.size();
@@ -131,9 +132,9 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       s.obstacle_radii_[o] = obstacles[o].body.radius();
       s.obstacle_motion_[o] = kInfinity;
     } else {
-      s.obstacle_motion_[o] = motion(s.obstacle_poses_[o], obstacles[o].pose,
-                                     obstacles[o].pose.inverse().apply(obstacles[o].center),
-                                     obstacles[o].radius);
+      s.obstacle_motion_[o] =
+          motion(s.obstacle_poses_[o], obstacles[o].pose,
+                 obstacles[o].pose.inverse().apply(obstacles[o].center), obstacles[o].radius);
     }
     s.obstacle_poses_[o] = obstacles[o].pose;
   }
@@ -181,16 +182,16 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       double& bound = s.self_bound_[static_cast<std::size_t>(p)];
       const double threshold = std::max(options.margin, out.min_self);
       if (bound > threshold) continue;
-      bound = std::max(bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b],
-                                           spheres[b].radius));
+      bound = std::max(
+          bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b], spheres[b].radius));
       if (bound > threshold) continue;
       ++out.pairs_queried;
       RobotPairDistance result;
       result.geometry_a = pair.a;
       result.geometry_b = pair.b;
-      result.result = distance(geometries[a].body, s.geometry_poses_[a], geometries[b].body,
-                               s.geometry_poses_[b], options.distance,
-                               &s.self_[static_cast<std::size_t>(p)]);
+      result.result =
+          distance(geometries[a].body, s.geometry_poses_[a], geometries[b].body,
+                   s.geometry_poses_[b], options.distance, &s.self_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
       report(std::move(result), out.min_self, p, last);
     }
@@ -219,9 +220,9 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       result.geometry_a = static_cast<std::int32_t>(g);
       result.geometry_b = static_cast<std::int32_t>(o);
       result.environment = true;
-      result.result = distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body,
-                               obstacles[o].pose, options.distance,
-                               &s.environment_[static_cast<std::size_t>(p)]);
+      result.result =
+          distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body, obstacles[o].pose,
+                   options.distance, &s.environment_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
       report(std::move(result), out.min_environment, p, last);
     }

@@ -66,17 +66,16 @@ urdf::ModelInterfaceSharedPtr parse_urdf(const std::string& xml, const std::stri
   }
   console_bridge::restorePreviousOutputHandler();
   if (!model) {
-    throw InvalidInput(name + ": not a valid URDF: " +
-                       (collect.errors.empty() ? std::string("the parser refused it")
-                                               : collect.errors));
+    throw InvalidInput(
+        name + ": not a valid URDF: " +
+        (collect.errors.empty() ? std::string("the parser refused it") : collect.errors));
   }
   return model;
 }
 
 Pose to_pose(const urdf::Pose& p) {
   const Eigen::Quaterniond q(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z);
-  return {Mat3(q.normalized().toRotationMatrix()),
-          Vec3(p.position.x, p.position.y, p.position.z)};
+  return {Mat3(q.normalized().toRotationMatrix()), Vec3(p.position.x, p.position.y, p.position.z)};
 }
 
 // The names of the <robot>'s direct <tag> children, in file order (urdfdom
@@ -99,8 +98,8 @@ std::string read_text_file(const std::string& path, const ReadOptions& options) 
   if (!fs::is_regular_file(path, error)) throw FileError::in_file(path, "no such file");
   const auto size = fs::file_size(path, error);
   if (!error && size > options.max_file_bytes) {
-    throw FileError::in_file(path, "larger than the limit of " +
-                                       std::to_string(options.max_file_bytes) + " bytes");
+    throw FileError::in_file(
+        path, "larger than the limit of " + std::to_string(options.max_file_bytes) + " bytes");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError::in_file(path, "cannot be opened");
@@ -169,7 +168,8 @@ Body geometry_body(const urdf::Geometry& geometry, const std::string& where,
       what = mesh.filename;
       const Vec3 scale(mesh.scale.x, mesh.scale.y, mesh.scale.z);
       if (!scale.allFinite() || scale.x() == 0 || scale.y() == 0 || scale.z() == 0) {
-        throw InvalidInput(where + ": mesh " + in_quotes(mesh.filename) + " has a zero or non-finite scale");
+        throw InvalidInput(where + ": mesh " + in_quotes(mesh.filename) +
+                           " has a zero or non-finite scale");
       }
       const std::string path = resolve_robot_uri(mesh.filename, base_dir, options.package_dirs);
       return meshes.body(path, scale, as);
@@ -279,7 +279,8 @@ RobotDescription read_urdf_string(const std::string& urdf_xml, const std::string
     joint.child = child->second;
     joint.origin = to_pose(source.parent_to_joint_origin_transform);
     joint.axis = Vec3(source.axis.x, source.axis.y, source.axis.z);
-    if (source.limits && (joint.type == JointType::revolute || joint.type == JointType::prismatic)) {
+    if (source.limits &&
+        (joint.type == JointType::revolute || joint.type == JointType::prismatic)) {
       joint.lower = source.limits->lower;
       joint.upper = source.limits->upper;
     }
@@ -304,7 +305,8 @@ RobotDescription read_urdf_string(const std::string& urdf_xml, const std::string
       std::string what;
       std::optional<Body> body;
       try {
-        body.emplace(geometry_body(*collision.geometry, where, base_dir, options, as, meshes, what));
+        body.emplace(
+            geometry_body(*collision.geometry, where, base_dir, options, as, meshes, what));
       } catch (const FileError&) {
         throw;
       } catch (const InvalidInput& e) {
@@ -313,7 +315,8 @@ RobotDescription read_urdf_string(const std::string& urdf_xml, const std::string
         throw InvalidInput(where + ": " + message);
       }
       RobotGeometry geometry{static_cast<std::int32_t>(l), std::move(*body),
-                             to_pose(collision.origin), link_name + "/" + std::to_string(c) + " " + what};
+                             to_pose(collision.origin),
+                             link_name + "/" + std::to_string(c) + " " + what};
       description.geometries.push_back(std::move(geometry));
     }
   }
@@ -340,8 +343,8 @@ std::vector<std::pair<std::string, std::string>> read_srdf_disabled_pairs(
   const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
   if (robot == nullptr) throw InvalidInput(srdf_path + ": no <robot> element (not an SRDF)");
   std::vector<std::pair<std::string, std::string>> pairs;
-  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("disable_collisions");
-       e != nullptr; e = e->NextSiblingElement("disable_collisions")) {
+  for (const tinyxml2::XMLElement* e = robot->FirstChildElement("disable_collisions"); e != nullptr;
+       e = e->NextSiblingElement("disable_collisions")) {
     const char* a = e->Attribute("link1");
     const char* b = e->Attribute("link2");
     if (a == nullptr || b == nullptr) {

@@ -3,7 +3,6 @@
 // and bad lines answered with errors naming the problem while the run goes
 // on. Skips when ../shared/robots (from the repository root) is absent.
 #include <gtest/gtest.h>
-
 #include <proxima/robot/robot_distance.h>
 #include <proxima/robot/urdf.h>
 
@@ -41,16 +40,19 @@ TEST(CliRobot, AnswersConfigurationsAsTheLibraryDoesAndBadLinesWithErrors) {
   {
     std::ofstream file(input.path());
     file << Json{{"id", 1}, {"q", ready}}.dump() << "\n";
-    file << R"({"id": "short", "q": [0, 0]})" << "\n";
+    file << R"({"id": "short", "q": [0, 0]})"
+         << "\n";
     file << "{not json\n";
-    file << R"({"id": 4, "q": {"panda_joint1": 0}})" << "\n";
-    file << R"({"id": 5, "q": [0, 0, 0, -0.1, 0, 0, 0, "x"]})" << "\n";
+    file << R"({"id": 4, "q": {"panda_joint1": 0}})"
+         << "\n";
+    file << R"({"id": 5, "q": [0, 0, 0, -0.1, 0, 0, 0, "x"]})"
+         << "\n";
     file << Json{{"id", 6}, {"q", ready}}.dump() << "\n";
   }
-  const proxima::test::CliRun run = run_cli(
-      "robot " + shell_quote(input.path()) + " --urdf " + shell_quote(kUrdf) + " --srdf " +
-      shell_quote(kSrdf) + " --package-dir " + shell_quote("example-robot-data=" + kRobots) +
-      " --margin 0.05 --gradients");
+  const proxima::test::CliRun run =
+      run_cli("robot " + shell_quote(input.path()) + " --urdf " + shell_quote(kUrdf) + " --srdf " +
+              shell_quote(kSrdf) + " --package-dir " +
+              shell_quote("example-robot-data=" + kRobots) + " --margin 0.05 --gradients");
   ASSERT_EQ(run.exit_code, 0) << run.out;
   const std::vector<Json> lines = answers(run.out);
   ASSERT_EQ(lines.size(), 6u);
@@ -70,14 +72,16 @@ TEST(CliRobot, AnswersConfigurationsAsTheLibraryDoesAndBadLinesWithErrors) {
     for (int v = 0; v < 8; ++v) EXPECT_NEAR(gradient[v], expected.closest.gradient[v], 1e-12);
   }
   EXPECT_EQ(lines[1]["id"], "short");
-  EXPECT_NE(lines[1]["error"].get<std::string>().find("line 2: q has 2 entries"), std::string::npos);
+  EXPECT_NE(lines[1]["error"].get<std::string>().find("line 2: q has 2 entries"),
+            std::string::npos);
   EXPECT_NE(lines[2]["error"].get<std::string>().find("line 3: not valid JSON"), std::string::npos);
   EXPECT_NE(lines[3]["error"].get<std::string>().find("panda_joint2"), std::string::npos);
   EXPECT_NE(lines[4]["error"].get<std::string>().find("q[7]"), std::string::npos);
 }
 
 TEST(CliRobot, AnUnreadableRobotIsAnErrorNamingTheFile) {
-  const proxima::test::CliRun run = run_cli("robot --urdf /nonexistent/robot.urdf < /dev/null", true);
+  const proxima::test::CliRun run =
+      run_cli("robot --urdf /nonexistent/robot.urdf < /dev/null", true);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.out.find("/nonexistent/robot.urdf"), std::string::npos) << run.out;
 }

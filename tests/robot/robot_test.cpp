@@ -9,10 +9,9 @@
 // repository root (the Panda, a UR5, Talos); the tests that need them skip
 // when it is absent.
 #include <gtest/gtest.h>
-
-#include <proxima/shape/primitives.h>
 #include <proxima/robot/robot_distance.h>
 #include <proxima/robot/urdf.h>
+#include <proxima/shape/primitives.h>
 
 #include <array>
 #include <cmath>
@@ -89,8 +88,8 @@ PandaPoses panda_fk_by_hand(const std::vector<double>& q) {
   PandaPoses p;
   for (int i = 0; i < 7; ++i) {
     const Pose turn(rpy(0, 0, q[static_cast<std::size_t>(i)]), Vec3::Zero());
-    p.arm[static_cast<std::size_t>(i + 1)] = p.arm[static_cast<std::size_t>(i)] *
-                                             origins[static_cast<std::size_t>(i)] * turn;
+    p.arm[static_cast<std::size_t>(i + 1)] =
+        p.arm[static_cast<std::size_t>(i)] * origins[static_cast<std::size_t>(i)] * turn;
   }
   p.link8 = p.arm[7] * Pose(Mat3::Identity(), Vec3(0, 0, 0.107));
   p.hand = p.link8 * Pose(rpy(0, 0, -std::numbers::pi / 4), Vec3::Zero());
@@ -214,10 +213,12 @@ TEST(RobotPairs, AdjacentAndSrdfPairsAreExcluded) {
   // Without the SRDF: link7 and the hand are adjacent through link8, which
   // has no geometry; link1 and link3 are tested.
   const Robot bare = proxima::load_robot(kPandaUrdf, "", packages());
-  EXPECT_FALSE(bare.link_pair_enabled(bare.link_index("panda_link7"), bare.link_index("panda_hand")));
-  EXPECT_FALSE(bare.link_pair_enabled(bare.link_index("panda_hand"),
-                                      bare.link_index("panda_leftfinger")));
-  EXPECT_TRUE(bare.link_pair_enabled(bare.link_index("panda_link1"), bare.link_index("panda_link3")));
+  EXPECT_FALSE(
+      bare.link_pair_enabled(bare.link_index("panda_link7"), bare.link_index("panda_hand")));
+  EXPECT_FALSE(
+      bare.link_pair_enabled(bare.link_index("panda_hand"), bare.link_index("panda_leftfinger")));
+  EXPECT_TRUE(
+      bare.link_pair_enabled(bare.link_index("panda_link1"), bare.link_index("panda_link3")));
   // The self pairs are the geometry pairs of enabled link pairs, each once.
   std::size_t expected = 0;
   for (std::size_t a = 0; a < robot.geometries().size(); ++a) {
@@ -253,7 +254,8 @@ SlowAnswer slow_panda(const Robot& robot, const std::vector<double>& q,
   SlowAnswer slow;
   for (std::size_t a = 0; a < robot.geometries().size(); ++a) {
     for (std::size_t b = a + 1; b < robot.geometries().size(); ++b) {
-      if (!robot.link_pair_enabled(robot.geometries()[a].link, robot.geometries()[b].link)) continue;
+      if (!robot.link_pair_enabled(robot.geometries()[a].link, robot.geometries()[b].link))
+        continue;
       const double sd = proxima::distance(robot.geometries()[a].body, pose_of(a),
                                           robot.geometries()[b].body, pose_of(b))
                             .signed_distance();
@@ -263,10 +265,9 @@ SlowAnswer slow_panda(const Robot& robot, const std::vector<double>& q,
   }
   for (std::size_t a = 0; a < robot.geometries().size(); ++a) {
     for (std::size_t o = 0; o < obstacles.size(); ++o) {
-      const double sd =
-          proxima::distance(robot.geometries()[a].body, pose_of(a), obstacles[o].body,
-                            obstacles[o].pose)
-              .signed_distance();
+      const double sd = proxima::distance(robot.geometries()[a].body, pose_of(a), obstacles[o].body,
+                                          obstacles[o].pose)
+                            .signed_distance();
       slow.min_environment = std::min(slow.min_environment, sd);
       if (sd <= margin) slow.close.push_back({static_cast<int>(a), static_cast<int>(o), true, sd});
     }
@@ -292,11 +293,13 @@ TEST(RobotDistance, EveryQueryMatchesTheSlowPathAlongATrajectory) {
   for (int step = 0; step < 120; ++step) {
     if (step % 10 == 0) target = random_q(robot, rng);
     for (std::size_t v = 0; v < q.size(); ++v) q[v] += 0.2 * (target[v] - q[v]);
-    const proxima::RobotDistances fast = proxima::robot_distances(robot, q, obstacles, options, &state);
+    const proxima::RobotDistances fast =
+        proxima::robot_distances(robot, q, obstacles, options, &state);
     const SlowAnswer slow = slow_panda(robot, q, obstacles, options.margin);
     EXPECT_NEAR(fast.min_self, slow.min_self, kAgreement) << "step " << step;
     EXPECT_NEAR(fast.min_environment, slow.min_environment, kAgreement) << "step " << step;
-    EXPECT_NEAR(fast.min_signed_distance, std::min(slow.min_self, slow.min_environment), kAgreement);
+    EXPECT_NEAR(fast.min_signed_distance, std::min(slow.min_self, slow.min_environment),
+                kAgreement);
     EXPECT_NEAR(fast.closest.signed_distance(), fast.min_signed_distance, 0.0);
     // The same close pairs, up to pairs at the margin within the agreement.
     std::size_t matched = 0;
@@ -313,9 +316,9 @@ TEST(RobotDistance, EveryQueryMatchesTheSlowPathAlongATrajectory) {
     EXPECT_EQ(matched, slow.close.size()) << "step " << step;
     EXPECT_EQ(fast.close_pairs.size(), slow.close.size()) << "step " << step;
     compared_pairs += static_cast<int>(slow.close.size());
-    pruned += static_cast<int>(robot.self_pairs().size() +
-                               robot.geometries().size() * obstacles.size()) -
-              fast.pairs_queried;
+    pruned +=
+        static_cast<int>(robot.self_pairs().size() + robot.geometries().size() * obstacles.size()) -
+        fast.pairs_queried;
   }
   // The trajectory met close and overlapping pairs, and the pruning skipped
   // pairs (so both of its sides were exercised).
@@ -345,19 +348,23 @@ TEST(RobotDistance, PairGradientsMatchCentralDifferences) {
       ASSERT_TRUE(pair.has_gradient);
       const auto pair_at = [&](const std::vector<double>& at) {
         const std::vector<Pose> poses = robot.forward_kinematics(at);
-        const proxima::RobotGeometry& a = robot.geometries()[static_cast<std::size_t>(pair.geometry_a)];
+        const proxima::RobotGeometry& a =
+            robot.geometries()[static_cast<std::size_t>(pair.geometry_a)];
         const Pose pose_a = poses[static_cast<std::size_t>(a.link)] * a.origin;
         if (pair.environment) {
           const proxima::Obstacle& o = obstacles[static_cast<std::size_t>(pair.geometry_b)];
           return proxima::distance(a.body, pose_a, o.body, o.pose);
         }
-        const proxima::RobotGeometry& b = robot.geometries()[static_cast<std::size_t>(pair.geometry_b)];
-        return proxima::distance(a.body, pose_a, b.body, poses[static_cast<std::size_t>(b.link)] * b.origin);
+        const proxima::RobotGeometry& b =
+            robot.geometries()[static_cast<std::size_t>(pair.geometry_b)];
+        return proxima::distance(a.body, pose_a, b.body,
+                                 poses[static_cast<std::size_t>(b.link)] * b.origin);
       };
-      const auto same_features = [](const proxima::BodyDistance& x, const proxima::BodyDistance& y) {
+      const auto same_features = [](const proxima::BodyDistance& x,
+                                    const proxima::BodyDistance& y) {
         return x.status == y.status && x.feature_a.vertices == y.feature_a.vertices &&
-               x.feature_b.vertices == y.feature_b.vertices && x.feature_a.type == y.feature_a.type &&
-               x.feature_b.type == y.feature_b.type;
+               x.feature_b.vertices == y.feature_b.vertices &&
+               x.feature_a.type == y.feature_a.type && x.feature_b.type == y.feature_b.type;
       };
       Eigen::VectorXd difference(robot.dof());
       bool smooth = true;
@@ -373,7 +380,8 @@ TEST(RobotDistance, PairGradientsMatchCentralDifferences) {
       ++checked;
       EXPECT_LT((pair.gradient - difference).norm(), kRelative * std::max(1.0, difference.norm()))
           << "pair " << pair.geometry_a << " " << pair.geometry_b << " env " << pair.environment
-          << " sd " << pair.signed_distance() << "\n" << pair.gradient.transpose() << "\n"
+          << " sd " << pair.signed_distance() << "\n"
+          << pair.gradient.transpose() << "\n"
           << difference.transpose();
     }
   }
@@ -407,15 +415,15 @@ TEST(RobotDistance, BatchMatchesOneQueryPerRow) {
 
 TEST(RobotLoad, Ur5AndTalosLoad) {
   if (!have_robots()) GTEST_SKIP() << kRobots << " absent";
-  const Robot ur5 = proxima::load_robot(kRobots + "/robots/ur_description/urdf/ur5_robot.urdf",
-                                        kRobots + "/robots/ur_description/srdf/ur5.srdf",
-                                        packages());
+  const Robot ur5 =
+      proxima::load_robot(kRobots + "/robots/ur_description/urdf/ur5_robot.urdf",
+                          kRobots + "/robots/ur_description/srdf/ur5.srdf", packages());
   EXPECT_EQ(ur5.dof(), 6);
   EXPECT_EQ(ur5.geometries().size(), 8u);
   // Talos writes package:///example-robot-data/... (three slashes).
-  const Robot talos = proxima::load_robot(kRobots + "/robots/talos_data/robots/talos_full_v2.urdf",
-                                          kRobots + "/robots/talos_data/srdf/talos.srdf",
-                                          packages());
+  const Robot talos =
+      proxima::load_robot(kRobots + "/robots/talos_data/robots/talos_full_v2.urdf",
+                          kRobots + "/robots/talos_data/srdf/talos.srdf", packages());
   EXPECT_EQ(talos.geometries().size(), 52u);
   EXPECT_GT(talos.dof(), 30);
   std::mt19937_64 rng(47);
@@ -431,7 +439,8 @@ TEST(RobotLoad, MeshModesGiveBodiesOfThatKind) {
   options.link_mesh_as["panda_link3"] = proxima::LoadAs::hull;
   const Robot robot = proxima::load_robot(kPandaUrdf, kPandaSrdf, options);
   const auto kind_of = [&](const char* link) {
-    return robot.geometries()[static_cast<std::size_t>(robot.link_geometries(robot.link_index(link))[0])]
+    return robot
+        .geometries()[static_cast<std::size_t>(robot.link_geometries(robot.link_index(link))[0])]
         .body.kind();
   };
   EXPECT_EQ(kind_of("panda_link2"), proxima::Body::Kind::mesh);
@@ -514,7 +523,8 @@ TEST(RobotLoad, BadDescriptionsGetErrorsNamingWhatAndWhere) {
     const std::string error = load_error(path);
     EXPECT_NE(error.find("spin"), std::string::npos) << error;
   }
-  EXPECT_NE(load_error("/nonexistent/robot.urdf").find("/nonexistent/robot.urdf"), std::string::npos);
+  EXPECT_NE(load_error("/nonexistent/robot.urdf").find("/nonexistent/robot.urdf"),
+            std::string::npos);
 }
 
 TEST(RobotDistance, BadQueriesAreRefusedNamingTheProblem) {

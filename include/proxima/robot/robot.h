@@ -28,6 +28,7 @@
 // base pose given to the queries, proxima/robot/robot_distance.h).
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <limits>
 #include <span>
@@ -36,10 +37,8 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Core>
-
-#include "proxima/shape/body.h"
 #include "proxima/core/types.h"
+#include "proxima/shape/body.h"
 
 namespace proxima {
 
@@ -170,8 +169,8 @@ class Robot {
                                                           const Vec3& point) const;
   // gradient += scale * direction^T J, J the point Jacobian above: the
   // derivative of direction . point, without forming J (O(depth of link)).
-  void add_directional_derivative(std::span<const Pose> poses, std::int32_t link,
-                                  const Vec3& point, const Vec3& direction, double scale,
+  void add_directional_derivative(std::span<const Pose> poses, std::int32_t link, const Vec3& point,
+                                  const Vec3& direction, double scale,
                                   std::span<double> gradient) const;
 
   // The pairs of geometries a self query tests: every pair of geometries of
@@ -210,11 +209,11 @@ class Robot {
   std::vector<RobotJoint> joints_;
   std::vector<RobotGeometry> geometries_;
   std::vector<std::int32_t> variable_joints_;
-  std::vector<Step> steps_;                   // topological order, root first
-  std::vector<std::int32_t> parent_step_;     // per link: its step in steps_, -1 for the root
-  std::vector<std::int32_t> parent_link_;     // per link, -1 for the root
+  std::vector<Step> steps_;                // topological order, root first
+  std::vector<std::int32_t> parent_step_;  // per link: its step in steps_, -1 for the root
+  std::vector<std::int32_t> parent_link_;  // per link, -1 for the root
   std::vector<std::vector<std::int32_t>> link_geometries_;
-  std::vector<std::uint8_t> pair_enabled_;    // links x links
+  std::vector<std::uint8_t> pair_enabled_;  // links x links
   std::vector<GeometryPair> self_pairs_;
   std::vector<BoundingSphere> geometry_spheres_;
   std::int32_t root_ = -1;

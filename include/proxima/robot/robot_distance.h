@@ -40,13 +40,12 @@
 // gradient is that of one active pair (a subgradient), as for poses.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <limits>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "proxima/query/body_distance.h"
 #include "proxima/robot/robot.h"
