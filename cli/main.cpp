@@ -29,6 +29,7 @@
 #include "demo.h"
 #include "proxima/core/types.h"
 #include "query.h"
+#include "robot.h"
 #include "tools.h"
 #include "view.h"
 
@@ -262,6 +263,35 @@ int main(int argc, char** argv) {
       "  proxima view --query query.jsonl --out query.html\n"
       "  proxima view --scene bodies.jsonl --margin 0.1 --out scene.html");
 
+  CLI::App* robot = app.add_subcommand(
+      "robot",
+      "A robot from its URDF (and SRDF): answer JSON Lines of configurations with the minimum "
+      "signed distance, the close pairs and the gradient (docs/robotics.md)");
+  proxima::cli::RobotCommand robot_command;
+  robot->add_option("FILE", robot_command.file,
+                    "Input file of configurations; '-' or none reads standard input");
+  robot->add_option("--urdf", robot_command.urdf, "The robot's URDF")->required();
+  robot->add_option("--srdf", robot_command.srdf,
+                    "Its SRDF: the disable_collisions pairs are not tested");
+  robot->add_option("--package-dir", robot_command.package_dirs,
+                    "Where package:// URIs point: NAME=DIR, or a directory holding packages "
+                    "(repeatable)");
+  robot->add_option("--mesh-as", robot_command.mesh_as,
+                    "How a collision mesh becomes a body: hull, mesh or pieces")
+      ->check(CLI::IsMember(std::vector<std::string>{"hull", "mesh", "pieces"}))
+      ->capture_default_str();
+  robot->add_option("--margin", robot_command.margin,
+                    "Pairs whose signed distance is at most this are listed")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  robot->add_flag("--gradients", robot_command.gradients,
+                  "Answer each pair's gradient with respect to the joint vector");
+  robot->footer(
+      "Example:\n"
+      "  echo '{\"id\":1,\"q\":[0,-0.78,0,-2.36,0,1.57,0.78,0.01]}' |\n"
+      "    proxima robot --urdf panda.urdf --srdf panda.srdf --package-dir NAME=DIR --gradients\n"
+      "Each line: {\"id\": any, \"q\": [numbers] or {\"joint name\": number, ...}}.");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -284,6 +314,19 @@ int main(int argc, char** argv) {
       return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
     }
     if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);
+    if (*robot) {
+      std::ios::sync_with_stdio(false);
+      if (robot_command.file == "-") {
+        return proxima::cli::run_robot(robot_command, std::cin, std::cout, std::cerr);
+      }
+      std::ifstream in(robot_command.file, std::ios::binary);
+      std::error_code ec;
+      if (!in || std::filesystem::is_directory(robot_command.file, ec)) {
+        std::cerr << "proxima robot: cannot open '" << robot_command.file << "'\n";
+        return kExitFailure;
+      }
+      return proxima::cli::run_robot(robot_command, in, std::cout, std::cerr);
+    }
     if (*view) {
       // Exactly one input: two files, a query file or a scene file.
       const bool files = !view_command.file_a.empty();

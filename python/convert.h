@@ -741,6 +741,7 @@ void bind_pair_batch(py::module_& m);
 // Body, the primitives and distance for any two bodies (body.cpp).
 void bind_bodies(py::module_& m);
 void bind_mesh(py::module_& m);
+void bind_robot(py::module_& m);
 // A Body from a Body, a ConvexPolytope or a CompoundBody (body.cpp);
 // TypeError naming `name` otherwise.
 Body to_body(py::handle obj, const char* name);

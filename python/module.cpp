@@ -570,4 +570,5 @@ feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k],
   bind_bodies(m);
   bind_mesh(m);
   bind_view(m);
+  bind_robot(m);
 }

@@ -1,0 +1,159 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// `proxima robot`: see robot.h.
+#include "robot.h"
+
+#include <cmath>
+#include <iostream>
+#include <string>
+
+#include "json_errors.h"
+#include "proxima/robot/robot_distance.h"
+#include "proxima/robot/urdf.h"
+
+namespace proxima::cli {
+namespace {
+
+Json vec3_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json vector_json(const Eigen::VectorXd& v) {
+  Json out = Json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(v[i]);
+  return out;
+}
+
+// A non-finite value (no pair at all: +infinity) is written as null, which
+// JSON can hold.
+Json number_json(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+std::vector<double> read_q(const Robot& robot, const Json& query) {
+  const auto it = query.find("q");
+  if (it == query.end()) fail("no \"q\" (the joint vector: an array, or an object by joint name)");
+  const std::vector<std::string> names = robot.variable_names();
+  std::vector<double> q(names.size());
+  const auto number = [](const Json& v, const std::string& path) {
+    if (!v.is_number()) fail(path + " is not a number " + kind(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail(path + " is not finite");
+    return x;
+  };
+  if (it->is_array()) {
+    if (it->size() != names.size()) {
+      fail("q has " + std::to_string(it->size()) + " entries, the robot " +
+           std::to_string(names.size()) + " joints (" +
+           [&] {
+             std::string list;
+             for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+             return list;
+           }() +
+           ")");
+    }
+    for (std::size_t v = 0; v < names.size(); ++v) q[v] = number((*it)[v], indexed("q", v));
+    return q;
+  }
+  if (it->is_object()) {
+    for (std::size_t v = 0; v < names.size(); ++v) {
+      const auto joint = it->find(names[v]);
+      if (joint == it->end()) fail("q names no value for joint \"" + names[v] + "\"");
+      q[v] = number(*joint, "q." + names[v]);
+    }
+    for (const auto& [key, value] : it->items()) {
+      if (std::find(names.begin(), names.end(), key) == names.end()) {
+        fail("q names \"" + key + "\", which is not a joint variable of the robot");
+      }
+    }
+    return q;
+  }
+  fail("q is neither an array nor an object " + kind(*it));
+}
+
+Json pair_json(const Robot& robot, const RobotPairDistance& pair, bool gradients) {
+  const auto& geometries = robot.geometries();
+  const RobotGeometry& a = geometries[static_cast<std::size_t>(pair.geometry_a)];
+  Json out;
+  out["a"] = a.name;
+  out["link_a"] = robot.links()[static_cast<std::size_t>(a.link)].name;
+  if (pair.environment) {
+    out["b"] = "obstacle " + std::to_string(pair.geometry_b);
+  } else {
+    const RobotGeometry& b = geometries[static_cast<std::size_t>(pair.geometry_b)];
+    out["b"] = b.name;
+    out["link_b"] = robot.links()[static_cast<std::size_t>(b.link)].name;
+  }
+  out["status"] = to_string(pair.result.status);
+  out["signed_distance"] = number_json(pair.signed_distance());
+  out["point_a"] = vec3_json(pair.result.point_a);
+  out["point_b"] = vec3_json(pair.result.point_b);
+  out["normal"] = vec3_json(pair.result.normal);
+  if (gradients) out["gradient"] = pair.has_gradient ? vector_json(pair.gradient) : Json(nullptr);
+  return out;
+}
+
+}  // namespace
+
+int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, std::ostream& err) {
+  RobotLoadOptions load;
+  load.package_dirs = command.package_dirs;
+  std::optional<Robot> robot;
+  try {
+    load.mesh_as = load_as_from_string(command.mesh_as);
+    robot.emplace(load_robot(command.urdf, command.srdf, load));
+  } catch (const std::exception& e) {
+    err << "proxima robot: " << e.what() << "\n";
+    return 1;
+  }
+  RobotQueryOptions options;
+  options.margin = command.margin;
+  options.gradients = command.gradients;
+  RobotQueryState state;
+  std::string line;
+  long line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    Json answer;
+    try {
+      if (const std::size_t column = nesting_overflow_column(line); column != 0) {
+        fail("the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
+             " levels (at column " + std::to_string(column) + ")");
+      }
+      Json query;
+      try {
+        query = Json::parse(line);
+      } catch (const Json::exception& e) {
+        fail(describe_parse_error(line, e));
+      }
+      if (!query.is_object()) fail("the line is not a JSON object " + kind(query));
+      if (const auto id = query.find("id"); id != query.end()) answer["id"] = *id;
+      const std::vector<double> q = read_q(*robot, query);
+      const RobotDistances r = robot_distances(*robot, q, {}, options, &state);
+      answer["min_signed_distance"] = number_json(r.min_signed_distance);
+      if (r.closest.geometry_a >= 0) {
+        answer["closest"] = pair_json(*robot, r.closest, command.gradients);
+      }
+      Json pairs = Json::array();
+      for (const RobotPairDistance& pair : r.close_pairs) {
+        pairs.push_back(pair_json(*robot, pair, command.gradients));
+      }
+      answer["pairs"] = std::move(pairs);
+      if (command.gradients && r.closest.geometry_a >= 0) {
+        answer["gradient"] = vector_json(r.closest.gradient);
+      }
+    } catch (const std::exception& e) {
+      Json error;
+      if (answer.contains("id")) error["id"] = answer["id"];
+      error["error"] = "line " + std::to_string(line_number) + ": " + e.what();
+      answer = std::move(error);
+    }
+    out << answer.dump(-1, ' ', false, Json::error_handler_t::replace) << "\n";
+  }
+  out.flush();
+  if (in.bad()) {
+    err << "proxima robot: reading the input failed after line " << line_number << "\n";
+    return 1;
+  }
+  return out ? 0 : 1;
+}
+
+}  // namespace proxima::cli
