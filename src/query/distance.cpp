@@ -131,9 +131,10 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // and (2, d) share the nine broadcast entries of R_a, each multiplied once
 // per pair of outputs. The rounding is the scalar product's, term by term.
 // Eigen's 3x3 product vectorizes each length-3 dot product with horizontal
-// adds instead: 127 instructions per query; the rows of R_a paired in
-// lanes, one column at a time: about 90; the columns paired: 11 fewer
-// (callgrind, bench/tracked_instructions translation 64).
+// adds instead, and pairing the rows of R_a in lanes, one column at a time,
+// broadcasts each entry of R_a once per column: pairing the columns takes
+// the fewest instructions of the three (bench/tracked_instructions under
+// callgrind).
 [[gnu::always_inline]] inline Pose relative_pose(const Pose& pose_a, const Pose& pose_b) {
 #if defined(__SSE2__)
   const double* ra = pose_a.rotation.data();  // column-major: R_a(k, i) = ra[3 i + k]
@@ -177,8 +178,8 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // them (rows 0 and 1: ((R0 x0 + R1 x1) + R2 x2) + t, with R_k column k;
 // row 2: (R_20 x0 + (R_21 x1 + R_22 x2)) + t_2). With SSE2 A's pose is
 // loaded once into registers before the first store: the compiler cannot
-// know that the result does not alias the caller's pose, and reloaded it
-// for every entry written (callgrind, bench/tracked_instructions).
+// know that the result does not alias the caller's pose, and would reload
+// it for every entry written (bench/tracked_instructions under callgrind).
 [[gnu::always_inline]] inline void to_world(const Pose& pose_a, DistanceResult& result) {
 #if defined(__SSE2__)
   const double* r = pose_a.rotation.data();  // column-major: column k at r + 3 k
@@ -278,8 +279,8 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // one. Its one named result is the caller's return slot itself (NRVO): with
 // the penetrating pair's answer a second named object here, the algorithm
 // wrote a local that was then copied out, field by field, and to_world's
-// stores went through the stack (about 40 instructions a query, callgrind,
-// bench/tracked_instructions).
+// stores went through the stack (bench/tracked_instructions under
+// callgrind).
 [[gnu::always_inline]] inline DistanceResult distance_in_frame(
     const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
     const DistanceOptions& options, DistanceCache& c) {
@@ -329,8 +330,8 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // distance() with a cold cache of its own, out of line: the cache's
 // destructor (it may own penetration state, types.h) then needs no cleanup
 // in distance() itself, whose tracked path would otherwise pay a frame
-// pointer and a spill for it (3 instructions a query, callgrind,
-// bench/tracked_instructions).
+// pointer and a spill for it on every query (bench/tracked_instructions
+// under callgrind).
 [[gnu::noinline]] DistanceResult distance_with_cold_cache(const ConvexPolytope& a,
                                                           const Pose& pose_a,
                                                           const ConvexPolytope& b,
@@ -374,8 +375,8 @@ DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose
                                        const DistanceOptions& options, DistanceCache* cache) {
   // A cold cache is built only when there is no caller's cache, out of line
   // (the scene's, the bodies' and the compounds' tracked queries come here
-  // with their own: initializing and destroying an unused cold one cost
-  // them about 30 instructions a query).
+  // with their own, and would pay for initializing and destroying an
+  // unused cold one on every query).
   if (cache == nullptr) [[unlikely]]
     return distance_of_rigid_poses_cold(a, pose_a, b, pose_b, options);
   return distance_in_frame(a, pose_a, b, pose_b, options, *cache);
