@@ -44,7 +44,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/triangle_distance.h"
+#include "geometry/triangle_distance.h"
 #include "peers/fcl_convex.h"
 
 namespace {

@@ -19,7 +19,7 @@
 // and each peer's misses (no contact where proxima found one) and largest
 // time error |t_peer - t_proxima| (proxima's t is tested never to be after
 // the true first contact and within 1e-9 of the size in distance,
-// tests/time_of_impact_test.cpp).
+// tests/motion/time_of_impact_test.cpp).
 //
 // Then compounds (proxima only): a grid of K convex pieces (hulls of 12
 // points) turning in place against a hull of 64 points thrown through it

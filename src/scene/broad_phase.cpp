@@ -3,7 +3,7 @@
 //
 // The scene's two pair finders (broad_phase.h says what they promise). Both
 // end with the same closed-box test on the caller's boxes, which is why they
-// return the same pairs; tests/broad_phase_test.cpp compares them with the
+// return the same pairs; tests/scene/broad_phase_test.cpp compares them with the
 // all-pairs loop, and bench/broad_phase_bench.cpp times them.
 #include "scene/broad_phase.h"
 

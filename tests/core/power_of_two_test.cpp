@@ -4,7 +4,7 @@
 // src/core/power_of_two.h reads exponents from a double's bits and builds powers
 // of two from them, where it used libm's frexp and ldexp: its twins here are
 // those calls, on every exponent of the doubles, normal and subnormal.
-#include "../src/power_of_two.h"
+#include "core/power_of_two.h"
 
 #include <gtest/gtest.h>
 

@@ -26,7 +26,7 @@
 #include <random>
 #include <vector>
 
-#include "../src/gjk_contact.h"
+#include "narrowphase/gjk_contact.h"
 #include "proxima/query/distance.h"
 #include "support/exact_oracle.h"
 

@@ -8,7 +8,7 @@
 // and triples of vertices, the answer without a cached face is the answer
 // with the true face cached, and it names the face a brute force over all
 // faces finds.
-#include "../src/witness_features.h"
+#include "narrowphase/witness_features.h"
 
 #include <gtest/gtest.h>
 

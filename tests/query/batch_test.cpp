@@ -25,7 +25,7 @@
 #include <thread>
 #include <vector>
 
-#include "../src/query/parallel_ranges.h"
+#include "query/parallel_ranges.h"
 #include "proxima/query/distance.h"
 #include "proxima/shape/primitives.h"
 #include "support/generators.h"

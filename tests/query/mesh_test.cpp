@@ -23,7 +23,7 @@
 #include <thread>
 #include <vector>
 
-#include "../src/triangle_distance.h"
+#include "geometry/triangle_distance.h"
 #include "proxima/geometry/closest_point.h"
 #include "support/generators.h"
 

@@ -5,7 +5,7 @@
 // multiples of 1/8, so that boxes whose faces exactly touch (the closed-box
 // case that contact at margin 0 depends on) and boxes of zero extent are
 // common; the tests check that they really occur.
-#include "../src/broad_phase.h"
+#include "scene/broad_phase.h"
 
 #include <gtest/gtest.h>
 
