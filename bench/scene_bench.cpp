@@ -17,9 +17,14 @@
 // next to the volume of the pair's Minkowski sum).
 //
 // A pair on which the two systems disagree (in one set only, not within
-// FCL's tolerance of the margin, or distances apart) is refereed by
-// proxima's cold distance query on the same poses; the output counts them
-// and shows the first few.
+// FCL's tolerance of the margin, or distances apart) is refereed twice on
+// the same poses: by proxima's cold distance query, and by the exact
+// reference of the paper's experiments (bench/paper/exact_reference.h: the
+// bodies placed in rational arithmetic from the very doubles both systems
+// get, the distance solved exactly and certified), which depends on neither
+// system. The output counts, for each system, the mismatches on which its
+// answer agrees with the exact distance (proxima within DESIGN.md's
+// standard, FCL within its own 1e-6 tolerance), and shows the first few.
 //
 // Each step, for each system, timed separately in the same loop (so machine
 // noise falls on both):
@@ -71,6 +76,7 @@
 #include <string>
 #include <vector>
 
+#include "paper/exact_reference.h"
 #include "paper/scene_scenario.h"
 #include "peers/fcl_scene.h"
 #include "proxima/query/distance.h"
@@ -87,6 +93,9 @@ constexpr double kDefaultFclBudgetSeconds = 240.0;
 // distance_tolerance of 1e-6 (fcl_scene.cpp); proxima is far tighter.
 constexpr double kCompareRelative = 1e-6;
 constexpr double kCompareAbsolute = 1e-6;
+// DESIGN.md's relative accuracy standard (its absolute part, 64 u R, is the
+// exact case's tolerance), the bound the exact referee holds the Scene to.
+constexpr double kStandardRelative = 1e-12;
 // A progress line at most this often (seconds of wall time).
 constexpr double kProgressSeconds = 5.0;
 
@@ -207,8 +216,8 @@ struct Series {
   }
 };
 
-// A pair on which FCL and the Scene disagree, with the cold distance query
-// of proxima on the same poses as the referee.
+// A pair on which FCL and the Scene disagree, with two referees on the same
+// poses: proxima's cold distance query, and the exact reference.
 struct Mismatch {
   int step = 0;
   int a = -1;
@@ -217,7 +226,23 @@ struct Mismatch {
   double fcl = -2;    // -2: not in FCL's close pairs (FCL's -1 is a collision)
   double cold = 0;
   bool scene_right = false;  // the Scene's answer (or absence) agrees with the cold query
+  ExactCase exact;           // d*, certified, and DESIGN.md's tolerance 64 u R
+  bool scene_exact = false;  // the Scene's answer (or absence) within the standard of d*
+  bool fcl_exact = false;    // FCL's answer (or absence) within FCL's tolerance of d*
 };
+
+// Whether a system's close-pair answer agrees with the exact distance d*,
+// up to the system's own error |d - d*| <= relative d* + absolute: a reported
+// distance within it of d*; "colliding" (FCL's -1) when d* is not separated;
+// absent when d* may exceed the margin (d* + error > margin, so a pair whose
+// d* is within the system's error of the margin may go either way).
+bool agrees_with_exact(double answer, double absent, const ExactCase& exact, double relative,
+                       double absolute) {
+  const double error = relative * exact.distance + absolute;
+  if (answer == absent) return exact.distance + error > kMargin;
+  if (answer < 0) return !exact.separated;  // FCL's collision
+  return std::abs(answer - exact.distance) <= error;
+}
 
 // Looks the pair up in both sets (sorted by (a, b)) and runs the cold query.
 Mismatch explain_mismatch(const SceneScenario& scenario, const std::vector<Pose>& poses, int step,
@@ -240,6 +265,13 @@ Mismatch explain_mismatch(const SceneScenario& scenario, const std::vector<Pose>
   // this scale (coordinates up to ~100: 64 u R ~ 1e-12).
   m.scene_right =
       m.scene >= 0 ? std::abs(m.scene - m.cold) <= 1e-9 * (1 + m.cold) : m.cold > kMargin;
+  ExactReference exact(*scenario.body_shape(a), *scenario.body_shape(b));
+  m.exact =
+      exact.solve(poses[static_cast<std::size_t>(a)], poses[static_cast<std::size_t>(b)]);
+  // DESIGN.md's standard for proxima: 1e-12 relative plus 64 u R absolute
+  // (the exact case's tolerance); FCL's own 1e-6 + 1e-6 for FCL.
+  m.scene_exact = agrees_with_exact(m.scene, -1, m.exact, kStandardRelative, m.exact.tolerance);
+  m.fcl_exact = agrees_with_exact(m.fcl, -2, m.exact, kCompareRelative, kCompareAbsolute);
   return m;
 }
 
@@ -462,14 +494,31 @@ void print_size(const SizeResult& r, const Options& options) {
     int scene_right = 0;
     for (const Mismatch& m : r.mismatch_details) scene_right += m.scene_right ? 1 : 0;
     std::cout << "  referee (proxima's cold query on the same poses) agrees with the Scene on "
-              << scene_right << " of " << r.mismatch_details.size() << " mismatches";
+              << scene_right << " of " << r.mismatch_details.size() << " mismatches\n";
+    int certified = 0, scene_exact = 0, fcl_exact = 0, both = 0, neither = 0;
+    double fcl_worst = 0.0, scene_worst = 0.0;
+    for (const Mismatch& m : r.mismatch_details) {
+      certified += m.exact.certified ? 1 : 0;
+      scene_exact += m.scene_exact ? 1 : 0;
+      fcl_exact += m.fcl_exact ? 1 : 0;
+      both += m.scene_exact && m.fcl_exact ? 1 : 0;
+      neither += !m.scene_exact && !m.fcl_exact ? 1 : 0;
+      if (m.scene >= 0) scene_worst = std::max(scene_worst, std::abs(m.scene - m.exact.distance));
+      if (m.fcl >= 0) fcl_worst = std::max(fcl_worst, std::abs(m.fcl - m.exact.distance));
+    }
+    std::cout << "  exact referee (bench/paper/exact_reference.h, certified on " << certified
+              << " of " << r.mismatch_details.size() << "): the Scene agrees with it on "
+              << scene_exact << " (within DESIGN.md's standard), FCL on " << fcl_exact
+              << " (within its 1e-6 tolerance), both on " << both << ", neither on " << neither
+              << "; largest |d - d*| of a reported distance: Scene " << scene_worst << ", FCL "
+              << fcl_worst;
     constexpr std::size_t kShown = 5;
     for (std::size_t i = 0; i < std::min(kShown, r.mismatch_details.size()); ++i) {
       const Mismatch& m = r.mismatch_details[i];
-      char line[200];
+      char line[240];
       std::snprintf(line, sizeof(line),
-                    "\n    step %d, bodies %d-%d: Scene %.9g, FCL %.9g, cold query %.9g", m.step,
-                    m.a, m.b, m.scene, m.fcl, m.cold);
+                    "\n    step %d, bodies %d-%d: Scene %.9g, FCL %.9g, cold query %.9g, exact %.9g",
+                    m.step, m.a, m.b, m.scene, m.fcl, m.cold, m.exact.distance);
       std::cout << line;
     }
     std::cout << "\n    (Scene -1: not reported by the Scene; FCL -2: not reported by FCL, -1: FCL "

@@ -407,9 +407,9 @@ inline int check_index(int i, int count, const char* what) {
 // arrays with K rows, one column per field: new arrays, or (PairBatch's
 // out=) the arrays of an earlier answer filled again in place, so that a
 // loop allocates nothing. The names (status, feature types) are fixed-width
-// unicode arrays written straight into numpy's UCS-4 buffer: a fancy-indexing
-// call in numpy cost 7 us per 1,000 rows, three of them a third of
-// PairBatch's Python overhead (bench/python_pair_batch.py).
+// unicode arrays written straight into numpy's UCS-4 buffer: a numpy
+// fancy-indexing call per name column was a large share of PairBatch's
+// Python overhead (bench/python_pair_batch.py).
 enum BatchColumn : int {
   kStatus,
   kDistance,

@@ -20,8 +20,9 @@
 namespace proxima::detail {
 
 // The exponent e with max|x| < 2^e (0 for an all-zero input): frexp's
-// exponent, read from the bits for a normal double (libm's frexp is a call
-// of about 80 instructions; the penetration query asks for two per query).
+// exponent, read from the bits for a normal double (libm's frexp is an
+// out-of-line call that handles every case; the penetration query asks for
+// two per query).
 inline int magnitude_exponent(double max_abs) {
   if (max_abs == 0.0) return 0;
   const auto biased = static_cast<int>((std::bit_cast<std::uint64_t>(max_abs) >> 52) & 0x7ff);

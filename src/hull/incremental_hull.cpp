@@ -262,10 +262,9 @@ std::uint64_t morton_code(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
 // The incremental hull on a copy of the points laid out in Morton order:
 // the points of one conflict list are near each other in space, so they are
 // near in memory too. On a million points the construction is bound by
-// memory traffic, not arithmetic (measured on 10^6 points on a sphere: 31 s
-// in the input's layout with a plain random order, 4.8 s with this layout
-// and the rounds of incremental_hull_in_order). Only the memory layout
-// changes; every decision is exact on the same doubles.
+// memory traffic, not arithmetic (10^6 points on a sphere; the figures are
+// in CHANGELOG.md), so the layout is worth several times its cost. Only the memory layout changes; every
+// decision is exact on the same doubles.
 bool exact_incremental_hull(std::span<const Vec3> pts, std::span<const Vec3> scaled,
                             const Frame& frame, Cycles& out) {
   const auto n = static_cast<Index>(pts.size());

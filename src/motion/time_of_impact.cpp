@@ -30,9 +30,9 @@ namespace detail {
 // (angle <= pi, 0 < t < 1): Taylor polynomials on [0, pi/4], their
 // truncation below 1e-19 there, and the cofunctions of pi/2 - x above it
 // (pi/2 - x exact by Sterbenz with pi/2's head, then its tail added). A
-// few ulps, as the library's; a quarter of glibc's sincos's instructions
-// (its argument reduction covers every double), one pair per body and
-// step. Outside the range: std::sin and std::cos.
+// few ulps, as the library's, in far fewer instructions than glibc's
+// sincos, whose argument reduction covers every double; one pair per body
+// and step. Outside the range: std::sin and std::cos.
 void sin_cos_quadrant(double x, double& sine, double& cosine) {
   constexpr double kHalfPiHead = 1.5707963267948966;
   constexpr double kHalfPiTail = 6.123233995736766e-17;
@@ -922,7 +922,7 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     // or an edge against it closes at its true rate (second order), where
     // the planes along a fixed n charge the fastest vertex of both
     // features. Against an edge or a vertex the gain is small and the cost
-    // shows (toi_bench, N = 8: 3.3 us with them everywhere, 3.1 us so).
+    // shows (bench/toi_bench at N = 8).
     const auto fixed = [&](double step, FeaturePlane& moving) {
       if (!(step > best.step)) return;
       if (relative_turn > 0.0)

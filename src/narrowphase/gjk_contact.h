@@ -41,8 +41,9 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
 // hints, the features left default and the cache's faces -1. For the
 // contact unit (contact.cpp), which keeps the status, the iterations and the
 // simplex only: the witness rule on its tetrahedron (four triangle
-// distances per dropped vertex, then the face searches) was about 45% of
-// its Enhanced GJK run (callgrind, scene_bench at 10,000 bodies).
+// distances per dropped vertex, then the face searches) is a large share of
+// an Enhanced GJK run that the contact unit would throw away
+// (bench/scene_bench at 10,000 bodies under callgrind shows it).
 DistanceResult enhanced_gjk_contact(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, const DistanceOptions& options,
                                     double contact_tolerance, DistanceCache& cache);

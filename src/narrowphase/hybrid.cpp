@@ -67,16 +67,15 @@ constexpr double kStaleMotion = 0.5;
 // in the loop of a query that started cold, whose hints are the supports
 // along the line of centres: no better than a scan's start, and the climb's
 // walk ends at a different step every time, a mispredicted branch per
-// search (cold queries on random poses, 2000 poses, median of 7: 8
-// vertices 240 -> 213 ns and 16 vertices 330 -> 287 with the cold start's
-// scan, where climbing in the loop took 225 and 309; at 32 scanning in the
-// loop took 390 against 380 climbing). A tracked query's hint is its answer
-// or next to it: it climbs.
+// search. Up to 16 vertices the fixed scan beats the climb on cold random
+// poses; at 32 the climb is as fast or faster (bench/distance_bench's cold
+// queries; the figures are in CHANGELOG.md). A tracked query's hint is its
+// answer or next to it: it climbs.
 constexpr int kColdLoopScanVertices = 16;
 
 // A support search of the loop: the scan or the climb (above). The scan is
-// out of line: inlined here it cost the tracked query instructions, and a
-// cold query at 8 vertices 35% more time (its compare became a branch).
+// out of line: inlined here it costs the tracked query instructions, and
+// the cold query time, because its compare becomes a branch.
 [[gnu::always_inline]] inline int support_point(const ConvexPolytope& p, const Vec3& dir, int hint,
                                                 bool scan) {
   if (scan) [[unlikely]]
@@ -87,9 +86,9 @@ constexpr int kColdLoopScanVertices = 16;
 // -(R^T w): the direction of B's support search in B's frame. Entry j is
 // column j of R (contiguous) dotted with w, rounded as Eigen rounds
 // -(R^T w), (c0 w0 + c1 w1) + c2 w2, then negated (exact): the same bits
-// (2e6 random rotations and directions compared). Eigen's transposed
-// product took about 35 instructions, twice a tracked query; this one
-// saves about 13 per tracked query (callgrind, bench/tracked_instructions).
+// (2e6 random rotations and directions compared). Written out because
+// Eigen's transposed product takes more instructions for the same bits, on
+// every tracked query (bench/tracked_instructions under callgrind).
 [[gnu::always_inline]] inline Vec3 minus_transpose_times(const Mat3& r, const Vec3& w) {
   const double* c = r.data();  // column-major: column j at c + 3 j
   const auto dot = [&](const double* col) {
@@ -366,13 +365,12 @@ bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const V
 // feature pair says nothing any more (a planner sampling unrelated
 // configurations with one cache per pair): a bound on how far any point of
 // B moved, |t - t'| + ||R - R'||_F max|y|, beyond a share of the bodies'
-// size. Such a warm start would cost more than a cold one
-// (bench/distance_bench WarmRandom: 7.7 iterations against 1.2, 2.7 times
-// the cold query's instructions at N = 4096), so the cold start is taken.
+// size. Such a warm start costs more iterations than a cold one
+// (bench/distance_bench WarmRandom), so the cold start is taken.
 // A cache without a pose (rotation zero: cold, or filled by GJK) moved
-// far. About 50 instructions on every query (callgrind,
-// bench/tracked_instructions); a heuristic for speed only: any start ends
-// in the same certified answer.
+// far. The test is paid by every query, so it is kept to a norm and a
+// Frobenius distance; a heuristic for speed only: any start ends in the
+// same certified answer.
 [[gnu::always_inline]] inline bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b,
                                              const Pose& b_in_a, const DistanceCache& cache) {
   const double turn2 = (b_in_a.rotation - cache.rotation).squaredNorm();
@@ -424,7 +422,7 @@ template <bool kScaled>
   FeatureSet fb;
   // A warm start from the cached pair, unless B moved far since (then the
   // pair says nothing: moved_far). A cold cache fails the first load and
-  // skips the test of its pose (46 instructions a cold query, callgrind).
+  // skips the test of its pose, which a cold query would pay for nothing.
   const bool warm = load_feature(cache.vertices_a, count_a, fa, a_point) &&
                     load_feature(cache.vertices_b, count_b, fb, b_point) &&
                     !moved_far(a, b, b_in_a, cache);

@@ -78,8 +78,9 @@ constexpr double kArcTolerance = 1e-12;
 // kArcTolerance and face_plane's own bound for a face of 32 vertices (16 u
 // per vertex). A well-shaped triangle's bound is about 45 u (equilateral);
 // slivers pay for face_plane. Saves face_plane on every face whose arcs
-// the walk reads but that it never evaluates (at N = 8, 20 of 24 faces;
-// 512 u rather than 128 u: 3% of a cold query at N = 8).
+// the walk reads but that it never evaluates (most of them: the walk
+// evaluates few of the faces it passes); 512 u rather than 128 u lets
+// more faces keep the fast normal (bench/penetration_bench's Cold).
 constexpr double kArcNormalError = 512.0 * kUnitRoundoff;
 
 // Slack on a value computed in double, in units of u times the scaled
@@ -518,13 +519,12 @@ void keep(Query& q, const Candidate& c, Candidates& out) {
 // a half circle that the side is unclear, kClearMiddle) both n and -n are
 // added (each an upper bound). Pruning: a0 is in A and b0 in B, so the
 // value h_A(n) + h_B(-n) is at least n.(a0 - b0), the value itself when
-// the pair is a face of A - B (its supports are the edges' points); at
-// N = 8 to 4096, 90 to 99% of the edge pairs the walk evaluated had a
-// value above the bound, each at the cost of two hill climbs. Not when
-// the pruned groups are recorded (an enumeration after a translation,
-// PenetrationCache::bounds): the tracked queries that follow searched one
-// more group per pair (bench/penetration_bench's TrackedSweep: 15.5
-// candidates a query instead of 14.5, 145 ns instead of 138 at N = 8).
+// the pair is a face of A - B (its supports are the edges' points); most
+// edge pairs the walk evaluates have a value above the bound, and each
+// evaluation costs two hill climbs. Not when the pruned groups are recorded
+// (an enumeration after a translation, PenetrationCache::bounds): the
+// tracked queries that follow would search one more group per pair
+// (bench/penetration_bench's TrackedSweep).
 void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
                         int b1, const std::array<Arc, 4>& yb, int nb, Candidates& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
@@ -584,9 +584,9 @@ void add_face_candidates(Query& q, Candidates& out) {
   // A face that the two lower bounds of pruned_by's comment leave gets a
   // third, the same with the hint's point of the other hull (a point of
   // it, and near its support along the face's normal, so that the bound
-  // is near the face's value): most faces evaluated had a value above the
-  // bound (bench/penetration_bench's Cold: 186 -> 48 candidates a query
-  // at N = 512, with the edge pairs').
+  // is near the face's value): most faces evaluated have a value above the
+  // bound, so the test saves most candidates of a cold query
+  // (bench/penetration_bench's Cold, with the edge pairs' test).
   std::int32_t*& near_b = q.near_b;
   std::int32_t* near_a = nullptr;
   int hint_b = 0;
@@ -731,11 +731,11 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
   const auto adjacency_b = q.b.adjacency();
   const auto faces_b = q.b.adjacency_faces();
   // Storage only (not value-initialized): with pruning a query reads a
-  // few of B's slots, and writing all of them (80 bytes each) was a tenth
-  // of a cold query at N = 4096 (page faults of the fresh allocation).
+  // few of B's slots, and writing all of them (80 bytes each) would make a
+  // large cold query pay the page faults of the fresh allocation.
   // From the scratch buffer when small; else from the heap (the buffer's
-  // next blocks double in size: at N = 512, 240 KB of arcs took a fresh
-  // 512 KB block, and its page faults, every query).
+  // next blocks double in size: a large body's arcs would take a fresh
+  // block, and its page faults, every query).
   const std::size_t slots = memo ? q.b.adjacency().size() : 0;
   std::unique_ptr<Arc[]> heap_arcs;
   Arc* slot_arc = nullptr;
@@ -1367,7 +1367,8 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
   Candidates candidates(q.memory);
   // Every face and crossing for the slow twin; a pruned walk keeps a few
   // hundred at most on the benchmarks' spheres (reserving for all of them,
-  // 2 MB at N = 4096, cost an mmap and its page faults per cold query).
+  // megabytes at N = 4096, would cost an mmap and its page faults per cold
+  // query).
   const auto all = static_cast<std::size_t>(q.a.face_count() + q.b.face_count() +
                                             2 * (q.a.vertex_count() + q.b.vertex_count()));
   candidates.reserve(walk ? std::min<std::size_t>(all, 512) : all);
@@ -1505,9 +1506,8 @@ struct TreeSearch {
 };
 
 // At most this many cached faces are searched one by one, without their
-// tree: measured on bench/penetration_peers' sweep with a warm cache
-// (every face found), N = 8 (43 faces): 151 ns a query against 164 with
-// the tree; N = 64 (407 faces): 383 against 229.
+// tree: a few dozen faces are scanned faster than the tree is walked, a
+// few hundred are not (bench/penetration_peers' sweep with a warm cache).
 constexpr std::size_t kScanFacets = 64;
 
 // B's translation since the enumeration, for the cached faces and groups.
@@ -1592,15 +1592,12 @@ bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationRes
 // The margin of an expansion or of an enumeration after a translation
 // outgrew the cache (PenetrationCache::prune_margin): twice the last one,
 // at least this many of B's last steps and a small fraction of the bodies'
-// radii, at most half of them (a B that jumps keeps pruning). Measured on
-// bench/penetration_peers' sweep (B through A and back, 6000 steps of
-// 1.6e-3, one cache a pass; /work/wt/pen.cpp, medians of 9 passes, ns a
-// query amortized, N = 512 / 4096): 8 steps that did not grow expanded 77
-// times a pass at N = 4096, each 100 to 3000 groups whose bounds had just
-// passed the best value (all the faces of A - B are near it when B nears
-// A's centre): about 7000 ns; doubling from 8 steps: 784 / 4819; from 32
-// steps: 777 / 4262 (the re-enumerations with a doubling margin before
-// the expansions: 785 / 4203).
+// radii, at most half of them (a B that jumps keeps pruning). A margin of
+// a few steps that does not grow is outgrown again and again when B nears
+// A's centre, where all the faces of A - B are near the best value: each
+// expansion then reopens hundreds to thousands of groups whose bounds had
+// just passed it. Doubling, from 32 steps, keeps those expansions rare
+// (bench/penetration_peers' sweep, B through A and back).
 constexpr double kMarginSteps = 32.0;
 
 double translation_margin(const ConvexPolytope& a, const ConvexPolytope& b,
@@ -1755,8 +1752,8 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
   // when the cache's own faces were outgrown by a translation (the next
   // query is likely a translation again): not for a rotated B (likely
   // rotated again) nor for a cold cache (a caller that queries cold every
-  // time paid for them: 0.37 -> 1.5 ms at N = 4096 in
-  // bench/penetration_bench's Cold, 20,000 groups), whose first tracked
+  // time would pay for tens of thousands of groups at N = 4096 and never
+  // use them, bench/penetration_bench's Cold), whose first tracked
   // query certifies with their least bound, as an unrecorded cache does.
   const bool has_start = same_polytopes && !cache.facets.empty();
   const bool turned = has_start && cache.rotation != b_in_a.rotation;

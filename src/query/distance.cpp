@@ -138,8 +138,8 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // one. Its one named result is the caller's return slot itself (NRVO): with
 // the penetrating pair's answer a second named object here, the algorithm
 // wrote a local that was then copied out, field by field, and to_world's
-// stores went through the stack (about 40 instructions a query, callgrind,
-// bench/tracked_instructions).
+// stores went through the stack (bench/tracked_instructions under
+// callgrind).
 [[gnu::always_inline]] inline DistanceResult distance_in_frame(
     const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
     const DistanceOptions& options, DistanceCache& c) {
@@ -184,8 +184,8 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
 // distance() with a cold cache of its own, out of line: the cache's
 // destructor (it may own penetration state, types.h) then needs no cleanup
 // in distance() itself, whose tracked path would otherwise pay a frame
-// pointer and a spill for it (3 instructions a query, callgrind,
-// bench/tracked_instructions).
+// pointer and a spill for it on every query (bench/tracked_instructions
+// under callgrind).
 [[gnu::noinline]] DistanceResult distance_with_cold_cache(const ConvexPolytope& a,
                                                           const Pose& pose_a,
                                                           const ConvexPolytope& b,
@@ -229,8 +229,8 @@ DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose
                                        const DistanceOptions& options, DistanceCache* cache) {
   // A cold cache is built only when there is no caller's cache, out of line
   // (the scene's, the bodies' and the compounds' tracked queries come here
-  // with their own: initializing and destroying an unused cold one cost
-  // them about 30 instructions a query).
+  // with their own, and would pay for initializing and destroying an
+  // unused cold one on every query).
   if (cache == nullptr) [[unlikely]]
     return distance_of_rigid_poses_cold(a, pose_a, b, pose_b, options);
   return distance_in_frame(a, pose_a, b, pose_b, options, *cache);

@@ -261,11 +261,11 @@ double test_pair(const Query& q, const Triangles& a, const Triangles& b, Best& b
   // A separating axis through the boxes' centers: along any direction w, the
   // gap between the triangles' projections over |w| is a lower bound on
   // their distance. Catches the pairs of large slanted triangles whose
-  // boxes overlap and whose planes cut each other (env/rob, cold random
-  // poses: kernel calls 47.5 -> 39.3 per query, and on the slowest poses
-  // 394 -> 200, 60 -> 45 us; medians unchanged). Rounding: scaled
-  // coordinates are at most 1 (so is |w| / 4), each projection is within
-  // 3u|w| and the gap within 6u|w|; the slack covers that and the squares.
+  // boxes overlap and whose planes cut each other, a large share of the
+  // kernel calls on the slowest poses (env/rob in bench/mesh_bench).
+  // Rounding: scaled coordinates are at most 1 (so is |w| / 4), each
+  // projection is within 3u|w| and the gap within 6u|w|; the slack covers
+  // that and the squares.
   {
     const Vec3 w = (b.lo + b.hi) - (a.lo + a.hi);  // twice the boxes' center difference
     const double a_max = std::max({w.dot(a.v[0]), w.dot(a.v[1]), w.dot(a.v[2])});
@@ -504,12 +504,11 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   // top, ties to the nearer centers), each pop followed by a dive to a leaf
   // pair along the nearer child: the first leaves reached are near the
   // closest pair, so the upper bound is tight early and prunes most of the
-  // rest. Measured (bench/mesh_bench, env/rob, medians, cold) against the
-  // depth-first stack it replaces: random poses 120 -> 51 us, 262 -> 54
-  // triangle pairs; smooth motion 82 -> 28 us. A plain heap without the
-  // dive tested about as few pairs but paid ~100 ns of heap work per node
-  // pair (slower when apart); a depth-first stack with the same tie rule
-  // reached 68 us.
+  // rest: far fewer triangle pairs than a depth-first stack, cold and along
+  // a motion (bench/mesh_bench, env/rob). A plain heap without the dive
+  // tests about as few pairs but pays heap work for every node pair (slower
+  // when the meshes are apart); a depth-first stack with the same tie rule
+  // stays slower than this.
   const auto later = [](const Entry& x, const Entry& y) {
     return x.lb2 > y.lb2 || (x.lb2 == y.lb2 && x.center2 > y.center2);
   };
@@ -528,10 +527,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   // Prepared leaves, direct-mapped by node id: a dive meets the same leaf
   // against several leaves of the other mesh in a row.
   // Per thread (the query is reentrant), stamped with this query so that no
-  // leaf placed at another query's pose is used. 128 slots a side (about
-  // 340 KB per thread): env/rob cold 130 -> 121 us against 32 slots with the
-  // depth-first traversal; with the best-first one 32, 128 and 512 slots
-  // measure the same (16.2 us, three alternating runs).
+  // leaf placed at another query's pose is used. 128 slots a side (a few
+  // hundred KB per thread); with the best-first traversal fewer or more
+  // slots measure the same (bench/mesh_bench, env/rob): the size is not
+  // critical.
   struct LeafSlot {
     std::uint64_t stamp = 0;
     std::int32_t node = -1;

@@ -26,13 +26,12 @@ namespace {
 
 // The arena of `threads` threads in which the calling thread runs its
 // parallel loops, kept from one loop to the next (one per calling thread,
-// destroyed with it). A new tbb::task_arena per loop cost 114 to 287 us on
-// this machine against 4.9 us for a kept one (a loop of 16,000 trivial items
-// in chunks of 1,024 on 2 threads, 20,000 times): the arena's setup and the
-// workers' move into it. Scene::step runs about eight loops per step (world
-// boxes, the pair finder's three, the cache merge, the narrow phase, the
-// close pairs' count and copy), so at 2 threads that was a millisecond or
-// more per step of the 5 ms the step is to take. A loop started inside
+// destroyed with it). A new tbb::task_arena per loop costs the arena's
+// setup and the workers' move into it, tens of times what a loop in a kept
+// arena costs. Scene::step runs about eight loops per step (world boxes,
+// the pair finder's three, the cache merge, the narrow phase, the close
+// pairs' count and copy), so a new arena per loop would add a large share
+// of a step's time. A loop started inside
 // another one with another thread count (a nested call) gets an arena of
 // its own, as before: the kept one is in use.
 class KeptArena {

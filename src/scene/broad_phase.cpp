@@ -217,9 +217,9 @@ class SweepAndPrune final : public PairFinder {
 // A leaf's fat box is its box grown by this fraction of its largest extent
 // on every side: a body moving less than that per step stays in its leaf for
 // several steps. Larger fat boxes move leaves less often but let more pairs
-// of fat boxes through to the box test. broad_phase_bench (bodies moving
-// about 2% of their size per step) measured 0.1 and 0.25 as the best of
-// 0.02, 0.05, 0.1, 0.25 and 0.5, 0.25 slightly ahead with support boxes.
+// of fat boxes through to the box test. The value is the best of a sweep
+// of fractions in bench/broad_phase_bench, whose bodies move about 2% of
+// their size per step, as a scene's bodies do between steps.
 constexpr double kFatFraction = 0.25;
 
 // Fixed chunks of the tree's parallel loops (parallel_ranges.h): ids checked
@@ -235,9 +235,9 @@ Aabb merged(const Aabb& a, const Aabb& b) { return {a.lo.cwiseMin(b.lo), a.hi.cw
 // Half the surface area: the insertion cost of the surface-area heuristic
 // (the chance that a random ray or box hits the node grows with it). The
 // half perimeter (Box2D v3's choice) cannot overflow, but made the tree's
-// steps slower at 1,000 bodies in broad_phase_bench (450 against 270 us);
-// the products overflow to inf only in scenes spanning more than ~1e154, and
-// growth() below keeps inf - inf from becoming NaN there.
+// steps slower (bench/broad_phase_bench); the products overflow to inf
+// only in scenes spanning more than ~1e154, and growth() below keeps
+// inf - inf from becoming NaN there.
 double cost_of(const Aabb& b) {
   const Vec3 e = b.hi - b.lo;
   return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();

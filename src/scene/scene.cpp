@@ -41,8 +41,8 @@ namespace {
 using detail::Aabb;
 
 // Smallest index range a sweep's task runs (its time of impact queries): a
-// tracked query costs about 0.1 to 0.3 us, a TBB task about 1 us to
-// schedule (as in batch.cpp).
+// tracked query costs a fraction of what a TBB task costs to schedule, so a
+// task must run tens of them to pay for itself (as in batch.cpp).
 constexpr std::size_t kGrainSize = 32;
 
 // Fixed chunks (parallel_ranges.h) of the step's parallel loops: the world
@@ -152,8 +152,9 @@ struct Scene::Impl {
     // pairs go through the compound query). Null for a mesh.
     std::shared_ptr<const CompoundBody> compound;
     // The body as a proxima::Body, on the heap: the step's loops read the
-    // fields around it for every pair, and scene_bench measured a step 4 to
-    // 8% slower at 10,000 bodies with the two Bodies held here.
+    // fields around it for every pair, and two Bodies held here would spread
+    // those fields over more cache lines (a slower step in bench/scene_bench
+    // at 10,000 bodies).
     std::unique_ptr<Shape> shape;
     double reach = 0.0;    // shape->padded.radius(): how far the body reaches beyond its core
     bool general = false;  // rounded, padded or a mesh: its pairs take the Body query
@@ -264,10 +265,9 @@ struct Scene::Impl {
   // World box inflated so that box overlap means "may be within margin":
   // each box takes half the margin (and half the touching tolerance Ae).
   // Convex bodies get the exact box of their placed hull (six warm hill
-  // climbs) rather than the box of their bounding sphere: broad_phase_bench
-  // measured 37% fewer candidate pairs and a 3 to 6% faster Scene::step at
-  // 1,000 and 10,000 bodies (the hill climbs cost less than the tracked
-  // queries they save).
+  // climbs) rather than the box of their bounding sphere: fewer candidate
+  // pairs reach the narrow phase, and the hill climbs cost less than the
+  // tracked queries they save (bench/broad_phase_bench).
   //
   // A mesh's box is its hierarchy's root box, placed (the box of the
   // turned box); a general body's box grows by its reach (radius plus

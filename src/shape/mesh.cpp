@@ -46,7 +46,7 @@ float float_up(double x) {
 
 // Floats: they only order the triangles and rank the splits (the node boxes
 // are computed from the vertices in doubles); half the bytes of doubles for
-// nth_element to move (10^6-triangle build 1.23 -> 1.07 s, one run each).
+// nth_element to move, which the build of a large mesh spends its time on.
 struct BuildItem {
   Eigen::Vector3f centroid;  // in units of the mesh's unit (|.| <= 1)
   std::int32_t triangle;
@@ -84,11 +84,10 @@ struct Builder {
     }
     // Median split of the centroids (equal halves: full leaves, so the node
     // count and the memory stay fixed) along the axis whose two halves have
-    // the smallest boxes (sum of their edge lengths). Against the longest
-    // axis of the centroids' box (bench/mesh_bench, env/rob, cold, medians):
-    // random poses 42 -> 16 us, node pairs 453 -> 221, triangle pairs 74 ->
-    // 48 per query; env's large slanted triangles are what the longest axis
-    // split badly.
+    // the smallest boxes (sum of their edge lengths), rather than the longest
+    // axis of the centroids' box: env's large slanted triangles are what the
+    // longest axis split badly, and the smaller halves let the query prune
+    // more node and triangle pairs (bench/mesh_bench, env/rob).
     const std::int32_t mid = first + (last - first) / 2;
     const auto by_axis = [](int axis) {
       return [axis](const BuildItem& x, const BuildItem& y) {
@@ -98,7 +97,7 @@ struct Builder {
     // The axis is chosen on the range itself, or on an even sample of it
     // when large (the top levels of a big mesh: the choice needs only the
     // halves' rough boxes, and three trial partitions of the whole range
-    // made the 10^6-triangle build take ~3x as long).
+    // would dominate the build of a large mesh).
     std::span<BuildItem> trial(items.data() + first, static_cast<std::size_t>(last - first));
     if (trial.size() > kSplitSample) {
       sample.clear();
@@ -159,19 +158,14 @@ std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t x) {
 // boxes' projections on A's three axes and on B's three axes (mesh_distance.cpp:
 // exact for aligned boxes, a few dozen flops, no square root), and a box
 // stores in 24 bytes of float, which keeps the hierarchy inside the memory
-// target (1.86x the raw vertices and triangles on the 10^6-triangle build,
-// leaf 4). Measured on FCL's env/rob pair (bench/mesh_bench, 200 random
-// poses / 500 motion steps, medians, cold): these boxes test 271 / 322
-// triangle pairs and 916 / 828 node pairs for separated poses, 141 / 99 us;
-// the bounding spheres of the same boxes 609 / 542 triangle pairs and
-// 4530 / 4218 node pairs, 517 / 326 us (3.7x / 3.3x slower). FCL's
-// OBBRSS took 67 / 60 us in the same runs. (Those figures are from the
-// depth-first traversal and the longest-axis split; with the best-first
-// traversal and the split of the smallest halves the same boxes take about
-// 17 / 9 us, 22 / 21 triangle pairs.) An oriented volume would be tighter
-// around env's large slanted triangles (median edge 490, up to 8450, in a
-// 6000 box) but needs its rotation stored per node, beyond the memory
-// target at 4 triangles per leaf; not measured here.
+// target (twice the raw vertices and triangles). Bounding spheres of the
+// same boxes are looser: on FCL's env/rob pair (bench/mesh_bench) they let
+// through about twice the triangle pairs and several times the node pairs,
+// and were slower (measured with an earlier traversal; the figures are in
+// CHANGELOG.md). An oriented volume would be tighter around env's large
+// slanted triangles (median edge 490, up to 8450, in a 6000 box) but needs
+// its rotation stored per node, beyond the memory target at 4 triangles
+// per leaf; it has not been tried.
 //
 // Fixed ray directions for the inside test, each with all components
 // non-zero (no division by zero in the slab test) and one of magnitude 1

@@ -15,6 +15,7 @@
 #include <atomic>
 #include <cfenv>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -395,6 +396,48 @@ TEST(Batch, ExceptionInsideAWorkerReachesTheCallerWithItsMessage) {
   }
 }
 
+// Waits, inside a parallel loop's tasks, until a second thread has been
+// seen running one of them: each task registers its thread, and the tasks
+// that run before another thread has registered block until one does. A
+// task that blocks keeps its thread busy, so the loop's remaining ranges can
+// only be run by another thread of the arena; if none ever joins (the loop
+// ran on one thread), the wait gives up after kSecondThreadTimeout and the
+// test sees one thread. Replaces a 1 ms sleep per task, which let a loop run
+// entirely on the calling thread and the test still pass.
+class SecondThreadRendezvous {
+ public:
+  // Generous: a worker that wakes late on a loaded machine (the suite runs
+  // on 2 shared cores, under the sanitizers too) must not fail the test; a
+  // loop that never gets a second thread costs this once, then every later
+  // task goes through without waiting.
+  static constexpr std::chrono::seconds kSecondThreadTimeout{30};
+
+  // Called by every task; returns once two threads have been seen or the
+  // wait has timed out once.
+  void arrive() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    threads_.insert(std::this_thread::get_id());
+    if (threads_.size() >= 2) {
+      joined_.notify_all();
+      return;
+    }
+    if (timed_out_) return;
+    if (!joined_.wait_for(lock, kSecondThreadTimeout, [&] { return threads_.size() >= 2; })) {
+      timed_out_ = true;
+    }
+  }
+  std::size_t threads_seen() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return threads_.size();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::condition_variable joined_;
+  std::set<std::thread::id> threads_;
+  bool timed_out_ = false;
+};
+
 // The floating-point traps of the test main cover the main thread only (the
 // FP environment is per thread). TBB hands the FP control settings of the
 // thread that initializes an arena to every task the arena runs (the
@@ -412,7 +455,7 @@ TEST(Batch, CallerArenaWithFloatingPointTrapsOnEveryThread) {
   tbb::task_arena arena(2);
   arena.initialize();
   std::mutex mutex;
-  std::set<std::thread::id> threads_seen;
+  SecondThreadRendezvous rendezvous;
   int tasks_without_traps = 0;
   // Through proxima's own pool (parallel_ranges, the code distance_batch
   // runs on), not a tbb::parallel_for instantiated here: under
@@ -421,17 +464,17 @@ TEST(Batch, CallerArenaWithFloatingPointTrapsOnEveryThread) {
   arena.execute([&] {
     detail::parallel_ranges(64, 1, 0, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        // Long enough for the worker to join in (the machine may be busy).
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        rendezvous.arrive();
         const bool traps =
             (fegetexcept() & (FE_INVALID | FE_DIVBYZERO)) == (FE_INVALID | FE_DIVBYZERO);
         const std::lock_guard<std::mutex> lock(mutex);
-        threads_seen.insert(std::this_thread::get_id());
         tasks_without_traps += traps ? 0 : 1;
       }
     });
   });
-  EXPECT_EQ(tasks_without_traps, 0) << "over " << threads_seen.size() << " threads";
+  // The premise is about the worker: without it, the loop proved nothing.
+  ASSERT_GE(rendezvous.threads_seen(), 2u) << "the arena's second thread never ran a task";
+  EXPECT_EQ(tasks_without_traps, 0) << "over " << rendezvous.threads_seen() << " threads";
   Rng rng(13);
   Scene s = make_scene(rng, kPairs);
   std::vector<DistanceCache> caches(s.pairs.size());
@@ -461,19 +504,24 @@ TEST(ParallelRanges, EachLoopRunsUnderTheCallersFloatingPointSettings) {
   const int traps = FE_INVALID | FE_DIVBYZERO;
   ASSERT_EQ(fegetexcept() & traps, traps);  // the test main's
   std::mutex mutex;
+  // Each loop must be seen running on two threads: the settings are the
+  // caller's on the caller's thread anyway, so a loop the worker never
+  // joined would check nothing.
   const auto tasks_with_traps = [&](int threads, int& tasks) {
     int trapping = 0;
     tasks = 0;
+    SecondThreadRendezvous rendezvous;
     detail::parallel_ranges(32, 1, threads, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        // Long enough for the worker to join in (the machine may be busy).
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        rendezvous.arrive();
         const bool on = (fegetexcept() & traps) == traps;
         const std::lock_guard<std::mutex> lock(mutex);
         ++tasks;
         trapping += on ? 1 : 0;
       }
     });
+    EXPECT_GE(rendezvous.threads_seen(), 2u)
+        << "the loop's second thread never ran a task (" << threads << " threads asked)";
     return trapping;
   };
   int tasks = 0;

@@ -67,17 +67,17 @@ struct SceneOptions {
   // overlapping pairs then report status intersecting with distance 0 and
   // no depth (signed distance 0, bounds [-inf, 0]). With
   // distance.penetration true every overlapping pair gets its depth, but
-  // while the depth's tracking re-enumerates A - B whenever a body turns,
-  // that costs 5 to 60 us per overlapping pair and step (distance_bench
-  // TrackingOverlap), and made scene_bench's Scene::step 25 times slower
-  // (0.58 -> 14.8 ms at 1,000 bodies).
+  // the depth's tracking re-enumerates A - B whenever a body turns, so each
+  // overlapping pair costs many times a tracked distance, every step
+  // (bench/distance_bench TrackingOverlap), and a scene's step, where most
+  // close pairs overlap, many times as long (bench/scene_bench).
   DistanceOptions distance = [] {
     DistanceOptions o;
     o.penetration = false;
     return o;
   }();
-  // The tree by default: broad_phase_bench measured it 2.5 to 4.5 times
-  // faster than sweep and prune (one sorted axis) at 1,000 and 10,000 bodies.
+  // The tree by default: it is faster than sweep and prune (one sorted
+  // axis) at 1,000 and 10,000 bodies (bench/broad_phase_bench).
   BroadPhase broad_phase = BroadPhase::dynamic_aabb_tree;
   // Narrow-phase threads: 1 runs in the caller's thread, 0 in the caller's
   // TBB arena, n > 1 in a dedicated arena, kept per calling thread (as
@@ -109,8 +109,9 @@ struct CollisionFilter {
 // pairs_tested 1, and triangle_a/triangle_b its closest triangles of mesh
 // bodies (-1 for other kinds and for every other pair). Overlapping convex
 // or compound cores get their depth when SceneOptions::distance.penetration
-// is set (signed distance minus the depth minus the radii; 5 to 60 us per
-// such pair and step, as for plain pairs); without it (the default), and
+// is set (signed distance minus the depth minus the radii; as costly per
+// such pair and step as for plain pairs, SceneOptions::distance); without
+// it (the default), and
 // for an overlap with a mesh, the cores' signed value is 0 with bounds
 // [-inf, 0] (signed distance minus the radii).
 struct ClosePair {
@@ -251,7 +252,8 @@ class Scene {
   std::span<const ImpactPair> sweep(const ImpactOptions& options);
   // The same with ImpactOptions{} but the scene's distance options
   // (options().distance): by default no penetration depth for pairs that
-  // overlap at t = 0 (as step(); with it, each such pair costs 5 to 60 us).
+  // overlap at t = 0 (as step(); with it, each such pair costs a depth
+  // query, SceneOptions::distance).
   std::span<const ImpactPair> sweep();
   const SweepStats& sweep_stats() const;
 

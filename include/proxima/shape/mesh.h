@@ -39,16 +39,11 @@ class TriangleMesh {
   // or all the other way; either works.
   using Triangle = std::array<std::uint32_t, 3>;
 
-  // The most triangles a leaf of the hierarchy holds. Measured on FCL's
-  // env/rob pair (bench/mesh_bench, 200 random poses and 500 motion steps,
-  // median cold query against FCL OBBRSS in the same run) and on the
-  // 10^6-triangle build (bytes against the raw vertices and triangles):
-  //   leaf 1: 0.61x / 0.80x FCL, 3.83x the raw bytes;
-  //   leaf 2: 0.46x / 0.62x FCL, 2.56x;
-  //   leaf 4: 0.48x / 0.66x FCL, 1.86x (tracked motion: 20x FCL for all).
-  // 4 is the only one inside the memory target (2x) at about leaf 1's time.
-  // (Measured with the depth-first traversal and the longest-axis split
-  // that mesh_distance.cpp and mesh.cpp have since replaced.)
+  // The most triangles a leaf of the hierarchy holds: the smallest leaf
+  // that keeps the hierarchy inside the memory target (twice the bytes of
+  // the raw vertices and triangles); smaller leaves cost more memory
+  // without a faster query (bench/mesh_bench on FCL's env/rob pair; the
+  // figures, from an earlier traversal, are in CHANGELOG.md).
   static constexpr std::int32_t kLeafSize = 4;
 
   // A node of the bounding-volume hierarchy: an axis-aligned box in the

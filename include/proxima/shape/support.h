@@ -22,13 +22,14 @@ int support_brute_force(std::span<const Vec3> vertices, const Vec3& dir);
 // support_without_hint: the scan is a fixed loop without a branch that
 // depends on the data, while a climb ends at a different step every time,
 // a mispredicted branch per search, and from a poor start crosses half the
-// body (cold queries on random poses, 2000 poses, median of 7: 32 vertices
-// 402 -> 380 ns against the seeded climb below, 64 vertices no faster).
+// body. Cold queries on random poses (bench/distance_bench) are faster
+// scanned up to 32 vertices, no faster at 64.
 inline constexpr int kScanVertices = 32;
 
 // Vertices at evenly spaced ids that seed support_without_hint's climb on
-// larger bodies (cold queries at 4096 vertices: 1440 ns from vertex 0,
-// 925 from 8 seeds, 830 from 16).
+// larger bodies: more seeds start the climb nearer the support point, at
+// the cost of a short scan (16 beat 8 and a start at vertex 0 in cold
+// queries at 4096 vertices, bench/distance_bench).
 inline constexpr int kSupportSeeds = 16;
 
 // Index of a vertex maximizing dir.dot(vertex) when no hint is known (a

@@ -74,8 +74,8 @@ namespace detail {
 
 // Dot and cross products and squared norms written out on the components.
 // Eigen evaluates them on 3-vectors of double with 2-wide SSE packets and
-// shuffles, which made the point-triangle kernel twice as slow as scalar
-// code (40 ns against 18 ns per call in closest_point_bench's setting).
+// shuffles, which made the point-triangle kernel slower than scalar code
+// (bench/closest_point_bench).
 // They take any 3-vector expression; .eval() is a reference for a plain
 // vector and evaluates an expression once.
 template <class D1, class D2>
