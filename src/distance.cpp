@@ -67,7 +67,8 @@ double world_magnitude_floor(const ConvexPolytope& p, const Pose& pose,
 // The checks of distance()'s options; throws InvalidInput naming the
 // option. Out of line: distance_in_frame calls it only when a cheaper
 // sufficient test on the bits fails.
-[[gnu::noinline]] void check_options(const DistanceOptions& options) {
+[[gnu::noinline]] void check_options(const DistanceOptions& options,
+                                     const char* what = "distance") {
   // Finite and >= 0, -0.0 included, decided on the bits: a comparison of a
   // NaN raises FE_INVALID, which a caller's trap turns into SIGFPE instead
   // of this refusal (Pose.DistanceOptionsAreCheckedExactly).
@@ -77,12 +78,12 @@ double world_magnitude_floor(const ConvexPolytope& p, const Pose& pose,
   };
   if (!finite_non_negative(options.relative_tolerance) ||
       !finite_non_negative(options.absolute_tolerance)) {
-    throw InvalidInput(
-        "distance: options.relative_tolerance and options.absolute_tolerance must be finite and >= "
-        "0");
+    throw InvalidInput(std::string(what) +
+                       ": options.relative_tolerance and options.absolute_tolerance must be "
+                       "finite and >= 0");
   }
   if (options.max_iterations < 1) {
-    throw InvalidInput("distance: options.max_iterations must be at least 1");
+    throw InvalidInput(std::string(what) + ": options.max_iterations must be at least 1");
   }
 }
 
@@ -368,6 +369,10 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
 }
 
 namespace detail {
+
+void check_distance_options(const DistanceOptions& options, const char* what) {
+  check_options(options, what);
+}
 
 DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
                                        const ConvexPolytope& b, const Pose& pose_b,

@@ -33,6 +33,10 @@ namespace detail {
 DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
                                        const ConvexPolytope& b, const Pose& pose_b,
                                        const DistanceOptions& options, DistanceCache* cache);
+// The checks of the options every query shares (tolerances finite and >= 0,
+// at least one iteration); throws InvalidInput naming the option, after
+// `what` (the query's name).
+void check_distance_options(const DistanceOptions& options, const char* what);
 }  // namespace detail
 
 }  // namespace proxima
