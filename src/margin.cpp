@@ -26,6 +26,14 @@ namespace {
 // (distance.cpp says why: beyond it differences of coordinates overflow).
 constexpr double kMaxMagnitude = 0x1p1018;
 
+// Slack of a sphere gap, in units of u times the magnitudes involved (the
+// centers' coordinates, the radii, the gap's norm): the placed centers are
+// a rotation and a translation away from stored doubles (a few u of their
+// magnitude each), a stored radius is a rounded maximum of rounded norms (a
+// few u of itself), and the norm and subtractions add a few u more. 256 u
+// covers all of them with room, as the compound pruning's slack does.
+constexpr double kSphereSlackUlps = 256.0;
+
 // The verdict of a full distance answer (the fallback, and the twin's
 // rule): touching and intersecting are within any margin; a separated or
 // capped answer is within when its closest points are at most margin +
@@ -107,14 +115,9 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
     const Pose place_a = pose_a * ma[i].pose;
     const Pose place_b = pose_b * mb[j].pose;
     if (pairs > 1) {
-      const Vec3 ca = place_a.apply(ma[i].mesh->center());
-      const Vec3 cb = place_b.apply(mb[j].mesh->center());
-      // Rounding of the placed centers and the norm: a relative 1e-12
-      // slack (as the distance query's pruning of mesh pairs).
-      const double gap =
-          ((ca - cb).norm() - ma[i].mesh->bounding_radius() - mb[j].mesh->bounding_radius()) *
-              (1.0 - 1e-12) -
-          1e-300;
+      const double gap = detail::sphere_gap_lower_bound(
+          place_a.apply(ma[i].mesh->center()), ma[i].mesh->bounding_radius(),
+          place_b.apply(mb[j].mesh->center()), mb[j].mesh->bounding_radius());
       if (gap > margin) {
         out.lower_bound = std::min(out.lower_bound, gap);
         continue;
@@ -150,6 +153,14 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
 
 namespace detail {
 
+double sphere_gap_lower_bound(const Vec3& center_a, double radius_a, const Vec3& center_b,
+                              double radius_b) {
+  const double d = (center_a - center_b).norm();
+  const double reach = center_a.cwiseAbs().maxCoeff() + center_b.cwiseAbs().maxCoeff() + d +
+                       radius_a + radius_b;
+  return d - radius_a - radius_b - kSphereSlackUlps * kUnitRoundoff * reach;
+}
+
 void check_margin(double margin, const char* what) {
   const std::uint64_t bits = std::bit_cast<std::uint64_t>(margin);
   if (!(bits < 0x7ff0000000000000ULL || bits == 0x8000000000000000ULL)) {
@@ -175,6 +186,15 @@ MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& p
     throw InvalidInput(message);
   }
   const double band = contact_band(magnitude, options.absolute_tolerance);
+  // Far apart: the bounding spheres prove it without the hulls.
+  const double gap = sphere_gap_lower_bound(pose_a.apply(a.centroid()), a.bounding_radius(),
+                                            pose_b.apply(b.centroid()), b.bounding_radius());
+  if (gap > margin) {
+    MarginResult out;
+    out.margin = margin;
+    out.lower_bound = gap;
+    return out;
+  }
   if (options.algorithm == Algorithm::hybrid) {
     const DistanceResult r =
         hybrid_within(a, b, pose_a.inverse() * pose_b, options, band, margin, cache);
@@ -202,15 +222,32 @@ MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& p
 
 }  // namespace detail
 
+namespace {
+
+// The convex query with poses to check (or re-orthonormalize) and a cold
+// cache of its own where the caller gave none: out of line, so that the
+// tracked query of rigid poses (a planner's every check) pays neither the
+// copies of the poses nor a cold cache's construction.
+[[gnu::noinline]] MarginResult convex_within_slow(const ConvexPolytope& a, const Pose& pose_a,
+                                                  const ConvexPolytope& b, const Pose& pose_b,
+                                                  double margin, const DistanceOptions& options,
+                                                  DistanceCache* cache) {
+  DistanceCache cold;
+  return detail::within_margin_of_rigid_poses(a, checked_pose(pose_a, "within_margin: pose_a"), b,
+                                              checked_pose(pose_b, "within_margin: pose_b"),
+                                              margin, options, cache != nullptr ? *cache : cold);
+}
+
+}  // namespace
+
 MarginResult within_margin(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
                            const Pose& pose_b, double margin, const DistanceOptions& options,
                            DistanceCache* cache) {
   detail::check_margin(margin, "within_margin");
   detail::check_distance_options(options, "within_margin");
-  DistanceCache cold;
-  return detail::within_margin_of_rigid_poses(a, checked_pose(pose_a, "within_margin: pose_a"), b,
-                                              checked_pose(pose_b, "within_margin: pose_b"),
-                                              margin, options, cache != nullptr ? *cache : cold);
+  if (cache == nullptr || !detail::are_rigid(pose_a, pose_b)) [[unlikely]]
+    return convex_within_slow(a, pose_a, b, pose_b, margin, options, cache);
+  return detail::within_margin_of_rigid_poses(a, pose_a, b, pose_b, margin, options, *cache);
 }
 
 MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,

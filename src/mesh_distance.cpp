@@ -532,11 +532,22 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
                            const Pose& pose_b, double margin, const DistanceOptions& options,
                            MeshCache* cache) {
   detail::check_margin(margin, "within_margin");
-  const Query q = make_query(a, pose_a, b, pose_b, options);
   const Pose pa = checked_pose(pose_a, "within_margin: pose_a");
-  MarginSearch search(q, margin);
+  const Pose pb = checked_pose(pose_b, "within_margin: pose_b");
   MarginResult r;
   r.margin = margin;
+  // Far apart: the root boxes' balls prove it without the hierarchies (the
+  // options are checked first, as every query checks them).
+  if (!is_finite_bits(options.absolute_tolerance) || !(options.absolute_tolerance >= 0.0))
+    throw InvalidInput("within_margin: absolute_tolerance must be finite and >= 0");
+  const double gap = detail::sphere_gap_lower_bound(pa.apply(a.center()), a.bounding_radius(),
+                                                    pb.apply(b.center()), b.bounding_radius());
+  if (gap > margin) {
+    r.lower_bound = gap;
+    return r;
+  }
+  const Query q = make_query(a, pa, b, pb, options);
+  MarginSearch search(q, margin);
   const bool same_pair = cache != nullptr && cache->mesh_a == a.id() && cache->mesh_b == b.id();
   // The last witness (or closest) pair first: a colliding pair often still
   // collides there.

@@ -154,6 +154,13 @@ MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& p
                                           const ConvexPolytope& b, const Pose& pose_b,
                                           double margin, const DistanceOptions& options,
                                           DistanceCache& cache);
+// A certified lower bound on the distance between two balls (world
+// centers and radii, each holding its body up to the rounding of the
+// radius): the gap |c_a - c_b| - r_a - r_b less a slack for the rounding of
+// the placed centers, the radii and the norm. O(1): the first test of every
+// margin query, which ends it for bodies far apart.
+double sphere_gap_lower_bound(const Vec3& center_a, double radius_a, const Vec3& center_b,
+                              double radius_b);
 // The margin, refused by name unless finite and >= 0 (decided on the bits:
 // no comparison of a NaN, which a caller's traps would turn into SIGFPE).
 void check_margin(double margin, const char* what);
