@@ -1,5 +1,5 @@
 // Collision checks at planner speed (issue 26): the boolean and margin
-// queries (proxima/margin.h) against FCL 0.7 on the same pairs and poses.
+// queries (proxima/query/margin.h) against FCL 0.7 on the same pairs and poses.
 // The robotics example's arm (the Franka Panda's seven links and hand,
 // examples/panda_arm.h), every non-adjacent pair of links (28), with the
 // links as their hulls and as their meshes as given, along the example's
@@ -29,10 +29,10 @@
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
-#include <proxima/distance.h>
 #include <proxima/io.h>
-#include <proxima/margin.h>
-#include <proxima/mesh.h>
+#include <proxima/query/distance.h>
+#include <proxima/query/margin.h>
+#include <proxima/query/mesh_distance.h>
 
 #include <algorithm>
 #include <array>

@@ -1,0 +1,53 @@
+# Proves that the layers of cmake/layers.cmake hold: for each layer, a scratch
+# source that includes a header of the next layer up, compiled with that
+# layer's include root, must fail ("file not found"); the same source
+# including a header of its own layer must compile. Run by ctest
+# (layering.upward_include_fails) with:
+#   -DCXX=<compiler> -DLAYERS_DIR=<build>/layers -DEIGEN_DIR=<dir> -DWORK_DIR=<scratch>
+#   -DLAYERS="core;geometry;..." -DHEADERS="<one header per layer, '-' where none>"
+file(MAKE_DIRECTORY ${WORK_DIR})
+list(LENGTH LAYERS count)
+math(EXPR last "${count} - 1")
+set(failures 0)
+foreach(i RANGE 0 ${last})
+  list(GET LAYERS ${i} layer)
+  list(GET HEADERS ${i} own)
+  # The first header of a layer above this one.
+  set(upper "-")
+  math(EXPR next "${i} + 1")
+  if(next LESS_EQUAL last)
+    foreach(j RANGE ${next} ${last})
+      list(GET HEADERS ${j} candidate)
+      if(upper STREQUAL "-" AND NOT candidate STREQUAL "-")
+        set(upper ${candidate})
+      endif()
+    endforeach()
+  endif()
+  foreach(kind own upper)
+    set(header ${${kind}})
+    if(header STREQUAL "-")
+      continue()
+    endif()
+    set(source ${WORK_DIR}/${layer}_${kind}.cpp)
+    file(WRITE ${source} "#include \"${header}\"\nint main() { return 0; }\n")
+    execute_process(COMMAND ${CXX} -std=c++20 -fsyntax-only -I${LAYERS_DIR}/${layer} -I${EIGEN_DIR} ${source}
+                    RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(kind STREQUAL "own" AND NOT result EQUAL 0)
+      message(SEND_ERROR "layer ${layer}: its own header ${header} does not compile at its root:\n${err}")
+      math(EXPR failures "${failures} + 1")
+    elseif(kind STREQUAL "upper")
+      if(result EQUAL 0)
+        message(SEND_ERROR "layer ${layer}: the upward include of ${header} compiled")
+        math(EXPR failures "${failures} + 1")
+      elseif(NOT err MATCHES "No such file or directory")
+        message(SEND_ERROR "layer ${layer}: the upward include of ${header} failed for another reason:\n${err}")
+        math(EXPR failures "${failures} + 1")
+      else()
+        message(STATUS "layer ${layer}: #include \"${header}\" refused, as it must be")
+      endif()
+    endif()
+  endforeach()
+endforeach()
+if(failures GREATER 0)
+  message(FATAL_ERROR "${failures} layering check(s) failed")
+endif()
