@@ -34,10 +34,11 @@
 
 #include "answer_writer.h"
 #include "json_errors.h"
+#include "proxima/motion/time_of_impact.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
+#include "proxima/query/margin.h"
 #include "proxima/shape/polytope.h"
-#include "proxima/motion/time_of_impact.h"
 
 namespace proxima::cli {
 namespace {
@@ -324,6 +325,47 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
     std::optional<Motion> motion_b;
     read_body(query, "a", order, work.vertices_a, work.triangles_a, pose_a, radius_a, motion_a);
     read_body(query, "b", order, work.vertices_b, work.triangles_b, pose_b, radius_b, motion_b);
+    const auto margin_it = query.find("margin");
+    if (margin_it != query.end() && !margin_it->is_null()) {
+      // The margin (or, at 0, boolean) query: its own answer line.
+      const double margin = read_nonnegative(query, "margin", 0.0);
+      if (motion_a || motion_b) {
+        fail("margin asks for the margin answer at one pose; a body with a motion asks for a "
+             "time of impact (use target_separation there)");
+      }
+      const MarginResult m =
+          within_margin(query_body(work.vertices_a, work.triangles_a, radius_a, "a"), pose_a,
+                        query_body(work.vertices_b, work.triangles_b, radius_b, "b"), pose_b,
+                        margin, options, nullptr);
+      if (!std::isfinite(m.lower_bound) || !m.point_a.allFinite() || !m.point_b.allFinite())
+        fail("the result is not finite: the coordinates are too large for double arithmetic");
+      out += "{\"id\":";
+      append_id(out, id);
+      out += ",\"within\":";
+      out += m.is_within() ? "true" : "false";
+      out += ",\"status\":\"";
+      out += to_string(m.status);
+      out += "\",\"margin\":";
+      append_number(out, m.margin);
+      out += ",\"lower_bound\":";
+      append_number(out, m.lower_bound);
+      out += ",\"upper_bound\":";
+      if (std::isfinite(m.upper_bound)) {
+        append_number(out, m.upper_bound);
+        out += ",\"point_a\":";
+        append_point(out, m.point_a);
+        out += ",\"point_b\":";
+        append_point(out, m.point_b);
+      } else {
+        out += "null";
+      }
+      if (!work.triangles_a.empty() || !work.triangles_b.empty()) {
+        out += ",\"triangle_a\":" + std::to_string(m.triangle_a);
+        out += ",\"triangle_b\":" + std::to_string(m.triangle_b);
+      }
+      out += '}';
+      return true;
+    }
     if ((!work.triangles_a.empty() || !work.triangles_b.empty()) && !motion_a && !motion_b) {
       // A mesh on either side: the one call for any two bodies.
       const BodyDistance m = distance(

@@ -428,9 +428,15 @@ PYBIND11_MODULE(_proxima, m) {
 
   m.def(
       "signed_distance_gradient",
-      [](const DistanceResult& r, py::object pose_a, py::object pose_b) {
+      [](py::object result, py::object pose_a, py::object pose_b) {
+        const Pose pa = to_pose(pose_a, "pose_a");
+        const Pose pb = to_pose(pose_b, "pose_b");
+        // A Body answer through its own overload: a mesh overlap is refused
+        // with its reason (no depth is defined for it).
         const SignedDistanceGradient g =
-            signed_distance_gradient(r, to_pose(pose_a, "pose_a"), to_pose(pose_b, "pose_b"));
+            py::isinstance<BodyDistance>(result)
+                ? signed_distance_gradient(result.cast<const BodyDistance&>(), pa, pb)
+                : signed_distance_gradient(result.cast<const DistanceResult&>(), pa, pb);
         py::array_t<double> out({py::ssize_t{2}, py::ssize_t{6}});
         auto o = out.mutable_unchecked<2>();
         for (int k = 0; k < 6; ++k) {
@@ -446,7 +452,8 @@ result: the answer of distance() (or of the compound distance) at pose_a, pose_b
 poses of that query). Returns a (2, 6) array: row 0 for A, row 1 for B, each the derivative
 along world translations (3) then along small rotations about world axes through the body's
 origin (3). Exact where the witness pair is unique, else one-sided (a subgradient); raises
-InvalidInput for an intersecting answer computed without the depth.)doc");
+InvalidInput for an intersecting answer computed without the depth, or for an overlap with a
+triangle mesh (no depth is defined for it: use the mesh's hull or convex pieces).)doc");
 
   // --- Queries --------------------------------------------------------------
   const DistanceOptions defaults;

@@ -24,6 +24,7 @@
 #include "proxima/query/body_distance.h"
 #include "proxima/query/compound_distance.h"
 #include "proxima/query/distance.h"
+#include "proxima/query/margin.h"
 #include "proxima/query/mesh_distance.h"
 #include "proxima/query/signed_distance.h"
 #include "proxima/scene/scene.h"

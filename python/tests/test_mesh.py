@@ -57,6 +57,20 @@ def test_mesh_against_any_body_equals_the_convex_query():
     assert r.triangle_a >= 0 and r.triangle_b >= 0
 
 
+def test_gradient_of_a_mesh_overlap_names_the_real_reason():
+    # Issue 26: the refusal blamed the penetration option (which was on); no
+    # depth is defined for an overlap with a mesh, and the message says so.
+    mesh = proxima.TriangleMesh(*cube(1.0))
+    at = ((1, 0, 0, 0), (0.9, 0, 0))
+    r = proxima.distance(mesh, None, proxima.sphere(0.5), at)
+    assert r.status == "intersecting"
+    with pytest.raises(proxima.InvalidInput, match="triangle mesh"):
+        proxima.signed_distance_gradient(r, None, at)
+    box = proxima.box((1, 1, 1))
+    g = proxima.signed_distance_gradient(proxima.distance(box, None, proxima.sphere(0.5), at), None, at)
+    assert g.shape == (2, 6)
+
+
 def test_bad_arrays_are_named():
     v, f = cube()
     with pytest.raises(ValueError, match="integer vertex indices"):

@@ -385,12 +385,17 @@ bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const V
 // kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
 // in the caller's units, like the result returned. The unscaled instance is
 // the hot path and multiplies by nothing.
-template <bool kScaled>
+//
+// kMargin: the margin query (hybrid_within): the loop stops at the first
+// proof about `margin` instead of converging (see hybrid_within), and the
+// answer skips what only a distance answer needs (contact classification,
+// witness features, cross-check).
+template <bool kScaled, bool kMargin = false>
 [[gnu::always_inline]] inline DistanceResult run_hybrid(const ConvexPolytope& a,
                                                         const ConvexPolytope& b, const Pose& b_in_a,
                                                         const DistanceOptions& options, double band,
                                                         DistanceCache& cache, double magnitude,
-                                                        double scale) {
+                                                        double scale, double margin = 0.0) {
   const double contact_tolerance = kScaled ? band * scale : band;
   const double r_local = kScaled ? magnitude * scale : magnitude;
   const Mat3& rot = b_in_a.rotation;
@@ -410,6 +415,11 @@ template <bool kScaled>
     }
   };
   const double ulp_r = kUnitRoundoff * r_local;
+  // The margin query's two proofs (hybrid_within), in local units: a
+  // witness pair at most margin + band apart, or a support gap above the
+  // margin by more than its rounding.
+  const double yes_at = kScaled ? (margin + band) * scale : margin + band;
+  const double no_above = (kScaled ? margin * scale : margin) + kGapUlps * ulp_r;
   // Features shorter or flatter than a few u R are reduced (closest_point.h).
   const KernelTolerance<double> tol = kernel_tolerance(r_local);
 
@@ -455,6 +465,9 @@ template <bool kScaled>
   bool contact = false;
   for (;;) {
     const double d = std::sqrt(loc.distance_squared);
+    if constexpr (kMargin) {
+      if (d <= yes_at) break;
+    }
     if (d <= contact_tolerance) {
       contact = true;
       break;
@@ -469,7 +482,12 @@ template <bool kScaled>
     const double wa = w.dot(pa);
     const double wb = w.dot(pb);
     lower = std::max(lower, wb - wa);
-    if (d - lower <= options.relative_tolerance * d + kTerminationGapUlps * ulp_r) break;
+    if constexpr (kMargin) {
+      if (lower > no_above) break;
+    }
+    // The margin query converges only to machine precision: a gap within
+    // Re d proves nothing about the margin.
+    if (d - lower <= (kMargin ? 0.0 : options.relative_tolerance * d) + kTerminationGapUlps * ulp_r) break;
     if (iterations >= options.max_iterations) {
       result.status = Status::iteration_cap;
       break;
@@ -527,6 +545,14 @@ template <bool kScaled>
     result.point_b *= unit;
     result.distance *= unit;
     result.lower_bound *= unit;
+  }
+  if constexpr (kMargin) {
+    // The support gap with its rounding slack taken off: certified. The
+    // faces of the last distance answer no longer describe the cached pair.
+    result.lower_bound = std::max(0.0, (lower - kGapUlps * ulp_r) * unit);
+    cache.face_a = -1;
+    cache.face_b = -1;
+    return result;
   }
   // The hybrid reports contact without telling touching from overlapping:
   // the contact unit (proxima/detail/narrowphase/contact.h) decides, in the caller's units,
@@ -603,6 +629,20 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
     return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
   }
   return run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
+}
+
+DistanceResult hybrid_within(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                             const DistanceOptions& options, double contact_tolerance,
+                             double margin, DistanceCache& cache) {
+  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
+  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
+      !std::isfinite(r_local)) [[likely]] {
+    return run_hybrid<false, true>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0,
+                                   margin);
+  }
+  const double scale = detail::power_of_two_unit(r_local).inverse;
+  return run_hybrid<true, true>(a, b, b_in_a, options, contact_tolerance, cache, r_local, scale,
+                                margin);
 }
 
 }  // namespace proxima

@@ -24,6 +24,7 @@
 #include "core/accuracy.h"
 #include "core/power_of_two.h"
 #include "proxima/query/distance.h"
+#include "proxima/query/margin.h"
 
 namespace proxima {
 
@@ -82,14 +83,14 @@ bool pair_less(const CompoundCache::Entry& x, const CompoundCache::Entry& y) {
   return std::pair(x.piece_a, x.piece_b) < std::pair(y.piece_a, y.piece_b);
 }
 
-// One branch-and-bound query. Lower bounds are computed in A's frame on
-// copies scaled by 2^-e, e the exponent of the two bodies' magnitude bound,
-// so that no square overflows at any scale the polytopes accept.
-class Search {
+// The sphere bounds of a query (the branch and bound's and the margin
+// query's). Lower bounds are computed in A's frame on copies scaled by
+// 2^-e, e the exponent of the two bodies' magnitude bound, so that no
+// square overflows at any scale the polytopes accept.
+class SphereBounds {
  public:
-  Search(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
-         const DistanceOptions& options, CompoundCache* cache)
-      : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options), cache_(cache) {
+  SphereBounds(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
+               const Pose& pose_b) {
     const double magnitude_a = world_magnitude_bound(a, pose_a);
     const double magnitude_b = world_magnitude_bound(b, pose_b);
     // The factor 2^-e as a normal double (clamped_magnitude_exponent): an
@@ -101,6 +102,43 @@ class Search {
     translation_ =
         pose_a.rotation.transpose() * (factor_ * pose_b.translation - factor_ * pose_a.translation);
     slack_ = detail::prune_slack(factor_ * magnitude);
+  }
+
+  // 2^-e: scaled units per world unit.
+  double factor() const { return factor_; }
+
+  // The pruning key of two spheres (body frames): their scaled lower bound
+  // minus its rounding slack. An overflowing distance cannot occur on scaled
+  // copies; the key is -inf (never pruned) should it anyway.
+  double key(const Vec3& center_a, double radius_a, const Vec3& center_b_in_a_scaled,
+             double radius_b) const {
+    const double d = (factor_ * center_a - center_b_in_a_scaled).norm();
+    if (!std::isfinite(d)) return -std::numeric_limits<double>::infinity();
+    const double ra = factor_ * radius_a;
+    const double rb = factor_ * radius_b;
+    return d - ra - rb - slack_ - kPruneRelativeUlps * kUnitRoundoff * (d + ra + rb);
+  }
+  Vec3 b_center_in_a(const Vec3& c) const { return rotation_ * (factor_ * c) + translation_; }
+
+ private:
+  double factor_ = 1.0;  // 2^-e, e the exponent of the magnitude bound
+  Mat3 rotation_;        // B's frame -> A's frame
+  Vec3 translation_;     // scaled by factor_
+  double slack_ = 0.0;   // scaled
+};
+
+// One branch-and-bound query.
+class Search {
+ public:
+  Search(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
+         const DistanceOptions& options, CompoundCache* cache)
+      : a_(a),
+        b_(b),
+        pose_a_(pose_a),
+        pose_b_(pose_b),
+        options_(options),
+        cache_(cache),
+        bounds_(a, pose_a, b, pose_b) {
     // A near list the caller did not keep sorted is ignored (a binary search
     // on it could miss entries): slower, never wrong.
     if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
@@ -137,18 +175,11 @@ class Search {
     return have_best_ && best_.status == Status::intersecting && !options_.penetration;
   }
 
-  // The pruning key of two spheres (body frames): their scaled lower bound
-  // minus its rounding slack. An overflowing distance cannot occur on scaled
-  // copies; the key is -inf (never pruned) should it anyway.
   double key(const Vec3& center_a, double radius_a, const Vec3& center_b_in_a_scaled,
              double radius_b) const {
-    const double d = (factor_ * center_a - center_b_in_a_scaled).norm();
-    if (!std::isfinite(d)) return -std::numeric_limits<double>::infinity();
-    const double ra = factor_ * radius_a;
-    const double rb = factor_ * radius_b;
-    return d - ra - rb - slack_ - kPruneRelativeUlps * kUnitRoundoff * (d + ra + rb);
+    return bounds_.key(center_a, radius_a, center_b_in_a_scaled, radius_b);
   }
-  Vec3 b_center_in_a(const Vec3& c) const { return rotation_ * (factor_ * c) + translation_; }
+  Vec3 b_center_in_a(const Vec3& c) const { return bounds_.b_center_in_a(c); }
   bool pruned(double k) const { return have_best_ && k > best_scaled_; }
 
   void traverse() {
@@ -231,7 +262,7 @@ class Search {
     if (!have_best_ || better(r, pa, pb, best_)) {
       take(best_, r, pa, pb);
       have_best_ = true;
-      best_scaled_ = factor_ * r.signed_distance();
+      best_scaled_ = bounds_.factor() * r.signed_distance();
     }
   }
 
@@ -259,12 +290,9 @@ class Search {
   const Pose& pose_b_;
   const DistanceOptions& options_;
   CompoundCache* cache_;
+  SphereBounds bounds_;
   std::span<CompoundCache::Entry> old_near_;
-  double factor_ = 1.0;       // 2^-e, e the exponent of the magnitude bound
-  Mat3 rotation_;             // B's frame -> A's frame
-  Vec3 translation_;          // scaled by factor_
-  double best_scaled_ = 0.0;  // best_.signed_distance() * factor_
-  double slack_ = 0.0;        // scaled
+  double best_scaled_ = 0.0;  // best_.signed_distance() * bounds_.factor()
   std::int32_t hint_a_ = -1;
   std::int32_t hint_b_ = -1;
   bool have_best_ = false;
@@ -273,7 +301,203 @@ class Search {
   std::vector<StackEntry> stack_;
 };
 
+// The margin query (proxima/query/margin.h): the same hierarchies, depth first
+// with the nearer child on top, a node pair pruned as soon as its sphere
+// bound is above the margin (its key has the rounding slack taken off: a
+// pruned pair is beyond in exact arithmetic too), and the first piece pair
+// proved within ends the search. The last witness pair is tried first; each
+// piece pair is tracked by the near list's DistanceCache, as in Search.
+class MarginSearch {
+ public:
+  MarginSearch(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
+               const Pose& pose_b, double margin, const DistanceOptions& options,
+               CompoundCache* cache)
+      : a_(a),
+        b_(b),
+        pose_a_(pose_a),
+        pose_b_(pose_b),
+        margin_(margin),
+        options_(options),
+        cache_(cache),
+        bounds_(a, pose_a, b, pose_b),
+        margin_scaled_(bounds_.factor() * margin) {
+    if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
+      old_near_ = std::span<CompoundCache::Entry>(cache_->near);
+    }
+    moved_.assign(old_near_.size(), false);
+    result_.margin = margin;
+    result_.lower_bound = std::numeric_limits<double>::infinity();
+  }
+
+  MarginResult run() {
+    if (cache_ != nullptr && cache_->piece_a >= 0 && cache_->piece_a < a_.piece_count() &&
+        cache_->piece_b >= 0 && cache_->piece_b < b_.piece_count()) {
+      hint_a_ = cache_->piece_a;
+      hint_b_ = cache_->piece_b;
+      test_pair(hint_a_, hint_b_);
+    }
+    if (!found_) traverse();
+    if (!found_) {
+      result_.status = undecided_ || !(result_.lower_bound > margin_) ? MarginStatus::undecided
+                                                                      : MarginStatus::beyond;
+    }
+    result_.pairs_tested = pairs_tested_;
+    if (cache_ != nullptr) update_cache();
+    return result_;
+  }
+
+ private:
+  // Whether a key (scaled) proves the pair beyond; if so it lowers the
+  // reported lower bound to it.
+  bool prune(double key) {
+    if (!(key > margin_scaled_)) return false;
+    result_.lower_bound = std::min(result_.lower_bound, key / bounds_.factor());
+    return true;
+  }
+
+  void traverse() {
+    const auto& nodes_a = a_.nodes();
+    const auto& nodes_b = b_.nodes();
+    const auto node_key = [&](std::int32_t ia, std::int32_t ib) {
+      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(ia)];
+      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(ib)];
+      return bounds_.key(na.center, na.radius, bounds_.b_center_in_a(nb.center), nb.radius);
+    };
+    std::vector<std::pair<std::int32_t, std::int32_t>> stack;
+    if (!prune(node_key(0, 0))) stack.emplace_back(0, 0);
+    while (!stack.empty() && !found_) {
+      const auto [ia, ib] = stack.back();
+      stack.pop_back();
+      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(ia)];
+      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(ib)];
+      const bool leaf_a = na.left < 0;
+      const bool leaf_b = nb.left < 0;
+      if (leaf_a && leaf_b) {
+        test_leaves(na, nb);
+        continue;
+      }
+      // Descend the larger sphere (as Search).
+      const bool split_a = !leaf_a && (leaf_b || na.radius >= nb.radius);
+      std::pair<std::int32_t, std::int32_t> first =
+          split_a ? std::pair(na.left, ib) : std::pair(ia, nb.left);
+      std::pair<std::int32_t, std::int32_t> second =
+          split_a ? std::pair(na.right, ib) : std::pair(ia, nb.right);
+      double first_key = node_key(first.first, first.second);
+      double second_key = node_key(second.first, second.second);
+      // The nearer child pair on top: the likelier to prove within first.
+      if (first_key < second_key) {
+        std::swap(first, second);
+        std::swap(first_key, second_key);
+      }
+      if (!prune(first_key)) stack.push_back(first);
+      if (!prune(second_key)) stack.push_back(second);
+    }
+  }
+
+  void test_leaves(const CompoundBody::Node& na, const CompoundBody::Node& nb) {
+    const auto order_a = a_.piece_order();
+    const auto order_b = b_.piece_order();
+    for (std::int32_t i = 0; i < na.count && !found_; ++i) {
+      const std::int32_t pa = order_a[static_cast<std::size_t>(na.first + i)];
+      for (std::int32_t j = 0; j < nb.count && !found_; ++j) {
+        const std::int32_t pb = order_b[static_cast<std::size_t>(nb.first + j)];
+        if (pa == hint_a_ && pb == hint_b_) continue;  // tested first
+        if (na.count > 1 || nb.count > 1) {
+          const CompoundBody::PieceSphere& sa = a_.piece_sphere(pa);
+          const CompoundBody::PieceSphere& sb = b_.piece_sphere(pb);
+          if (prune(bounds_.key(sa.center, sa.radius, bounds_.b_center_in_a(sb.center),
+                                sb.radius)))
+            continue;
+        }
+        test_pair(pa, pb);
+      }
+    }
+  }
+
+  void test_pair(std::int32_t pa, std::int32_t pb) {
+    CompoundCache::Entry& t = tested_.emplace_back();
+    t.piece_a = pa;
+    t.piece_b = pb;
+    const CompoundCache::Entry probe{pa, pb, {}};
+    const auto it = std::lower_bound(old_near_.begin(), old_near_.end(), probe, pair_less);
+    if (it != old_near_.end() && it->piece_a == pa && it->piece_b == pb) {
+      t.cache = std::move(it->cache);
+      moved_[static_cast<std::size_t>(it - old_near_.begin())] = true;  // not kept twice
+    }
+    const CompoundPiece& piece_a = a_.piece(pa);
+    const CompoundPiece& piece_b = b_.piece(pb);
+    const MarginResult r = detail::within_margin_of_rigid_poses(
+        *piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope, pose_b_ * piece_b.pose,
+        margin_, options_, t.cache);
+    ++pairs_tested_;
+    result_.iterations += r.iterations;
+    if (r.status == MarginStatus::within) {
+      const double lower = result_.lower_bound;
+      result_ = r;
+      result_.lower_bound = std::min(lower, r.lower_bound);
+      result_.piece_a = pa;
+      result_.piece_b = pb;
+      found_ = true;
+      return;
+    }
+    undecided_ = undecided_ || r.status == MarginStatus::undecided;
+    result_.lower_bound = std::min(result_.lower_bound, r.lower_bound);
+    if (r.upper_bound < result_.upper_bound) {
+      result_.upper_bound = r.upper_bound;
+      result_.point_a = r.point_a;
+      result_.point_b = r.point_b;
+      result_.piece_a = pa;
+      result_.piece_b = pb;
+    }
+  }
+
+  // The tested pairs' caches join the near list (with the old entries not
+  // tested, up to its capacity), sorted by pair; the witness pair is the
+  // next query's first.
+  void update_cache() {
+    for (std::size_t i = 0; i < old_near_.size() && tested_.size() < kNearCapacity; ++i) {
+      if (!moved_[i]) tested_.push_back(std::move(old_near_[i]));
+    }
+    if (tested_.size() > kNearCapacity) tested_.resize(kNearCapacity);
+    std::sort(tested_.begin(), tested_.end(), pair_less);
+    cache_->near = std::move(tested_);
+    if (found_) {
+      cache_->piece_a = result_.piece_a;
+      cache_->piece_b = result_.piece_b;
+    }
+  }
+
+  const CompoundBody& a_;
+  const CompoundBody& b_;
+  const Pose& pose_a_;
+  const Pose& pose_b_;
+  double margin_;
+  const DistanceOptions& options_;
+  CompoundCache* cache_;
+  SphereBounds bounds_;
+  double margin_scaled_;
+  std::span<CompoundCache::Entry> old_near_;
+  std::vector<bool> moved_;  // per old_near_ entry: its cache moved to a tested pair
+  std::int32_t hint_a_ = -1;
+  std::int32_t hint_b_ = -1;
+  bool found_ = false;
+  bool undecided_ = false;
+  int pairs_tested_ = 0;
+  MarginResult result_;
+  std::vector<CompoundCache::Entry> tested_;
+};
+
 }  // namespace
+
+MarginResult within_margin(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
+                           const Pose& pose_b, double margin, const DistanceOptions& options,
+                           CompoundCache* cache) {
+  detail::check_margin(margin, "within_margin");
+  detail::check_distance_options(options, "within_margin: options");
+  return MarginSearch(a, checked_pose(pose_a, "within_margin: pose_a"), b,
+                      checked_pose(pose_b, "within_margin: pose_b"), margin, options, cache)
+      .run();
+}
 
 CompoundResult distance(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                         const Pose& pose_b, const DistanceOptions& options, CompoundCache* cache) {

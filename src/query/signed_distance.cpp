@@ -156,6 +156,37 @@ bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pos
 
 }  // namespace detail
 
+namespace {
+
+// The refusal of a mesh overlap's gradient, with its reason.
+[[noreturn]] void refuse_mesh_overlap() {
+  throw InvalidInput(
+      "signed_distance_gradient: the bodies overlap and one of them is a triangle mesh; no "
+      "penetration depth is defined for an overlap with a mesh (its answer brackets the signed "
+      "distance in [-infinity, 0]), so there is no gradient to give. Use the mesh's convex hull "
+      "or convex pieces (a compound), whose overlaps have a depth, or treat the overlap as a "
+      "collision (intersects())");
+}
+
+}  // namespace
+
+SignedDistanceGradient signed_distance_gradient(const MeshResult& result, const Pose& pose_a,
+                                                const Pose& pose_b) {
+  if (result.status == Status::intersecting) refuse_mesh_overlap();
+  return signed_distance_gradient(static_cast<const DistanceResult&>(result), pose_a, pose_b);
+}
+
+SignedDistanceGradient signed_distance_gradient(const BodyDistance& result, const Pose& pose_a,
+                                                const Pose& pose_b) {
+  // A pair with a mesh side reports that side's closest triangle.
+  const bool mesh_pair = result.triangle_a >= 0 || result.triangle_b >= 0;
+  if (mesh_pair && result.cores_overlap &&
+      result.depth_upper_bound == std::numeric_limits<double>::infinity()) {
+    refuse_mesh_overlap();
+  }
+  return signed_distance_gradient(static_cast<const DistanceResult&>(result), pose_a, pose_b);
+}
+
 SignedDistanceGradient signed_distance_gradient(const DistanceResult& result, const Pose& pose_a,
                                                 const Pose& pose_b) {
   if (result.status == Status::intersecting &&

@@ -336,18 +336,10 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
   nodes_.shrink_to_fit();
   order_.resize(triangles_.size());
   for (std::size_t k = 0; k < order_.size(); ++k) order_[k] = builder.items[k].triangle;
-}
-
-Vec3 TriangleMesh::center() const {
-  Vec3 lo, hi;
-  box(0, lo, hi);
-  return 0.5 * (lo + hi);
-}
-
-double TriangleMesh::bounding_radius() const {
-  Vec3 lo, hi;
-  box(0, lo, hi);
-  return 0.5 * (hi - lo).stableNorm();
+  Vec3 root_lo, root_hi;
+  box(0, root_lo, root_hi);
+  center_ = 0.5 * (root_lo + root_hi);
+  bounding_radius_ = 0.5 * (root_hi - root_lo).stableNorm();
 }
 
 void TriangleMesh::box(int i, Vec3& lo, Vec3& hi) const {

@@ -9,12 +9,14 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "proxima/query/batch.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
 #include "proxima/query/mesh_distance.h"
+#include "proxima/query/signed_distance.h"
 #include "proxima/shape/primitives.h"
 #include "support/generators.h"
 
@@ -247,6 +249,35 @@ TEST(BodyMesh, ANullMeshIsRefused) {
   EXPECT_EQ(m.compound(), nullptr);
   EXPECT_EQ(m.convex(), nullptr);
   EXPECT_NEAR(m.scale(), 1.0, 0.0);
+}
+
+// Regression (issue 26): the gradient of a mesh overlap was refused with a
+// message that blamed DistanceOptions::penetration (which was on); no depth
+// is defined for an overlap with a mesh, and the message now says so and
+// what to use instead. Convex bodies that overlap still have their gradient.
+TEST(BodyMesh, GradientOfAMeshOverlapNamesTheRealReason) {
+  const Body room(box_mesh(1.0));
+  const Body ball = make_sphere(0.5);
+  const Pose at(Mat3::Identity(), Vec3(0.9, 0.0, 0.0));
+  const BodyDistance r = distance(room, Pose::identity(), ball, at);
+  ASSERT_EQ(r.status, Status::intersecting);
+  try {
+    signed_distance_gradient(r, Pose::identity(), at);
+    ADD_FAILURE() << "a mesh overlap has no gradient";
+  } catch (const InvalidInput& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("triangle mesh"), std::string::npos) << what;
+    EXPECT_NE(what.find("hull"), std::string::npos) << what;
+    EXPECT_EQ(what.find("penetration false"), std::string::npos) << what;
+  }
+  // The same bodies as convex ones overlap with a depth: a gradient.
+  const Body box = make_box(Vec3(1.0, 1.0, 1.0));
+  EXPECT_NO_THROW(signed_distance_gradient(distance(box, Pose::identity(), ball, at),
+                                           Pose::identity(), at));
+  // Apart, the mesh pair's gradient is the distance's.
+  const Pose far(Mat3::Identity(), Vec3(3.0, 0.0, 0.0));
+  EXPECT_NO_THROW(signed_distance_gradient(distance(room, Pose::identity(), ball, far),
+                                           Pose::identity(), far));
 }
 
 }  // namespace

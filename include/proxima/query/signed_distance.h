@@ -26,6 +26,8 @@
 #include <Eigen/Core>
 
 #include "proxima/core/types.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/mesh_distance.h"
 
 namespace proxima {
 
@@ -54,6 +56,15 @@ struct SignedDistanceGradient {
 // intersecting answer computed without the depth
 // (DistanceOptions::penetration false: its normal is not the depth's).
 SignedDistanceGradient signed_distance_gradient(const DistanceResult& result, const Pose& pose_a,
+                                                const Pose& pose_b);
+
+// The same for the answers that may involve a triangle mesh: an overlap
+// with a mesh has no penetration depth (none is defined for a mesh: see
+// docs/bodies.md for what to use instead, the hull or convex pieces), so an
+// intersecting answer of a mesh pair is refused with that reason.
+SignedDistanceGradient signed_distance_gradient(const MeshResult& result, const Pose& pose_a,
+                                                const Pose& pose_b);
+SignedDistanceGradient signed_distance_gradient(const BodyDistance& result, const Pose& pose_a,
                                                 const Pose& pose_b);
 
 }  // namespace proxima

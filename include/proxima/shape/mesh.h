@@ -97,8 +97,8 @@ class TriangleMesh {
   // A ball holding every vertex (mesh frame): the root box's center and
   // half diagonal. What sweeps, time of impact and piece pruning bound the
   // mesh by.
-  Vec3 center() const;
-  double bounding_radius() const;
+  const Vec3& center() const { return center_; }
+  double bounding_radius() const { return bounding_radius_; }
 
   // The hierarchy: nodes()[0] is the root.
   std::span<const Node> nodes() const { return nodes_; }
@@ -138,6 +138,10 @@ class TriangleMesh {
   std::vector<std::int32_t> component_vertices_;
   double scale_ = 0.0;
   double unit_ = 1.0;
+  // The root box's center and half diagonal, computed once (every margin
+  // query's first test reads them).
+  Vec3 center_ = Vec3::Zero();
+  double bounding_radius_ = 0.0;
   bool closed_ = false;
   std::uint64_t id_ = 0;
 };

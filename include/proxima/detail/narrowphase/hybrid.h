@@ -21,4 +21,16 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
                                const DistanceOptions& options, double contact_tolerance,
                                DistanceCache& cache);
 
+// The margin query's loop (proxima/query/margin.h): the same iterations, stopped
+// at the first proof about `margin` (>= 0): a feature pair whose closest
+// points are at most margin + contact_tolerance apart (distance, point_a,
+// point_b), or a support gap that certifies lower_bound > margin (the gap
+// minus its rounding slack). Otherwise the loop ran to machine precision or
+// to the iteration cap (status iteration_cap), and neither may hold. The
+// cache is tracked as by hybrid_distance; no features, no contact
+// classification, status separated unless capped.
+DistanceResult hybrid_within(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                             const DistanceOptions& options, double contact_tolerance,
+                             double margin, DistanceCache& cache);
+
 }  // namespace proxima
