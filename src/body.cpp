@@ -394,6 +394,24 @@ double placed_magnitude(const TriangleMesh& m, const Pose& pose) {
   return r;
 }
 
+// Slack of a piece pair's sphere bound before it prunes, in units of u
+// times the magnitudes the bound is formed from. The placed centers are a
+// pose product and a transformed point (a few u of the translations and the
+// local centers each), the norm and the two subtractions a few u of the
+// center distance and the radii; 64 u covers them with room, so that a
+// pruned pair is farther than the best in exact arithmetic too. A relative
+// slack of the gap alone (as before) missed the centers' rounding far from
+// the origin. BodyMesh.CompoundAgainstAMeshIsTheNearestPiece compares the
+// pruned search with every pair.
+constexpr double kSpherePruneUlps = 64.0;
+
+// The magnitude a placed piece center is rounded against: the
+// translations of both poses plus the local center.
+double placed_size(const Pose& pose, const Body::MeshOfPiece& m) {
+  return pose.translation.cwiseAbs().maxCoeff() + m.pose.translation.cwiseAbs().maxCoeff() +
+         m.mesh->center().cwiseAbs().maxCoeff();
+}
+
 // A pair with a mesh on at least one side: every pair of meshes of
 // Body::meshes() (one per convex piece, one for a mesh), each tracked by its
 // own MeshCache, the closest (or a crossing) pair kept. A pair is skipped
@@ -429,9 +447,12 @@ BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const P
     if (have && pairs > 1) {
       const auto [ca, ra] = sphere(ma[i], pose_a);
       const auto [cb, rb] = sphere(mb[j], pose_b);
-      const double gap = (ca - cb).norm() - ra - rb;
-      // Rounding of the placed centers and norm: a relative 1e-12 slack.
-      if (gap * (1.0 - 1e-12) - 1e-300 > best.distance) continue;
+      const double center_distance = (ca - cb).norm();
+      const double gap = center_distance - ra - rb;
+      const double slack = kSpherePruneUlps * kUnitRoundoff *
+                           (placed_size(pose_a, ma[i]) + placed_size(pose_b, mb[j]) +
+                            center_distance + ra + rb);
+      if (gap - slack > best.distance) continue;
     }
     MeshResult r = distance(*ma[i].mesh, place_a, *mb[j].mesh, place_b, options, &cache.mesh[k]);
     const bool better = !have ||
