@@ -337,9 +337,9 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   std::array<std::int32_t, 4> ids_a{};
   std::array<std::int32_t, 4> ids_b{};
   int ids_used = simplex.size;
-  if (polished.have && !(status == Status::intersecting)) {
+  if (polished.have) {
     // The polished features' own coefficients (polish_stalled). Padded
-    // with repeats of the first id: the witness rule takes distinct ids.
+    // with repeats of the last id: the witness rule takes distinct ids.
     for (int i = 0; i < polished.na; ++i)
       point_a += polished.coef_a[idx(i)] * frame.a.vertex(polished.ids_a[idx(i)]);
     for (int j = 0; j < polished.nb; ++j)
