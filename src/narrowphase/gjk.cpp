@@ -51,6 +51,7 @@
 #include "narrowphase/gjk_frame.h"
 #include "narrowphase/simplex_solver.h"
 #include "narrowphase/witness_features.h"
+#include "proxima/geometry/closest_point.h"
 
 namespace proxima {
 namespace {
@@ -68,6 +69,135 @@ using detail::SupportPoint;
 // are sums of products of coordinates of that size and v itself is rebuilt
 // from the simplex points (|w| <= 2 sqrt(3) R).
 using detail::kTerminationGapUlps;
+
+// ---------------------------------------------------------------------------
+// Polishing a stalled simplex.
+//
+// GJK works on differences a - b of hull points. When the bodies sit far
+// from the origin or far apart in size, a simplex mixes points of C near
+// the origin with points of C as large as the bodies, and its closest point
+// is a small difference of large quantities: the solver's rounding (a few u
+// of the largest point, times the conditioning of a thin simplex) can hide
+// a step that would bring |v| from many bands down to 0. The loop then
+// stops on "|v| did not decrease" with a lower bound of 0, and the answer
+// was `touching` at a distance of 700 bands (two boxes' vertex on a
+// segment's end 1e12 from the origin: GjkRegression.TouchingFarFromTheOrigin).
+//
+// The hull vertices behind the simplex and the stalled support point are
+// the features the answer lies on. Their closest points in closed form (the
+// kernels of closest_point.h, which work on the vertices themselves, not on
+// their differences, and drop inactive vertices) give a new v, exact to a
+// few u of the coordinates; the simplex becomes the pairs of the kernel's
+// active vertices, whose weights are the products of the two sides'
+// coefficients (sum l_i m_j (a_i - b_j) = sum l_i a_i - sum m_j b_j). The
+// support along the new v tests the gap as the loop does; a new support
+// point is polished the same way. |v| strictly decreases and each round
+// costs an iteration, so it ends.
+// ---------------------------------------------------------------------------
+
+// The polished answer: the active hull vertices of each body with their
+// coefficients (the final points are formed from them as from the
+// simplex's weights), and how the polish ended.
+struct Polished {
+  bool have = false;       // the kernels improved on the stalled |v|
+  bool contact = false;    // |v| reached the band
+  bool certified = false;  // the gap test passed
+  bool capped = false;     // stopped undecided at options.max_iterations
+  std::array<std::int32_t, 3> ids_a{};
+  std::array<std::int32_t, 3> ids_b{};
+  std::array<double, 3> coef_a{};
+  std::array<double, 3> coef_b{};
+  int na = 0;
+  int nb = 0;
+};
+
+template <class Support>
+Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, double tol,
+                        Simplex& simplex, SupportPoint w, Support& support, int& iterations,
+                        double& lower, double& w_max2) {
+  const KernelTolerance<double> kernel_tol = kernel_tolerance(frame.magnitude * frame.inv_unit);
+  const auto add = [](std::array<std::int32_t, 3>& ids, int& n, std::int32_t id) {
+    for (int k = 0; k < n; ++k)
+      if (ids[idx(k)] == id) return true;
+    if (n == 3) return false;  // the kernels take at most three vertices a side
+    ids[idx(n++)] = id;
+    return true;
+  };
+  Polished out;
+  // The first features: the stalled simplex's vertices of each body.
+  std::array<std::int32_t, 3> ids_a{};
+  std::array<std::int32_t, 3> ids_b{};
+  int na = 0;
+  int nb = 0;
+  for (int k = 0; k < simplex.size; ++k) {
+    if (!add(ids_a, na, simplex.p[idx(k)].ia) || !add(ids_b, nb, simplex.p[idx(k)].ib))
+      return out;
+  }
+  for (;;) {
+    if (!add(ids_a, na, w.ia) || !add(ids_b, nb, w.ib)) return out;
+    std::array<Vec3, 3> pa;
+    std::array<Vec3, 3> pb;
+    for (int k = 0; k < na; ++k) pa[idx(k)] = frame.a.vertex(ids_a[idx(k)]) * frame.inv_unit;
+    for (int k = 0; k < nb; ++k) pb[idx(k)] = frame.b_point(ids_b[idx(k)]) * frame.inv_unit;
+    const ClosestPoints<double> c = closest_points<double>(pa.data(), na, pb.data(), nb, kernel_tol);
+    if (!(c.distance_squared < simplex.vv)) return out;
+    // The features reduced to the kernel's active vertices.
+    out.have = true;
+    out.na = 0;
+    out.nb = 0;
+    for (int i = 0; i < na; ++i) {
+      if (!(c.active_a & (1u << i))) continue;
+      out.ids_a[idx(out.na)] = ids_a[idx(i)];
+      out.coef_a[idx(out.na++)] = c.coef_a[idx(i)];
+    }
+    for (int j = 0; j < nb; ++j) {
+      if (!(c.active_b & (1u << j))) continue;
+      out.ids_b[idx(out.nb)] = ids_b[idx(j)];
+      out.coef_b[idx(out.nb++)] = c.coef_b[idx(j)];
+    }
+    ids_a = out.ids_a;
+    ids_b = out.ids_b;
+    na = out.na;
+    nb = out.nb;
+    // The simplex: the pairs of active vertices, at most four of them
+    // (points of C for the contact classification's seed and the cache;
+    // the final points come from the coefficients above). A crossing or
+    // parallel pair has more: any four are points of C all the same.
+    Simplex next;
+    for (int i = 0; i < na && next.size < 4; ++i) {
+      for (int j = 0; j < nb && next.size < 4; ++j) {
+        next.p[idx(next.size)] = frame.point(ids_a[idx(i)], ids_b[idx(j)]);
+        next.lambda[idx(next.size++)] = out.coef_a[idx(i)] * out.coef_b[idx(j)];
+      }
+    }
+    next.v = c.point_a - c.point_b;
+    next.vv = c.distance_squared;
+    simplex = next;
+    if (simplex.vv <= tol * tol) {
+      out.contact = true;
+      return out;
+    }
+    if (iterations >= options.max_iterations) {
+      out.capped = true;
+      return out;
+    }
+    const double v_norm = std::sqrt(simplex.vv);
+    w = support(-simplex.v);
+    ++iterations;
+    w_max2 = std::max(w_max2, w.w.squaredNorm());
+    lower = std::max(lower, simplex.v.dot(w.w) / v_norm);
+    // Only the gap certifies: support points already in the features with
+    // the gap open mean the kernels' reductions (a needle's width below
+    // 4 u R) hide the answer, not that v is optimal
+    // (GjkTouching.NeedlesSideBySideTouch). The next round then finds no
+    // decrease and leaves the answer uncertified.
+    if (v_norm - lower <=
+        options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
+      out.certified = true;
+      return out;
+    }
+  }
+}
 
 // ---------------------------------------------------------------------------
 // The loop shared by both variants.
@@ -100,6 +230,8 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   bool certified = false;
   std::array<SupportPoint, 3> stall_plane;  // a triangle through v and the new point, if stalled
   bool stalled = false;
+  SupportPoint stall_point;  // the support point that did not decrease |v|
+  bool rounding_stall = false;
   for (;;) {
     if (simplex.encloses_origin || simplex.vv <= tol * tol) {
       contact = true;
@@ -128,6 +260,8 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     next.p[idx(next.size++)] = w;
     detail::solve(next);
     if (!next.encloses_origin && next.vv >= simplex.vv) {  // rounding has taken over: keep v
+      stall_point = w;
+      rounding_stall = true;
       if (next.size == 3) {
         stall_plane = {next.p[0], next.p[1], next.p[2]};
         stalled = true;
@@ -156,6 +290,14 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   // only when a lower bound certifies it (above the band); otherwise the
   // pair is in contact as far as GJK can tell, and touching is reported
   // with GJK's distance as the upper bound it is.
+  Polished polished;
+  if (rounding_stall && !contact && !capped && !certified) {
+    polished = polish_stalled(frame, options, tol, simplex, stall_point, support, iterations,
+                              lower, w_max2);
+    contact = polished.contact;
+    certified = polished.certified;
+    capped = polished.capped;
+  }
   if (!contact && !capped && !certified && stalled && iterations < options.max_iterations) {
     Vec3 n = detail::face_normal(stall_plane[1].w - stall_plane[0].w,
                                  stall_plane[2].w - stall_plane[0].w)
@@ -172,8 +314,12 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
 
   Status status = Status::separated;
   if (contact) {
-    status =
-        detail::classify_contact(simplex, tol, support, iterations, options.max_iterations, deep);
+    // The classification grows its polytope from any points of C. A polished
+    // simplex of four points (two edges' vertex pairs) is flat, not a
+    // tetrahedron around the origin: three of them seed it.
+    Simplex seed = simplex;
+    if (seed.size == 4 && !seed.encloses_origin) seed.size = 3;
+    status = detail::classify_contact(seed, tol, support, iterations, options.max_iterations, deep);
     // A touching contact whose tetrahedron encloses the origin (by rounding,
     // or within the band): the origin is within tol of a face of it (else
     // the classification would have certified depth), so that face's
@@ -190,12 +336,27 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   Vec3 local_b = Vec3::Zero();
   std::array<std::int32_t, 4> ids_a{};
   std::array<std::int32_t, 4> ids_b{};
-  for (int k = 0; k < simplex.size; ++k) {
-    const SupportPoint& sp = simplex.p[idx(k)];
-    point_a += simplex.lambda[idx(k)] * frame.a.vertex(sp.ia);
-    local_b += simplex.lambda[idx(k)] * frame.b.vertex(sp.ib);
-    ids_a[idx(k)] = sp.ia;
-    ids_b[idx(k)] = sp.ib;
+  int ids_used = simplex.size;
+  if (polished.have) {
+    // The polished features' own coefficients (polish_stalled). Padded
+    // with repeats of the last id: the witness rule takes distinct ids.
+    for (int i = 0; i < polished.na; ++i)
+      point_a += polished.coef_a[idx(i)] * frame.a.vertex(polished.ids_a[idx(i)]);
+    for (int j = 0; j < polished.nb; ++j)
+      local_b += polished.coef_b[idx(j)] * frame.b.vertex(polished.ids_b[idx(j)]);
+    ids_used = std::max(polished.na, polished.nb);
+    for (int k = 0; k < ids_used; ++k) {
+      ids_a[idx(k)] = polished.ids_a[idx(std::min(k, polished.na - 1))];
+      ids_b[idx(k)] = polished.ids_b[idx(std::min(k, polished.nb - 1))];
+    }
+  } else {
+    for (int k = 0; k < simplex.size; ++k) {
+      const SupportPoint& sp = simplex.p[idx(k)];
+      point_a += simplex.lambda[idx(k)] * frame.a.vertex(sp.ia);
+      local_b += simplex.lambda[idx(k)] * frame.b.vertex(sp.ib);
+      ids_a[idx(k)] = sp.ia;
+      ids_b[idx(k)] = sp.ib;
+    }
   }
   const Vec3 point_b = frame.b_in_a.apply(local_b);
 
@@ -231,8 +392,8 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   // The witness features by the rule all algorithms share
   // (witness_features.h), A's in A's frame, B's in B's.
   const double witness_band = detail::witness_band(frame.magnitude);
-  const std::span ids_a_used(ids_a.data(), idx(simplex.size));
-  const std::span ids_b_used(ids_b.data(), idx(simplex.size));
+  const std::span ids_a_used(ids_a.data(), idx(ids_used));
+  const std::span ids_b_used(ids_b.data(), idx(ids_used));
   const bool locate = status != Status::intersecting;  // witness_features.h
   result.feature_a = detail::witness_feature(
       frame.a, ids_a_used, witness_band, cached_face_a,

@@ -33,6 +33,7 @@
 #include "core/accuracy.h"
 #include "core/power_of_two.h"
 #include "narrowphase/witness_features.h"
+#include "proxima/detail/geometry/tetrahedron_coordinates.h"
 #include "proxima/detail/narrowphase/contact.h"
 #include "proxima/geometry/closest_point.h"
 #include "proxima/shape/support.h"
@@ -145,25 +146,6 @@ struct FeatureSet {
 // tracked query's one kernel call is not copied into another struct).
 using Local = ClosestPoints<double>;
 
-// Barycentric coordinates of x in the tetrahedron t when x lies inside it
-// (signed volumes of the sub-tetrahedra over the whole), nothing otherwise or
-// when the tetrahedron is flat.
-std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Vec3, 4>& t,
-                                                             const Vec3& x) {
-  const auto volume = [](const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
-    return (p1 - p0).cross(p2 - p0).dot(p3 - p0);
-  };
-  const double whole = volume(t[0], t[1], t[2], t[3]);
-  if (whole == 0.0) return std::nullopt;
-  std::array<double, 4> c = {volume(x, t[1], t[2], t[3]), volume(t[0], x, t[2], t[3]),
-                             volume(t[0], t[1], x, t[3]), volume(t[0], t[1], t[2], x)};
-  for (double& ci : c) {
-    if (ci * whole < 0.0) return std::nullopt;
-    ci /= whole;
-  }
-  return c;
-}
-
 // Closest points of conv(fa) and conv(fb) when one of them has four vertices.
 // A fourth vertex only appears on the side that just received its
 // support point (index 3): the feature is then a tetrahedron whose closest
@@ -179,7 +161,7 @@ std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Ve
   // then no triangle is closest and the distance is 0. It suffices to test
   // one of its vertices: if the feature crosses the boundary instead, a
   // triangle below finds the crossing at distance 0.
-  if (const auto inside = tetrahedron_coordinates(four.p, other.p[0])) {
+  if (const auto inside = detail::tetrahedron_coordinates(four.p, other.p[0])) {
     Local hit;
     hit.distance_squared = 0.0;
     hit.point_a = other.p[0];

@@ -671,11 +671,20 @@ void add_face_candidates(Query& q, Candidates& out) {
 // ends within `error` of the exact arc's (fast face normals,
 // kArcNormalError), |w| <= reach: each end's value within error * reach,
 // and the exact cos(alpha / 2) at least |p + q| / 2 - error.
+//
+// kMinArcHalfCos: below it the arc is taken as a half circle. Soundness
+// needs only a positive threshold (the lower bound on cos(alpha / 2) must
+// be positive for the division to keep the sign); at 1e-3 the bound m /
+// half_cos is already a thousand times m, too loose to prune a group, so a
+// smaller threshold would buy nothing and risk dividing by rounding noise.
+// The fast-against-brute-force twins (PenetrationTwins.WalkMatchesBruteForce,
+// ...SmallHullsWithFastArcNormalsMatchBruteForce) catch an unsound prune.
+constexpr double kMinArcHalfCos = 1e-3;
 double arc_minimum(const Arc& arc, const Vec3& w, double error, double reach) {
   const double m = std::min(arc.p.dot(w), arc.q.dot(w)) - error * reach;
   if (m >= 0.0) return m;
   const double half_cos = 0.5 * (arc.p + arc.q).norm() - error;
-  return half_cos > 1e-3 ? m / half_cos : -std::numeric_limits<double>::infinity();
+  return half_cos > kMinArcHalfCos ? m / half_cos : -std::numeric_limits<double>::infinity();
 }
 
 // Brute force over all edge pairs.

@@ -333,6 +333,13 @@ BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, con
   return r;
 }
 
+// The magnitude a placed piece center is rounded against: the
+// translations of both poses plus the local center.
+double placed_size(const Pose& pose, const Body::MeshOfPiece& m) {
+  return pose.translation.cwiseAbs().maxCoeff() + m.pose.translation.cwiseAbs().maxCoeff() +
+         m.mesh->center().cwiseAbs().maxCoeff();
+}
+
 // A pair with a mesh on at least one side: every pair of meshes of
 // Body::meshes() (one per convex piece, one for a mesh), each tracked by its
 // own MeshCache, the closest (or a crossing) pair kept. A pair is skipped
@@ -368,9 +375,16 @@ BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const P
     if (have && pairs > 1) {
       const auto [ca, ra] = sphere(ma[i], pose_a);
       const auto [cb, rb] = sphere(mb[j], pose_b);
-      const double gap = (ca - cb).norm() - ra - rb;
-      // Rounding of the placed centers and norm: a relative 1e-12 slack.
-      if (gap * (1.0 - 1e-12) - 1e-300 > best.distance) continue;
+      const double center_distance = (ca - cb).norm();
+      const double gap = center_distance - ra - rb;
+      // The placed centers are rounded against the poses' translations and
+      // the local centers (placed_size), the norm and subtractions against
+      // the center distance and the radii: the shared prune slack of their
+      // sum keeps a pruned pair farther than the best in exact arithmetic
+      // (BodyMesh.CompoundAgainstAMeshIsTheNearestPiece).
+      const double slack = detail::prune_slack(placed_size(pose_a, ma[i]) + placed_size(pose_b, mb[j]) +
+                                               center_distance + ra + rb);
+      if (gap - slack > best.distance) continue;
     }
     MeshResult r = distance(*ma[i].mesh, place_a, *mb[j].mesh, place_b, options, &cache.mesh[k]);
     const bool better = !have ||

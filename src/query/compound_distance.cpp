@@ -154,6 +154,7 @@ class Search {
       test_pair(hint_a_, hint_b_);
     }
     if (!done()) traverse();
+    certify();
     best_.pairs_tested = static_cast<int>(tested_.size());
     if (cache_ != nullptr) update_cache();
     return best_;
@@ -259,11 +260,31 @@ class Search {
         *piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope, pose_b_ * piece_b.pose,
         options_, &t.entry.cache);
     t.distance = r.signed_distance();
+    lowest_lower_ = std::min(lowest_lower_, r.lower_bound);
+    lowest_signed_lower_ = std::min(lowest_signed_lower_, r.signed_lower_bound());
     if (!have_best_ || better(r, pa, pb, best_)) {
       take(best_, r, pa, pb);
       have_best_ = true;
       best_scaled_ = bounds_.factor() * r.signed_distance();
     }
+  }
+
+  // The answer's certificate over the whole search, not the best pair's
+  // alone: a tested pair that ended with a loose bound (an iteration cap,
+  // an uncertified depth) may hold a closer pair than the best reported
+  // value, so the lower bounds are the minimum over every tested pair's.
+  // Pruned node pairs need no term: a key prunes only above the best
+  // signed distance at that time, which the final best's does not exceed,
+  // and that is at least the final best's lower bounds. Node pairs left on
+  // the stack by an early end (an intersection without the depth) need none
+  // either: the answer's bounds are then 0 and -infinity, below any key.
+  // (CompoundRegression.LowerBoundCoversALooselyCertifiedPair.)
+  void certify() {
+    if (!have_best_) return;
+    best_.lower_bound = std::min(best_.lower_bound, lowest_lower_);
+    const double signed_lower = best_.signed_lower_bound();
+    if (lowest_signed_lower_ < signed_lower)
+      best_.depth_upper_bound += signed_lower - lowest_signed_lower_;
   }
 
   // The next query's warm start: the best pair, and the feature caches of
@@ -297,6 +318,9 @@ class Search {
   std::int32_t hint_b_ = -1;
   bool have_best_ = false;
   CompoundResult best_;
+  // The least lower bound and signed lower bound of the tested pairs.
+  double lowest_lower_ = std::numeric_limits<double>::infinity();
+  double lowest_signed_lower_ = std::numeric_limits<double>::infinity();
   std::vector<NearEntry> tested_;
   std::vector<StackEntry> stack_;
 };
@@ -512,16 +536,24 @@ CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, con
   check_pose(pose_b, "distance_all_pairs: pose_b");
   CompoundResult best;
   bool have_best = false;
+  double lowest_lower = std::numeric_limits<double>::infinity();
+  double lowest_signed_lower = std::numeric_limits<double>::infinity();
   for (std::int32_t pa = 0; pa < a.piece_count(); ++pa) {
     for (std::int32_t pb = 0; pb < b.piece_count(); ++pb) {
       const DistanceResult r = distance(*a.piece(pa).polytope, pose_a * a.piece(pa).pose,
                                         *b.piece(pb).polytope, pose_b * b.piece(pb).pose, options);
+      lowest_lower = std::min(lowest_lower, r.lower_bound);
+      lowest_signed_lower = std::min(lowest_signed_lower, r.signed_lower_bound());
       if (!have_best || better(r, pa, pb, best)) {
         take(best, r, pa, pb);
         have_best = true;
       }
     }
   }
+  // The certificate over every pair, as the search's (Search::certify).
+  best.lower_bound = std::min(best.lower_bound, lowest_lower);
+  if (lowest_signed_lower < best.signed_lower_bound())
+    best.depth_upper_bound += best.signed_lower_bound() - lowest_signed_lower;
   // Saturated: the product of two piece counts can exceed an int.
   best.pairs_tested = static_cast<int>(std::min<std::int64_t>(
       std::int64_t{a.piece_count()} * b.piece_count(), std::numeric_limits<int>::max()));

@@ -119,6 +119,12 @@ MeshResult finish(const ConvexQuery& q, const Best& best, int tested, int nodes)
   bool inside = false;
   if (r.status != Status::intersecting && q.a.is_closed())
     inside = q.a.contains(q.rotation * q.b.vertex(0) + q.translation);
+  if (inside) {
+    // The closest points of the surfaces are apart; B's vertex inside the
+    // mesh is a point of both bodies.
+    r.point_a = q.pose_b.apply(q.b.vertex(0));
+    r.point_b = r.point_a;
+  }
   if (r.status == Status::intersecting || inside) {
     r.status = Status::intersecting;
     r.distance = 0.0;

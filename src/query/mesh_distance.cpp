@@ -322,22 +322,36 @@ Feature feature_of(const TriangleMesh& mesh, std::int32_t t, std::uint8_t active
   return f;
 }
 
+// A surface component of one mesh inside the other, closed mesh: which
+// side holds it and one of its vertices, a point of both bodies (on the one
+// surface, inside the other's solid).
+struct Containment {
+  std::int8_t side = 0;  // 0: none; 1: a vertex of B inside A; 2: a vertex of A inside B
+  std::int32_t vertex = -1;
+};
+
 // Whether a surface component of one mesh lies inside the other, closed
 // mesh. Component vertices are placed in the other mesh's frame.
-bool contained(const Query& q) {
+Containment contained(const Query& q) {
   if (q.a.is_closed()) {
     for (const std::int32_t v : q.b.component_vertices())
-      if (q.a.contains(q.rotation * q.b.vertex(v) + q.translation)) return true;
+      if (q.a.contains(q.rotation * q.b.vertex(v) + q.translation)) return {1, v};
   }
   if (q.b.is_closed()) {
     const Mat3 rt = q.rotation.transpose();
     for (const std::int32_t v : q.a.component_vertices())
-      if (q.b.contains(rt * (q.a.vertex(v) - q.translation))) return true;
+      if (q.b.contains(rt * (q.a.vertex(v) - q.translation))) return {2, v};
   }
-  return false;
+  return {};
 }
 
-MeshResult finish(const Query& q, const Pose& pose_a, const Best& best, bool inside) {
+// The contained vertex in A's frame (unscaled).
+Vec3 containment_point(const Query& q, const Containment& c) {
+  return c.side == 1 ? Vec3(q.rotation * q.b.vertex(c.vertex) + q.translation)
+                     : q.a.vertex(c.vertex);
+}
+
+MeshResult finish(const Query& q, const Pose& pose_a, const Best& best, const Containment& inside) {
   const Pose pa = checked_pose(pose_a, "mesh distance: pose_a");
   MeshResult r;
   r.triangle_a = best.ta;
@@ -366,7 +380,14 @@ MeshResult finish(const Query& q, const Pose& pose_a, const Best& best, bool ins
     r.normal =
         n.squaredNorm() > 0.0 ? Vec3(pa.rotation * n.normalized()) : Vec3(pa.rotation.col(0));
   }
-  if (best.crossing || inside) {
+  if (!best.crossing && inside.side != 0) {
+    // No surfaces cross: the closest points above are those of the two
+    // surfaces, apart by up to the inner body's size, and realize no
+    // answer of distance 0. The contained vertex lies on both bodies.
+    r.point_a = pa.apply(containment_point(q, inside));
+    r.point_b = r.point_a;
+  }
+  if (best.crossing || inside.side != 0) {
     r.status = Status::intersecting;
     r.distance = 0.0;
     r.lower_bound = 0.0;
@@ -620,7 +641,7 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const T
       if (best.crossing) break;
     }
   }
-  const bool inside = !best.crossing && contained(q);
+  const Containment inside = best.crossing ? Containment{} : contained(q);
   MeshResult r = finish(q, pose_a, best, inside);
   r.pairs_tested = tested;
   return r;
@@ -661,10 +682,13 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
                   std::sqrt(best.d2) + slack_s);
         if (best.crossing) break;
       }
-      bool inside = false;
+      // The containment found at the list's collection still holds while
+      // B moved less than the surfaces' distance then: the contained vertex
+      // cannot have crossed the other surface.
+      Containment inside;
       if (!best.crossing) {
         inside = moved + unscaled_slack < cache->base_distance && cache->inside >= 0
-                     ? cache->inside == 1
+                     ? Containment{cache->inside, cache->inside_vertex}
                      : contained(q);
       }
       MeshResult r = finish(q, pose_a, best, inside);
@@ -846,7 +870,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     }
   }
 
-  const bool inside = !best.crossing && contained(q);
+  const Containment inside = best.crossing ? Containment{} : contained(q);
   MeshResult r = finish(q, pose_a, best, inside);
   r.pairs_tested = tested;
   r.nodes_tested = nodes_tested;
@@ -878,7 +902,8 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
         cache->margin = std::ldexp(margin, q.exponent);
         cache->rotation = q.rotation;
         cache->translation = q.translation;
-        cache->inside = inside ? 1 : 0;
+        cache->inside = inside.side;
+        cache->inside_vertex = inside.vertex;
       } else {
         cache->near.clear();
         list_failed();

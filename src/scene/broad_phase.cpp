@@ -151,12 +151,21 @@ class SweepAndPrune final : public PairFinder {
   // The axis along which the centers spread most: the one where sorted
   // intervals overlap least. Computed on centers scaled by their largest
   // magnitude, so that squares neither overflow nor underflow.
+  //
+  // kMinSpreadScale: centers all below it in magnitude keep the current
+  // axis. The scale factor 1 / largest must be finite (it overflows for
+  // largest below 1 / DBL_MAX, about 5.6e-309, subnormal centers); 1e-300
+  // keeps a margin above that. The axis only orders the sweep, any axis
+  // finds the same pairs (PairFinderTest.MatchesAllPairsWhileBoxesMoveAndMembersChange
+  // compares with all pairs; SweepAndPrune.TinyCentersKeepTheirAxis pins
+  // the threshold).
+  static constexpr double kMinSpreadScale = 1e-300;
   void choose_axis() {
     const std::size_t n = centers_.size();
     if (n < 2) return;
     double largest = 0.0;
     for (const Vec3& c : centers_) largest = std::max(largest, c.cwiseAbs().maxCoeff());
-    if (!(largest > 1e-300) || !std::isfinite(largest)) return;
+    if (!(largest > kMinSpreadScale) || !std::isfinite(largest)) return;
     const double s = 1.0 / largest;
     Vec3 mean = Vec3::Zero();
     for (const Vec3& c : centers_) mean += s * c;

@@ -960,6 +960,14 @@ std::optional<ClosePair> Scene::nearest_pair() {
   Impl::PairState scratch;
   double margin = s.options.margin;
   bool refined = false;
+  // The widenings a search may take: the first widening sets the margin to
+  // at least span / 64 and each next one doubles it, so the seventh reaches
+  // the span, where every pair is a candidate (an infinite span is reached
+  // at the first: the margin is then infinite too). Past that the span is
+  // not a number, which the bodies' finite poses and boxes rule out; the
+  // bound makes the loop's end independent of that argument.
+  constexpr int kMaxWidenings = 7;
+  int widenings = 0;
   for (;;) {
     for (std::size_t k = 0; k < s.bodies.size(); ++k) {
       if (s.bodies[k].live) boxes[k] = s.world_box(s.bodies[k], margin);
@@ -986,7 +994,9 @@ std::optional<ClosePair> Scene::nearest_pair() {
       refined = true;
       continue;
     }
-    if (margin >= span) return std::nullopt;  // every pair was a candidate: none is tested
+    // Every pair was a candidate: none is tested.
+    if (margin >= span || widenings == kMaxWidenings) return std::nullopt;
+    ++widenings;
     margin = std::max({2.0 * margin, span / 64.0, std::numeric_limits<double>::min()});
   }
 }

@@ -92,7 +92,7 @@ Boundary solid_boundary(std::span<const Vec3> pts, std::span<const Vec3> scaled,
     b.faces = clean_faces(triangles, point_count, pts, scaled, proven_convex);
   }
   if (!proven_convex) {
-    throw std::logic_error("ConvexPolytope: internal error: the exact hull of " +
+    throw InternalError("ConvexPolytope: internal error: the exact hull of " +
                            std::to_string(pts.size()) +
                            " distinct points is not a proven convex surface");
   }
@@ -198,8 +198,9 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
     adjacency.offsets = {0, 0};
   } else {
     if (!build_adjacency(faces, vertex_count, adjacency)) {
-      throw InvalidInput("ConvexPolytope: the hull of " + std::to_string(points.size()) +
-                         " points is not a closed surface after cleaning (internal error)");
+      throw InternalError("ConvexPolytope: internal error: the hull of " +
+                          std::to_string(points.size()) +
+                          " points is not a closed surface after cleaning");
     }
     face_offsets = std::move(faces.offsets);
     face_vertices = std::move(faces.vertices);

@@ -24,6 +24,7 @@
 #include <limits>
 #include <optional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "narrowphase/gjk_contact.h"
@@ -899,6 +900,47 @@ TEST(GjkRegression, KissingBoxesWithTinyRotatedGap) {
 // ---------------------------------------------------------------------------
 // Limits.
 // ---------------------------------------------------------------------------
+
+// Regression (issue 25, repro gjk_touch_far.py): a box's vertex placed on
+// the end of a segment 1e12 from the origin, the box first. GJK's simplex
+// mixed points of A - B near the origin with points 2e12 away; its solver
+// could not resolve the step that brought |v| from 16.65 to 0 (700 bands),
+// stalled with a lower bound of 0 and answered `touching` at distance
+// 16.65 (swapped, it answered 0). The stalled simplex is now polished by the
+// closed-form kernels on its hull vertices (polish_stalled in gjk.cpp).
+TEST(GjkRegression, TouchingFarFromTheOrigin) {
+  const ConvexPolytope segment(std::vector<Vec3>{Vec3(-688382873359.9867, 1705734364702.0273, 333218255102.6336),
+      Vec3(-1021122306432.1952, 87003358780.82507, -8473866307.86056)});
+  const ConvexPolytope box(std::vector<Vec3>{Vec3(-61.08071682972654, -15.6226471992511, -37.98999450136053),
+      Vec3(-61.08071682972654, -15.6226471992511, 37.98999450136053),
+      Vec3(-61.08071682972654, 15.6226471992511, -37.98999450136053),
+      Vec3(-61.08071682972654, 15.6226471992511, 37.98999450136053),
+      Vec3(61.08071682972654, -15.6226471992511, -37.98999450136053),
+      Vec3(61.08071682972654, -15.6226471992511, 37.98999450136053),
+      Vec3(61.08071682972654, 15.6226471992511, -37.98999450136053),
+      Vec3(61.08071682972654, 15.6226471992511, 37.98999450136053)});
+  Mat3 rotation;
+  rotation << 0.5322460407755973, -0.776140333215319, -0.3381129030887686,
+              0.3415844782257567, -0.16854816761794855, 0.9246142760242617,
+              -0.7746187425527082, -0.6076164072414814, 0.17540839585668477;
+  const Pose box_pose(rotation, Vec3(-688382873326.7572, 1705734364685.1323, 333218255039.163));
+  // R: the largest coordinate, the segment's (the box is placed next to it).
+  const double band = 64 * kUnitRoundoff * 1705734364702.0273;
+  for (const Algorithm alg : {Algorithm::gjk, Algorithm::enhanced_gjk, Algorithm::hybrid}) {
+    DistanceOptions options;
+    options.algorithm = alg;
+    for (const bool box_first : {true, false}) {
+      SCOPED_TRACE(std::string(to_string(alg)) + (box_first ? ", box first" : ", segment first"));
+      const DistanceResult r =
+          box_first ? distance(box, box_pose, segment, Pose::identity(), options)
+                    : distance(segment, Pose::identity(), box, box_pose, options);
+      EXPECT_EQ(r.status, Status::touching);
+      EXPECT_LE(r.distance, band);
+      EXPECT_LE((r.point_a - r.point_b).norm(), 2 * band);
+      EXPECT_LE(r.lower_bound, r.distance);
+    }
+  }
+}
 
 TEST(Gjk, IterationCapIsReportedWithValidBounds) {
   Rng rng(8);

@@ -10,11 +10,13 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <vector>
 
+#include "proxima/detail/geometry/tetrahedron_coordinates.h"
 #include "proxima/geometry/closest_point.h"
 #include "proxima/query/distance.h"
 
@@ -74,6 +76,34 @@ Pose random_pose(std::mt19937& rng, double spread) {
   std::normal_distribution<double> g;
   const Quat q(g(rng), g(rng), g(rng), g(rng));
   return Pose(q, Vec3(spread * g(rng), spread * g(rng), spread * g(rng)));
+}
+
+// Regression (issue 24): the hybrid's inside test of a four-vertex feature
+// compared the signs of the sub-volumes with the whole's through their
+// product. The hybrid runs unscaled for R in 2^-64 .. 2^64, and a feature
+// of a small body beside a large one (kernel tolerances keep features down
+// to 4 u R long) has a volume of 1e-210 while a far point's sub-volumes are
+// about 1e-140: the products underflowed to 0, passed as "same sign", and a
+// point far outside was reported inside (distance 0).
+TEST(TetrahedronCoordinates, UnderflowingVolumesKeepTheirSigns) {
+  const double s = 1e-70;
+  const std::array<Vec3, 4> t = {Vec3(0, 0, 0), Vec3(s, 0, 0), Vec3(0, s, 0), Vec3(0, 0, s)};
+  // Points on the axes: every difference with a vertex is exact, so the
+  // sub-volumes are exact too (about -1e-140 for the far side).
+  EXPECT_FALSE(detail::tetrahedron_coordinates(t, Vec3(-1.0, 0.0, 0.0)));
+  EXPECT_FALSE(detail::tetrahedron_coordinates(t, Vec3(0.0, -1.0, 0.0)));
+  EXPECT_FALSE(detail::tetrahedron_coordinates(t, Vec3(0.0, 0.0, -1.0)));
+  // Inside, at the same scale: coordinates that sum to one.
+  const auto inside = detail::tetrahedron_coordinates(t, Vec3(0.25 * s, 0.25 * s, 0.25 * s));
+  ASSERT_TRUE(inside);
+  EXPECT_NEAR((*inside)[0] + (*inside)[1] + (*inside)[2] + (*inside)[3], 1.0, 1e-15);
+  for (const double c : *inside) EXPECT_GE(c, 0.0);
+  // The same at 1e70, where the products overflow instead (their signs held).
+  const double big = 1e70;
+  const std::array<Vec3, 4> t_big = {Vec3(0, 0, 0), Vec3(big, 0, 0), Vec3(0, big, 0),
+                                     Vec3(0, 0, big)};
+  EXPECT_FALSE(detail::tetrahedron_coordinates(t_big, Vec3(big, big, big)));
+  EXPECT_TRUE(detail::tetrahedron_coordinates(t_big, Vec3(0.25 * big, 0.25 * big, 0.25 * big)));
 }
 
 TEST(Hybrid, UnitCubesFaceToFace) {

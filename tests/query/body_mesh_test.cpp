@@ -141,6 +141,66 @@ TEST(BodyMesh, InsideAClosedMeshIsIntersectingInsideAnOpenOneIsNot) {
   EXPECT_EQ(distance(big, Pose::identity(), small, at).status, Status::intersecting);
 }
 
+// Regression (issue 25, exact_cases.jsonl line 4): a mesh inside a convex
+// solid (no surfaces crossing) was `intersecting` with distance 0 but with
+// the surfaces' closest points, 0.056 apart on that case: points that
+// realize no answer of distance 0. They are now one common point, the
+// contained vertex, through every path: the Body call (a convex body as its
+// hull's closed mesh), the mesh-mesh and mesh-polytope queries, both
+// orders, cold and tracked.
+TEST(BodyMesh, AMeshInsideASolidAnswersWithACommonPoint) {
+  const double h_small = 0.1;
+  const double h_big = 3.0;
+  const auto inside_box = [](const Vec3& p, double h) {
+    return (p.cwiseAbs().array() <= h * (1 + 1e-12)).all();
+  };
+  const Pose at(Mat3::Identity(), Vec3(0.3, -0.2, 0.1));
+  const double band = 64 * kUnitRoundoff * 4.0;
+  const auto check = [&](const DistanceResult& r, const Pose& small_pose, const Pose& big_pose) {
+    EXPECT_EQ(r.status, Status::intersecting);
+    EXPECT_EQ(r.distance, 0.0);
+    EXPECT_LE((r.point_a - r.point_b).norm(), band);
+    // On the small box (its surface) and inside the big one, in the world.
+    EXPECT_TRUE(inside_box(small_pose.inverse().apply(r.point_a), h_small)) << r.point_a.transpose();
+    EXPECT_TRUE(inside_box(big_pose.inverse().apply(r.point_a), h_big)) << r.point_a.transpose();
+  };
+  const Body small(box_mesh(h_small));
+  const Body big_convex = make_box(Vec3(h_big, h_big, h_big));
+  {
+    SCOPED_TRACE("Body: mesh first");
+    check(distance(small, at, big_convex, Pose::identity()), at, Pose::identity());
+  }
+  {
+    SCOPED_TRACE("Body: convex first");
+    check(distance(big_convex, Pose::identity(), small, at), at, Pose::identity());
+  }
+  const TriangleMesh small_mesh = box_mesh(h_small);
+  const TriangleMesh big_mesh = box_mesh(h_big);
+  const ConvexPolytope small_hull(std::vector<Vec3>(small_mesh.vertices().begin(),
+                                                    small_mesh.vertices().end()));
+  {
+    SCOPED_TRACE("mesh-mesh, inner first");
+    check(distance(small_mesh, at, big_mesh, Pose::identity()), at, Pose::identity());
+  }
+  {
+    SCOPED_TRACE("mesh-mesh, outer first");
+    check(distance(big_mesh, Pose::identity(), small_mesh, at), at, Pose::identity());
+  }
+  {
+    SCOPED_TRACE("mesh-polytope, the polytope inside the closed mesh");
+    check(distance(big_mesh, Pose::identity(), small_hull, at), at, Pose::identity());
+  }
+  {
+    SCOPED_TRACE("mesh-mesh, tracked");
+    MeshCache cache;
+    for (int step = 0; step < 6; ++step) {
+      const Pose moved(Mat3::Identity(), at.translation + Vec3(1e-3 * step, 0, 0));
+      const MeshResult r = distance(small_mesh, moved, big_mesh, Pose::identity(), {}, &cache);
+      check(r, moved, Pose::identity());
+    }
+  }
+}
+
 // A non-convex mesh: a sphere in the notch of the L is nearer to the L than
 // to its hull; the answer equals the brute force over all triangle pairs
 // (the mesh twin) against the sphere's center as a one-point mesh, minus

@@ -634,5 +634,35 @@ TEST(Compound, BadInputNamesThePiece) {
             std::string::npos);
 }
 
+// Regression (issue 24): the compound's lower bound was the best pair's own
+// certificate, not one over the whole search. Capped at one iteration, the
+// pair of piece 0 stopped with a loose answer (an upper bound above the
+// point piece's distance) and a lower bound below it; the point piece's pair
+// won with its exact distance 3.8715 as the lower bound, above the true
+// distance 3.7076 of piece 0. The certificate must cover every tested pair:
+// the least of their lower bounds. Found by a seeded search against
+// distance_all_pairs at the default options.
+TEST(CompoundRegression, LowerBoundCoversALooselyCertifiedPair) {
+  const CompoundBody a = CompoundBody::from_point_sets(std::vector<Points>{
+      {Vec3(-6.08, -6.6, -0.07), Vec3(-1.26, 1.25, -0.5), Vec3(-1.85, -2.13, -0.56),
+       Vec3(-1.83, 1.06, -0.24)},
+      {Vec3(-4.19, -3.59, 0.7)}});
+  const CompoundBody b = CompoundBody::from_point_sets(std::vector<Points>{{Vec3(-0.16, -0.66, 0.84)}});
+  const Pose pose_b = Pose::from_translation(Vec3(-0.77, -4.54, 1.19));
+  const CompoundResult exact = distance_all_pairs(a, Pose::identity(), b, pose_b);
+  ASSERT_EQ(exact.status, Status::separated);
+  const double band = kBandUlps * kUnitRoundoff * 8.0;
+  DistanceOptions capped;
+  capped.max_iterations = 1;
+  for (const bool twin : {false, true}) {
+    SCOPED_TRACE(twin ? "distance_all_pairs" : "distance");
+    const CompoundResult r = twin ? distance_all_pairs(a, Pose::identity(), b, pose_b, capped)
+                                  : distance(a, Pose::identity(), b, pose_b, capped);
+    EXPECT_LE(r.lower_bound, exact.distance + band);
+    EXPECT_LE(r.signed_lower_bound(), exact.signed_distance() + band);
+    EXPECT_GE(r.distance, exact.distance - band);  // an upper bound all the same
+  }
+}
+
 }  // namespace
 }  // namespace proxima

@@ -26,7 +26,9 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -1213,6 +1215,29 @@ std::string build_error(const Points& pts) {
     return e.what();
   }
   return "";
+}
+
+// Regression (issue 24): the hull reported its own inconsistency (a
+// cleaned surface that is not closed) as InvalidInput, so a caller that
+// rejects bad user data by catching InvalidInput swallowed a library bug.
+// Internal failures have their own type, which no InvalidInput handler
+// catches; bad input keeps InvalidInput.
+TEST(Polytope, InternalErrorsAreNotInvalidInput) {
+  static_assert(!std::is_base_of_v<InvalidInput, InternalError>);
+  static_assert(!std::is_base_of_v<std::invalid_argument, InternalError>);
+  static_assert(std::is_base_of_v<std::logic_error, InternalError>);
+  bool caught_as_invalid_input = false;
+  try {
+    try {
+      throw InternalError("ConvexPolytope: internal error: test");
+    } catch (const InvalidInput&) {
+      caught_as_invalid_input = true;
+    }
+  } catch (const InternalError& e) {
+    EXPECT_NE(std::string(e.what()).find("internal error"), std::string::npos);
+  }
+  EXPECT_FALSE(caught_as_invalid_input);
+  EXPECT_THROW(ConvexPolytope(std::vector<Vec3>{}), InvalidInput);
 }
 
 TEST(Polytope, BadInputThrowsNamingTheIndex) {

@@ -58,6 +58,15 @@ class InvalidInput : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// Thrown when the library finds a defect of its own (a construction that
+// should be exact produced an inconsistent result). Not an InvalidInput:
+// a caller that rejects bad user data by catching InvalidInput must not
+// swallow a library bug. Please report the input that raised it.
+class InternalError : public std::logic_error {
+ public:
+  using std::logic_error::logic_error;
+};
+
 // True when x is neither NaN nor infinite. Tests the exponent bits (all ones
 // for both) with integer operations: no floating-point comparison that could
 // raise FE_INVALID under a caller's traps.

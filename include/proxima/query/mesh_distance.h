@@ -44,9 +44,11 @@ struct MeshCache {
   Mat3 last_rotation = Mat3::Zero();
   Vec3 last_translation = Vec3::Zero();
   // The containment found when `near` was collected (-1: unknown, 0: no, 1:
-  // a surface inside the other's closed mesh); valid while the motion is
-  // below base_distance.
+  // a component of B inside A's closed mesh, 2: one of A inside B's) and
+  // the contained vertex (of B for 1, of A for 2); valid while the motion
+  // is below base_distance.
   std::int8_t inside = -1;
+  std::int32_t inside_vertex = -1;
   // Collecting a list costs a wider search; when lists do not pay (too many
   // pairs within the margin, or the motion outran the margin before the
   // list was used once), the next collections wait `list_wait` queries, a
@@ -81,8 +83,9 @@ struct MeshResult : DistanceResult {
 //     other triangle's interior with its ends farther than the contact band
 //     64 u R on either side of its plane, decided with exact predicates), or
 //     a connected component of one surface lies inside the other mesh, when
-//     that mesh is closed (TriangleMesh::contains). The points are then a
-//     crossing point (on both) or the closest points, distance 0.
+//     that mesh is closed (TriangleMesh::contains). The points are then
+//     one common point, distance 0: a crossing point, or a vertex of the
+//     contained component.
 //   - touching: distance <= 64 u R + options.absolute_tolerance otherwise.
 //   - separated: otherwise. An open mesh has no inside: a body within an
 //     open (or inconsistently oriented) mesh is separated from it by the
@@ -110,8 +113,10 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const T
 // ids. Status: intersecting when a triangle overlaps the polytope (deeper
 // than the contact band, as the convex query decides: a mesh inside the
 // polytope is intersecting) or when the polytope lies inside the mesh, if
-// the mesh is closed; touching and separated as in the convex query. The
-// depth is not computed (distance 0, depth_upper_bound +infinity). A
+// the mesh is closed; touching and separated as in the convex query. An
+// intersecting answer's points are one common point (a point of the
+// overlapping triangle and the polytope, or the polytope's vertex inside
+// the mesh). The depth is not computed (distance 0, depth_upper_bound +infinity). A
 // rounded body (core plus radius r, body.h) is the core's answer offset by
 // r along the normal: the closest triangle is the same.
 //
