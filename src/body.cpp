@@ -22,11 +22,6 @@
 namespace proxima {
 namespace {
 
-// The largest coordinate magnitude of a rounded body (core plus radius)
-// accepted: the cores' query's own limit (distance.cpp), so that no sum of
-// radii, signed distance or offset point can overflow.
-constexpr double kMaxMagnitude = 0x1p1018;
-
 // A radius or an approximation error: finite and >= 0, else refused by
 // name. Finiteness on the bits first: no comparison with a NaN, which
 // would raise FE_INVALID under a caller's traps.

@@ -23,14 +23,6 @@
 namespace proxima {
 namespace {
 
-// Largest coordinate magnitude (bounded as below) accepted. The algorithms
-// take differences of coordinates and map B into A's frame (|R y + t| up
-// to sqrt(3) |y| + |t|), and the hybrid and GJK then work in units of a
-// power of two near that magnitude; beyond 2^1018 (2.8e306) those
-// intermediate values can overflow to inf, and differences of infinities
-// are NaN. Such input is refused by name instead of answered with NaN.
-constexpr double kMaxMagnitude = 0x1p1018;
-
 // Upper bound on the largest coordinate magnitude of a body placed at
 // `pose` (types.h). O(1).
 double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
