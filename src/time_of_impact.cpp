@@ -716,6 +716,13 @@ Pose Motion::at(double t) const { return Sweep(*this).at(t); }
 
 namespace {
 
+// The fastest turn followed, radians per unit t: beyond it consecutive
+// doubles of the angle t |w| are more than a radian apart (u |w| > 1/2),
+// so the pose at t is not defined by the motion, only by rounding; below
+// it |w|^2 and its products with the bodies' sizes stay far from
+// overflowing in the bounds.
+constexpr double kMaxTurnRate = 0x1p52;
+
 // checked_sweep's checks after the pose contract's, on rigid poses.
 Sweep limited_sweep(const Motion& m, double scale, const char* name) {
   const Motion& checked = m;
@@ -724,6 +731,14 @@ Sweep limited_sweep(const Motion& m, double scale, const char* name) {
   };
   if (m.angular && !(finite(*m.angular) && std::isfinite(m.angular->stableNorm())))
     refuse(".angular is not finite (NaN or infinite, or its length overflows)");
+  if (m.angular && !(m.angular->stableNorm() <= kMaxTurnRate)) {
+    char what[240];
+    std::snprintf(what, sizeof what,
+                  ".angular turns at %.3g rad per unit t, beyond the supported %.3g (2^52), where "
+                  "the angle t |w| is not known to a radian in doubles: scale the motion's time down",
+                  m.angular->stableNorm(), kMaxTurnRate);
+    refuse(what);
+  }
   for (const Pose* end : {&checked.start, &checked.end}) {
     const double magnitude = magnitude_bound(*end, scale);
     if (!(magnitude <= kMaxMagnitude)) {

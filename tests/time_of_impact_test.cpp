@@ -1014,9 +1014,9 @@ TEST(TimeOfImpact, AToleranceBelowTheContactBandIsRaisedToIt) {
 // away at 1e308 failed in the query at t = 1; an angular velocity of
 // 1e300 (every input finite) was refused as a non-finite end pose (its
 // norm squared overflowed). Now: a motion whose end lies beyond the
-// coordinates the distance queries accept (2^1018) is refused by name,
-// the spin turns (a cube spinning about its center far from another is
-// separated), and a closing speed bound that overflows is refused by name.
+// coordinates the distance queries accept (2^1018) is refused by name, a
+// turn too fast for doubles to know its angle is refused by name, and so
+// is a closing speed bound that overflows.
 TEST(TimeOfImpact, VelocitiesNearTheLargestDoubleAreAnsweredOrRefusedByName) {
   const ConvexPolytope cube(box(Vec3(1, 1, 1)));
   const Pose at5 = Pose::from_translation(Vec3(5, 0, 0));
@@ -1049,15 +1049,30 @@ TEST(TimeOfImpact, VelocitiesNearTheLargestDoubleAreAnsweredOrRefusedByName) {
   EXPECT_LE(both.t, 1.5e-306);
   EXPECT_GE(both.t, 1.5e-306 * (1 - 1e-6));
 
+  // A turn of 1e300 rad per unit t: its angle at t is not known to a
+  // radian (consecutive doubles near it are 1e284 apart), refused by name;
+  // at 2^52 rad per unit t it still turns (a cube spinning about its
+  // center beside another is separated).
   const Motion spin = Motion::from_velocity(at5, Vec3::Zero(), Vec3(0, 0, 1e300));
   ASSERT_TRUE(spin.angular.has_value());
-  const ImpactResult r = time_of_impact(cube, origin, cube, spin);
+  EXPECT_NE(message(origin, spin).find("motion_b.angular turns at 1e+300 rad per unit t, beyond "
+                                       "the supported 4.5e+15"),
+            std::string::npos)
+      << message(origin, spin);
+  const Motion fastest = Motion::from_velocity(at5, Vec3::Zero(), Vec3(0, 0, 0x1p52));
+  const ImpactResult r = time_of_impact(cube, origin, cube, fastest);
   EXPECT_EQ(r.status, ImpactStatus::separated);
   EXPECT_TRUE(r.at_t.distance >= 4.0 - std::sqrt(2.0) && r.at_t.distance <= 3.0 + 1e-12);
 
-  const Motion spin_max = Motion::from_velocity(at5, Vec3::Zero(), Vec3(0, 0, 1.5e308));
-  EXPECT_NE(message(origin, spin_max).find("closing speed bound"), std::string::npos)
-      << message(origin, spin_max);
+  // A body of size 1e300 turning at 1e10: its points' speed overflows.
+  const ConvexPolytope huge(box(Vec3(1e300, 1e300, 1e300)));
+  const Motion turning = Motion::from_velocity(Pose::identity(), Vec3::Zero(), Vec3(0, 0, 1e10));
+  try {
+    time_of_impact(huge, turning, cube, Motion::fixed(Pose::from_translation(Vec3(3e300, 0, 0))));
+    ADD_FAILURE() << "no error";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("closing speed bound"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(Motion::from_velocity(at5, Vec3(1e308, 0, 0), Vec3::Zero(), 10.0), InvalidInput);
   EXPECT_THROW(Motion::from_velocity(at5, Vec3::Zero(), Vec3(1e308, 1e308, 1e308)),
                InvalidInput);

@@ -161,7 +161,9 @@ struct ImpactResult {
 // the distance at t is within options.tolerance of the target. Throws
 // InvalidInput for bad poses (the pose contract of proxima/pose.h at both
 // ends), a Motion::angular that is not finite or does not end at
-// end.rotation, motions that cannot be followed in doubles (an end pose
+// end.rotation, motions that cannot be followed in doubles (a turn faster
+// than 2^52 (4.5e15) rad per unit t, whose angle doubles cannot tell to a
+// radian; an end pose
 // beyond the supported coordinate magnitude 2^1018, about 2.8e306, as
 // distance(); or a closing speed |v_b - v_a| + |w_a| reach_a + |w_b|
 // reach_b that overflows), or options (negative target, tolerance < 0 or

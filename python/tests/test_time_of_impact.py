@@ -147,6 +147,9 @@ def test_a_tiny_tolerance_and_huge_velocities():
                                proxima.Motion.from_velocity(T((5, 0, 0)), (1e308, 0, 0),
                                                             (0, 0, 0)))
     spin = proxima.Motion.from_velocity(T((5, 0, 0)), (0, 0, 0), (0, 0, 1e300))
+    with pytest.raises(ValueError, match="motion_b.angular turns at 1e\\+300 rad per unit t"):
+        proxima.time_of_impact(a, proxima.Motion.fixed(None), a, spin)
+    spin = proxima.Motion.from_velocity(T((5, 0, 0)), (0, 0, 0), (0, 0, 2.0 ** 52))
     assert proxima.time_of_impact(a, proxima.Motion.fixed(None), a, spin).status == "separated"
 
 
