@@ -611,8 +611,8 @@ void bind_compound_and_scene(py::module_& m) {
           },
           py::arg("id"), py::arg("pose"),
           "Where body id moves to over the next sweep() (its motion: constant linear velocity of "
-          "its frame's origin and constant angular velocity about it, the shorter way round). "
-          "set_pose ends the motion (the end pose becomes the new pose).")
+          "its frame's origin and constant angular velocity about it, the shorter way round; "
+          "set_velocity for more than a half turn). set_pose ends the motion (the end pose becomes the new pose).")
       .def(
           "set_end_poses",
           [](PyScene& s, py::object ids, py::object poses) {
@@ -621,6 +621,19 @@ void bind_compound_and_scene(py::module_& m) {
           },
           py::arg("ids"), py::arg("poses"),
           "set_end_pose for many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing.")
+      .def(
+          "set_velocity",
+          [](PyScene& s, BodyId id, py::handle linear, py::handle angular) {
+            const Vec3 v = to_vec3(linear, "linear");
+            const Vec3 w = to_vec3(angular, "angular");
+            const InUse in_use(s, "Scene");
+            s.set_velocity(id, v, w);
+          },
+          py::arg("id"), py::arg("linear"), py::arg("angular"),
+          "Body id's motion over the next sweep() by velocities instead of an end pose: its "
+          "frame's origin moves at `linear` (units per unit t) and it turns at `angular` (world "
+          "frame, radians per unit t) through any angle, several turns included. The end pose "
+          "becomes where they take it; set_end_pose and set_pose forget the velocities.")
       .def(
           "end_pose",
           [](const PyScene& s, BodyId id) {

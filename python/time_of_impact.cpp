@@ -39,7 +39,8 @@ void bind_time_of_impact(py::module_& m) {
   py::class_<Motion>(m, "Motion",
                      "A body's motion over t in [0, 1]: its frame's origin moves at constant "
                      "velocity from start to end and the body turns at constant angular "
-                     "velocity about it, the shorter way.")
+                     "velocity about it: from_velocity's rate through any angle (several turns "
+                     "included), or from start to end the shorter way.")
       .def(py::init([](py::object start, py::object end) {
              return Motion{to_pose(start, "start"), to_pose(end, "end")};
            }),
@@ -55,16 +56,25 @@ void bind_time_of_impact(py::module_& m) {
           },
           py::arg("pose"), py::arg("linear"), py::arg("angular"), py::arg("duration") = 1.0,
           "From a pose, a linear velocity of its origin and an angular velocity (world frame, "
-          "radians per unit time) over `duration`; t = 1 is the end of it.")
+          "radians per unit time; the body turns at it through any angle, several turns "
+          "included) over `duration`; t = 1 is the end of it.")
       .def_readwrite("start", &Motion::start, "Pose at t = 0.")
       .def_readwrite("end", &Motion::end, "Pose at t = 1.")
+      .def_property_readonly(
+          "angular",
+          [](const Motion& mo) -> py::object {
+            if (!mo.angular) return py::none();
+            return vec3_array(*mo.angular);
+          },
+          "The angular velocity from_velocity kept (world frame, radians per unit t; the body "
+          "turns at it through any angle), or None: the shorter way from start to end.")
       .def("at", &Motion::at, py::arg("t"), "The pose at time t (clamped to [0, 1]).")
       .def(
           "linear_velocity", [](const Motion& mo) { return vec3_array(mo.linear_velocity()); },
           "Velocity of the frame's origin per unit t.")
       .def(
           "angular_velocity", [](const Motion& mo) { return vec3_array(mo.angular_velocity()); },
-          "Angular velocity per unit t, world frame.");
+          "Angular velocity per unit t, world frame: `angular` when set, else the shorter way's.");
 
   py::class_<ImpactResult>(m, "ImpactResult", "The answer of time_of_impact.")
       .def_property_readonly(

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <queue>
@@ -21,13 +22,14 @@
 #include "proxima/geometry/closest_point.h"
 #include "proxima/query/compound_distance.h"
 #include "proxima/shape/support.h"
+#include "time_of_impact.h"
 
 namespace proxima {
 
 namespace detail {
 
 // sin x and cos x for x in [0, pi/2], the range of a sweep's half angle
-// (angle <= pi, 0 < t < 1): Taylor polynomials on [0, pi/4], their
+// when it turns the shorter way (angle <= pi, 0 < t < 1): Taylor polynomials on [0, pi/4], their
 // truncation below 1e-19 there, and the cofunctions of pi/2 - x above it
 // (pi/2 - x exact by Sterbenz with pi/2's head, then its tail added). A
 // few ulps, as the library's, in far fewer instructions than glibc's
@@ -129,7 +131,10 @@ struct PlaneBound {
   double span = 0.0;
 };
 
-// Cone margins a hair inside the computed ones, for their rounding.
+// Cone margins a hair inside the computed ones, for their rounding: a
+// margin is a root of a ratio of dot products, off by a few u relative
+// (far below 1e-9), and the bounds it limits only need it not to be
+// larger than the true one; 1e-9 of a margin shortens a span by as little.
 constexpr double kConeMarginShrink = 1.0 - 1e-9;
 
 // The largest face taken whole into S (bigger faces: S is the witness
@@ -137,13 +142,20 @@ constexpr double kConeMarginShrink = 1.0 - 1e-9;
 // |S| times the degree times |S|.
 constexpr std::size_t kMaxFeatureVertices = 16;
 
+// Squares below this bound are taken as they are (their root in one
+// sqrt): a sum of three squares below 2^1000 cannot have overflowed, and
+// its root is as accurate as the stable norm's; from 2^1000 up (and in the
+// subnormals, where the squares lose bits) the norms and ratios below take
+// the stable way.
+constexpr double kSquareInRange = 0x1p1000;
+
 // |x| from its square where that neither overflows nor underflows (the
 // common case, one sqrt), else the stable norm.
 // Inlined: with the mesh traversal in this file GCC stopped inlining it,
 // a call for three multiplies and a root on every bound (callgrind).
 [[gnu::always_inline]] inline double fast_norm(const Vec3& x) {
   const double squared = x.squaredNorm();
-  if (squared >= std::numeric_limits<double>::min() && squared < 0x1p1000)
+  if (squared >= std::numeric_limits<double>::min() && squared < kSquareInRange)
     return std::sqrt(squared);
   return x.stableNorm();
 }
@@ -229,9 +241,15 @@ struct MarginMemo {
   double margin = -1.0;  // none yet
 };
 
-// Rounding of |d' - d| (unit vectors) and of the kept margin's ratios,
-// far above it.
+// What a kept margin loses besides |d' - d|: the rounding of |d' - d|
+// (unit vectors, a few u) and of the kept margin's ratios (a few u
+// relative, of a margin <= 1): 1e-14 is about 45 u, far above both.
 constexpr double kMarginSlack = 1e-14;
+
+// Squared cone margins below this count as none: a square in the
+// subnormals may have been rounded up (margins below 2^-450, whose spans
+// are no use anyway).
+constexpr double kSmallestSquaredMargin = 0x1p-900;
 
 // How far the unit direction seen from a body (`direction`, times `sign`)
 // may turn, as |e(t) - e(0)|, before a neighbour of the vertex set S may
@@ -256,7 +274,7 @@ double cone_margin(const ConvexPolytope& body, const VertexSet& set, const Vec3&
       const double rise = d.dot(edge);
       if (rise < 0.0) return 0.0;
       const double length2 = edge.squaredNorm();
-      if (length2 >= std::numeric_limits<double>::min() && length2 < 0x1p1000) [[likely]] {
+      if (length2 >= std::numeric_limits<double>::min() && length2 < kSquareInRange) [[likely]] {
         margin2 = std::min(margin2, rise * rise / length2);
       } else {
         const double length = edge.stableNorm();
@@ -265,7 +283,7 @@ double cone_margin(const ConvexPolytope& body, const VertexSet& set, const Vec3&
       }
     }
   }
-  if (!(margin2 >= 0x1p-900)) return 0.0;
+  if (!(margin2 >= kSmallestSquaredMargin)) return 0.0;
   return std::sqrt(margin2) * kConeMarginShrink;
 }
 
@@ -299,7 +317,7 @@ class FeaturePlane {
       arm2 = std::max(arm2, (q - origin).squaredNorm());
     }
     double arm = std::sqrt(arm2);
-    if (!(arm2 >= std::numeric_limits<double>::min() && arm2 < 0x1p1000)) {
+    if (!(arm2 >= std::numeric_limits<double>::min() && arm2 < kSquareInRange)) {
       arm = 0.0;
       for (std::size_t k = 0; k < set.size; ++k)
         arm = std::max(arm, (body.vertex(set.ids[k]) - origin).stableNorm());
@@ -486,6 +504,13 @@ struct EdgePairs {
   double margin_b = -1.0;
 };
 
+// The smallest sine of the angle between the two edges for which their
+// plane is used: m = c / rho's rounding grows as 1 / rho, and at rho >=
+// 1/2 it stays a few u (inside the band that keep_off keeps off); the
+// horizon keeps rho >= rho(0) / 2 too, so that the bound on |m''| (which
+// grows as 1 / rho^2) stays within 16 times its value at right angles.
+constexpr double kMinEdgePairSine = 0.5;
+
 double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origin_a, const Vec3& va,
                       const Vec3& wa, const Feature& fa, const Vec3& p, const ConvexPolytope& b,
                       const Pose& pb, const Vec3& origin_b, const Vec3& vb, const Vec3& wb,
@@ -501,11 +526,11 @@ double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origi
   // e_a x e_b of the unit edges: one root for both lengths (out of range:
   // no bound).
   const double lengths2 = edge_a.squaredNorm() * edge_b.squaredNorm();
-  if (!(lengths2 >= std::numeric_limits<double>::min() && lengths2 < 0x1p1000)) return 0.0;
+  if (!(lengths2 >= std::numeric_limits<double>::min() && lengths2 < kSquareInRange)) return 0.0;
   const double inverse = 1.0 / std::sqrt(lengths2);
   const Vec3 c = edge_a.cross(edge_b) * inverse;
   const double rho = std::sqrt(c.squaredNorm());
-  if (!(rho >= 0.5)) return 0.0;
+  if (!(rho >= kMinEdgePairSine)) return 0.0;
   Vec3 m = c / rho;
   if (m.dot(n) < 0.0) m = -m;
   const Vec3 d0 = q - p;
@@ -571,7 +596,10 @@ double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origi
 
 // A motion with its turn precomputed (Motion::at would convert the rotation
 // to an angle and an axis on every call; a time of impact takes poses at a
-// dozen times). The turn by phi = t angle about the unit axis k is
+// dozen times). The turn's angle and axis are the angular velocity's when
+// the motion has one (any angle, several turns included), else the
+// shorter way's from start to end (an angle in [0, pi]). The turn by
+// phi = t angle about the unit axis k is
 // Rodrigues' I + sin(phi) K + (1 - cos(phi)) K^2 (K the cross product
 // matrix of k), so the pose's rotation is R0 + sin(phi) (K R0) +
 // (1 - cos(phi)) (K^2 R0): the two products are made once, and each pose
@@ -580,9 +608,14 @@ double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3& origi
 class Sweep {
  public:
   explicit Sweep(const Motion& m) : motion_(m) {
-    const Eigen::AngleAxisd turn(Mat3(m.end.rotation * m.start.rotation.transpose()));
-    angle_ = turn.angle();
-    axis_ = turn.axis();
+    if (m.angular) {
+      angle_ = m.angular->stableNorm();
+      if (angle_ > 0.0) axis_ = *m.angular / angle_;
+    } else {
+      const Eigen::AngleAxisd turn(Mat3(m.end.rotation * m.start.rotation.transpose()));
+      angle_ = turn.angle();
+      axis_ = turn.axis();
+    }
     // K x = axis x x, column by column.
     for (int j = 0; j < 3; ++j) {
       k_r0_.col(j) = axis_.cross(m.start.rotation.col(j));
@@ -593,19 +626,22 @@ class Sweep {
     if (t <= 0.0) return motion_.start;
     if (t >= 1.0) return motion_.end;
     Pose p;
-    if (angle_ > 0.0) {
-      const double half = 0.5 * t * angle_;
-      double s, c;
-      detail::sin_cos_quadrant(half, s, c);
-      p.rotation = motion_.start.rotation + (2.0 * s * c) * k_r0_ + (2.0 * s * s) * kk_r0_;
-    } else {
-      p.rotation = motion_.start.rotation;
-    }
+    p.rotation = turned(t);
     p.translation =
         motion_.start.translation + t * (motion_.end.translation - motion_.start.translation);
     return p;
   }
-  Vec3 angular_velocity() const { return angle_ * axis_; }
+  // The rotation at t by the turn's formula (at t = 1 too, where at() gives
+  // the end pose as stored).
+  Mat3 turned(double t) const {
+    if (!(angle_ > 0.0)) return motion_.start.rotation;
+    const double half = 0.5 * t * angle_;
+    double s, c;
+    detail::sin_cos_quadrant(half, s, c);
+    return motion_.start.rotation + (2.0 * s * c) * k_r0_ + (2.0 * s * s) * kk_r0_;
+  }
+  Vec3 angular_velocity() const { return motion_.angular ? *motion_.angular : angle_ * axis_; }
+  double angle() const { return angle_; }
   Vec3 linear_velocity() const { return motion_.linear_velocity(); }
 
  private:
@@ -656,17 +692,22 @@ Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& a
     throw InvalidInput(
         "Motion::from_velocity: the velocities must be finite and the duration finite and > 0");
   }
-  const double angle = angular.norm() * duration;
-  Pose end = pose;
-  end.translation = pose.translation + duration * linear;
-  if (angle > 0.0) {
-    end.rotation =
-        Eigen::AngleAxisd(angle, angular.normalized()).toRotationMatrix() * pose.rotation;
+  // The turn per unit t, kept: the end pose alone cannot say how many
+  // turns the body made, nor which way past a half turn.
+  Motion m{pose, pose, Vec3(duration * angular)};
+  m.end.translation = pose.translation + duration * linear;
+  if (!finite(*m.angular) || !std::isfinite(m.angular->stableNorm()) ||
+      !finite(m.end.translation)) {
+    throw InvalidInput(
+        "Motion::from_velocity: the turn or the end translation over the duration overflows "
+        "doubles (duration * velocity beyond about 1.8e308)");
   }
-  return {pose, end};
+  m.end.rotation = Sweep(m).turned(1.0);
+  return m;
 }
 
 Vec3 Motion::angular_velocity() const {
+  if (angular) return *angular;
   const Eigen::AngleAxisd turn(Mat3(end.rotation * start.rotation.transpose()));
   return turn.angle() * turn.axis();
 }
@@ -675,13 +716,85 @@ Pose Motion::at(double t) const { return Sweep(*this).at(t); }
 
 namespace {
 
-// Both motions under the pose contract (re-orthonormalized where the
-// contract allows it).
-Sweep checked_sweep(const Motion& m, const char* start, const char* end) {
+// The fastest turn followed, radians per unit t: beyond it consecutive
+// doubles of the angle t |w| are more than a radian apart (u |w| > 1/2),
+// so the pose at t is not defined by the motion, only by rounding; below
+// it |w|^2 and its products with the bodies' sizes stay far from
+// overflowing in the bounds.
+constexpr double kMaxTurnRate = 0x1p52;
+
+// checked_sweep's checks after the pose contract's, on rigid poses.
+Sweep limited_sweep(const Motion& m, double scale, const char* name) {
+  const Motion& checked = m;
+  const auto refuse = [&](const std::string& what) {
+    throw InvalidInput(std::string(name) + what);
+  };
+  if (m.angular && !(finite(*m.angular) && std::isfinite(m.angular->stableNorm())))
+    refuse(".angular is not finite (NaN or infinite, or its length overflows)");
+  if (m.angular && !(m.angular->stableNorm() <= kMaxTurnRate)) {
+    char what[240];
+    std::snprintf(what, sizeof what,
+                  ".angular turns at %.3g rad per unit t, beyond the supported %.3g (2^52), where "
+                  "the angle t |w| is not known to a radian in doubles: scale the motion's time down",
+                  m.angular->stableNorm(), kMaxTurnRate);
+    refuse(what);
+  }
+  for (const Pose* end : {&checked.start, &checked.end}) {
+    const double magnitude = magnitude_bound(*end, scale);
+    if (!(magnitude <= kMaxMagnitude)) {
+      char what[220];
+      std::snprintf(what, sizeof what,
+                    ".%s reaches coordinates of magnitude %.3g (vertices and pose translation), "
+                    "beyond the supported %.3g where differences of coordinates may overflow",
+                    end == &checked.start ? "start" : "end", magnitude, kMaxMagnitude);
+      refuse(what);
+    }
+  }
+  Sweep sweep(checked);
+  if (m.angular) {
+    // The turn must end where the motion says it does: the angle's
+    // rounding (a few u of it, a rotation a few u off) is far inside the
+    // pose contract's tolerance, which a different end (a motion built
+    // with one angular velocity and another end pose) is not.
+    const double off = (sweep.turned(1.0) - checked.end.rotation).cwiseAbs().maxCoeff();
+    if (!(off <= kRotationTolerance)) {
+      refuse(".end.rotation is not where .angular turns .start.rotation at t = 1 (off by " +
+             std::to_string(off) + "): give the end pose that angular velocity reaches, as " +
+             "Motion::from_velocity does");
+    }
+  }
+  return sweep;
+}
+
+// A motion under the pose contract (re-orthonormalized where the contract
+// allows it), its angular velocity (when given) finite and ending at
+// end.rotation, and both ends within the coordinate magnitude the distance
+// queries accept, for a body of `scale` (its coordinates' largest
+// magnitude in its own frame). `name`: "time_of_impact: motion_a".
+Sweep checked_sweep(const Motion& m, double scale, const char* name) {
   // Both ends' check at once (the common case), else each end's own.
   if (detail::are_rigid(m.start, m.end)) [[likely]]
-    return Sweep(m);
-  return Sweep(Motion{checked_pose(m.start, start), checked_pose(m.end, end)});
+    return limited_sweep(m, scale, name);
+  return limited_sweep(Motion{checked_pose(m.start, std::string(name) + ".start"),
+                              checked_pose(m.end, std::string(name) + ".end"), m.angular},
+                       scale, name);
+}
+
+// The motions' closing speed bound |v_b - v_a| + |w_a| reach_a + |w_b|
+// reach_b, each reach bounded by sqrt(3) scale (the farthest a body's
+// point is from its reference point): finite, or the motions are refused
+// (every step's bounds would overflow to infinity and no step could be
+// taken).
+void check_closing_speed(const Sweep& ma, double scale_a, const Sweep& mb, double scale_b) {
+  const double speed = (mb.linear_velocity() - ma.linear_velocity()).stableNorm() +
+                       ma.angle() * std::sqrt(3.0) * scale_a +
+                       mb.angle() * std::sqrt(3.0) * scale_b;
+  if (!std::isfinite(speed)) {
+    throw InvalidInput(
+        "time_of_impact: the motions' closing speed bound |v_b - v_a| + |w_a| reach_a + "
+        "|w_b| reach_b overflows doubles (velocities times sizes beyond about 1.8e308): "
+        "scale the motions' time down");
+  }
 }
 
 // A step that is safe from time t: no contact before t + step, or none at
@@ -691,20 +804,33 @@ struct SafeStep {
   bool never = false;
 };
 
+// The tolerance is at least this many contact bands at the poses of a
+// step (ImpactOptions::tolerance says so): the steps keep one band off
+// the planes' gaps and two off the edge pair's (the query's rounding and
+// the plane's own), and the gaps are the distance within a band of
+// rounding, so a distance within a few bands of the target may allow no
+// step at all; above four bands every gap still exceeds what is kept off,
+// and the step is positive. A finer tolerance would end at the iteration
+// cap with the distance already as close as doubles can tell.
+constexpr double kMinToleranceBands = 4.0;
+
 // The advancement loop shared by every body kind, over [t_begin, t_end]
 // (no contact before t_begin is known): `poses(t)` the two poses at t,
 // `query(pa, pb)` the distance query at them (its signed distance and
-// status decide contact), `safe_step(r, pa, pb)` how far time may advance
-// after answer r. Safe up to t_end < 1: status separated at t = t_end, no
-// query there (a caller that already has a contact at t_end).
-template <class Poses, class Query, class Step>
+// status decide contact), `band(pa, pb)` the contact band there (the
+// tolerance's floor, kMinToleranceBands), `safe_step(r, pa, pb)` how far
+// time may advance after answer r. Safe up to t_end < 1: status separated
+// at t = t_end, no query there (a caller that already has a contact at
+// t_end).
+template <class Poses, class Query, class Band, class Step>
 ImpactResult advance(const Poses& poses, const ImpactOptions& options, double tolerance,
-                     const Query& query, const Step& safe_step, double t_begin = 0.0,
-                     double t_end = 1.0) {
+                     const Query& query, const Band& band, const Step& safe_step,
+                     double t_begin = 0.0, double t_end = 1.0) {
   const double target = options.target_separation;
-  const auto in_contact = [&](const DistanceResult& r) {
+  const auto in_contact = [&](const DistanceResult& r, const Pose& pa, const Pose& pb) {
     return r.status == Status::intersecting || r.status == Status::touching ||
-           r.signed_distance() <= target + tolerance;
+           r.signed_distance() <=
+               target + std::max(tolerance, kMinToleranceBands * band(pa, pb));
   };
   ImpactResult out;
   double t = t_begin;
@@ -726,7 +852,7 @@ ImpactResult advance(const Poses& poses, const ImpactOptions& options, double to
       out.at_t = r;
       return out;
     };
-    if (in_contact(r)) {
+    if (in_contact(r, pa, pb)) {
       // At t = 0: overlapping when the bodies overlap or are strictly within
       // the offset; touching (or at the offset) is a contact at t = 0.
       return stop_here(t == 0.0 &&
@@ -747,7 +873,8 @@ ImpactResult advance(const Poses& poses, const ImpactOptions& options, double to
       out.at_t = query(out.pose_a, out.pose_b);
       ++out.iterations;
       out.t = 1.0;
-      out.status = in_contact(out.at_t) ? ImpactStatus::contact : ImpactStatus::separated;
+      out.status = in_contact(out.at_t, out.pose_a, out.pose_b) ? ImpactStatus::contact
+                                                                : ImpactStatus::separated;
       return out;
     }
     if (!(t + s.step > t)) {
@@ -806,7 +933,7 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
   const Vec3 wb = hb.sweep->angular_velocity();
   const double reach_a = ha.reach;
   const double reach_b = hb.reach;
-  const double any_speed = (vb - va).stableNorm() + wa.norm() * reach_a + wb.norm() * reach_b;
+  const double any_speed = (vb - va).stableNorm() + fast_norm(wa) * reach_a + fast_norm(wb) * reach_b;
 
   const auto poses = [&](double t) {
     return std::pair<Pose, Pose>(ha.placed(ha.sweep->at(t)), hb.placed(hb.sweep->at(t)));
@@ -842,9 +969,11 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
   edge_pairs.speed = fast_norm(vb - va);
   edge_pairs.reach_a = reach_a;
   edge_pairs.reach_b = reach_b;
+  const auto contact_band_at = [&](const Pose& pa, const Pose& pb) {
+    return contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
+  };
   const auto safe_step = [&](const DistanceResult& r, const Pose& pa, const Pose& pb, double t) {
-    const double band =
-        contact_band(std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())));
+    const double band = contact_band_at(pa, pb);
     const Vec3& n = r.normal;
     const SupportPlanes hull = support_planes(a, pa, b, pb, n, c);
     const double turn_a = fast_norm(wa.cross(n));
@@ -941,7 +1070,7 @@ ImpactResult advance_hulls(const MovingHull& ha, const MovingHull& hb, const Imp
     }
     return best;
   };
-  return advance(poses, options, tolerance, query, safe_step, t_begin, t_end);
+  return advance(poses, options, tolerance, query, contact_band_at, safe_step, t_begin, t_end);
 }
 
 // A ball carried by a moving body: its center in the body's frame.
@@ -1170,6 +1299,11 @@ class CompoundTree {
   int hint_ = 0;  // lowest()'s last support vertex
 };
 
+// A triangle's radius and reach computed in doubles are off by a few u
+// relative; the speed bounds need every corner inside them, so both are
+// taken this hair larger (1e-12 is thousands of u, and costs nothing).
+constexpr double kTriangleRadiusGrowth = 1.0 + 1e-12;
+
 class MeshTree {
  public:
   static constexpr bool kMesh = true;
@@ -1201,7 +1335,7 @@ class MeshTree {
     const Vec3 center = (corners[0] + corners[1] + corners[2]) / 3.0;
     double radius = 0.0;
     for (const Vec3& x : corners) radius = std::max(radius, (x - center).stableNorm());
-    return {Ball{center, radius * (1.0 + 1e-12)}, Bound::Shape::triangle, corners};
+    return {Ball{center, radius * kTriangleRadiusGrowth}, Bound::Shape::triangle, corners};
   }
   const ConvexPolytope& hull(std::int32_t p) {
     auto it = triangles_.find(p);
@@ -1220,7 +1354,7 @@ class MeshTree {
   double reach(std::int32_t p) const {
     double r = 0.0;
     for (const Vec3& x : triangle_corners(p)) r = std::max(r, x.stableNorm());
-    return r * (1.0 + 1e-12);
+    return r * kTriangleRadiusGrowth;
   }
   std::array<Vec3, 3> triangle_corners(std::int32_t p) const {
     const TriangleMesh::Triangle& t = mesh_->triangle(p);
@@ -1367,7 +1501,7 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
   PosesAt poses(ma, mb);
   // |v_b - v_a|, |w_a|, |w_b|: the balls' speeds.
   const Vec3 speeds((mb.linear_velocity() - ma.linear_velocity()).stableNorm(),
-                    ma.angular_velocity().norm(), mb.angular_velocity().norm());
+                    fast_norm(ma.angular_velocity()), fast_norm(mb.angular_velocity()));
   const auto push = [&](Candidate k, const auto& ba, const auto& bb) {
     k.t = earliest_of(poses, speeds, ba, bb, target, k.t, best.t);
     if (may_beat(k.t)) queue.push(k);
@@ -1473,13 +1607,13 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
                             const ImpactOptions& options, DistanceCache* cache) {
   detail::check_impact_options(options, "time_of_impact");
-  const Sweep ma =
-      checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
-  const Sweep mb =
-      checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
+  const Sweep ma = checked_sweep(motion_a, a.scale(), "time_of_impact: motion_a");
+  const Sweep mb = checked_sweep(motion_b, b.scale(), "time_of_impact: motion_b");
+  check_closing_speed(ma, a.scale(), mb, b.scale());
   const double tolerance = options.tolerance > 0.0
                                ? options.tolerance
-                               : 1e-6 * (a.bounding_radius() + b.bounding_radius());
+                               : detail::kDefaultImpactTolerance *
+                                     (a.bounding_radius() + b.bounding_radius());
   DistanceCache local;
   return advance_hulls(MovingHull(a, ma), MovingHull(b, mb), options, tolerance,
                        cache != nullptr ? *cache : local);
@@ -1493,7 +1627,7 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
   BodyCache& c = cache != nullptr ? *cache : local;
   const double ra = a.radius();
   const double rb = b.radius();
-  const double default_tolerance = 1e-6 * (body_size(a) + body_size(b));
+  const double default_tolerance = detail::kDefaultImpactTolerance * (body_size(a) + body_size(b));
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
     // The cores, with the radii added to the target; then the answer at t
     // moved onto the rounded surfaces.
@@ -1505,10 +1639,9 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
     return r;
   }
 
-  const Sweep ma =
-      checked_sweep(motion_a, "time_of_impact: motion_a.start", "time_of_impact: motion_a.end");
-  const Sweep mb =
-      checked_sweep(motion_b, "time_of_impact: motion_b.start", "time_of_impact: motion_b.end");
+  const Sweep ma = checked_sweep(motion_a, a.scale(), "time_of_impact: motion_a");
+  const Sweep mb = checked_sweep(motion_b, b.scale(), "time_of_impact: motion_b");
+  check_closing_speed(ma, a.scale(), mb, b.scale());
   const double tolerance = options.tolerance > 0.0 ? options.tolerance : default_tolerance;
   // A closed mesh has an inside: a body that starts there overlaps it
   // without touching a triangle. Otherwise the surfaces first come within

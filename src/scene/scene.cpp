@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <utility>
@@ -32,6 +33,7 @@
 #include "core/accuracy.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
+#include "motion/time_of_impact.h"
 #include "query/parallel_ranges.h"
 #include "scene/broad_phase.h"
 
@@ -80,10 +82,6 @@ constexpr double kBoxSlackUlps = 128.0;
 // the target and the turn's sag: a few more units of rounding on each.
 constexpr double kSweptBoxSlackUlps = kBoxSlackUlps + 32.0;
 constexpr double kSweptPadSlackUlps = 8.0;
-
-// time_of_impact's default tolerance, relative to the bodies' size
-// (src/motion/time_of_impact.cpp): 1e-6 of the sum of their bounding radii.
-constexpr double kDefaultImpactTolerance = 1e-6;
 
 std::size_t slot(BodyId id) { return static_cast<std::size_t>(id); }
 
@@ -160,6 +158,9 @@ struct Scene::Impl {
     bool general = false;  // rounded, padded or a mesh: its pairs take the Body query
     Pose pose;
     Pose end;                // the end pose of the next sweep
+    // The angular velocity of the next sweep when set_velocity gave it (the
+    // body turns at this rate through any angle), else the shorter way.
+    std::optional<Vec3> angular;
     detail::BoxHints hints;  // support_box's
     CollisionFilter filter;
     bool live = false;
@@ -494,8 +495,10 @@ struct Scene::Impl {
     double scale = 0.0;
     double arm = 0.0;   // bound on rho over the points (or the sphere's center) boxed
     double size = 0.0;  // bound on the body's size in any query's default tolerance
-    const bool moving =
-        !(b.end.translation == b.pose.translation && b.end.rotation == b.pose.rotation);
+    // A body turning by velocity moves even when its end pose is its pose
+    // (whole turns).
+    const bool moving = b.angular.has_value() || !(b.end.translation == b.pose.translation &&
+                                                   b.end.rotation == b.pose.rotation);
     if (b.convex) {
       start = detail::support_box(*b.convex, b.pose, b.hints);
       end = moving ? detail::support_box(*b.convex, b.end, b.hints) : start;
@@ -535,11 +538,21 @@ struct Scene::Impl {
       const Vec3 v = b.end.translation - b.pose.translation;
       box.lo = start.lo.cwiseMin(end.lo).cwiseMin(start.lo + v).cwiseMin(end.lo - v);
       box.hi = start.hi.cwiseMax(end.hi).cwiseMax(start.hi + v).cwiseMax(end.hi - v);
-      // The turn as time_of_impact's motion takes it (Eigen's angle in [0, pi]).
+      // The turn as time_of_impact's motion takes it: the angular velocity's
+      // whole angle when set_velocity gave it, else the shorter way's (in
+      // [0, pi]). A point at `arm` from the reference point sweeps an arc
+      // of that angle, no farther than arm (1 - cos(theta / 2)) from its
+      // chord while theta <= pi; beyond, anywhere on its circle, within
+      // 2 arm of the chord's ends.
       const double theta =
-          Eigen::AngleAxisd(Mat3(b.end.rotation * b.pose.rotation.transpose())).angle();
-      const double q = std::sin(0.25 * theta);
-      sag = 2.0 * arm * q * q;
+          b.angular ? b.angular->stableNorm()
+                    : Eigen::AngleAxisd(Mat3(b.end.rotation * b.pose.rotation.transpose())).angle();
+      if (theta <= std::numbers::pi) {
+        const double q = std::sin(0.25 * theta);
+        sag = 2.0 * arm * q * q;
+      } else {
+        sag = 2.0 * arm;
+      }
     }
     const double grow = pad + size_pad * size + sag + b.reach;
     const double magnitude =
@@ -555,8 +568,8 @@ struct Scene::Impl {
   // `state`'s cache when given.
   static ImpactResult impact(const Body& a, const Body& b, const ImpactOptions& impact_options,
                              PairState* state) {
-    const Motion ma{a.pose, a.end};
-    const Motion mb{b.pose, b.end};
+    const Motion ma{a.pose, a.end, a.angular};
+    const Motion mb{b.pose, b.end, b.angular};
     if (a.general || b.general) {
       return time_of_impact(a.shape->padded, ma, b.shape->padded, mb, impact_options,
                             state != nullptr ? &state->body.get() : nullptr);
@@ -666,12 +679,31 @@ void Scene::set_pose(BodyId id, const Pose& pose) {
   Impl::Body& b = impl_->bodies[slot(id)];
   b.pose = checked_pose(pose, [&] { return "Scene::set_pose: pose of " + name(id); });
   b.end = b.pose;
+  b.angular.reset();
 }
 
 void Scene::set_end_pose(BodyId id, const Pose& end) {
   impl_->live_body(id, "set_end_pose");
-  impl_->bodies[slot(id)].end =
-      checked_pose(end, [&] { return "Scene::set_end_pose: end pose of " + name(id); });
+  Impl::Body& b = impl_->bodies[slot(id)];
+  b.end = checked_pose(end, [&] { return "Scene::set_end_pose: end pose of " + name(id); });
+  b.angular.reset();
+}
+
+void Scene::set_velocity(BodyId id, const Vec3& linear, const Vec3& angular) {
+  impl_->live_body(id, "set_velocity");
+  Impl::Body& b = impl_->bodies[slot(id)];
+  Motion m;
+  try {
+    m = Motion::from_velocity(b.pose, linear, angular);
+  } catch (const InvalidInput& e) {
+    throw InvalidInput("Scene::set_velocity: " + name(id) + ": " + e.what());
+  }
+  b.end = m.end;
+  b.angular = m.angular;
+}
+
+std::optional<Vec3> Scene::angular_velocity(BodyId id) const {
+  return impl_->live_body(id, "angular_velocity").angular;
 }
 
 const Pose& Scene::end_pose(BodyId id) const { return impl_->live_body(id, "end_pose").end; }
@@ -855,7 +887,7 @@ std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   const double explicit_tolerance = options.tolerance;
   const double pad =
       0.5 * (options.target_separation + explicit_tolerance + options.distance.absolute_tolerance);
-  const double size_pad = explicit_tolerance > 0.0 ? 0.0 : kDefaultImpactTolerance;
+  const double size_pad = explicit_tolerance > 0.0 ? 0.0 : detail::kDefaultImpactTolerance;
   s.swept_boxes.resize(s.bodies.size());
   detail::parallel_chunks(s.bodies.size(), kBoxChunk, threads,
                           [&](std::size_t, std::size_t begin, std::size_t end) {
@@ -891,7 +923,8 @@ std::span<const ImpactPair> Scene::sweep(const ImpactOptions& options) {
   stats = SweepStats{};
   stats.bodies = s.live_count;
   for (const Impl::Body& b : s.bodies) {
-    if (b.live && !(b.end.translation == b.pose.translation && b.end.rotation == b.pose.rotation))
+    if (b.live && (b.angular.has_value() || !(b.end.translation == b.pose.translation &&
+                                              b.end.rotation == b.pose.rotation)))
       ++stats.moving_bodies;
   }
   stats.candidate_pairs = static_cast<int>(n);

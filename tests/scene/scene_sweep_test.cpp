@@ -150,6 +150,53 @@ TEST(SceneSweep, TurnInPlaceIsCaughtWhereTheBoxesAtBothEndsMissIt) {
   EXPECT_TRUE(same_impact(hits[0], twin[0]));
 }
 
+// Issue 25: a body given velocities turns at their rate through any angle
+// in a sweep. A bar spinning one whole turn in place (set_velocity, w =
+// 2 pi) sweeps through a block beside it, though its end pose is its start
+// pose: set_end_pose to that same end pose (no turn, the shorter way) and
+// the sweep before the fix (which kept end poses only) found nothing. The
+// swept box grows by the whole circle the bar's points run round (a box of
+// the two ends would miss the block, above the bar's line).
+TEST(SceneSweep, AWholeTurnByVelocityIsSweptThroughAndAnEndPoseIsNot) {
+  Scene scene;
+  const auto bar_shape = box(Vec3(1.0, 0.02, 0.02));
+  const auto block_shape = box(Vec3::Constant(0.05));
+  const BodyId bar = scene.add(bar_shape, at(Vec3::Zero()));
+  const BodyId block = scene.add(block_shape, at(Vec3(0.0, 0.7, 0.0)));
+  const double w = 2 * M_PI;
+  scene.set_velocity(bar, Vec3::Zero(), Vec3(0, 0, w));
+  ASSERT_TRUE(scene.angular_velocity(bar).has_value());
+  EXPECT_TRUE(scene.end_pose(bar).rotation.isApprox(Mat3::Identity(), 1e-14));
+
+  const std::span<const ImpactPair> hits = scene.sweep();
+  ASSERT_EQ(hits.size(), 1u);
+  EXPECT_EQ(hits[0].result.status, ImpactStatus::contact);
+  // The first contact of the true motion (angle s w), by dense sampling.
+  const auto true_pose = [&](double s) { return at(Vec3::Zero(), turn_z(s * w)); };
+  double first = 2.0;
+  for (int i = 0; i <= 4000 && first > 1.0; ++i) {
+    const double s = i / 4000.0;
+    if (distance(*bar_shape, true_pose(s), *block_shape, scene.pose(block)).distance <= 0.0)
+      first = s;
+  }
+  ASSERT_LE(first, 1.0);
+  EXPECT_LE(hits[0].result.t, first);
+  EXPECT_GE(hits[0].result.t, first - 1.0 / 4000);
+  const std::vector<ImpactPair> twin = scene.impact_pairs_all_pairs();
+  ASSERT_EQ(twin.size(), 1u);
+  EXPECT_TRUE(same_impact(hits[0], twin[0]));
+
+  // The same end pose as an end pose: no turn at all.
+  scene.set_end_pose(bar, scene.end_pose(bar));
+  EXPECT_FALSE(scene.angular_velocity(bar).has_value());
+  EXPECT_TRUE(scene.sweep().empty());
+  // set_pose forgets the velocities too.
+  scene.set_velocity(bar, Vec3::Zero(), Vec3(0, 0, w));
+  scene.set_pose(bar, at(Vec3::Zero()));
+  EXPECT_FALSE(scene.angular_velocity(bar).has_value());
+  EXPECT_THROW(scene.set_velocity(bar, Vec3::Zero(), Vec3(0, 0, NAN)), InvalidInput);
+}
+
 TEST(SceneSweep, FiltersAndExclusionsDropPairsBeforeAnyQuery) {
   // Two cubes fall through one plate at different places; they never meet.
   Scene scene;

@@ -37,6 +37,14 @@ inline double magnitude_bound(const Pose& pose, double scale) {
   return pose.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * scale;
 }
 
+// Largest coordinate magnitude (bounded as above) accepted. The algorithms
+// take differences of coordinates and map B into A's frame (|R y + t| up
+// to sqrt(3) |y| + |t|), and the hybrid and GJK then work in units of a
+// power of two near that magnitude; beyond 2^1018 (2.8e306) those
+// intermediate values can overflow to inf, and differences of infinities
+// are NaN. Such input is refused by name instead of answered with NaN.
+inline constexpr double kMaxMagnitude = 0x1p1018;
+
 // Which kind of boundary piece of a hull realizes a closest point.
 enum class FeatureType : std::uint8_t { vertex, edge, face };
 

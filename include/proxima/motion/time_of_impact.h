@@ -13,13 +13,15 @@
 // The motion of a body over t in [0, 1] (Motion): its reference point (the
 // origin of its frame, where its pose's translation puts it) moves at
 // constant velocity from start.translation to end.translation, and the body
-// turns at constant angular velocity about that point, from start.rotation
-// to end.rotation by the shorter way (the rotation R1 R0^T as an angle in
-// [0, pi] about a world axis; a half turn is ambiguous and takes either
-// axis). FCL's interpolated motion and Box3D's sweep move the same way
-// about their own reference points. Motion::from_velocity gives the motion
-// of a pose under a linear and an angular velocity (world frame) over a
-// duration.
+// turns at constant angular velocity about that point. A motion given by
+// velocities (Motion::from_velocity, which keeps the angular velocity in
+// Motion::angular) turns at that rate through any angle, several turns
+// included: a spinning wheel, a body tumbling over a long step. A motion
+// given by its end poses alone turns from start.rotation to end.rotation
+// by the shorter way (the rotation R1 R0^T as an angle in [0, pi] about a
+// world axis; a half turn is ambiguous and takes either axis). FCL's
+// interpolated motion and Box3D's sweep move the same way about their own
+// reference points.
 //
 // The method: conservative advancement (Mirtich) on the tracked distance
 // query. At time t the query's normal n (unit, A towards B) and the support
@@ -46,6 +48,8 @@
 // Thread safety: as distance(); the cache belongs to one pair.
 #pragma once
 
+#include <optional>
+
 #include "proxima/core/types.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
@@ -55,23 +59,36 @@ namespace proxima {
 
 // A body's motion over t in [0, 1] (see above).
 struct Motion {
+  Motion() = default;
+  Motion(const Pose& start_pose, const Pose& end_pose) : start(start_pose), end(end_pose) {}
+  Motion(const Pose& start_pose, const Pose& end_pose, const std::optional<Vec3>& angular_velocity)
+      : start(start_pose), end(end_pose), angular(angular_velocity) {}
+
   Pose start;
   Pose end;
+  // The angular velocity (world frame, radians per unit t) of a motion
+  // given by velocities: the body turns at this rate through any angle,
+  // and end.rotation is where that turn ends (time_of_impact refuses an
+  // end.rotation that is not, beyond the pose contract's kRotationTolerance).
+  // Unset: the turn from start.rotation to end.rotation the shorter way.
+  std::optional<Vec3> angular;
 
   // A body that does not move.
   static Motion fixed(const Pose& pose) { return {pose, pose}; }
   // From `pose`, moving its reference point at `linear` (units per unit
   // time) and turning at `angular` (radians per unit time, about the world
-  // axis angular / |angular|) for `duration`; t = 1 is the end of it.
-  // Throws InvalidInput for a non-finite velocity or duration, or a duration
-  // <= 0.
+  // axis angular / |angular|, through any angle) for `duration`; t = 1 is
+  // the end of it. Throws InvalidInput for a non-finite velocity or
+  // duration, a duration <= 0, or an end pose or a turn per unit t that
+  // overflows doubles.
   static Motion from_velocity(const Pose& pose, const Vec3& linear, const Vec3& angular,
                               double duration = 1.0);
 
   // The pose at time t (0 <= t <= 1; clamped outside).
   Pose at(double t) const;
   // The reference point's velocity (units per unit t) and the angular
-  // velocity (world frame, radians per unit t).
+  // velocity (world frame, radians per unit t): `angular` when set, else
+  // the shorter way's.
   Vec3 linear_velocity() const { return end.translation - start.translation; }
   Vec3 angular_velocity() const;
 };
@@ -103,8 +120,12 @@ struct ImpactOptions {
   double target_separation = 0.0;
   // How close to the target the distance must come before contact is
   // reported: at the reported t, target <= distance <= target + tolerance
-  // (up to the contact band 64 u R of the accuracy standard). > 0. The
-  // default is relative to the bodies' size (bounding radii): 1e-6 of it.
+  // (up to the contact band 64 u R of the accuracy standard). >= 0; 0: the
+  // default, relative to the bodies' size (bounding radii): 1e-6 of it. A
+  // tolerance below 4 contact bands at the poses of a step (4 x 64 u R,
+  // R the largest coordinate magnitude there) is raised to that there:
+  // the distance is not known more finely, and the advancement keeps the
+  // band off its steps.
   double tolerance = 0.0;
   // Cap on advancement steps (each one distance query).
   int max_iterations = 256;
@@ -139,8 +160,14 @@ struct ImpactResult {
 // ever missed, whatever the speeds and thicknesses), and for status contact
 // the distance at t is within options.tolerance of the target. Throws
 // InvalidInput for bad poses (the pose contract of proxima/core/pose.h at both
-// ends) or options (negative target, tolerance < 0 or not finite,
-// max_iterations < 1). `cache` (may be null) is carried from step to step
+// ends), a Motion::angular that is not finite or does not end at
+// end.rotation, motions that cannot be followed in doubles (a turn faster
+// than 2^52 (4.5e15) rad per unit t, whose angle doubles cannot tell to a
+// radian; an end pose
+// beyond the supported coordinate magnitude 2^1018, about 2.8e306, as
+// distance(); or a closing speed |v_b - v_a| + |w_a| reach_a + |w_b|
+// reach_b that overflows), or options (negative target, tolerance < 0 or
+// not finite, max_iterations < 1). `cache` (may be null) is carried from step to step
 // and left as the last query's, so that a next interval tracks on.
 ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
                             const ConvexPolytope& b, const Motion& motion_b,
@@ -161,16 +188,5 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
 ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b,
                             const Motion& motion_b, const ImpactOptions& options = {},
                             BodyCache* cache = nullptr);
-
-namespace detail {
-// The checks of `options` that time_of_impact makes (InvalidInput naming
-// `who` and the field), for callers that validate once before many calls
-// (Scene::sweep).
-void check_impact_options(const ImpactOptions& options, const char* who);
-// sin x and cos x as a sweep's poses take them: a few ulps of std::sin and
-// std::cos on [0, pi/2] (the half angles of a sweep) at a quarter of their
-// cost, std::sin and std::cos elsewhere. Exposed for its twin test.
-void sin_cos_quadrant(double x, double& sine, double& cosine);
-}  // namespace detail
 
 }  // namespace proxima

@@ -134,7 +134,7 @@ struct ImpactPair {
 // What the last sweep did.
 struct SweepStats {
   int bodies = 0;
-  int moving_bodies = 0;     // bodies whose end pose differs from their pose
+  int moving_bodies = 0;     // bodies whose end pose differs from their pose, or given velocities
   int candidate_pairs = 0;   // pairs whose swept boxes overlap, after the filters
   int impact_pairs = 0;      // of those, not separated over the motion (reported)
   int distance_queries = 0;  // advancement steps of all candidate pairs
@@ -219,7 +219,8 @@ class Scene {
   // Continuous collision (issue 13): each body moves over t in [0, 1] from
   // its pose to its end pose with the motion of proxima/motion/time_of_impact.h
   // (constant linear velocity of its frame's origin, constant angular
-  // velocity about it, the shorter way round), and sweep() reports the
+  // velocity about it: the rate set_velocity gave, through any angle, or
+  // else the shorter way round to the end pose), and sweep() reports the
   // first time of contact of every pair that meets on the way, even pairs
   // that are apart at both ends (a thin or fast body passing through
   // another between two steps).
@@ -231,6 +232,16 @@ class Scene {
   // for an unknown id or a non-finite pose.
   void set_end_pose(BodyId id, const Pose& end);
   const Pose& end_pose(BodyId id) const;
+  // The motion by velocities instead (Motion::from_velocity over t in
+  // [0, 1]): the end pose becomes where `linear` (units per unit t) and
+  // `angular` (world frame, radians per unit t) take the body, and the
+  // sweep turns it at that rate through any angle, several turns included
+  // (an end pose alone cannot say how many). set_end_pose, set_pose and add
+  // forget it. Throws InvalidInput naming the id for an unknown id or
+  // velocities Motion::from_velocity refuses.
+  void set_velocity(BodyId id, const Vec3& linear, const Vec3& angular);
+  // The angular velocity set_velocity gave, if it is still in force.
+  std::optional<Vec3> angular_velocity(BodyId id) const;
 
   // Sweeps every body from its pose to its end pose: a broad phase on boxes
   // that hold each body's whole swept volume (the boxes of the body at both
