@@ -37,19 +37,8 @@ double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
   return magnitude_bound(pose, p.scale());
 }
 
-// The largest coordinate magnitude of vertex y placed at `pose`.
-double placed_magnitude(const Vec3& y, const Pose& pose) {
-  return pose.apply(y).cwiseAbs().maxCoeff();
-}
-
-// The largest coordinate magnitude of the placed vertices themselves: the R
-// of the accuracy standard. O(N), so only computed when a distance falls
-// between the band of this R and the band of the bound above.
-double world_magnitude(const ConvexPolytope& p, const Pose& pose) {
-  double r = 0.0;
-  for (const Vec3& y : p.vertices()) r = std::max(r, placed_magnitude(y, pose));
-  return r;
-}
+using detail::placed_magnitude;
+using detail::world_magnitude;
 
 // A lower bound on world_magnitude(p, pose) from a few vertices (ids out of
 // range skipped), computed as world_magnitude computes them: a distance
@@ -247,7 +236,7 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   // stay 0); a contact gets its penetration depth, computed only now, and
   // an uncertified answer its bounds (src/signed_distance.cpp).
   if (result.status != Status::separated) [[unlikely]] {
-    detail::finish_signed_distance(a, b, b_in_a, options, c, result);
+    detail::finish_signed_distance(a, pose_a, b, pose_b, b_in_a, options, c, result);
   }
   // Back to the world frame, in place.
   to_world(pose_a, result);

@@ -6,11 +6,27 @@
 // by distance() after its algorithm answered.
 #pragma once
 
+#include <algorithm>
+
 #include "proxima/penetration.h"
 #include "proxima/polytope.h"
 #include "proxima/types.h"
 
 namespace proxima::detail {
+
+// The largest coordinate magnitude of vertex y placed at `pose`.
+inline double placed_magnitude(const Vec3& y, const Pose& pose) {
+  return pose.apply(y).cwiseAbs().maxCoeff();
+}
+
+// The largest coordinate magnitude of the placed vertices themselves: the R
+// of the accuracy standard (R_w). O(N), so only computed when an answer
+// falls between the band of this R and the band of a cheap bound on it.
+inline double world_magnitude(const ConvexPolytope& p, const Pose& pose) {
+  double r = 0.0;
+  for (const Vec3& y : p.vertices()) r = std::max(r, placed_magnitude(y, pose));
+  return r;
+}
 
 // Fills the signed distance of `result` (A's frame; distance() maps it to
 // the world afterwards) when result.status is not separated. Intersecting:
@@ -20,9 +36,14 @@ namespace proxima::detail {
 // options.penetration, the depth too, and a depth beyond the contact band
 // turns the answer into intersecting (the contact classification can call
 // an overlap of coplanar faces touching). Iteration cap: the bounds.
-void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                            const DistanceOptions& options, DistanceCache& cache,
-                            DistanceResult& result);
+// A touching answer turns intersecting exactly when the depth exceeds
+// the band of the exact R_w (the world poses pose_a, pose_b give it): its
+// O(1) certificate (an overlap of the supports within the band) is
+// checked against a lower bound on that band first, the band itself
+// computed (O(N)) only when that does not decide.
+void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                            const Pose& pose_b, const Pose& b_in_a, const DistanceOptions& options,
+                            DistanceCache& cache, DistanceResult& result);
 
 // Whether tracked_overlap may answer for the pair: its last depth was
 // penetrating, with options.penetration and the hybrid. Inline: distance()
