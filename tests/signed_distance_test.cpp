@@ -311,6 +311,7 @@ TEST(SignedDistanceRegression, DepthJustAboveTheBandIsIntersecting) {
 // both sides of the band (counted).
 TEST(SignedDistanceOracle, OverlapsAtTheBandHaveTheExactStatus) {
   Rng rng(20261130);
+  ExactOracle oracle;
   int above = 0, below = 0;
   for (int trial = 0; trial < 160; ++trial) {
     const double s = log_uniform(rng, 1e-5, 1e5);
@@ -321,7 +322,13 @@ TEST(SignedDistanceOracle, OverlapsAtTheBandHaveTheExactStatus) {
         offset);
     Points b = translated(scaled(points_on_sphere(rng, uniform_int(rng, 5, 10)), s * 0.7), offset);
     const double band_guess = kContactBandUlps * kUnitRoundoff * (offset.norm() + 2 * s);
-    b = place_along(a, b, random_unit_vector(rng), -uniform(rng, 0.3, 3.0) * band_guess);
+    // Apart along a random direction, then moved back along the closest
+    // points' direction by the distance and 0.3 to 3 bands.
+    b = place_along(a, b, random_unit_vector(rng), 0.25 * s);
+    const std::optional<ExactDistance> apart = oracle.distance(a, b);
+    ASSERT_TRUE(apart && !apart->is_zero()) << trial;
+    const Vec3 w = (to_double(apart->point_b) - to_double(apart->point_a)).normalized();
+    b = translated(b, -(apart->distance() + uniform(rng, 0.3, 3.0) * band_guess) * w);
     const ExactDepth exact = exact_depth(a, b);
     if (exact.flat || exact.origin != OriginInM::inside) continue;
     const double band = band_of(a, b);
