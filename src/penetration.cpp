@@ -424,9 +424,16 @@ Candidate evaluate(const Query& q, const MinkowskiFaceId& id, const Vec3& n, int
   // a pair the arc test kept without a crossing can sit on the far side of
   // a hull, on a facet split by rounding into nearly coplanar faces, where
   // the plain climb stops far below the support and the value is no upper
-  // bound (support_hill_climb_through_plateaus).
-  c.support_a = support_hill_climb_through_plateaus(q.a, n, hint_a);
-  c.support_b = support_hill_climb_through_plateaus(q.b, q.rotation_t * (-n), hint_b);
+  // bound (support_hill_climb_through_plateaus). Not from a face along its
+  // own normal: its vertices are supports already (up to the normal's
+  // rounding), and a climb from a support only rises.
+  const bool own_face_a = id.kind == MinkowskiFace::face_vertex && id.a0 >= 0;
+  const bool own_face_b = id.kind == MinkowskiFace::vertex_face && id.b0 >= 0;
+  const Vec3 n_b = q.rotation_t * (-n);
+  c.support_a = own_face_a ? support_hill_climb(q.a, n, hint_a)
+                           : support_hill_climb_through_plateaus(q.a, n, hint_a);
+  c.support_b = own_face_b ? support_hill_climb(q.b, n_b, hint_b)
+                           : support_hill_climb_through_plateaus(q.b, n_b, hint_b);
   c.value = n.dot(q.point_a(c.support_a) - q.point_b(c.support_b));
   return c;
 }
@@ -1376,6 +1383,12 @@ bool near_band(const Query& q, double value) {
   return std::abs(value) <= kRefineBands * kValueSlackUlps * kUnitRoundoff * q.magnitude * q.inverse;
 }
 
+// Whether an answer is one to refine: an overlap (a separated answer's
+// value is below minus the band) within kRefineBands bands of zero.
+bool needs_refinement(const Query& q, const PenetrationResult& r) {
+  return r.status != PenetrationStatus::separated && near_band(q, r.depth * q.inverse);
+}
+
 // The vertices of `poly` (mapped by `point`) connected to v through
 // vertices whose value along d is within `tie` of v's, appended to `out`.
 template <class PointOf>
@@ -1592,7 +1605,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
       }
     }
   }
-  if (r.status != PenetrationStatus::separated && near_band(q, r.depth * q.inverse))
+  if (needs_refinement(q, r))
     r = refine(q, std::span<const Candidate>(candidates.data(), candidates.size()), *best, r, count);
   if (cache != nullptr) {
     cache->a = &q.a;
@@ -1951,8 +1964,7 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
     // enumerate again, keeping the faces within the margin (track_or_expand
     // set cache.prune_margin to it).
     // An answer near the band is refined by an enumeration (kRefineBands).
-    if (track_or_expand(q, cache, b_in_a, r, margin) && !near_band(q, r.depth * q.inverse))
-      return r;
+    if (track_or_expand(q, cache, b_in_a, r, margin) && !needs_refinement(q, r)) return r;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
@@ -1994,8 +2006,8 @@ bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b,
   double margin = 0.0;
   // Near the band the answer needs an enumeration (kRefineBands): not
   // certified here.
-  const bool certified = track_or_expand(q, cache, b_in_a, out, margin) &&
-                         !near_band(q, out.depth * q.inverse);
+  const bool certified =
+      track_or_expand(q, cache, b_in_a, out, margin) && !needs_refinement(q, out);
   cache.previous_translation = b_in_a.translation;
   if (!certified) return false;
   cache.last_status = out.status;
