@@ -30,10 +30,10 @@
 #include <utility>
 #include <vector>
 
-#include "proxima/body.h"
-#include "proxima/distance.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/distance.h"
 #include "proxima/io.h"
-#include "proxima/polytope.h"
+#include "proxima/shape/polytope.h"
 
 namespace proxima::cli {
 namespace {
@@ -409,7 +409,7 @@ Pose parse_pose(const std::vector<std::string>& tokens, const std::string& optio
   std::array<double, 7> v{};
   for (std::size_t i = 0; i < v.size(); ++i)
     v[i] = parse_number(tokens[i], option, static_cast<int>(i), order);
-  // The pose contract's quaternion (proxima/pose.h): normalized at any
+  // The pose contract's quaternion (proxima/core/pose.h): normalized at any
   // magnitude, a zero one refused in the same words as everywhere.
   try {
     const char* words = order == QuaternionOrder::wxyz ? " (qw qx qy qz)" : " (qx qy qz qw)";

@@ -1,0 +1,91 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// The library's own rules of the accuracy standard (DESIGN.md), one
+// definition each, for every query and algorithm that applies them. The
+// rules a caller sees (the unit roundoff, the contact band, the magnitude
+// bound) are public in proxima/core/pose.h and proxima/core/types.h; these
+// are the internal ones: the largest magnitude accepted, the exact R, the
+// termination and pruning slacks, and the checks of DistanceOptions.
+#pragma once
+
+#include <bit>
+#include <cstdint>
+#include <span>
+
+#include "proxima/core/types.h"
+
+namespace proxima::detail {
+
+// Largest coordinate magnitude (bounded as magnitude_bound does) accepted by
+// a query. The algorithms take differences of coordinates and map B into
+// A's frame (|R y + t| up to sqrt(3) |y| + |t|), and the hybrid and GJK then
+// work in units of a power of two near that magnitude; beyond 2^1018
+// (2.8e306) those intermediate values can overflow to inf, and differences
+// of infinities are NaN. Such input is refused by name instead of answered
+// with NaN (Accuracy.MagnitudesBeyondTheLimitAreRefusedByName pins
+// both sides of the limit; BodyRefusals.BadPosesAreNamed the rounded body's). A rounded body's
+// core plus radius is held to the same limit, so that no sum of radii,
+// signed distance or offset point can overflow either.
+inline constexpr double kMaxMagnitude = 0x1p1018;
+
+// The largest coordinate magnitude of vertex y placed at `pose`.
+double placed_magnitude(const Vec3& y, const Pose& pose);
+
+// The largest coordinate magnitude of `vertices` placed at `pose`: the exact
+// R of the accuracy standard for one body, as every query computes it (the
+// O(1) magnitude_bound is an upper bound on it). O(N), so only computed when
+// a distance falls between the contact bands of the two; out of line, off
+// the hot path of the queries that may call it.
+double placed_magnitude(std::span<const Vec3> vertices, const Pose& pose);
+
+// Rounding slack of the algorithms' termination test (the gap between the
+// upper bound and the support's certified lower bound), in units of u times
+// the magnitude of the coordinates it is computed from: the hybrid's support
+// values w.a* and w.b*, and GJK's v.w with v rebuilt from the simplex
+// points, each carry an error of a few u of that magnitude, so a gap below
+// this slack cannot be resolved by more iterations. Well inside the 64 u R
+// contact band (kContactBandUlps). Pinned by the certified answers at every
+// scale of Gjk.ScaleInvariance and DistanceAccuracy.ScalesAndFarFromOrigin.
+inline constexpr double kTerminationGapUlps = 16.0;
+
+// Slack of a pruning test in a hierarchy traversal (compound pieces, mesh
+// triangles and boxes), in units of u times the query's magnitude R (the
+// largest of the bodies' magnitude bounds): a pair is pruned only when its
+// rounded lower bound exceeds the best distance found by more than this, so
+// that a pruned pair is farther than the best in exact arithmetic too. The
+// bound (a box or sphere gap formed from transformed coordinates, a few u R
+// each) and the best distance (a convex query's answer, within the 64 u R
+// band of the exact one, or a triangle kernel's, within 32 u R) are each a
+// few tens of u R off. 512 u R is at least the slack each traversal derived
+// for itself (the compound's 256 u (R_a + R_b), the mesh-convex's 128 u R,
+// the mesh-mesh's 64 u in units below 2 R), so no traversal prunes a pair it
+// kept before, and it still prunes everything farther than 6e-14 R. Pinned
+// by the brute-force twins: Compound.RandomCompoundsAgreeWithTheTwin,
+// MeshDistanceTraversal.MatchesBruteForceAtAnyScale.
+inline constexpr double kPruneSlackUlps = 512.0;
+
+// The slack above for a query of magnitude R.
+inline double prune_slack(double magnitude) { return kPruneSlackUlps * kUnitRoundoff * magnitude; }
+
+// The checks of DistanceOptions, the same for every entry point that takes
+// them: relative_tolerance and absolute_tolerance finite and >= 0 (-0.0
+// included), max_iterations at least 1. Throws InvalidInput naming the field
+// and its value, after `who` ("distance: options", "Scene:
+// options.distance").
+void check_distance_options(const DistanceOptions& options, const char* who);
+
+// True when every DistanceOptions check passes, decided on the bits with no
+// floating-point comparison (a NaN compared raises FE_INVALID, which a
+// caller's trap would turn into SIGFPE instead of the refusal): both
+// tolerances have their sign clear and their exponent below all ones (so
+// does their bitwise or), and at least one iteration. -0.0 fails this
+// sufficient test and is accepted by check_distance_options. O(1), for the
+// hot path: call check_distance_options only when it fails.
+inline bool distance_options_plainly_valid(const DistanceOptions& options) {
+  return (std::bit_cast<std::uint64_t>(options.relative_tolerance) |
+          std::bit_cast<std::uint64_t>(options.absolute_tolerance)) < 0x7ff0000000000000ULL &&
+         options.max_iterations >= 1;
+}
+
+}  // namespace proxima::detail

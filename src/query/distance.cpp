@@ -1,0 +1,240 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// The query API: checks the poses, moves the problem into A's frame (only
+// B's relative pose is formed, never transformed vertex arrays), picks the
+// contact band from the accuracy standard, runs the chosen algorithm (whole:
+// the hybrid's cross-check and contact classification are its own,
+// proxima/detail/narrowphase/contact.h) and maps its answer back to the world frame.
+#include "proxima/query/distance.h"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "proxima/detail/narrowphase/gjk.h"
+#include "proxima/detail/narrowphase/hybrid.h"
+#include "core/accuracy.h"
+#include "core/paired_pose.h"
+#include "query/signed_distance.h"
+
+namespace proxima {
+namespace {
+
+// Upper bound on the largest coordinate magnitude of a body placed at
+// `pose` (types.h). O(1).
+double world_magnitude_bound(const ConvexPolytope& p, const Pose& pose) {
+  return magnitude_bound(pose, p.scale());
+}
+
+// The largest coordinate magnitude of the placed vertices themselves: the R
+// of the accuracy standard (core/accuracy.h).
+double world_magnitude(const ConvexPolytope& p, const Pose& pose) {
+  return detail::placed_magnitude(p.vertices(), pose);
+}
+
+// A lower bound on world_magnitude(p, pose) from a few vertices (ids out of
+// range skipped), computed as world_magnitude computes them: a distance
+// inside the band of this R is inside the band of the exact R. O(1).
+template <std::size_t kCount>
+double world_magnitude_floor(const ConvexPolytope& p, const Pose& pose,
+                             const std::array<std::int32_t, kCount>& ids) {
+  double r = 0.0;
+  for (const std::int32_t id : ids) {
+    if (id >= 0 && id < p.vertex_count()) r = std::max(r, detail::placed_magnitude(p.vertex(id), pose));
+  }
+  return r;
+}
+
+DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                   const DistanceOptions& options, double contact_tolerance, DistanceCache& cache) {
+  switch (options.algorithm) {
+    case Algorithm::gjk:
+      return gjk_distance(a, b, b_in_a, options, contact_tolerance);
+    case Algorithm::enhanced_gjk:
+      return enhanced_gjk_distance(a, b, b_in_a, options, contact_tolerance, cache);
+    case Algorithm::hybrid:
+      break;
+  }
+  return hybrid_distance(a, b, b_in_a, options, contact_tolerance, cache);
+}
+
+// The result's points and normal from A's frame to the world frame, in
+// place (core/paired_pose.h).
+[[gnu::always_inline]] inline void to_world(const Pose& pose_a, DistanceResult& result) {
+  detail::to_frame(pose_a, result.point_a, result.point_b, result.normal);
+}
+
+// The end of a query after its algorithm's answer `result` (A's frame, the
+// cheap contact band `band_bound`): the exact band where it matters, the
+// signed distance, the world frame. In place, so that distance() builds the
+// answer in its caller's return slot (below).
+[[gnu::always_inline]] inline void finish_query(const ConvexPolytope& a, const Pose& pose_a,
+                                                const ConvexPolytope& b, const Pose& pose_b,
+                                                const Pose& b_in_a, const DistanceOptions& options,
+                                                double band_bound, DistanceCache& c,
+                                                DistanceResult& result) {
+  // Most contacts (overlapping bodies) end with a distance of a few
+  // roundings: inside the band of a lower bound on R taken from the cached
+  // features and support hints, where the exact R could not change the
+  // answer, and it is not computed.
+  const auto band_floor = [&] {
+    const std::array ids_a = {c.vertices_a[0], c.vertices_a[1], c.vertices_a[2], c.hint_a};
+    const std::array ids_b = {c.vertices_b[0], c.vertices_b[1], c.vertices_b[2], c.hint_b};
+    const double r_floor =
+        std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
+    return contact_band(r_floor, options.absolute_tolerance);
+  };
+  // A touching answer above the band of the exact R is re-solved with that
+  // band, the algorithm's cross-check and contact classification included,
+  // so that whichever stage answers decides with it
+  // (StatusBand.VertexJustAboveAFaceIsSeparatedOutsideTheExactBand: the
+  // cross-check used the cheap band and turned the refined separated answer
+  // back into touching).
+  if (result.status == Status::touching && result.distance > 0.0 &&
+      result.distance > band_floor()) {
+    const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
+    const double exact_band = contact_band(r_exact, options.absolute_tolerance);
+    if (exact_band < band_bound && result.distance > exact_band) {
+      result = run(a, b, b_in_a, options, exact_band, c);
+    }
+  }
+  // The signed distance: nothing to add when separated (the depth fields
+  // stay 0); a contact gets its penetration depth, computed only now, and
+  // an uncertified answer its bounds (src/query/signed_distance.cpp).
+  if (result.status != Status::separated) [[unlikely]] {
+    detail::finish_signed_distance(a, pose_a, b, pose_b, b_in_a, options, c, result);
+  }
+  // Back to the world frame, in place.
+  to_world(pose_a, result);
+}
+
+// The query of a pair that was penetrating: the tracked depth first, and
+// when it certifies the overlap, its answer without the algorithm's
+// (src/query/signed_distance.cpp). Out of line, so that the common path returns
+// one object only (below).
+[[gnu::noinline]] DistanceResult penetrating_query(const ConvexPolytope& a, const Pose& pose_a,
+                                                   const ConvexPolytope& b, const Pose& pose_b,
+                                                   const Pose& b_in_a,
+                                                   const DistanceOptions& options,
+                                                   double band_bound, DistanceCache& c) {
+  // One named result (NRVO, as distance_in_frame): the tracked answer is
+  // built in the caller's slot, not copied there.
+  DistanceResult result;
+  if (detail::tracked_overlap(a, b, b_in_a, band_bound, c, result)) [[likely]] {
+    to_world(pose_a, result);
+    return result;
+  }
+  result = run(a, b, b_in_a, options, band_bound, c);
+  finish_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c, result);
+  return result;
+}
+
+// The query for poses under the contract, with the caller's cache or a cold
+// one. Its one named result is the caller's return slot itself (NRVO): with
+// the penetrating pair's answer a second named object here, the algorithm
+// wrote a local that was then copied out, field by field, and to_world's
+// stores went through the stack (about 40 instructions a query, callgrind,
+// bench/tracked_instructions).
+[[gnu::always_inline]] inline DistanceResult distance_in_frame(
+    const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
+    const DistanceOptions& options, DistanceCache& c) {
+  if (!detail::distance_options_plainly_valid(options)) [[unlikely]] {
+    detail::check_distance_options(options, "distance: options");
+  }
+
+  // The contact band 64 u R + Ae, first with a cheap bound on R. A distance
+  // found inside that band but above 0 may still be outside the band of the
+  // exact R; then the exact R is computed and the query resumed from its own
+  // cache with the exact band, so that "separated" means d > 64 u R exactly
+  // (finish_query).
+  const double r_bound = detail::magnitude_bound_pair(pose_a, a.scale(), pose_b, b.scale());
+  if (!(r_bound <= detail::kMaxMagnitude)) [[unlikely]] {
+    char what[200];
+    std::snprintf(
+        what, sizeof what,
+        "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
+        "beyond the supported %.3g where differences of coordinates may overflow",
+        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
+        detail::kMaxMagnitude);
+    throw InvalidInput(what);
+  }
+  const Pose b_in_a = detail::relative_pose(pose_a, pose_b);
+  const double band_bound = contact_band(r_bound, options.absolute_tolerance);
+
+  // One initialization from either call, not two returns: GCC 12 elides
+  // the copy of a named result only when every return names it. A pair
+  // whose last depth was not penetrating (one that overlapped once and
+  // separated since) takes the common path: the tracked depth would not be
+  // tried for it.
+  const bool penetrating = detail::overlap_trackable(options, c);
+  DistanceResult result =
+      penetrating ? penetrating_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c)
+                  : run(a, b, b_in_a, options, band_bound, c);
+  if (!penetrating) [[likely]] {
+    finish_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c, result);
+  }
+  return result;
+}
+
+// distance() with a cold cache of its own, out of line: the cache's
+// destructor (it may own penetration state, types.h) then needs no cleanup
+// in distance() itself, whose tracked path would otherwise pay a frame
+// pointer and a spill for it (3 instructions a query, callgrind,
+// bench/tracked_instructions).
+[[gnu::noinline]] DistanceResult distance_with_cold_cache(const ConvexPolytope& a,
+                                                          const Pose& pose_a,
+                                                          const ConvexPolytope& b,
+                                                          const Pose& pose_b,
+                                                          const DistanceOptions& options) {
+  DistanceCache cold;
+  return distance(a, pose_a, b, pose_b, options, &cold);
+}
+
+// distance_of_rigid_poses with a cold cache of its own (see
+// distance_with_cold_cache).
+[[gnu::noinline]] DistanceResult distance_of_rigid_poses_cold(const ConvexPolytope& a,
+                                                              const Pose& pose_a,
+                                                              const ConvexPolytope& b,
+                                                              const Pose& pose_b,
+                                                              const DistanceOptions& options) {
+  DistanceCache cold;
+  return distance_in_frame(a, pose_a, b, pose_b, options, cold);
+}
+
+}  // namespace
+
+DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                        const Pose& pose_b, const DistanceOptions& options, DistanceCache* cache) {
+  // The poses as the contract takes them (proxima/core/pose.h): the caller's own
+  // when rigid to machine precision, else re-orthonormalized copies, or the
+  // contract's refusal.
+  if (cache == nullptr) return distance_with_cold_cache(a, pose_a, b, pose_b, options);
+  if (!detail::are_rigid(pose_a, pose_b)) [[unlikely]] {
+    return detail::distance_of_rigid_poses(a, checked_pose(pose_a, "distance: pose_a"), b,
+                                           checked_pose(pose_b, "distance: pose_b"), options,
+                                           cache);
+  }
+  return distance_in_frame(a, pose_a, b, pose_b, options, *cache);
+}
+
+namespace detail {
+
+DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
+                                       const ConvexPolytope& b, const Pose& pose_b,
+                                       const DistanceOptions& options, DistanceCache* cache) {
+  // A cold cache is built only when there is no caller's cache, out of line
+  // (the scene's, the bodies' and the compounds' tracked queries come here
+  // with their own: initializing and destroying an unused cold one cost
+  // them about 30 instructions a query).
+  if (cache == nullptr) [[unlikely]]
+    return distance_of_rigid_poses_cold(a, pose_a, b, pose_b, options);
+  return distance_in_frame(a, pose_a, b, pose_b, options, *cache);
+}
+
+}  // namespace detail
+}  // namespace proxima
