@@ -11,6 +11,8 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <span>
+#include <vector>
 
 namespace proxima::detail {
 namespace {
@@ -221,6 +223,107 @@ Vec3 exact_triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
     const double d = static_cast<double>(m.convert_to<std::uint64_t>());
     out[k] = v < 0 ? -d : d;
   }
+  return out;
+}
+
+
+namespace {
+
+// Doubles as big integers q_i = x_i / 2^s sharing the smallest exponent s
+// of the nonzero ones (exact; the dynamic form of CommonIntegers).
+struct BigIntegers {
+  std::vector<BigInt> q;
+  int exponent = 0;  // s
+
+  explicit BigIntegers(std::span<const double> x) {
+    std::vector<std::int64_t> mantissa(x.size(), 0);
+    std::vector<int> exponent_of(x.size(), 0);
+    int smallest = INT_MAX;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if (x[i] == 0.0) continue;
+      int e = 0;
+      const double f = std::frexp(x[i], &e);
+      mantissa[i] = static_cast<std::int64_t>(std::ldexp(f, 53));
+      exponent_of[i] = e - 53;
+      smallest = std::min(smallest, exponent_of[i]);
+    }
+    exponent = smallest == INT_MAX ? 0 : smallest;
+    q.resize(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if (mantissa[i] == 0) continue;
+      BigInt m = mantissa[i] < 0 ? -mantissa[i] : mantissa[i];
+      m <<= static_cast<unsigned>(exponent_of[i] - exponent);
+      q[i] = mantissa[i] < 0 ? BigInt(-m) : m;
+    }
+  }
+};
+
+// |v| as m * 2^e with m a double in [2^61, 2^62) (top 62 bits of v,
+// truncated: relative error below 2^-61), or 0.
+double big_to_double(const BigInt& v, int& e) {
+  if (v == 0) {
+    e = 0;
+    return 0.0;
+  }
+  const BigInt a = abs(v);
+  const auto bits = static_cast<int>(boost::multiprecision::msb(a)) + 1;
+  const int cut = bits > 62 ? bits - 62 : 0;
+  e = cut;
+  return static_cast<double>((a >> static_cast<unsigned>(cut)).convert_to<std::uint64_t>());
+}
+
+}  // namespace
+
+ExactOffset exact_offset(const Vec3& u0, const Vec3& u1, const Vec3& w0, const Vec3& w1,
+                         std::span<const Vec3> xs, std::span<const Vec3> ys, double c) {
+  // Every input in one integer frame: 12 edge coordinates, the points, c.
+  std::vector<double> all;
+  all.reserve(13 + 3 * (xs.size() + ys.size()));
+  for (const Vec3* p : {&u0, &u1, &w0, &w1})
+    for (int k = 0; k < 3; ++k) all.push_back((*p)[k]);
+  for (const Vec3& p : xs)
+    for (int k = 0; k < 3; ++k) all.push_back(p[k]);
+  for (const Vec3& p : ys)
+    for (int k = 0; k < 3; ++k) all.push_back(p[k]);
+  all.push_back(c);
+  const BigIntegers z(all);
+  const auto at = [&](std::size_t i) -> const BigInt& { return z.q[i]; };
+  const BigInt ux = at(3) - at(0), uy = at(4) - at(1), uz = at(5) - at(2);
+  const BigInt wx = at(9) - at(6), wy = at(10) - at(7), wz = at(11) - at(8);
+  const BigInt nx = uy * wz - uz * wy, ny = uz * wx - ux * wz, nz = ux * wy - uy * wx;
+  ExactOffset out;
+  if (nx == 0 && ny == 0 && nz == 0) {
+    out.degenerate = true;
+    return out;
+  }
+  const auto dot = [&](std::size_t i) { return BigInt(nx * at(i) + ny * at(i + 1) + nz * at(i + 2)); };
+  std::size_t i = 12;
+  BigInt top = dot(i);
+  for (std::size_t k = 1; k < xs.size(); ++k) top = std::max(top, dot(i + 3 * k));
+  i += 3 * xs.size();
+  BigInt bottom = dot(i);
+  for (std::size_t k = 1; k < ys.size(); ++k) bottom = std::min(bottom, dot(i + 3 * k));
+  // h = width / |N| in units of 2^s: width has degree 3 in the integers,
+  // |N| degree 2.
+  const BigInt width = top - bottom;
+  const BigInt norm2 = nx * nx + ny * ny + nz * nz;
+  const BigInt& cq = z.q.back();
+  // Sign of h - c: of width - c |N|, by squares when both sides are >= 0.
+  if (width <= 0) {
+    out.versus = cq == 0 && width == 0 ? 0 : -1;
+  } else {
+    const BigInt lhs = width * width, rhs = cq * cq * norm2;
+    out.versus = lhs > rhs ? 1 : lhs < rhs ? -1 : 0;
+  }
+  int ew = 0, en = 0;
+  const double mw = big_to_double(width, ew);
+  double mn = big_to_double(norm2, en);
+  if (en % 2 != 0) {
+    mn *= 2.0;
+    --en;
+  }
+  const double h = mw / std::sqrt(mn);
+  out.offset = std::ldexp(width < 0 ? -h : h, ew - en / 2 + z.exponent);
   return out;
 }
 

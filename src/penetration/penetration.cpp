@@ -16,8 +16,10 @@
 //      arcs cross (tested with a tolerance that errs towards inclusion);
 //   2. every candidate's value is h_A(n) + h_B(-n) evaluated with
 //      hill-climbing supports started at the candidate's own vertices (one
-//      look at their neighbours when the candidate is a true facet), so a
-//      wrong inclusion only adds an upper bound;
+//      look at their neighbours when the candidate is a true facet; the
+//      climb goes on across ties, so that rounding on nearly flat vertices
+//      cannot stop it below the support), so a wrong inclusion only adds
+//      an upper bound;
 //   3. depth = the smallest value; its normal, supports and the Minkowski
 //      face are the answer.
 // The slow twin tests every pair of edges; the fast cold query walks the
@@ -53,10 +55,13 @@
 #include <limits>
 #include <memory>
 #include <memory_resource>
+#include <optional>
 #include <span>
 #include <type_traits>
+#include <vector>
 
 #include "core/power_of_two.h"
+#include "proxima/detail/geometry/exact_predicates.h"
 #include "proxima/geometry/closest_point.h"
 #include "proxima/shape/support.h"
 
@@ -417,8 +422,20 @@ Candidate evaluate(const Query& q, const MinkowskiFaceId& id, const Vec3& n, int
   Candidate c;
   c.id = id;
   c.normal = n;
-  c.support_a = support_hill_climb(q.a, n, hint_a);
-  c.support_b = support_hill_climb(q.b, q.rotation_t * (-n), hint_b);
+  // Through plateaus: a candidate's hints are its own vertices, which for
+  // a pair the arc test kept without a crossing can sit on the far side of
+  // a hull, on a facet split by rounding into nearly coplanar faces, where
+  // the plain climb stops far below the support and the value is no upper
+  // bound (support_hill_climb_through_plateaus). Not from a face along its
+  // own normal: its vertices are supports already (up to the normal's
+  // rounding), and a climb from a support only rises.
+  const bool own_face_a = id.kind == MinkowskiFace::face_vertex && id.a0 >= 0;
+  const bool own_face_b = id.kind == MinkowskiFace::vertex_face && id.b0 >= 0;
+  const Vec3 n_b = q.rotation_t * (-n);
+  c.support_a = own_face_a ? support_hill_climb(q.a, n, hint_a)
+                           : support_hill_climb_through_plateaus(q.a, n, hint_a);
+  c.support_b = own_face_b ? support_hill_climb(q.b, n_b, hint_b)
+                           : support_hill_climb_through_plateaus(q.b, n_b, hint_b);
   c.value = n.dot(q.point_a(c.support_a) - q.point_b(c.support_b));
   return c;
 }
@@ -893,7 +910,8 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
         // From the support found for a face through v, when one was
         // evaluated (for a solid A, p is the normal of such a face).
         const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
-        const int start = support_hill_climb(q.b, q.rotation_t * (-x.p), near >= 0 ? near : hint);
+        const int start = support_hill_climb_through_plateaus(q.b, q.rotation_t * (-x.p),
+                                                              near >= 0 ? near : hint);
         hint = start;
         chain.clear();
         chain.push_back(start);
@@ -1098,10 +1116,16 @@ bool same_face(const MinkowskiFaceId& x, const MinkowskiFaceId& y) {
     r.feature_b = *best_tb;
   }
   const double depth = value * q.unit;
-  if (depth < -band || residual > band) {
+  if (depth < -band || (residual > band && depth <= band)) {
     // Separated: a plane separates them (depth < 0), or the supporting
     // features along the nearest plane do not meet (a flat M whose plane
-    // holds the origin outside M).
+    // holds the origin outside M; solve_cold first tries the faces tied
+    // with it). Not for a value above the band: then the origin is inside
+    // a solid M deeper than the band (every face's value is above it),
+    // and features that do not meet only mean that a face tied with this
+    // one within rounding holds the witness (a sliver's nearly coplanar
+    // faces: the origin's foot on this face's plane lies outside it), not
+    // that the hulls are apart (PenetrationRegression.SliverWithNearlyCoplanarFaces).
     r.status = PenetrationStatus::separated;
     r.depth = r.lower_bound = r.upper_bound = 0.0;
     return r;
@@ -1343,6 +1367,171 @@ class ScratchScope {
   std::pmr::monotonic_buffer_resource memory_;
 };
 
+// Refinement at the contact band. In double, a value's error is a few u
+// R (the normal's rounding times the support points' magnitude), so a
+// depth within a few bands of the band cannot be told above or below it:
+// the status there would follow rounding (a depth 1.09 bands deep was
+// called touching, PenetrationRegression.DepthJustAboveTheBandIsPenetrating).
+// Answers whose least value is within kRefineBands bands of zero are
+// refined: each face of A - B that can realize the depth (value within
+// kRefineWindow of the least, plus its own normal's error times the
+// points' magnitude for an edge pair, whose normal is ill-conditioned when
+// the edges are nearly parallel) gets its value exactly (exact_offset: the
+// face's normal N from its edge vectors in integers, the supports along N
+// the exact best of the tie region along the rounded normal, which holds an
+// exact maximizer by support_hill_climb_through_plateaus' argument), and
+// the depth is the least exact value, rounded, its status decided exactly
+// against 64 u R (R the largest coordinate of A's vertices and B's placed
+// ones). Off the tracked path: a tracked answer there enumerates again.
+constexpr double kRefineBands = 4.0;
+// Twice a value's slack: the face that realizes the depth, whose exact
+// value is the least, has a rounded value within it of the least rounded.
+constexpr double kRefineWindow = 2.0 * kValueSlackUlps;
+
+// Whether a value (scaled units) is within kRefineBands bands of zero.
+bool near_band(const Query& q, double value) {
+  return std::abs(value) <= kRefineBands * kValueSlackUlps * kUnitRoundoff * q.magnitude * q.inverse;
+}
+
+// Whether an answer is one to refine: an overlap (a separated answer's
+// value is below minus the band) within kRefineBands bands of zero.
+bool needs_refinement(const Query& q, const PenetrationResult& r) {
+  return r.status != PenetrationStatus::separated && near_band(q, r.depth * q.inverse);
+}
+
+// The vertices of `poly` (mapped by `point`) connected to v through
+// vertices whose value along d is within `tie` of v's, appended to `out`.
+template <class PointOf>
+void tie_region(const ConvexPolytope& poly, PointOf&& point, const Vec3& d, int v, double tie,
+                std::vector<int>& ids, std::vector<Vec3>& out) {
+  const double top = d.dot(point(v));
+  ids.assign(1, v);
+  for (std::size_t head = 0; head < ids.size(); ++head)
+    for (const std::int32_t w : poly.neighbors(ids[head]))
+      if (std::find(ids.begin(), ids.end(), w) == ids.end() && d.dot(point(w)) >= top - tie)
+        ids.push_back(w);
+  out.clear();
+  for (const int i : ids) out.push_back(point(i));
+}
+
+// The exact value of candidate c (scaled units) against c_band, or
+// nothing for a candidate that is not a named face of A - B.
+std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& c, double c_band) {
+  const MinkowskiFaceId& id = c.id;
+  Vec3 u0, u1, w0, w1;
+  // The normal's angle error (of the rounded normal from the exact one).
+  double angle = 0.0;
+  if (id.kind == MinkowskiFace::face_vertex && id.a0 >= 0) {
+    const auto cycle = q.a.face(id.a0);
+    u0 = w0 = q.point_a(cycle[0]);
+    u1 = q.point_a(cycle[1]);
+    w1 = q.point_a(cycle[2]);
+    angle = 16.0 * (static_cast<double>(cycle.size()) + 1.0) * kUnitRoundoff;
+  } else if (id.kind == MinkowskiFace::vertex_face && id.b0 >= 0) {
+    const auto cycle = q.b.face(id.b0);
+    u0 = w0 = q.point_b(cycle[0]);
+    u1 = q.point_b(cycle[1]);
+    w1 = q.point_b(cycle[2]);
+    angle = (16.0 * (static_cast<double>(cycle.size()) + 1.0) + 8.0) * kUnitRoundoff;
+  } else if (id.kind == MinkowskiFace::edge_edge && id.a0 >= 0 && id.b0 >= 0) {
+    u0 = q.point_a(id.a0);
+    u1 = q.point_a(id.a1);
+    w0 = q.point_b(id.b0);
+    w1 = q.point_b(id.b1);
+    const Vec3 ea = u1 - u0, eb = w1 - w0;
+    const double cross = ea.cross(eb).norm();
+    if (!(cross > 0.0)) return std::nullopt;
+    angle = (8.0 * ea.norm() * eb.norm() / cross + 4.0) * kUnitRoundoff;
+  } else {
+    return std::nullopt;
+  }
+  // N along the rounded normal: (u1 - u0) x (w1 - w0), or with the edges
+  // swapped its negative.
+  if ((u1 - u0).cross(w1 - w0).dot(c.normal) < 0.0) {
+    std::swap(u0, w0);
+    std::swap(u1, w1);
+  }
+  // Rounded values along c.normal are within (angle + 4 u) |x| of the
+  // exact ones along N / |N| (|x| <= 2 in scaled units): twice that is the
+  // tie that keeps an exact maximizer in the region.
+  const double tie = 2.0 * (angle + 4.0 * kUnitRoundoff) * 2.0;
+  std::vector<int> ids;
+  std::vector<Vec3> xs, ys;
+  tie_region(
+      q.a, [&](int i) { return q.point_a(i); }, c.normal, c.support_a, tie, ids, xs);
+  tie_region(
+      q.b, [&](int j) { return q.point_b(j); }, Vec3(-c.normal), c.support_b, tie, ids, ys);
+  const detail::ExactOffset e = detail::exact_offset(u0, u1, w0, w1, xs, ys, c_band);
+  if (e.degenerate) return std::nullopt;
+  return e;
+}
+
+// The largest coordinate of A's vertices and B's placed ones (scaled):
+// the R of the standard in A's frame.
+double frame_magnitude(const Query& q) {
+  double r = 0.0;
+  for (int i = 0; i < q.a.vertex_count(); ++i) r = std::max(r, q.point_a(i).cwiseAbs().maxCoeff());
+  for (int j = 0; j < q.b.vertex_count(); ++j) r = std::max(r, q.point_b(j).cwiseAbs().maxCoeff());
+  return r;
+}
+
+// Refines an answer near the band (see kRefineBands): `r` from `best`
+// among `candidates`. The least exact value's candidate gives the answer,
+// its status exact against the band of the frame's R.
+PenetrationResult refine(const Query& q, std::span<const Candidate> candidates,
+                         const Candidate& best, const PenetrationResult& r, int count) {
+  const double band_scaled = contact_band(frame_magnitude(q));
+  const double reach = 2.0;
+  const Candidate* winner = nullptr;
+  double least = kInfinity;
+  bool touching = false;
+  for (const Candidate& c : candidates) {
+    // The window, widened by an edge pair's normal error times the points'
+    // magnitude (exact_value's angle, recomputed cheaply here).
+    double widen = 0.0;
+    if (c.id.kind == MinkowskiFace::edge_edge && c.id.a0 >= 0 && c.id.b0 >= 0) {
+      const Vec3 ea = q.point_a(c.id.a1) - q.point_a(c.id.a0);
+      const Vec3 eb = q.point_b(c.id.b1) - q.point_b(c.id.b0);
+      const double cross = ea.cross(eb).norm();
+      widen = cross > 0.0 ? 8.0 * ea.norm() * eb.norm() / cross * kUnitRoundoff * reach : kInfinity;
+    }
+    if (!(c.value <= best.value + kRefineWindow * kUnitRoundoff + widen)) continue;
+    const std::optional<detail::ExactOffset> e = exact_value(q, c, band_scaled);
+    if (!e) continue;
+    touching = touching || e->versus <= 0;
+    if (e->offset < least) {
+      least = e->offset;
+      winner = &c;
+    }
+  }
+  if (winner == nullptr) return r;
+  Candidate refined = *winner;
+  refined.value = least;
+  PenetrationResult out = finish(q, refined, least, count, false);
+  if (out.status == PenetrationStatus::separated) return out;
+  // The exact value is within 4 u of `least`; the bounds say so.
+  const double depth = std::max(least, 0.0) * q.unit;
+  out.status = touching ? PenetrationStatus::touching : PenetrationStatus::penetrating;
+  out.depth = depth;
+  out.upper_bound = depth * (1.0 + 8.0 * kUnitRoundoff);
+  out.lower_bound = depth * (1.0 - 8.0 * kUnitRoundoff);
+  return out;
+}
+
+// The faces of A - B whose values are within this many u (scaled units)
+// of the least are tried for witnesses that meet when the least one's do
+// not (solve_cold): twice the slack of a value (kValueSlackUlps), so that
+// the face that holds the origin's foot, whose exact value is the least,
+// is among them. Pinned by PenetrationRegression.SliverWithNearlyCoplanarFaces.
+constexpr double kWitnessWindow = 2.0 * kValueSlackUlps;
+
+// Whether an answer's witnesses realize its depth: point_b + depth * normal
+// within the contact band of point_a (a separated answer's do not).
+bool witnesses_meet(const Query& q, const PenetrationResult& r) {
+  if (r.status == PenetrationStatus::separated) return false;
+  return (r.point_b + r.depth * r.normal - r.point_a).norm() <= contact_band(q.magnitude);
+}
+
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
@@ -1401,6 +1590,34 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
       std::min_element(candidates.begin(), candidates.end(),
                        [](const Candidate& x, const Candidate& y) { return x.value < y.value; });
   PenetrationResult r = finish(q, *best, best->value, count, false);
+  if (!witnesses_meet(q, r) && !(best->value < -kValueSlackUlps * kUnitRoundoff)) {
+    // The least value's features do not meet: a flat M whose plane holds
+    // the origin outside M, or a face tied with the least within rounding
+    // (nearly coplanar faces of A - B) holds the origin's foot. The faces
+    // within kWitnessWindow of the least are tried, least first; the first
+    // whose features meet gives the answer (its value is the depth within
+    // the window).
+    const double window = best->value + kWitnessWindow * kUnitRoundoff;
+    const Candidate* tried = &*best;
+    for (;;) {
+      const Candidate* next = nullptr;
+      for (const Candidate& c : candidates)
+        if (c.value <= window && c.value >= tried->value && &c != tried &&
+            (c.value > tried->value || &c > tried) &&
+            (next == nullptr || c.value < next->value ||
+             (c.value == next->value && &c < next)))
+          next = &c;
+      if (next == nullptr) break;
+      const PenetrationResult alt = finish(q, *next, best->value, count, false);
+      tried = next;
+      if (witnesses_meet(q, alt)) {
+        r = alt;
+        break;
+      }
+    }
+  }
+  if (needs_refinement(q, r))
+    r = refine(q, std::span<const Candidate>(candidates.data(), candidates.size()), *best, r, count);
   if (cache != nullptr) {
     cache->a = &q.a;
     cache->b = &q.b;
@@ -1753,7 +1970,8 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
     // Else the pruned faces were not recorded, or too many are nearer now:
     // enumerate again, keeping the faces within the margin (track_or_expand
     // set cache.prune_margin to it).
-    if (track_or_expand(q, cache, b_in_a, r, margin)) return r;
+    // An answer near the band is refined by an enumeration (kRefineBands).
+    if (track_or_expand(q, cache, b_in_a, r, margin) && !needs_refinement(q, r)) return r;
   }
   // Enumerate, pruned by the last answer's direction when there is one. A
   // rotated B halves the margin (rotating bodies enumerate every query:
@@ -1793,7 +2011,10 @@ bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b,
     return false;
   Query q(a, b, b_in_a);
   double margin = 0.0;
-  const bool certified = track_or_expand(q, cache, b_in_a, out, margin);
+  // Near the band the answer needs an enumeration (kRefineBands): not
+  // certified here.
+  const bool certified =
+      track_or_expand(q, cache, b_in_a, out, margin) && !needs_refinement(q, out);
   cache.previous_translation = b_in_a.translation;
   if (!certified) return false;
   cache.last_status = out.status;

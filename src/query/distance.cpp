@@ -107,7 +107,7 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   // stay 0); a contact gets its penetration depth, computed only now, and
   // an uncertified answer its bounds (src/query/signed_distance.cpp).
   if (result.status != Status::separated) [[unlikely]] {
-    detail::finish_signed_distance(a, b, b_in_a, options, c, result);
+    detail::finish_signed_distance(a, pose_a, b, pose_b, b_in_a, options, c, result);
   }
   // Back to the world frame, in place.
   to_world(pose_a, result);

@@ -56,46 +56,73 @@ void take_depth(const PenetrationResult& p, DistanceResult& result) {
   result.feature_b = p.feature_b;
 }
 
-// Whether the overlap of the supports of a and b (placed by b_in_a) along
-// the unit direction n (A's frame) is within `band`: then the depth is too.
-bool overlap_within(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                    const DistanceCache& cache, const Vec3& n, double band) {
+// The overlap h_A(n) + h_B(-n) of the supports of a and b (placed by
+// b_in_a) along the unit direction n (A's frame), an upper bound on the
+// depth, and the supports (hill climbing from the algorithm's hints, which
+// are read, not updated).
+struct Overlap {
+  double value;
+  int support_a, support_b;
+};
+Overlap overlap_along(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                      const DistanceCache& cache, const Vec3& n) {
   const Vec3 n_in_b = b_in_a.rotation.transpose() * n;
-  const int ia = support_hill_climb(a, n, cache.hint_a);
-  const int ib = support_hill_climb(b, -n_in_b, cache.hint_b);
-  const double overlap =
-      n.dot(a.vertex(ia)) - (n_in_b.dot(b.vertex(ib)) + n.dot(b_in_a.translation));
-  return overlap <= band;
+  // Through plateaus: a climb stopped below the support by rounding would
+  // understate the overlap and certify touching a pair that overlaps.
+  const int ia = support_hill_climb_through_plateaus(a, n, cache.hint_a);
+  const int ib = support_hill_climb_through_plateaus(b, -n_in_b, cache.hint_b);
+  return {n.dot(a.vertex(ia)) - (n_in_b.dot(b.vertex(ib)) + n.dot(b_in_a.translation)), ia, ib};
 }
+
+// The rounding of an overlap (Overlap::value), in u of the magnitude
+// bound: the two dot products of |.| <= sqrt(3) R (3 u each), the
+// rotation of n (3 u of R) and the sums; pinned with the band's edge by
+// SignedDistanceRegression.DepthJustAboveTheBandIsIntersecting.
+constexpr double kOverlapErrorUlps = 16.0;
 
 // Whether a touching answer is certified touching in O(1): the overlap of
 // the supports along one of a few directions (the answer's normal, which at
 // a distance of a few roundings may be noise, and the outward normals of
 // its witness faces, which for a resting contact face on face are the
-// contact's) is within the contact band of the bodies' magnitude bound.
-bool touching_certified(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                        const DistanceOptions& options, const DistanceCache& cache,
-                        const DistanceResult& result) {
+// contact's), plus its rounding, is within the contact band of R_w. R_w is
+// bounded below by the supports' own placed coordinates (computed as
+// placed_magnitude computes them), and computed (O(N), once) only when that
+// lower band does not decide.
+bool touching_certified(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                        const Pose& pose_b, const Pose& b_in_a, const DistanceOptions& options,
+                        const DistanceCache& cache, const DistanceResult& result,
+                        double& exact_band) {
   const double magnitude =
       std::max(magnitude_bound(Pose::identity(), a.scale()), magnitude_bound(b_in_a, b.scale()));
-  const double band = contact_band(magnitude, options.absolute_tolerance);
-  if (overlap_within(a, b, b_in_a, cache, result.normal, band)) return true;
+  const double error = kOverlapErrorUlps * kUnitRoundoff * magnitude;
+  const auto within = [&](const Vec3& n) {
+    const Overlap o = overlap_along(a, b, b_in_a, cache, n);
+    const double floor = contact_band(std::max(placed_magnitude(a.vertex(o.support_a), pose_a),
+                                               placed_magnitude(b.vertex(o.support_b), pose_b)),
+                                      options.absolute_tolerance);
+    if (o.value + error <= floor) return true;
+    if (!(o.value + error <= contact_band(magnitude, options.absolute_tolerance))) return false;
+    if (exact_band < 0.0)
+      exact_band = contact_band(std::max(placed_magnitude(a.vertices(), pose_a), placed_magnitude(b.vertices(), pose_b)),
+                                options.absolute_tolerance);
+    return o.value + error <= exact_band;
+  };
+  if (within(result.normal)) return true;
   const Feature& fa = result.feature_a;
   if (fa.type == FeatureType::face && fa.face >= 0 && fa.face < a.face_count() &&
-      overlap_within(a, b, b_in_a, cache, a.face_plane(fa.face).normal, band)) {
+      within(a.face_plane(fa.face).normal)) {
     return true;
   }
   const Feature& fb = result.feature_b;
   return fb.type == FeatureType::face && fb.face >= 0 && fb.face < b.face_count() &&
-         overlap_within(a, b, b_in_a, cache,
-                        Vec3(-(b_in_a.rotation * b.face_plane(fb.face).normal)), band);
+         within(Vec3(-(b_in_a.rotation * b.face_plane(fb.face).normal)));
 }
 
 }  // namespace
 
-void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                            const DistanceOptions& options, DistanceCache& cache,
-                            DistanceResult& result) {
+void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                            const Pose& pose_b, const Pose& b_in_a, const DistanceOptions& options,
+                            DistanceCache& cache, DistanceResult& result) {
   if (result.status == Status::iteration_cap) {
     // The distance is an upper bound on the signed distance (a pair that
     // overlaps has a negative one); the lower bound certifies separation
@@ -118,13 +145,24 @@ void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, co
     // depth decides, tracked like an overlap's. First a certificate in O(1)
     // from the answer's normal n: depth <= h_A(n) + h_B(-n) (the overlap of
     // the supports along any unit direction bounds it), so when that
-    // overlap is within the contact band of the magnitude bound the pair
+    // overlap and its rounding are within the contact band of R_w the pair
     // is touching and the depth is not computed (resting contacts: face on
     // face, n the face normal; hill climbing from the algorithm's support
-    // hints, which are read, not updated).
-    if (touching_certified(a, b, b_in_a, options, cache, result)) return;
+    // hints, which are read, not updated). A band of the magnitude bound
+    // instead (up to sqrt(3) times R_w) called an overlap 1.09 bands deep
+    // touching (SignedDistanceRegression.DepthJustAboveTheBandIsIntersecting).
+    double exact_band = -1.0;  // not computed yet
+    if (touching_certified(a, pose_a, b, pose_b, b_in_a, options, cache, result, exact_band))
+      return;
     const PenetrationResult p = penetration_depth(a, b, b_in_a, cache.penetration.get_or_create());
-    if (p.status != PenetrationStatus::penetrating) return;
+    if (p.status == PenetrationStatus::separated) return;
+    // Intersecting exactly when the depth is above the band of R_w (near
+    // the band the depth is exact up to 8 u of itself: penetration.cpp,
+    // kRefineBands), whatever the band of A's frame that p.status used.
+    if (exact_band < 0.0)
+      exact_band = contact_band(std::max(placed_magnitude(a.vertices(), pose_a), placed_magnitude(b.vertices(), pose_b)),
+                                options.absolute_tolerance);
+    if (!(p.depth > exact_band)) return;
     result.status = Status::intersecting;
     result.distance = 0.0;
     result.lower_bound = 0.0;

@@ -6,6 +6,7 @@
 // by distance() after its algorithm answered.
 #pragma once
 
+#include "core/accuracy.h"
 #include "proxima/core/types.h"
 #include "proxima/detail/penetration/penetration.h"
 #include "proxima/shape/polytope.h"
@@ -20,9 +21,14 @@ namespace proxima::detail {
 // options.penetration, the depth too, and a depth beyond the contact band
 // turns the answer into intersecting (the contact classification can call
 // an overlap of coplanar faces touching). Iteration cap: the bounds.
-void finish_signed_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                            const DistanceOptions& options, DistanceCache& cache,
-                            DistanceResult& result);
+// A touching answer turns intersecting exactly when the depth exceeds
+// the band of the exact R_w (the world poses pose_a, pose_b give it): its
+// O(1) certificate (an overlap of the supports within the band) is
+// checked against a lower bound on that band first, the band itself
+// computed (O(N)) only when that does not decide.
+void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                            const Pose& pose_b, const Pose& b_in_a, const DistanceOptions& options,
+                            DistanceCache& cache, DistanceResult& result);
 
 // Whether tracked_overlap may answer for the pair: its last depth was
 // penetrating, with options.penetration and the hybrid. Inline: distance()

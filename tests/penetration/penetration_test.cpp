@@ -7,11 +7,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
+#include "proxima/shape/support.h"
 #include "support/exact_oracle.h"
 #include "support/generators.h"
 #include "support/penetration_oracle.h"
+#include "support/regression_clouds.h"
 #include "support/same_bits.h"
 
 namespace proxima::test {
@@ -457,6 +460,98 @@ TEST(PenetrationRegression, NeedleOfWidthOneUlpOnAPlate) {
   ExactOracle oracle;
   EXPECT_TRUE(meets_standard(a, b, fast(a, b), oracle));
   EXPECT_TRUE(meets_standard(a, b, slow(a, b), oracle));
+}
+
+TEST(PenetrationRegression, PrismsWithCoplanarFacetsAtSmallScale) {
+  // Story (issue 25, the second reliability tour): two prisms of size 2e-5
+  // extruded along one direction overlap by 1.05e-6 through caps that
+  // rounding splits into nearly coplanar faces. An edge pair kept by the
+  // arc test without crossing was evaluated from its own vertices, on B's
+  // far cap: hill climbing along the cap's inward normal stopped on a
+  // nearly flat vertex 6e-6 below B's support (every edge there rises by
+  // less than the rounding), so the value was negative, a "separating"
+  // direction: both algorithms answered separated, depth 0 with the
+  // certificate [0, 0]. The climb now goes on across ties
+  // (support_hill_climb_through_plateaus).
+  const Points a = coplanar_prism_a(), b = coplanar_prism_b();
+  ExactOracle oracle;
+  const PenetrationResult rf = fast(a, b), rs = slow(a, b);
+  EXPECT_TRUE(meets_standard(a, b, rf, oracle));
+  EXPECT_TRUE(meets_standard(a, b, rs, oracle));
+  EXPECT_EQ(rf.status, PenetrationStatus::penetrating);
+  EXPECT_EQ(rs.status, PenetrationStatus::penetrating);
+}
+
+TEST(PenetrationRegression, SliverWithNearlyCoplanarFaces) {
+  // Story (issue 25): a sliver A of size 4 whose faces around one vertex
+  // have normals within 1e-11 of each other, and a small box B pushed
+  // 4.74e-8 into it. Two of those faces give values of A - B within
+  // rounding of each other; the least in double is not the exact least,
+  // and the origin's foot on its plane lies 8e-9 outside it, so its
+  // supporting features did not meet and the answer was "separated"
+  // (a rule meant for a flat A - B whose plane holds the origin outside
+  // it), depth 0 and the certificate [0, 0]. Now a value above the band is
+  // never called separated, and the faces tied with the least within
+  // twice a value's slack are tried for witnesses that meet.
+  const Points a = sliver_with_nearly_coplanar_faces_a(), b = sliver_with_nearly_coplanar_faces_b();
+  ExactOracle oracle;
+  const PenetrationResult rf = fast(a, b), rs = slow(a, b);
+  EXPECT_TRUE(meets_standard(a, b, rf, oracle));
+  EXPECT_TRUE(meets_standard(a, b, rs, oracle));
+  EXPECT_EQ(rf.status, PenetrationStatus::penetrating);
+  EXPECT_EQ(rs.status, PenetrationStatus::penetrating);
+}
+
+TEST(PenetrationRegression, DepthJustAboveTheBandIsPenetrating) {
+  // Story (issue 25): an overlap of 1.09 contact bands (exact depth
+  // 7.662e-15, band 64 u R 7.047e-15) was called touching: the status was
+  // decided against the band of a bound on R (up to sqrt(3) R), and a
+  // value in double is off by a few u R anyway. Answers within a few bands
+  // of zero are now refined exactly and decided against 64 u R.
+  const Points a = overlap_at_the_band_a(), b = overlap_at_the_band_b();
+  ExactOracle oracle;
+  for (const PenetrationResult& r : {fast(a, b), slow(a, b)}) {
+    EXPECT_TRUE(meets_standard(a, b, r, oracle));
+    EXPECT_EQ(r.status, PenetrationStatus::penetrating);
+    EXPECT_NEAR(r.depth, 7.662212386177775e-15, 1e-28);
+    EXPECT_LE(r.lower_bound, 7.662212386177775e-15);
+    EXPECT_GE(r.upper_bound, 7.662212386177775e-15);
+  }
+}
+
+// The adversarial family of PrismsWithCoplanarFacetsAtSmallScale: prisms
+// extruded along one random direction, B's cap pushed into A's through
+// their nearly coplanar caps by 1e-3 to 0.3 of A's height, at scales 1e-6
+// to 1e3, a third of them 100 sizes from the origin, against the exact
+// depth. The first version answered half of these pairs separated. The set
+// holds the hard cases: B's hull has vertices where the plain climb along
+// its cap's inward normal stops below the support (counted).
+TEST(PenetrationOracle, PrismsOverlappingThroughNearlyCoplanarCaps) {
+  Rng rng(20261129);
+  ExactOracle oracle;
+  int penetrating = 0, stuck = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const Vec3 w = random_unit_vector(rng);
+    const double s = log_uniform(rng, 1e-6, 1e3);
+    const Vec3 offset = trial % 3 == 0 ? Vec3(100 * s * random_unit_vector(rng)) : Vec3::Zero();
+    const double ha = s * uniform(rng, 0.2, 1.0), hb = s * uniform(rng, 0.2, 1.0);
+    const double overlap = ha * log_uniform(rng, 1e-3, 0.3);
+    const Points a = rounded_prism(rng, w, s, ha, uniform_int(rng, 4, 12), offset);
+    const Vec3 side = 0.3 * s * random_unit_vector(rng).cross(w);
+    const Points b = rounded_prism(rng, w, s * uniform(rng, 0.3, 1.0), hb, uniform_int(rng, 4, 12),
+                                   offset + (ha - overlap) * w + side);
+    ASSERT_TRUE(meets_standard(a, b, fast(a, b), oracle)) << "fast, trial " << trial;
+    ASSERT_TRUE(meets_standard(a, b, slow(a, b), oracle)) << "slow, trial " << trial;
+    const ConvexPolytope pb(b);
+    const double best = w.dot(pb.vertex(support_brute_force(pb.vertices(), w)));
+    bool trapped = false;
+    for (int v = 0; v < pb.vertex_count() && !trapped; ++v)
+      trapped = w.dot(pb.vertex(support_hill_climb(pb, w, v))) < best - 0.01 * s;
+    stuck += trapped;
+    penetrating += fast(a, b).status == PenetrationStatus::penetrating;
+  }
+  EXPECT_GE(penetrating, 55);
+  EXPECT_GE(stuck, 5);
 }
 
 // ---------------------------------------------------------------------------

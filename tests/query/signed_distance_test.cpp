@@ -16,10 +16,12 @@
 #include "proxima/query/batch.h"
 #include "proxima/query/compound_distance.h"
 #include "proxima/query/distance.h"
+#include "proxima/detail/penetration/penetration.h"
 #include "proxima/scene/scene.h"
 #include "support/exact_oracle.h"
 #include "support/generators.h"
 #include "support/penetration_oracle.h"
+#include "support/regression_clouds.h"
 #include "support/same_bits.h"
 
 namespace proxima::test {
@@ -281,6 +283,75 @@ TEST(SignedDistanceOracle, RandomOverlapsAreMinusTheExactDepth) {
   EXPECT_GE(deep, 60);
   EXPECT_GE(shallow, 3);
   EXPECT_GE(flat, 5);
+}
+
+TEST(SignedDistanceRegression, DepthJustAboveTheBandIsIntersecting) {
+  // Story (issue 25): bodies of size 1 overlapping by 7.662e-15 with a
+  // band 64 u R of 7.047e-15 were answered touching at +2.33e-15: the
+  // hybrid's touching answer was certified by an overlap of the supports
+  // within the band of a bound on R (up to sqrt(3) R), and the depth, in
+  // double, is off by a few u R. The certificate now adds its rounding and
+  // uses the band of the exact R, and the depth near the band is exact.
+  const Points a = overlap_at_the_band_a(), b = overlap_at_the_band_b();
+  const ConvexPolytope pa(a), pb(b);
+  const DistanceResult r = distance(pa, Pose::identity(), pb, Pose::identity());
+  const ExactDepth exact = exact_depth(a, b);
+  ASSERT_EQ(exact.origin, OriginInM::inside);
+  EXPECT_EQ(r.status, Status::intersecting);
+  EXPECT_NEAR(r.signed_distance(), -exact.depth(), 1e-28);
+  EXPECT_TRUE(brackets(r, -exact.depth(), 0.0));
+}
+
+// Overlaps within two bands of the band, of solids of size 1e-5 to 1e5, a
+// third of them 1e3 sizes from the origin (overlaps of 1e-17 of R): the
+// status is intersecting exactly when the exact depth exceeds 64 u R, for
+// distance() and for penetration_depth (penetrating), and the signed
+// distance is within the standard. The first version's status followed
+// rounding there (a quarter of such cases wrong); the set holds cases on
+// both sides of the band (counted).
+TEST(SignedDistanceOracle, OverlapsAtTheBandHaveTheExactStatus) {
+  Rng rng(20261130);
+  ExactOracle oracle;
+  int above = 0, below = 0;
+  for (int trial = 0; trial < 160; ++trial) {
+    const double s = log_uniform(rng, 1e-5, 1e5);
+    const Vec3 offset = trial % 3 == 0 ? Vec3(1e3 * s * random_unit_vector(rng)) : Vec3::Zero();
+    const Points a = translated(
+        transformed(scaled(points_on_sphere(rng, uniform_int(rng, 5, 10)), s), random_rotation(rng),
+                    Vec3::Zero()),
+        offset);
+    Points b = translated(scaled(points_on_sphere(rng, uniform_int(rng, 5, 10)), s * 0.7), offset);
+    const double band_guess = kContactBandUlps * kUnitRoundoff * (offset.norm() + 2 * s);
+    // Apart along a random direction, then moved back along the closest
+    // points' direction by the distance and 0.3 to 3 bands.
+    b = place_along(a, b, random_unit_vector(rng), 0.25 * s);
+    const std::optional<ExactDistance> apart = oracle.distance(a, b);
+    ASSERT_TRUE(apart && !apart->is_zero()) << trial;
+    const Vec3 w = (to_double(apart->point_b) - to_double(apart->point_a)).normalized();
+    b = translated(b, -(apart->distance() + uniform(rng, 0.3, 3.0) * band_guess) * w);
+    const ExactDepth exact = exact_depth(a, b);
+    if (exact.flat || exact.origin != OriginInM::inside) continue;
+    const double band = band_of(a, b);
+    const double d = exact.depth();
+    const bool deep = exact.depth_squared > ExactFT(band) * ExactFT(band);
+    above += deep && d < 2 * band;
+    below += !deep && d > 0.5 * band;
+    const ConvexPolytope pa(a), pb(b);
+    const DistanceResult r = distance(pa, Pose::identity(), pb, Pose::identity());
+    ASSERT_EQ(r.status, deep ? Status::intersecting : Status::touching)
+        << trial << ": exact depth " << d << ", band " << band << ", answer "
+        << r.signed_distance();
+    ASSERT_TRUE(brackets(r, -d, band)) << trial;
+    // Touching: the distance (>= 0, within the band) for minus a depth
+    // within the band.
+    ASSERT_NEAR(r.signed_distance(), -d, deep ? band : 2 * band) << trial;
+    PenetrationCache cache;
+    const PenetrationResult p = penetration_depth(pa, pb, Pose::identity(), cache);
+    ASSERT_EQ(p.status, deep ? PenetrationStatus::penetrating : PenetrationStatus::touching)
+        << trial << ": exact depth " << d << ", band " << band << ", depth " << p.depth;
+  }
+  EXPECT_GE(above, 10);
+  EXPECT_GE(below, 10);
 }
 
 TEST(SignedDistanceOracle, SeparatedRandomPairsBracketTheExactDistance) {

@@ -196,6 +196,23 @@ inline Points with_duplicates(Rng& rng, Points pts, int copies) {
   return pts;
 }
 
+// A prism: n points of a disc of `radius` about `at` in the plane
+// orthogonal to the unit w (a third of them inside), and their copies moved
+// by h w, all rounded: each cap is a facet that rounding splits into
+// nearly coplanar faces, with nearly flat vertices.
+inline Points rounded_prism(Rng& rng, const Vec3& w, double radius, double h, int n, const Vec3& at) {
+  const Vec3 u = w.unitOrthogonal(), v = w.cross(u);
+  Points p;
+  for (int i = 0; i < n; ++i) {
+    const double t = uniform(rng, 0, 2 * std::numbers::pi);
+    const double r = radius * ((i % 3 == 2) ? uniform(rng, 0.3, 1.0) : 1.0);
+    const Vec3 x = at + r * std::cos(t) * u + r * std::sin(t) * v;
+    p.push_back(x);
+    p.push_back(x + h * w);
+  }
+  return p;
+}
+
 // ---------------------------------------------------------------------------
 // Placement.
 

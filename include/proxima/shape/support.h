@@ -82,4 +82,36 @@ inline int support_hill_climb(const ConvexPolytope& polytope, const Vec3& dir, i
   }
 }
 
+// support_hill_climb made robust to rounding on nearly flat vertices: the
+// index of a vertex whose value d.x is within 2 delta of the exact maximum,
+// delta = gamma_3 |d|_1 scale() the rounding bound of one computed d.x.
+//
+// Why the plain climb is not enough: its exactness argument holds for
+// exact values. At a vertex whose tangent cone is nearly flat (a hull of
+// nearly coplanar points: a prism's facet split by rounding into many
+// faces) every edge may rise by less than the rounding of d.x, and the
+// climb then stops there however far below the maximum it is: climbing
+// from the bottom of such a facet along its inward normal stopped 6e-6
+// below the top on a body of size 2e-5 (PenetrationRegression.
+// PrismsWithCoplanarFacetsAtSmallScale).
+//
+// The repair: after the climb stops at v, the vertices connected to v
+// through vertices of computed value >= d.v - tie (tie = 2 delta; d.v the
+// computed value of v) are searched; one whose computed value is above d.v
+// restarts the climb from it, and when there is none, v is returned.
+// Proof that v is then within 2 delta of the maximum: let y be the vertex
+// of that region with the largest exact value. If y were not a maximizer,
+// an edge y-z would rise exactly (the tangent-cone argument of
+// support_hill_climb), so z's computed value would be above exact(z) -
+// delta > exact(y) - delta >= exact(v) - delta >= d.v - tie, and z would be
+// in the region, above y. So y is a maximizer, and since no vertex of the
+// region is computed above v, exact(v) >= d.v - delta >= computed(y) -
+// delta >= exact(y) - 2 delta. The computed values rise strictly at every
+// restart, so the loop ends.
+//
+// Cost over support_hill_climb: nothing when no neighbour of the climb's
+// last vertex is within the tie (the climb already read them); else a walk
+// over the tie region (a face of the hull when d is its normal).
+int support_hill_climb_through_plateaus(const ConvexPolytope& polytope, const Vec3& dir, int hint);
+
 }  // namespace proxima

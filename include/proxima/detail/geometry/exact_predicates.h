@@ -13,6 +13,8 @@
 // subnormals and the largest magnitudes included (see exact_predicates.cpp).
 #pragma once
 
+#include <span>
+
 #include "proxima/core/types.h"
 
 namespace proxima::detail {
@@ -31,5 +33,25 @@ bool collinear3d(const Vec3& a, const Vec3& b, const Vec3& c);
 // component within about 2^-53 of the length); zero exactly when a, b, c
 // are collinear.
 Vec3 exact_triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
+
+// The offset of a plane of support pairs, exactly: for the direction
+// N = (u1 - u0) x (w1 - w0) of the given doubles (two edge vectors, or two
+// edges of a triangle from one corner), the width
+//   h = (max over x in xs of N.x - min over y in ys of N.y) / |N|
+// (the value h_X(n) + h_Y(-n) of two point sets along n = N / |N|: the
+// penetration depth's value of a face of X - Y). `offset` is h rounded
+// (within 4 u of it); `versus` the exact sign of h - c for the double c
+// (>= 0): the status of a depth against the contact band, decided without
+// rounding. `degenerate` when N is exactly 0 (offset and versus 0). xs and
+// ys must not be empty. Exact for every finite input: integers of any size
+// (Boost.Multiprecision), so a few microseconds; for the rare answers that
+// rounding cannot decide.
+struct ExactOffset {
+  double offset = 0.0;
+  int versus = 0;
+  bool degenerate = false;
+};
+ExactOffset exact_offset(const Vec3& u0, const Vec3& u1, const Vec3& w0, const Vec3& w1,
+                         std::span<const Vec3> xs, std::span<const Vec3> ys, double c);
 
 }  // namespace proxima::detail
