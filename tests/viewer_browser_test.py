@@ -287,6 +287,38 @@ def main():
     assert all(p["distance"] <= 0.45 for p in data["pairs"])
     pages.append(("scene", w("scene.html"), None))
 
+    # 6. Hostile text (issue 25): the page once escaped only "</" in its
+    # data, so an id, a file name or a title holding "<!--<script>" put the
+    # HTML parser in its "script data double escaped" state, the data element
+    # swallowed three.js and the viewer code, and the page stayed at "loading
+    # three.js..." with no error. Every string from input must be inert: the
+    # data element holds no '<', '>' or '&' at all, and the pages render.
+    hostile = "<!--<script></script><script>document.body.dataset.rendered='pwned'</script>-->&\u2028\u2029"
+    query = {"id": hostile, "a": {"vertices": tetrahedron([0, 0, 0])},
+             "b": {"vertices": tetrahedron([2, 0, 0])}}
+    open(w("hostile.jsonl"), "w", encoding="utf-8").write(json.dumps(query, ensure_ascii=False) + "\n")
+    answer = json.loads(run([proxima, "query", w("hostile.jsonl")]))
+    run([proxima, "view", "--query", w("hostile.jsonl"), "--out", w("hostile-id.html")])
+    assert hostile in page_data(w("hostile-id.html"))["title"], page_data(w("hostile-id.html"))["title"]
+    pages.append(("hostile-id", w("hostile-id.html"), answer["distance"]))
+    # File names: any bytes but '/' and NUL, so also bytes that are not
+    # UTF-8 (which once failed with json type_error.316).
+    names = [os.fsencode(w("<!--<script>&\u2028a.xyz")), os.fsencode(w("b")) + b"\xff<!--<script>.xyz"]
+    for name, offset in zip(names, ([0, 0, 0], [2, 0, 0])):
+        with open(name, "w") as f:
+            f.writelines("%r %r %r\n" % tuple(p) for p in tetrahedron(offset))
+    r = subprocess.run([os.fsencode(proxima), b"view", *names, b"--out", os.fsencode(w("hostile-names.html"))],
+                       capture_output=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    data = page_data(w("hostile-names.html"))
+    assert data["bodies"][0]["name"] == "<!--<script>&\u2028a.xyz", data["bodies"][0]["name"]
+    assert data["bodies"][1]["name"] == "b\ufffd<!--<script>.xyz", data["bodies"][1]["name"]
+    pages.append(("hostile-names", w("hostile-names.html"), data["pair"]["distance"]))
+    for name in ("hostile-id", "hostile-names"):
+        text = open(w(name + ".html"), encoding="utf-8").read()
+        inside = re.search(r'<script id="proxima-data" type="application/json">(.*?)</script>', text, re.S)
+        assert not re.search("[<>&\u2028\u2029]", inside.group(1)), f"{name}: the data holds raw markup"
+
     check_bad_input(proxima, w)
 
     # A time-of-impact line: the bodies drawn at the time found (the
