@@ -17,15 +17,16 @@
 #include <utility>
 #include <vector>
 
+#include "magnitude_limit.h"
 #include "proxima/distance.h"
 
 namespace proxima {
 namespace {
 
 // The largest coordinate magnitude of a rounded body (core plus radius)
-// accepted: the cores' query's own limit (distance.cpp), so that no sum of
-// radii, signed distance or offset point can overflow.
-constexpr double kMaxMagnitude = 0x1p1018;
+// accepted: the cores' query's own limit, so that no sum of radii, signed
+// distance or offset point can overflow.
+using detail::kMaxMagnitude;  // magnitude_limit.h
 
 // A radius or an approximation error: finite and >= 0, else refused by
 // name. Finiteness on the bits first: no comparison with a NaN, which
@@ -569,12 +570,10 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
   for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
     const double reach = magnitude_bound(*pose, body->scale());
     if (!(reach <= kMaxMagnitude)) {
-      char message[200];
-      std::snprintf(message, sizeof message,
-                    "distance: body %s with radius %g reaches coordinates of magnitude %g, beyond "
-                    "the supported %g",
-                    name, body->radius(), reach, kMaxMagnitude);
-      throw InvalidInput(message);
+      char radius[64];
+      std::snprintf(radius, sizeof radius, "%.3g", body->radius());
+      throw InvalidInput(detail::beyond_magnitude(std::string("distance: body ") + name, reach,
+                                                  std::string("with its radius ") + radius));
     }
   }
   // The cores' queries without their own depth: the depth of overlapping

@@ -18,18 +18,13 @@
 
 #include "proxima/gjk.h"
 #include "proxima/hybrid.h"
+#include "magnitude_limit.h"
 #include "signed_distance.h"
 
 namespace proxima {
 namespace {
 
-// Largest coordinate magnitude (bounded as below) accepted. The algorithms
-// take differences of coordinates and map B into A's frame (|R y + t| up
-// to sqrt(3) |y| + |t|), and the hybrid and GJK then work in units of a
-// power of two near that magnitude; beyond 2^1018 (2.8e306) those
-// intermediate values can overflow to inf, and differences of infinities
-// are NaN. Such input is refused by name instead of answered with NaN.
-constexpr double kMaxMagnitude = 0x1p1018;
+using detail::kMaxMagnitude;  // magnitude_limit.h
 
 // Upper bound on the largest coordinate magnitude of a body placed at
 // `pose` (types.h). O(1).
@@ -299,14 +294,10 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   // (finish_query).
   const double r_bound = magnitude_bounds(a, pose_a, b, pose_b);
   if (!(r_bound <= kMaxMagnitude)) [[unlikely]] {
-    char what[200];
-    std::snprintf(
-        what, sizeof what,
-        "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
-        "beyond the supported %.3g where differences of coordinates may overflow",
-        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
-        kMaxMagnitude);
-    throw InvalidInput(what);
+    throw InvalidInput(detail::beyond_magnitude(
+        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "distance: body a"
+                                                                              : "distance: body b",
+        r_bound, "vertices and pose translation"));
   }
   const Pose b_in_a = relative_pose(pose_a, pose_b);
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);
