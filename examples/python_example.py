@@ -13,8 +13,8 @@ a = proxima.ConvexPolytope(rng.normal(size=(40, 3)))  # the hull of 40 points
 b = proxima.ConvexPolytope(rng.uniform(-1, 1, size=(30, 3)))
 
 # Poses: None (identity), a 4x4 or 3x4 matrix, a scipy Rotation, a Pose, or
-# (rotation, translation) where a quaternion is (w, x, y, z), SCALAR FIRST.
-# ROS and scipy write (x, y, z, w): say so with Pose.from_xyzw(q, t).
+# (rotation matrix, translation). A quaternion names its order: ROS and scipy
+# write (x, y, z, w), Pose.from_xyzw(q, t); Eigen (w, x, y, z), Pose.from_wxyz.
 r = proxima.distance(a, None, b, proxima.Pose.from_translation((4, 0, 0)))
 r = proxima.distance(a, None, b, proxima.Pose.from_xyzw((0, 0, 0, 1), (4, 0, 0)))  # the same pose
 print(r.status, r.distance, r.point_a, r.point_b, r.feature_a, r.feature_b)
