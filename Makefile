@@ -17,7 +17,7 @@ release: setup
 
 # The sanitizer build compiles at -O1 with line tables only (-g1): enough for
 # ASan's stack traces, and 40% less compile time than -O2 -g (measured on
-# tests/gjk_test.cpp), which keeps `make test` inside its budget on 2 cores.
+# tests/narrowphase/gjk_test.cpp), which keeps `make test` inside its budget on 2 cores.
 asan: setup
 	cmake --preset asan >/dev/null
 	cmake --build --preset asan -j $(JOBS)

@@ -23,7 +23,7 @@
 #include <random>
 #include <vector>
 
-#include "proxima/batch.h"
+#include "proxima/query/batch.h"
 #include "support/random.h"
 
 namespace proxima {

@@ -19,9 +19,9 @@
 #include <random>
 #include <vector>
 
-#include "proxima/body.h"
-#include "proxima/distance.h"
-#include "proxima/primitives.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/distance.h"
+#include "proxima/shape/primitives.h"
 
 namespace proxima {
 namespace {

@@ -26,8 +26,8 @@
 #include <random>
 #include <vector>
 
-#include "../src/broad_phase.h"
-#include "proxima/scene.h"
+#include "scene/broad_phase.h"
+#include "proxima/scene/scene.h"
 #include "support/random.h"
 
 namespace proxima {
@@ -36,7 +36,7 @@ namespace {
 constexpr int kPoolSize = 64;
 constexpr double kMargin = 0.1;
 // Side of the cube holding 120 bodies with a few neighbours each (the
-// density of tests/scene_test.cpp); grown with the cube root of the count.
+// density of tests/scene/scene_test.cpp); grown with the cube root of the count.
 constexpr double kSideAt120 = 10.0;
 
 using bench::random_quaternion;

@@ -17,7 +17,7 @@
 #include <random>
 #include <vector>
 
-#include "proxima/closest_point.h"
+#include "proxima/geometry/closest_point.h"
 
 namespace {
 

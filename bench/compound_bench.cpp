@@ -7,7 +7,7 @@
 // BM_ColdBoxes runs the same cold branch and bound with axis-aligned boxes
 // (in each body's frame, re-fitted to the query frame by |R| h every visit)
 // in place of the library's spheres: the measured comparison behind the
-// choice of spheres (see src/compound.cpp).
+// choice of spheres (see src/shape/compound.cpp).
 //
 //   ./build/release/bench/compound_bench --benchmark_repetitions=3
 //       --benchmark_report_aggregates_only=true   (one command line)
@@ -20,8 +20,8 @@
 #include <random>
 #include <vector>
 
-#include "proxima/compound.h"
-#include "proxima/distance.h"
+#include "proxima/query/compound_distance.h"
+#include "proxima/query/distance.h"
 
 namespace proxima {
 namespace {
@@ -208,7 +208,7 @@ struct BoxTree {
   }
 };
 
-// The cold branch and bound of src/compound.cpp, depth first, nearer child
+// The cold branch and bound of src/shape/compound.cpp, depth first, nearer child
 // pair first, descending the larger volume, with boxes. Returns the distance
 // and counts the pairs tested.
 double box_distance(const CompoundBody& a, const BoxTree& ta, const CompoundBody& b,

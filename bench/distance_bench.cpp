@@ -17,7 +17,7 @@
 #include <random>
 #include <vector>
 
-#include "proxima/distance.h"
+#include "proxima/query/distance.h"
 
 namespace proxima {
 namespace {

@@ -10,7 +10,7 @@
 // number of support evaluations per query.
 //
 //   build/<dir>/bench/gjk_bench --benchmark_min_time=0.2
-#include "proxima/gjk.h"
+#include "proxima/detail/narrowphase/gjk.h"
 #include "support/random.h"
 
 #include <benchmark/benchmark.h>

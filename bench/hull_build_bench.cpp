@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "proxima/polytope.h"
+#include "proxima/shape/polytope.h"
 #include "support/random.h"
 
 namespace {

@@ -4,7 +4,7 @@
 //
 //   ./build/release/bench/mesh_bench [--poses N] [--steps S] [--referee K] [mesh directory]
 //   (defaults: N = 200 random poses, S = 2000 motion steps, K = 10 refereed
-//   poses of each kind, directory /work/shared/meshes/fcl)
+//   poses of each kind, directory bench/data/fcl)
 //
 // Workloads, env.obj at the identity, rob.obj at each pose:
 //   random   translations uniform in [-3000, 3000] x [-3000, 3000] x
@@ -29,10 +29,10 @@
 // time, and the build of a ~10^6-triangle mesh (time, bytes against the raw vertices + triangles).
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/distance.h>
-#include <proxima/closest_point.h>
-#include <proxima/distance.h>
+#include <proxima/geometry/closest_point.h>
+#include <proxima/query/distance.h>
 #include <proxima/io.h>
-#include <proxima/mesh.h>
+#include <proxima/query/mesh_distance.h>
 
 #include <algorithm>
 #include <chrono>
@@ -44,7 +44,7 @@
 #include <string>
 #include <vector>
 
-#include "../src/triangle_distance.h"
+#include "geometry/triangle_distance.h"
 #include "peers/fcl_convex.h"
 
 namespace {
@@ -176,7 +176,7 @@ void run(const char* title, const TriangleMesh& env, const TriangleMesh& rob,
 
 int main(int argc, char** argv) {
   int pose_count = 200, steps = 2000, referee = 10;
-  std::string dir = "/work/shared/meshes/fcl";
+  std::string dir = PROXIMA_BENCH_DATA "/fcl";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--poses" && i + 1 < argc) {

@@ -1,4 +1,4 @@
-// Penetration depth benchmarks (include/proxima/penetration.h): cold and
+// Penetration depth benchmarks (include/proxima/detail/penetration/penetration.h): cold and
 // tracked queries, the fast algorithm (Gauss-map overlay walk, cached
 // margin) against its slow twin (every edge pair), N = 8 ... 4096 points on
 // a sphere (seeded). B, a sphere of radius 0.8, sweeps through A (radius 1)
@@ -18,7 +18,7 @@
 #include <cmath>
 #include <vector>
 
-#include "proxima/penetration.h"
+#include "proxima/detail/penetration/penetration.h"
 #include "support/random.h"
 
 namespace proxima {

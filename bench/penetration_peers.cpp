@@ -93,8 +93,8 @@
 #include <vector>
 
 #include "peers/fcl_convex.h"
-#include "proxima/distance.h"
-#include "proxima/penetration.h"
+#include "proxima/query/distance.h"
+#include "proxima/detail/penetration/penetration.h"
 #include "support/exact_oracle.h"
 #include "support/penetration_oracle.h"
 #include "support/random.h"

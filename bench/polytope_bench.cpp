@@ -9,8 +9,8 @@
 //                               interior), with memory counters
 //
 // Polytopes: N = 8, 64, 512, 4096, 10000 points on the unit sphere, seeded.
-#include "proxima/polytope.h"
-#include "proxima/support.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/shape/support.h"
 #include "support/random.h"
 
 #include <benchmark/benchmark.h>

@@ -39,7 +39,7 @@ def main():
     directions = rng.normal(size=(k, 3))
     directions /= np.linalg.norm(directions, axis=1)[:, None]
     poses_b[:, :3, 3] = directions * 2.5
-    print(f"pairs {k}, steps {args.steps}, proxima {proxima.__file__}")
+    print(f"pairs {k}, steps {args.steps}, proxima {proxima.__version__ if hasattr(proxima, '__version__') else 'module'} from the build tree")
     for threads in (1, 0):
         reused, fresh = proxima.PairBatch(a, b), proxima.PairBatch(a, b)
         out = None

@@ -30,9 +30,9 @@
 // difference over pairs the referee reports separated, and the pairs where a
 // system says overlap and the referee does not (or the reverse).
 #include <fcl/narrowphase/distance.h>
-#include <proxima/distance.h>
+#include <proxima/query/distance.h>
 #include <proxima/io.h>
-#include <proxima/scene.h>
+#include <proxima/scene/scene.h>
 
 #include <algorithm>
 #include <array>

@@ -25,7 +25,7 @@
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/narrowphase/distance.h>
 #include <proxima/io.h>
-#include <proxima/mesh.h>
+#include <proxima/query/mesh_distance.h>
 
 #include <algorithm>
 #include <array>

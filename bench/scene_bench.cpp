@@ -73,8 +73,8 @@
 
 #include "paper/scene_scenario.h"
 #include "peers/fcl_scene.h"
-#include "proxima/distance.h"
-#include "proxima/scene.h"
+#include "proxima/query/distance.h"
+#include "proxima/scene/scene.h"
 
 namespace proxima::bench {
 namespace {

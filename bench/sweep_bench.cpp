@@ -40,7 +40,7 @@
 #include <vector>
 
 #include "paper/scene_scenario.h"
-#include "proxima/scene.h"
+#include "proxima/scene/scene.h"
 
 namespace proxima::bench {
 namespace {

@@ -19,25 +19,25 @@
 // and each peer's misses (no contact where proxima found one) and largest
 // time error |t_peer - t_proxima| (proxima's t is tested never to be after
 // the true first contact and within 1e-9 of the size in distance,
-// tests/time_of_impact_test.cpp).
+// tests/motion/time_of_impact_test.cpp).
 //
 // Then compounds (proxima only): a grid of K convex pieces (hulls of 12
 // points) turning in place against a hull of 64 points thrown through it
 // while turning, the same kind of motions. Per K: the median time of
 // proxima's pruned time of impact (the Body call: piece pairs in order of
-// their moving bounding balls, src/time_of_impact.cpp), the mean number of
+// their moving bounding balls, src/motion/time_of_impact.cpp), the mean number of
 // piece pairs advanced and of distance queries, and the median time of
 // every piece pair advanced on its own (each piece re-hulled in its body's
 // frame, the convex call per pair, the earliest kept: no pruning), with
 // the largest difference of the two times.
 //
-// Then meshes (given a mesh directory, default /work/shared/meshes/fcl):
+// Then meshes (given a mesh directory, default bench/data/fcl):
 // FCL's env.obj (2180 triangles, a box of about 6000 units, fixed) against
 // the hull of rob.obj's vertices thrown through it from random poses in
 // FCL's test box [-3000, 3000]^2 x [0, 3000] to others, turning up to a
 // full turn. Per row: the median time of proxima's time of impact (the
 // Body call: the branch and bound over the mesh's triangles,
-// src/time_of_impact.cpp), the mean triangles advanced and distance
+// src/motion/time_of_impact.cpp), the mean triangles advanced and distance
 // queries, and FCL 0.7's continuousCollide on the same motions
 // (conservative advancement, BVHModel<OBBRSS> against fcl::Convexd of the
 // same hull) with its misses, extra contacts and largest time error
@@ -64,11 +64,11 @@
 #include <vector>
 
 #include "peers/fcl_convex.h"
-#include "proxima/body.h"
-#include "proxima/compound.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/compound_distance.h"
 #include "proxima/io.h"
-#include "proxima/mesh.h"
-#include "proxima/time_of_impact.h"
+#include "proxima/query/mesh_distance.h"
+#include "proxima/motion/time_of_impact.h"
 
 namespace {
 
@@ -309,7 +309,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: toi_bench [motions per N >= 1] [mesh directory]\n");
     return 2;
   }
-  const std::string mesh_dir = argc > 2 ? argv[2] : "/work/shared/meshes/fcl";
+  const std::string mesh_dir = argc > 2 ? argv[2] : PROXIMA_BENCH_DATA "/fcl";
   std::printf(
       "# time of impact, %d motions per N (median ns per query; steps: mean distance queries of "
       "motions that meet)\n",

@@ -22,7 +22,7 @@
 #include <random>
 #include <vector>
 
-#include "proxima/distance.h"
+#include "proxima/query/distance.h"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 
 namespace proxima::cli {
 

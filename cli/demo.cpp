@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "proxima/closest_point.h"
-#include "proxima/distance.h"
-#include "proxima/polytope.h"
+#include "proxima/geometry/closest_point.h"
+#include "proxima/query/distance.h"
+#include "proxima/shape/polytope.h"
 
 namespace proxima::cli {
 namespace {

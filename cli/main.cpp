@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "demo.h"
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 #include "query.h"
 #include "tools.h"
 #include "view.h"

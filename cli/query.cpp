@@ -10,8 +10,8 @@
 // hulls, run one cold distance query, print one answer line. Nothing but
 // buffers survives from one line to the next, so a bad line can never change
 // the answer to a good one. A body with a "radius" is a rounded body
-// (proxima/body.h); a body with a motion ("pose_end" or velocities) makes
-// the line a time-of-impact query (proxima/time_of_impact.h).
+// (proxima/query/body_distance.h); a body with a motion ("pose_end" or velocities) makes
+// the line a time-of-impact query (proxima/motion/time_of_impact.h).
 #include "query.h"
 
 #include <algorithm>
@@ -34,10 +34,10 @@
 
 #include "answer_writer.h"
 #include "json_errors.h"
-#include "proxima/body.h"
-#include "proxima/distance.h"
-#include "proxima/polytope.h"
-#include "proxima/time_of_impact.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/distance.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/motion/time_of_impact.h"
 
 namespace proxima::cli {
 namespace {
@@ -99,7 +99,7 @@ Quat read_rotation(const Json& value, const std::string& path,
                  numbers);
   }
   // Normalized at any magnitude, a zero quaternion refused: the pose
-  // contract's own functions (proxima/pose.h), as in Python.
+  // contract's own functions (proxima/core/pose.h), as in Python.
   try {
     if (!order) {
       fail(path + " " + value.dump() + " does not name its quaternion order: " +
@@ -131,7 +131,7 @@ Pose read_pose(const Json& object, const std::string& path,
 }  // namespace
 
 // Reads body `name` ("a" or "b") of `query` into vertices, pose, radius and
-// motion (time of impact, proxima/time_of_impact.h: "pose_end", or
+// motion (time of impact, proxima/motion/time_of_impact.h: "pose_end", or
 // "linear_velocity" and "angular_velocity" per unit t; none: no motion),
 // its rotations' four numbers in `order`.
 void read_body(const Json& query, const std::string& name, std::optional<QuaternionOrder> order,
@@ -166,7 +166,7 @@ void read_body(const Json& query, const std::string& name, std::optional<Quatern
     vertices.emplace_back(xyz[0], xyz[1], xyz[2]);
   }
 
-  // "triangles": a mesh body (proxima/mesh.h) of the vertices as given;
+  // "triangles": a mesh body (proxima/query/mesh_distance.h) of the vertices as given;
   // absent or null, the hull of the vertices. Indices are checked here so
   // that the message names the JSON path.
   triangles.clear();
@@ -205,7 +205,7 @@ void read_body(const Json& query, const std::string& name, std::optional<Quatern
   // fields need not special-case them.
   pose = read_pose(*body, name + ".", order);
 
-  // The body's radius (proxima/body.h): absent or null, 0.
+  // The body's radius (proxima/query/body_distance.h): absent or null, 0.
   radius = 0.0;
   const auto r = body->find("radius");
   if (r != body->end() && !r->is_null()) {

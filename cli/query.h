@@ -16,9 +16,9 @@
 #include <vector>
 
 #include "json_errors.h"
-#include "proxima/body.h"
-#include "proxima/time_of_impact.h"
-#include "proxima/types.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/motion/time_of_impact.h"
+#include "proxima/core/types.h"
 
 namespace proxima::cli {
 

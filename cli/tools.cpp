@@ -30,10 +30,10 @@
 #include <utility>
 #include <vector>
 
-#include "proxima/body.h"
-#include "proxima/distance.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/distance.h"
 #include "proxima/io.h"
-#include "proxima/polytope.h"
+#include "proxima/shape/polytope.h"
 
 namespace proxima::cli {
 namespace {
@@ -424,7 +424,7 @@ Pose parse_pose(const std::vector<std::string>& tokens, const std::string& optio
     v[i] = parse_number(tokens[i], option, static_cast<int>(i), order);
   const Vec3 translation(v[0], v[1], v[2]);
   if (tokens.size() == 3) return Pose(Mat3::Identity(), translation);
-  // The pose contract's quaternion (proxima/pose.h): normalized at any
+  // The pose contract's quaternion (proxima/core/pose.h): normalized at any
   // magnitude, a zero one refused in the same words as everywhere. Four
   // numbers whose order is not named are refused with both readings: in
   // the other order they are another rotation.

@@ -25,10 +25,10 @@
 #include <vector>
 
 #include "json_errors.h"
-#include "proxima/body.h"
-#include "proxima/distance.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/distance.h"
 #include "proxima/io.h"
-#include "proxima/scene.h"
+#include "proxima/scene/scene.h"
 #include "query.h"
 #include "tools.h"
 #include "viewer.h"

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "proxima/io.h"
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 
 namespace proxima::cli {
 

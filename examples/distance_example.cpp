@@ -1,7 +1,7 @@
 // The C++ example of the README, built and run by `make test`.
 // Two unit cubes; B moves and turns a little at each step and the same
 // cache is passed each time (tracking).
-#include <proxima/distance.h>
+#include <proxima/query/distance.h>
 
 #include <cmath>
 #include <cstdio>

@@ -4,7 +4,7 @@
 // joint limits. One copy, so that both measure the same arm on the same path.
 #pragma once
 
-#include <proxima/types.h>
+#include <proxima/core/types.h>
 
 #include <array>
 #include <cstdint>

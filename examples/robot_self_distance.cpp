@@ -10,7 +10,7 @@
 //
 //   robot_self_distance [mesh directory]   (default: examples/data/panda)
 #include <proxima/io.h>
-#include <proxima/scene.h>
+#include <proxima/scene/scene.h>
 
 #include <algorithm>
 #include <array>

@@ -2,7 +2,7 @@
 // bodies and two L-shaped compound bodies drift and turn; every step asks for
 // the pairs within the margin. Each step is checked against the slow twin
 // close_pairs_all_pairs() (cold queries on every pair); a mismatch returns 1.
-#include <proxima/scene.h>
+#include <proxima/scene/scene.h>
 
 #include <algorithm>
 #include <cmath>

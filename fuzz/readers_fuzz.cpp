@@ -14,7 +14,7 @@
 #include <string_view>
 
 #include "proxima/io.h"
-#include "proxima/polytope.h"
+#include "proxima/shape/polytope.h"
 
 namespace {
 

@@ -24,7 +24,7 @@
 #include <string>
 #include <vector>
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 #include "source.h"
 
 namespace proxima::io_detail {

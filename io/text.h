@@ -11,7 +11,7 @@
 #include <string>
 #include <string_view>
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 #include "source.h"
 
 namespace proxima::io_detail {

@@ -8,7 +8,7 @@
 // as module.cpp: names one for one with C++ (the primitives without the
 // make_ prefix), arrays are numpy copies, enums are strings, queries
 // release the GIL.
-#include "proxima/body.h"
+#include "proxima/query/body_distance.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -20,8 +20,8 @@
 #include <utility>
 
 #include "convert.h"
-#include "proxima/compound.h"
-#include "proxima/primitives.h"
+#include "proxima/query/compound_distance.h"
+#include "proxima/shape/primitives.h"
 
 namespace proxima::python {
 // A Body from a Body, a ConvexPolytope or a CompoundBody (radius 0): the

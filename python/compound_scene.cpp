@@ -24,10 +24,10 @@
 #include <vector>
 
 #include "convert.h"
-#include "proxima/body.h"
-#include "proxima/compound.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/compound_distance.h"
 #include "proxima/io.h"
-#include "proxima/scene.h"
+#include "proxima/scene/scene.h"
 
 namespace proxima::python {
 namespace {

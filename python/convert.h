@@ -32,10 +32,10 @@
 #include <utility>
 #include <vector>
 
-#include "proxima/body.h"
+#include "proxima/query/body_distance.h"
 #include "proxima/io.h"
-#include "proxima/polytope.h"
-#include "proxima/types.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/core/types.h"
 
 namespace proxima::python {
 
@@ -124,7 +124,7 @@ inline Pose pose_from_rows(const double* rows, const std::string& name) {
   return pose_from_rows(rows, [&name] { return name; });
 }
 
-// A 4x4 matrix under the rigid-pose contract (proxima/pose.h): every entry
+// A 4x4 matrix under the rigid-pose contract (proxima/core/pose.h): every entry
 // finite (the bottom row too), the bottom row (0, 0, 0, 1) within the
 // contract's tolerance, the rest checked (and re-orthonormalized when
 // needed) by checked_pose, whose refusal (InvalidInput) names `name()`.
@@ -258,7 +258,7 @@ enum class PoseCheck { here, by_the_batch };
 // or (K, 3, 4) array, written into `poses` (resized to K; a caller that
 // keeps the vector from call to call allocates nothing). `k` is the batch
 // size, or -1 when this argument decides it. With PoseCheck::here every
-// pose meets the contract of proxima/pose.h on return (a refusal names the
+// pose meets the contract of proxima/core/pose.h on return (a refusal names the
 // pose, name[i]).
 inline void to_poses(py::handle obj, py::ssize_t k, const std::string& name, PoseCheck check,
                      std::vector<Pose>& poses) {

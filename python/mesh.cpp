@@ -5,7 +5,7 @@
 // file), and load_body, which reads a file as the kind of body the caller
 // names (mesh, hull or pieces). A mesh meets any body through distance()
 // (body.cpp), which answers a BodyDistance with the closest triangles.
-#include "proxima/mesh.h"
+#include "proxima/query/mesh_distance.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>

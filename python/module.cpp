@@ -30,12 +30,12 @@
 #include <vector>
 
 #include "convert.h"
-#include "proxima/batch.h"
-#include "proxima/distance.h"
+#include "proxima/query/batch.h"
+#include "proxima/query/distance.h"
 #include "proxima/io.h"
-#include "proxima/polytope.h"
-#include "proxima/signed_distance.h"
-#include "proxima/types.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/query/signed_distance.h"
+#include "proxima/core/types.h"
 
 namespace py = pybind11;
 

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "convert.h"
-#include "proxima/batch.h"
+#include "proxima/query/batch.h"
 
 namespace proxima::python {
 namespace {

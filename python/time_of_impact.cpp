@@ -5,7 +5,7 @@
 // time_of_impact). Same conventions as module.cpp: names one for one with
 // C++, poses in any form to_pose reads, enums as strings, the query without
 // the GIL.
-#include "proxima/time_of_impact.h"
+#include "proxima/motion/time_of_impact.h"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -14,7 +14,7 @@
 #include <string>
 
 #include "convert.h"
-#include "proxima/body.h"
+#include "proxima/query/body_distance.h"
 
 namespace proxima::python {
 namespace {

@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "convert.h"
-#include "proxima/body.h"
-#include "proxima/scene.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/scene/scene.h"
 #include "viewer.h"
 
 namespace proxima::python {

@@ -15,7 +15,7 @@
 #include <span>
 #include <string_view>
 
-#include "proxima/polytope.h"
+#include "proxima/shape/polytope.h"
 
 namespace proxima::viewer {
 namespace assets {

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "proxima/body.h"
-#include "proxima/compound.h"
-#include "proxima/types.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/compound_distance.h"
+#include "proxima/core/types.h"
 
 namespace proxima::viewer {
 

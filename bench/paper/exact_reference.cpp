@@ -20,7 +20,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "proxima/closest_point.h"
+#include "proxima/geometry/closest_point.h"
 
 namespace proxima::bench {
 namespace {

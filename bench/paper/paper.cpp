@@ -51,8 +51,8 @@
 #include "paper/proxima_system.h"
 #include "peers/bullet_peer.h"
 #include "peers/fcl_peer.h"
-#include "proxima/polytope.h"
-#include "proxima/types.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/core/types.h"
 #include "support/random.h"
 
 #ifndef PROXIMA_PLOT_SCRIPT

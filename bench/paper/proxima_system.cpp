@@ -4,7 +4,7 @@
 
 #include <stdexcept>
 
-#include "proxima/distance.h"
+#include "proxima/query/distance.h"
 
 namespace proxima::bench {
 

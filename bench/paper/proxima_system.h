@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "peers/system.h"
-#include "proxima/polytope.h"
-#include "proxima/types.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/core/types.h"
 
 namespace proxima::bench {
 

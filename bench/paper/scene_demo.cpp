@@ -7,7 +7,7 @@
 // benchmark (bench/paper/scene_scenario.h) run through proxima::Scene alone: each
 // step moves every body and asks for every pair within the margin. Rows are
 // plain whitespace-separated columns so that a script (and
-// tests/cli_scene_test.cpp) can read them; the progress line goes to its own
+// tests/cli/cli_scene_test.cpp) can read them; the progress line goes to its own
 // stream so that it never mixes with them.
 #include "scene_demo.h"
 
@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "paper/scene_scenario.h"
-#include "proxima/scene.h"
+#include "proxima/scene/scene.h"
 
 namespace proxima::bench {
 namespace {

@@ -27,8 +27,8 @@
 #include <span>
 #include <vector>
 
-#include "proxima/polytope.h"
-#include "proxima/types.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/core/types.h"
 
 namespace proxima::bench {
 

@@ -28,7 +28,7 @@
 #include <memory>
 
 #include "peers/system.h"
-#include "proxima/polytope.h"
+#include "proxima/shape/polytope.h"
 
 namespace proxima::bench {
 

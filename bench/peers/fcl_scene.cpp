@@ -27,9 +27,8 @@
 //   FclBoxes::tight variant replaces it by the tight box of the transformed
 //   vertices, to show how much of the difference the loose box makes.
 // - The solver: GST_LIBCCD by default. In the paper experiments' cold queries
-//   (bench/results/cpp-2core/cold.csv) it is FCL's faster solver from 16 to
-//   4096 vertices (2.6 us against 3.6 us for GST_INDEP at 32 vertices, 5.2
-//   against 10.9 at 128) and the more accurate one; a broad-phase callback is
+//   (make run's cold.csv) it is FCL's faster solver from 16 to 4096 vertices
+//   and the more accurate one; a broad-phase callback is
 //   a cold query (FCL 0.7's DistanceRequest has no cached guess, and no
 //   per-pair state survives a traversal).
 // - distance_tolerance stays at FCL's default 1e-6 (absolute), as in

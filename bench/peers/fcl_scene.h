@@ -32,8 +32,8 @@
 #include <vector>
 
 #include "peers/fcl_peer.h"
-#include "proxima/polytope.h"
-#include "proxima/types.h"
+#include "proxima/shape/polytope.h"
+#include "proxima/core/types.h"
 
 namespace proxima::bench {
 

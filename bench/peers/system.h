@@ -15,7 +15,7 @@
 #include <span>
 #include <string>
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 
 namespace proxima::bench {
 

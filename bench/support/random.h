@@ -15,7 +15,7 @@
 #include <random>
 #include <vector>
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 
 namespace proxima::bench {
 

@@ -35,11 +35,11 @@
 #include <string_view>
 #include <vector>
 
-#include "proxima/body.h"
-#include "proxima/compound.h"
-#include "proxima/mesh.h"
-#include "proxima/polytope.h"
-#include "proxima/types.h"
+#include "proxima/core/types.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/query/compound_distance.h"
+#include "proxima/query/mesh_distance.h"
+#include "proxima/shape/polytope.h"
 
 namespace proxima {
 
@@ -188,7 +188,7 @@ LoadedCompound load_compound(const std::string& path, const ReadOptions& options
 // hulled; errors name cloud.source and the group.
 LoadedCompound compound_from_cloud(const PointCloud& cloud);
 
-// A file as a triangle mesh (proxima/mesh.h): its vertices and faces as
+// A file as a triangle mesh (proxima/query/mesh_distance.h): its vertices and faces as
 // given, nothing merged or replaced (STL corners are merged by the reader,
 // see PointCloud). Degenerate triangles are kept and counted.
 struct LoadedMesh {

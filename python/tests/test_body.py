@@ -1,6 +1,6 @@
 """Tests of the Python bindings of bodies with a radius and of the primitives.
 
-The C++ tests check the answers (tests/body_test.cpp); these check what the
+The C++ tests check the answers (tests/query/body_test.cpp); these check what the
 binding adds: distance for any two body kinds in any combination (a
 ConvexPolytope against a CompoundBody raised TypeError before), the
 primitives' arguments and errors, the result's fields, and the cache.

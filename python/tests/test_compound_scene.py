@@ -1,7 +1,7 @@
 """Tests of the Python bindings of compound bodies and scenes.
 
-The C++ tests check the algorithms (tests/compound_test.cpp,
-tests/scene_test.cpp); these check what the binding adds: argument
+The C++ tests check the algorithms (tests/query/compound_test.cpp,
+tests/scene/scene_test.cpp); these check what the binding adds: argument
 conversion, ownership across the language boundary, errors, and that each
 fast call agrees with its slow twin as seen from Python.
 """

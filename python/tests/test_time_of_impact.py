@@ -1,7 +1,7 @@
 """Tests of the Python bindings of continuous collision (time_of_impact).
 
 The C++ tests check the guarantee against closed forms and dense sampling
-(tests/time_of_impact_test.cpp); these check what the binding adds: motions
+(tests/motion/time_of_impact_test.cpp); these check what the binding adds: motions
 from Motion objects or (start, end) pose pairs, the result's fields, the
 cache, and errors by name.
 """

@@ -1,6 +1,6 @@
 """proxima.view() and proxima.view_scene() (issue 15, "Look"): the page of
 `proxima view` from Python, written by the same C++ writer. The browser test
-(tests/viewer_browser_test.py) renders the CLI's pages; these check that the
+(tests/viewer/viewer_browser_test.py) renders the CLI's pages; these check that the
 Python pages carry the right data, go where they are asked to, and show
 inline in a notebook (a stand-in IPython kernel here)."""
 

@@ -5,9 +5,9 @@
 // through proxima::io, one distance query. Exits 0 when the answer is the
 // known distance, so the CTest test fails if the installed package builds
 // but links or computes wrongly.
-#include <proxima/distance.h>
+#include <proxima/query/distance.h>
 #include <proxima/io.h>
-#include <proxima/polytope.h>
+#include <proxima/shape/polytope.h>
 
 #include <cmath>
 #include <cstdio>

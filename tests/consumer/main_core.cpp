@@ -4,9 +4,9 @@
 // The consumer of proxima::proxima alone: two bodies from points, one
 // distance query and one batch (TBB inside proxima), built with Eigen as its
 // only dependency. Exits 0 when the answers are the known distance.
-#include <proxima/batch.h>
-#include <proxima/distance.h>
-#include <proxima/polytope.h>
+#include <proxima/query/batch.h>
+#include <proxima/query/distance.h>
+#include <proxima/shape/polytope.h>
 
 #include <cmath>
 #include <cstdio>

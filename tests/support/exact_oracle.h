@@ -35,8 +35,8 @@
 // next method is tried.
 #pragma once
 
-#include "proxima/closest_point.h"
-#include "proxima/types.h"
+#include "proxima/geometry/closest_point.h"
+#include "proxima/core/types.h"
 #include "support/generators.h"
 
 // CGAL's Polytope_distance_d default-constructs a coordinate iterator from

@@ -11,7 +11,7 @@
 // the exact oracle see the same doubles) or pass a Pose.
 #pragma once
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 
 #include <algorithm>
 #include <array>

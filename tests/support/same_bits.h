@@ -10,7 +10,7 @@
 #include <bit>
 #include <cstdint>
 
-#include "proxima/types.h"
+#include "proxima/core/types.h"
 
 namespace proxima::test {
 

@@ -1,0 +1,24 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// narrowphase layer (internal): the paper's hybrid algorithm (sections 4-5, as DESIGN.md reads
+// it). Works in A's frame: B's vertices are mapped by `b_in_a` on demand and
+// support directions are rotated into B's frame, never the vertex arrays.
+#pragma once
+
+#include "proxima/core/types.h"
+#include "proxima/shape/polytope.h"
+
+namespace proxima {
+
+// Result points, normal and features are in A's frame. The status is decided
+// by the caller's contact band `contact_tolerance` (64 u R plus Ae): the
+// hybrid's own answer, cross-checked by Enhanced GJK where it could not
+// certify it, and classified as touching or intersecting within the band
+// (proxima/detail/narrowphase/contact.h; DistanceResult::second_algorithm says when either
+// ran). The same answer as distance(..., Algorithm::hybrid) given the band.
+DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                               const DistanceOptions& options, double contact_tolerance,
+                               DistanceCache& cache);
+
+}  // namespace proxima

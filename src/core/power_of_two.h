@@ -1,0 +1,83 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Power-of-two scaling, one definition for every part that works in units
+// near the bodies' magnitude: the hull build (its heuristics, farthest
+// points and Newell sums, run on scaled copies so that no square
+// overflows; exact decisions use the original doubles), the compound
+// hierarchy's spheres, GJK and the hybrid. Multiplying by a power of two is
+// exact, so the scaled problem has the same answer.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <span>
+
+#include "proxima/core/types.h"
+
+namespace proxima::detail {
+
+// The exponent e with max|x| < 2^e (0 for an all-zero input): frexp's
+// exponent, read from the bits for a normal double (libm's frexp is a call
+// of about 80 instructions; the penetration query asks for two per query).
+inline int magnitude_exponent(double max_abs) {
+  if (max_abs == 0.0) return 0;
+  const auto biased = static_cast<int>((std::bit_cast<std::uint64_t>(max_abs) >> 52) & 0x7ff);
+  if (biased != 0 && biased != 0x7ff) return biased - 1022;  // 2^(b-1023) <= x < 2^(b-1022)
+  int e = 0;
+  std::frexp(max_abs, &e);  // subnormal (inf and NaN: frexp's unspecified e)
+  return e;
+}
+
+// 2^e, exactly (0 or inf where 2^e is out of the doubles' range).
+inline double pow2(int e) {
+  if (e >= -1022 && e <= 1023)
+    return std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52);
+  return std::ldexp(1.0, e);
+}
+
+// p * 2^e per component: exact unless a component underflows. Through the
+// factor 2^e (built from its bits) when it is a normal double: the product
+// by a power of two is the correctly rounded p 2^e, the same as ldexp's,
+// at a multiplication's cost (face_plane calls this per face vertex: ldexp
+// was half of a cold penetration query). Through ldexp otherwise, when
+// |e| > 1022 (inputs near the largest doubles, or subnormal ones).
+inline Vec3 times_pow2(const Vec3& p, int e) {
+  if (e >= -1022 && e <= 1023) {
+    return p * pow2(e);
+  }
+  return {std::ldexp(p.x(), e), std::ldexp(p.y(), e), std::ldexp(p.z(), e)};
+}
+
+inline double max_abs_coordinate(std::span<const Vec3> pts) {
+  double m = 0.0;
+  for (const Vec3& p : pts) m = std::max(m, p.cwiseAbs().maxCoeff());
+  return m;
+}
+
+// The largest exponent e of an inverse unit 2^e. A magnitude in the
+// subnormal range (below 2^-1022) would need up to 2^1074, which overflows
+// to inf (SubnormalInput.AnswersAreFiniteAndWithinTheStandard: NaN from the
+// hybrid, inf from GJK). Capped here, the scaled magnitude is at least
+// 2^-74 (the smallest subnormal is 2^-1074), far from underflow in the
+// algorithms' squares and cubes.
+inline constexpr int kMaxInverseUnitExponent = 1000;
+
+// A unit 2^e near `magnitude` (magnitude < unit <= 2 magnitude) and its
+// exact reciprocal; (1, 1) for a zero or non-finite magnitude.
+struct PowerOfTwoUnit {
+  double unit = 1.0;
+  double inverse = 1.0;
+};
+
+inline PowerOfTwoUnit power_of_two_unit(double magnitude) {
+  if (!std::isfinite(magnitude) || !(magnitude > 0.0))
+    return {};  // NaN never compared: quiet under traps
+  // magnitude = f 2^e, 1/2 <= f < 1
+  const int e = std::max(magnitude_exponent(magnitude), -kMaxInverseUnitExponent);
+  return {pow2(e), pow2(-e)};
+}
+
+}  // namespace proxima::detail

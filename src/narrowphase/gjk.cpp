@@ -1,0 +1,355 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// The GJK baselines: classic GJK (Gilbert, Johnson & Keerthi 1988) and
+// Cameron's Enhanced GJK (1997), both in A's frame.
+//
+// GJK in one paragraph. The distance between hulls A and B is the distance
+// from the origin to their Minkowski difference C = A - B, whose vertices are
+// differences a_i - b_j of hull vertices. GJK keeps a simplex Y of at most
+// four points of C and the closest point v of conv(Y) to the origin. The
+// support point w = argmin over C of v.x = s_A(-v) - s_B(v) then gives:
+//   - a certified lower bound: every x in C has v.x >= v.w, hence
+//     |x| >= v.w / |v| (the support plane through w separates the origin
+//     from C by that much);
+//   - an upper bound |v| (v is a point of C).
+// If w does not close the gap, Y + w is solved for its closest point, which
+// keeps the smallest sub-simplex realizing it; |v| strictly decreases, and as
+// C has finitely many vertices the loop ends. Stopping rules (van den
+// Bergen 1999): the gap |v| - v.w/|v| is within the relative tolerance (the
+// same Re d test as the hybrid's eq. 19, so both stop at the same certified
+// gap) plus rounding, w's vertex pair is already in Y, |v| did not decrease
+// (rounding has taken over), |v| is in the contact band, or the cap.
+//
+// Each simplex point carries its vertex pair (i in A, j in B), so the closest
+// points are sum(lambda_k a_ik) and sum(lambda_k b_jk) with the barycentric
+// weights lambda of v; the ids and those points give the witness features
+// (witness_features.h, the rule the hybrid uses too).
+//
+// Enhanced GJK differs in two places only: the support points come from hill
+// climbing over the vertex adjacency, starting from the previous answers
+// (near constant time under coherence), and the first simplex is the last
+// query's final simplex, re-evaluated at the current pose. Any four points of
+// C are a valid start for GJK (only the first closest point changes), so a
+// stale or foreign cache can only cost iterations.
+//
+// Units. All simplex arithmetic runs on coordinates divided by a power of two
+// near the bodies' magnitude: exact, and it keeps the cubic terms (face
+// normals dotted with points) away from overflow and underflow whatever the
+// scale.#include "proxima/detail/narrowphase/gjk.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "narrowphase/gjk_contact.h"
+#include "narrowphase/gjk_frame.h"
+#include "narrowphase/simplex_solver.h"
+#include "narrowphase/witness_features.h"
+
+namespace proxima {
+namespace {
+
+using detail::BruteForceSupport;
+using detail::GjkFrame;
+using detail::HillClimbSupport;
+using detail::idx;
+using detail::Points;
+using detail::Simplex;
+using detail::SupportPoint;
+
+// Rounding slack of the termination test, in units of u * max|w| (the
+// largest simplex point seen, in scaled units): v.w and |v| are sums of
+// products of coordinates of that size and v itself is rebuilt from the
+// simplex points, so the computed gap |v| - v.w/|v| carries an error of a few
+// u max|w|. Below this slack more iterations cannot improve v. Well inside
+// the 64 u R contact band of the accuracy standard (|w| <= 2 sqrt(3) R).
+constexpr double kGapUlps = 16.0;
+
+// ---------------------------------------------------------------------------
+// The loop shared by both variants.
+// ---------------------------------------------------------------------------
+
+// `simplex` is solved on entry (at least one point); `iterations` counts the
+// support evaluations made so far; `direction` is the search direction used
+// so far (from A towards B), the normal reported when no better one exists.
+// `deep` receives the contact classification's tetrahedron around the origin
+// when it certifies intersection (classify_contact). `cached_face_a` and
+// `cached_face_b` are a previous answer's witness faces (-1 for none).
+// `witnesses` false leaves the features default (vertex -1): for a caller
+// that keeps only the status, iterations and simplex (the contact unit).
+template <class Support>
+DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
+                       double contact_tolerance, Simplex& simplex, int iterations, Vec3 direction,
+                       Support& support, Points& deep, std::int32_t cached_face_a = -1,
+                       std::int32_t cached_face_b = -1, bool witnesses = true) {
+  const double tol = contact_tolerance * frame.inv_unit;
+  double lower = 0.0;  // certified lower bound, scaled units
+  double w_max2 = 0.0;
+  for (int k = 0; k < simplex.size; ++k)
+    w_max2 = std::max(w_max2, simplex.p[idx(k)].w.squaredNorm());
+  direction = direction.squaredNorm() > 0.0 ? Vec3(direction.normalized()) : Vec3(Vec3::UnitX());
+
+  bool contact = false;
+  bool capped = false;
+  // The gap test passed, or the support point was already in the simplex
+  // (v is then optimal up to rounding): |v| is the distance.
+  bool certified = false;
+  std::array<SupportPoint, 3> stall_plane;  // a triangle through v and the new point, if stalled
+  bool stalled = false;
+  for (;;) {
+    if (simplex.encloses_origin || simplex.vv <= tol * tol) {
+      contact = true;
+      break;
+    }
+    if (iterations >= options.max_iterations) {
+      capped = true;
+      break;
+    }
+    const double v_norm = std::sqrt(simplex.vv);  // > 0: vv > tol^2 >= 0
+    direction = -simplex.v / v_norm;
+    const SupportPoint w = support(-simplex.v);
+    ++iterations;
+    w_max2 = std::max(w_max2, w.w.squaredNorm());
+    lower = std::max(lower, simplex.v.dot(w.w) / v_norm);
+    if (v_norm - lower <=
+        options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
+      certified = true;
+      break;
+    }
+    if (simplex.contains(w.ia, w.ib)) {  // nothing new: v is exact for this simplex
+      certified = true;
+      break;
+    }
+    Simplex next = simplex;
+    next.p[idx(next.size++)] = w;
+    detail::solve(next);
+    if (!next.encloses_origin && next.vv >= simplex.vv) {  // rounding has taken over: keep v
+      if (next.size == 3) {
+        stall_plane = {next.p[0], next.p[1], next.p[2]};
+        stalled = true;
+      } else if (simplex.size == 2) {
+        stall_plane = {simplex.p[0], simplex.p[1], w};
+        stalled = true;
+      } else if (simplex.size == 3) {
+        stall_plane = {simplex.p[0], simplex.p[1], simplex.p[2]};
+        stalled = true;
+      }
+      break;
+    }
+    simplex = next;
+  }
+
+  // Stalled: the loop left because |v| did not decrease at this precision
+  // while the support point beyond v was new, so |v| may be far above the
+  // distance, and its lower bound from v's direction may be 0. On a flat
+  // Minkowski difference (two nearly parallel needles or slivers in contact)
+  // the support point beyond v improves |v| only at second order, below
+  // rounding, and GJK stopped with |v| many bands above a distance of 0 and
+  // called the pair separated (GjkTouching.NeedlesSideBySideTouch). The
+  // plane through v's simplex and that support point is then nearly C's
+  // closest face (for a vertex just above a face, exactly it), and its
+  // normal gives one more lower bound (one support). Separated is reported
+  // only when a lower bound certifies it (above the band); otherwise the
+  // pair is in contact as far as GJK can tell, and touching is reported
+  // with GJK's distance as the upper bound it is.
+  if (!contact && !capped && !certified && stalled && iterations < options.max_iterations) {
+    Vec3 n = detail::face_normal(stall_plane[1].w - stall_plane[0].w,
+                                 stall_plane[2].w - stall_plane[0].w)
+                 .n;
+    if (n.dot(simplex.v) < 0.0) n = -n;
+    const double n_norm = n.norm();
+    if (n_norm > 0.0) {
+      const SupportPoint w = support(-n);
+      ++iterations;
+      lower = std::max(lower, n.dot(w.w) / n_norm);
+    }
+  }
+  const bool separation_certified = certified || lower > tol;
+
+  Status status = Status::separated;
+  if (contact) {
+    status =
+        detail::classify_contact(simplex, tol, support, iterations, options.max_iterations, deep);
+    // A touching contact whose tetrahedron encloses the origin (by rounding,
+    // or within the band): the origin is within tol of a face of it (else
+    // the classification would have certified depth), so that face's
+    // closest points are the witnesses. Its barycentric weights of the
+    // origin would only give rounding noise from a sliver tetrahedron.
+    if (status == Status::touching && simplex.encloses_origin)
+      detail::apply(simplex, detail::nearest_face(simplex.p));
+  }
+
+  // Closest points from the original coordinates (the weights are
+  // unit-free): sums of hull points with weights summing to one. B's is
+  // formed in B's frame and mapped once (the pose is affine).
+  Vec3 point_a = Vec3::Zero();
+  Vec3 local_b = Vec3::Zero();
+  std::array<std::int32_t, 4> ids_a{};
+  std::array<std::int32_t, 4> ids_b{};
+  for (int k = 0; k < simplex.size; ++k) {
+    const SupportPoint& sp = simplex.p[idx(k)];
+    point_a += simplex.lambda[idx(k)] * frame.a.vertex(sp.ia);
+    local_b += simplex.lambda[idx(k)] * frame.b.vertex(sp.ib);
+    ids_a[idx(k)] = sp.ia;
+    ids_b[idx(k)] = sp.ib;
+  }
+  const Vec3 point_b = frame.b_in_a.apply(local_b);
+
+  DistanceResult result;
+  result.iterations = iterations;
+  if (status == Status::intersecting) {
+    // A tetrahedron around the origin gives one point in both hulls
+    // (sum lambda a = sum lambda b); otherwise the two are within tol.
+    const Vec3 contact_point = 0.5 * (point_a + point_b);
+    result.point_a = contact_point;
+    result.point_b = contact_point;
+    result.distance = 0.0;
+    result.lower_bound = 0.0;
+    result.normal = direction;
+  } else {
+    result.point_a = point_a;
+    result.point_b = point_b;
+    result.distance = ((point_b - point_a) * frame.inv_unit).norm() * frame.unit;
+    result.lower_bound = std::clamp(lower * frame.unit, 0.0, result.distance);
+    if (!contact) {
+      status = result.distance > contact_tolerance && separation_certified ? Status::separated
+                                                                           : Status::touching;
+    }
+    if (capped) status = Status::iteration_cap;
+    // Within the band the points' difference is rounding noise: keep the
+    // last search direction there.
+    result.normal = (!contact && status != Status::touching && result.distance > 0.0)
+                        ? Vec3((point_b - point_a) / result.distance)
+                        : direction;
+  }
+  result.status = status;
+  if (!witnesses) return result;
+  // The witness features by the rule all algorithms share
+  // (witness_features.h), A's in A's frame, B's in B's.
+  const double witness_band = detail::witness_band(frame.magnitude);
+  const std::span ids_a_used(ids_a.data(), idx(simplex.size));
+  const std::span ids_b_used(ids_b.data(), idx(simplex.size));
+  const bool locate = status != Status::intersecting;  // witness_features.h
+  result.feature_a = detail::witness_feature(
+      frame.a, ids_a_used, witness_band, cached_face_a,
+      [&] {
+        return detail::WitnessPoint{point_a, result.normal};
+      },
+      locate);
+  result.feature_b = detail::witness_feature(
+      frame.b, ids_b_used, witness_band, cached_face_b,
+      [&] {
+        return detail::WitnessPoint{local_b, frame.dir_in_b(-result.normal)};
+      },
+      locate);
+  return result;
+}
+
+// The first simplex of a cold query: the support point in the direction from
+// A's centroid towards B's, i.e. the point of C least far along the
+// centroids' difference (a point of C near the closest one when the bodies
+// are apart).
+//
+// The direction is taken in the unit's scale: the supports dot it with the
+// vertices, and at coordinates from 1e155 on the raw difference of
+// centroids times a vertex overflowed to inf and -inf, whose sum is NaN
+// (DistanceRegression.ScalesFrom1eMinus300To1e300).
+template <class Support>
+Simplex cold_start(const GjkFrame& frame, Support& support, Vec3& direction) {
+  direction = (frame.b_in_a.apply(frame.b.centroid()) - frame.a.centroid()) * frame.inv_unit;
+  if (!(direction.squaredNorm() > 0.0)) direction = Vec3::UnitX();
+  Simplex s;
+  s.p[0] = support(direction);
+  s.size = 1;
+  detail::solve(s);
+  return s;
+}
+
+}  // namespace
+
+DistanceResult gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                            const DistanceOptions& options, double contact_tolerance) {
+  const GjkFrame frame(a, b, b_in_a);
+  BruteForceSupport support{frame};
+  Vec3 direction;
+  Simplex simplex = cold_start(frame, support, direction);
+  Points deep;
+  return run_gjk(frame, options, contact_tolerance, simplex, 1, direction, support, deep);
+}
+
+namespace {
+
+DistanceResult run_enhanced_gjk(const ConvexPolytope& a, const ConvexPolytope& b,
+                                const Pose& b_in_a, const DistanceOptions& options,
+                                double contact_tolerance, DistanceCache& cache, bool witnesses) {
+  const GjkFrame frame(a, b, b_in_a);
+  const auto valid = [](std::int32_t id, int count) { return id >= 0 && id < count; };
+  HillClimbSupport support{frame, valid(cache.hint_a, a.vertex_count()) ? cache.hint_a : 0,
+                           valid(cache.hint_b, b.vertex_count()) ? cache.hint_b : 0};
+
+  // Warm start: the cached vertex pairs, re-evaluated at the current pose.
+  // Ids out of range are dropped, repeated pairs kept once.
+  Simplex simplex;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const std::int32_t ia = cache.vertices_a[k];
+    const std::int32_t ib = cache.vertices_b[k];
+    if (valid(ia, a.vertex_count()) && valid(ib, b.vertex_count()) && !simplex.contains(ia, ib)) {
+      simplex.p[idx(simplex.size++)] = frame.point(ia, ib);
+    }
+  }
+  int iterations = 0;
+  Vec3 direction;
+  if (simplex.size == 0) {
+    simplex = cold_start(frame, support, direction);
+    iterations = 1;
+  } else {
+    detail::solve(simplex);
+    direction = -simplex.v;
+    if (!(direction.squaredNorm() > 0.0))
+      direction = (frame.b_in_a.apply(b.centroid()) - a.centroid()) * frame.inv_unit;
+  }
+
+  Points deep;
+  const DistanceResult result =
+      run_gjk(frame, options, contact_tolerance, simplex, iterations, direction, support, deep,
+              cache.face_a, cache.face_b, witnesses);
+  // run_gjk reduced `simplex` in place to the final one. An intersection
+  // certified by a tetrahedron around the origin caches that tetrahedron
+  // instead: while the bodies overlap by more than the band, the next query
+  // starts from it enclosing the origin and certifies it again without a
+  // support search.
+  if (result.status == Status::intersecting && deep[0].ia >= 0) {
+    simplex.p = deep;
+    simplex.size = 4;
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    const bool used = static_cast<int>(k) < simplex.size;
+    cache.vertices_a[k] = used ? simplex.p[k].ia : -1;
+    cache.vertices_b[k] = used ? simplex.p[k].ib : -1;
+  }
+  cache.hint_a = support.hint_a;
+  cache.hint_b = support.hint_b;
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
+  return result;
+}
+
+}  // namespace
+
+DistanceResult enhanced_gjk_distance(const ConvexPolytope& a, const ConvexPolytope& b,
+                                     const Pose& b_in_a, const DistanceOptions& options,
+                                     double contact_tolerance, DistanceCache& cache) {
+  return run_enhanced_gjk(a, b, b_in_a, options, contact_tolerance, cache, true);
+}
+
+DistanceResult detail::enhanced_gjk_contact(const ConvexPolytope& a, const ConvexPolytope& b,
+                                            const Pose& b_in_a, const DistanceOptions& options,
+                                            double contact_tolerance, DistanceCache& cache) {
+  return run_enhanced_gjk(a, b, b_in_a, options, contact_tolerance, cache, false);
+}
+
+}  // namespace proxima

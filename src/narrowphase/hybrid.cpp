@@ -1,0 +1,611 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// The paper's hybrid algorithm (sections 4-5), as DESIGN.md reads it.
+//
+// State: a feature pair (FA, FB), each one to three hull vertices. The local
+// method gives the closest points XA in conv(FA) and XB in conv(FB) in closed
+// form, with barycentric coefficients; vertices whose coefficient is zero are
+// dropped, so the pair is always the minimal one realizing d = |XB - XA|.
+//
+// With w = XB - XA, the support points a* = argmax_A w.x and
+// b* = argmin_B w.y bound the distance from below:
+//     lower = (w.b* - w.a*) / |w|   (the slab between the two support planes)
+// and d is an upper bound. We stop when d - lower <= Re d (+ rounding), when
+// d falls in the contact band, or when no support point can improve the pair
+// any more (the answer is at machine precision).
+//
+// Otherwise one body is updated at a time: its support point joins its
+// feature, the local distance is recomputed and the pair reduced. Moving XA
+// towards a* decreases |w| at first order whenever w.(a* - XA) > 0, so an
+// accepted update strictly decreases d; a pair is never visited twice (the
+// paper's recycling) because d only decreases, and a hard cap bounds the loop.
+//
+// Everything happens in A's frame: B's vertices are mapped on demand, the
+// direction is rotated into B's frame for B's support search.
+#include "proxima/detail/narrowphase/hybrid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <span>
+
+#include "core/power_of_two.h"
+#include "narrowphase/witness_features.h"
+#include "proxima/detail/narrowphase/contact.h"
+#include "proxima/geometry/closest_point.h"
+#include "proxima/shape/support.h"
+
+namespace proxima {
+namespace {
+
+// Rounding slack of the termination test, in units of u * R: the support
+// values w.a* and w.b* each carry an error of a few u |w| R, so the computed
+// gap d - lower cannot be resolved below this. Well inside the 64 u R of the
+// accuracy standard.
+constexpr double kGapUlps = 16.0;
+
+// Range of R (the largest coordinate magnitude in A's frame) in which the
+// algorithm runs on the given coordinates. Squared lengths overflow from
+// R ~ 1e154 on (inf - inf: NaN) and underflow to subnormals or 0 from
+// R ~ 1e-154 down (answers off by 1e-5, then distances of 0); the kernels'
+// length^4 and length^6 terms are only valid for extents within 1e-75 ..
+// 1e75 (closest_point.h). Outside this range every coordinate is
+// multiplied by the power of two that brings R into [1/2, 1): exact, so the
+// answer is the same one the unscaled algorithm would give in exact range.
+// 2^+-64 leaves a wide margin both ways and sends the paper's stress cases
+// (cubes at 1e39, tetrahedra of 1e-23) and the accuracy suite's 1e-20 ..
+// 1e20 scales through the scaled path too, where the tests compare them
+// with the oracle. DistanceRegression.ScalesFrom1eMinus300To1e300 pins it.
+constexpr double kMinUnscaled = 0x1p-64;
+constexpr double kMaxUnscaled = 0x1p64;
+
+// A cache whose pose is further than this share of the bodies' size from
+// the query's is taken for stale (see moved_far).
+constexpr double kStaleMotion = 0.5;
+
+// Bodies of at most this many vertices are scanned (support_brute_force)
+// in the loop of a query that started cold, whose hints are the supports
+// along the line of centres: no better than a scan's start, and the climb's
+// walk ends at a different step every time, a mispredicted branch per
+// search (cold queries on random poses, 2000 poses, median of 7: 8
+// vertices 240 -> 213 ns and 16 vertices 330 -> 287 with the cold start's
+// scan, where climbing in the loop took 225 and 309; at 32 scanning in the
+// loop took 390 against 380 climbing). A tracked query's hint is its answer
+// or next to it: it climbs.
+constexpr int kColdLoopScanVertices = 16;
+
+// A support search of the loop: the scan or the climb (above). The scan is
+// out of line: inlined here it cost the tracked query instructions, and a
+// cold query at 8 vertices 35% more time (its compare became a branch).
+[[gnu::always_inline]] inline int support_point(const ConvexPolytope& p, const Vec3& dir, int hint,
+                                                bool scan) {
+  if (scan) [[unlikely]]
+    return support_brute_force(p.vertices(), dir);
+  return support_hill_climb(p, dir, hint);
+}
+
+// -(R^T w): the direction of B's support search in B's frame. Entry j is
+// column j of R (contiguous) dotted with w, rounded as Eigen rounds
+// -(R^T w), (c0 w0 + c1 w1) + c2 w2, then negated (exact): the same bits
+// (2e6 random rotations and directions compared). Eigen's transposed
+// product took about 35 instructions, twice a tracked query; this one
+// saves about 13 per tracked query (callgrind, bench/tracked_instructions).
+[[gnu::always_inline]] inline Vec3 minus_transpose_times(const Mat3& r, const Vec3& w) {
+  const double* c = r.data();  // column-major: column j at c + 3 j
+  const auto dot = [&](const double* col) {
+    return -((col[0] * w[0] + col[1] * w[1]) + col[2] * w[2]);
+  };
+  return Vec3(dot(c), dot(c + 3), dot(c + 6));
+}
+
+// A feature of one body: up to three hull vertex ids (a fourth slot for the
+// support point being added), with their positions in A's frame. The slots
+// from n on hold -1, so that the cache takes the ids as they are.
+struct FeatureSet {
+  std::array<std::int32_t, 4> id = {-1, -1, -1, -1};
+  std::array<Vec3, 4> p;
+  int n = 0;
+
+  void clear() {
+    id = {-1, -1, -1, -1};
+    n = 0;
+  }
+  bool contains(std::int32_t v) const {
+    for (int i = 0; i < n; ++i) {
+      if (id[static_cast<std::size_t>(i)] == v) return true;
+    }
+    return false;
+  }
+  void push(std::int32_t v, const Vec3& x) {
+    id[static_cast<std::size_t>(n)] = v;
+    p[static_cast<std::size_t>(n)] = x;
+    ++n;
+  }
+  // Undoes the last push.
+  void pop() {
+    --n;
+    id[static_cast<std::size_t>(n)] = -1;
+  }
+  // Keeps the vertices whose bit is set in `active`, in order.
+  void reduce(std::uint8_t active) {
+    if (active == (1u << n) - 1u) return;  // all kept: the tracked case
+    int k = 0;
+    for (int i = 0; i < n; ++i) {
+      if (active & (1u << i)) {
+        id[static_cast<std::size_t>(k)] = id[static_cast<std::size_t>(i)];
+        p[static_cast<std::size_t>(k)] = p[static_cast<std::size_t>(i)];
+        ++k;
+      }
+    }
+    for (int i = k; i < n; ++i) id[static_cast<std::size_t>(i)] = -1;
+    n = k;
+  }
+};
+
+// The local method's answer: the kernel's own result, used in place (the
+// tracked query's one kernel call is not copied into another struct).
+using Local = ClosestPoints<double>;
+
+// Barycentric coordinates of x in the tetrahedron t when x lies inside it
+// (signed volumes of the sub-tetrahedra over the whole), nothing otherwise or
+// when the tetrahedron is flat.
+std::optional<std::array<double, 4>> tetrahedron_coordinates(const std::array<Vec3, 4>& t,
+                                                             const Vec3& x) {
+  const auto volume = [](const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3) {
+    return (p1 - p0).cross(p2 - p0).dot(p3 - p0);
+  };
+  const double whole = volume(t[0], t[1], t[2], t[3]);
+  if (whole == 0.0) return std::nullopt;
+  std::array<double, 4> c = {volume(x, t[1], t[2], t[3]), volume(t[0], x, t[2], t[3]),
+                             volume(t[0], t[1], x, t[3]), volume(t[0], t[1], t[2], x)};
+  for (double& ci : c) {
+    if (ci * whole < 0.0) return std::nullopt;
+    ci /= whole;
+  }
+  return c;
+}
+
+// Closest points of conv(fa) and conv(fb) when one of them has four vertices.
+// A fourth vertex only appears on the side that just received its
+// support point (index 3): the feature is then a tetrahedron whose closest
+// point to the other feature lies on one of the three triangles through the
+// new vertex (the old triangle was the previous answer, which the new vertex
+// improves on), so the minimum over those three is the answer.
+[[gnu::noinline]] Local tetrahedron_distance(const FeatureSet& fa, const FeatureSet& fb,
+                                             const KernelTolerance<double>& tol) {
+  const bool on_a = fa.n == 4;
+  const FeatureSet& four = on_a ? fa : fb;
+  const FeatureSet& other = on_a ? fb : fa;
+  // The other feature may lie inside the tetrahedron (the bodies overlap):
+  // then no triangle is closest and the distance is 0. It suffices to test
+  // one of its vertices: if the feature crosses the boundary instead, a
+  // triangle below finds the crossing at distance 0.
+  if (const auto inside = tetrahedron_coordinates(four.p, other.p[0])) {
+    Local hit;
+    hit.distance_squared = 0.0;
+    hit.point_a = other.p[0];
+    hit.point_b = other.p[0];
+    std::uint8_t tet_bits = 0;
+    for (int i = 0; i < 4; ++i) {
+      if ((*inside)[static_cast<std::size_t>(i)] != 0.0)
+        tet_bits = static_cast<std::uint8_t>(tet_bits | (1u << i));
+    }
+    hit.active_a = on_a ? tet_bits : std::uint8_t{1};
+    hit.active_b = on_a ? std::uint8_t{1} : tet_bits;
+    return hit;
+  }
+  static constexpr std::array<std::array<int, 3>, 3> kTriangles = {
+      {{0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
+  Local best{};
+  bool have = false;
+  for (const auto& tri : kTriangles) {
+    const std::array<Vec3, 3> pts = {four.p[static_cast<std::size_t>(tri[0])],
+                                     four.p[static_cast<std::size_t>(tri[1])],
+                                     four.p[static_cast<std::size_t>(tri[2])]};
+    const ClosestPoints<double> c =
+        on_a ? closest_points<double>(pts.data(), 3, other.p.data(), other.n, tol)
+             : closest_points<double>(other.p.data(), other.n, pts.data(), 3, tol);
+    if (have && c.distance_squared >= best.distance_squared) continue;
+    const std::uint8_t tri_bits = on_a ? c.active_a : c.active_b;
+    std::uint8_t mapped = 0;
+    for (int i = 0; i < 3; ++i) {
+      if (tri_bits & (1u << i))
+        mapped = static_cast<std::uint8_t>(mapped | (1u << tri[static_cast<std::size_t>(i)]));
+    }
+    best = c;
+    if (on_a) {
+      best.active_a = mapped;
+    } else {
+      best.active_b = mapped;
+    }
+    have = true;
+  }
+  return best;
+}
+
+// Closest points of conv(fa) and conv(fb). Sizes 1..3 (every query's first
+// call, and all of a tracked one) go straight to the closed-form kernels,
+// whose result is the answer.
+inline Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
+                            const KernelTolerance<double>& tol) {
+  if (fa.n <= 3 && fb.n <= 3) [[likely]]
+    return closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol);
+  return tetrahedron_distance(fa, fb, tol);
+}
+
+// 0 <= id < count, in one comparison (count >= 0).
+bool valid_id(std::int32_t id, int count) {
+  return static_cast<std::uint32_t>(id) < static_cast<std::uint32_t>(count);
+}
+
+// Unit direction from A towards B, as accurate as the features allow. The
+// difference XB - XA of two computed points carries an absolute error of a
+// few u R, so for nearly touching bodies (d << R) its direction is off by
+// u R / d: enough to pick wrong support points on a needle or a sliver. A
+// face normal or the cross product of two edges is accurate to a few u
+// whatever d is, so those are used where the pair is vertex-face or
+// edge-edge; XB - XA where it is exact (vertex-vertex).
+//
+// What matters for the support search is the error of the direction along
+// the bodies' long dimensions: tilted by e, a direction moves the support
+// value of a vertex a length L away by e L, and on a needle of thickness h
+// the wrong end of the needle wins once e L > h. Two such errors are removed
+// by projection, which is exact in theory (the true direction is orthogonal
+// to the edge or to the face's edges):
+//  * vertex-edge: XB - XA is orthogonal to the edge; its rounding is not.
+//    Removing its component along the edge leaves an error across the edge
+//    only, which a support value sees times the body's thickness.
+//  * vertex-face: the cross product of a sliver's edges is off by u / sin
+//    (sin: the face's smallest angle) in a direction that tilts it along the
+//    face; its component along the longest edge is removed, as in
+//    crossing_candidate (closest_point.h).
+// (DistanceRegression.PointOnTheSurfaceOfANeedle: a point on an edge of a
+// needle 1.6 long and 1e-9 thick stopped on the needle's inner diagonal at
+// 1.7e-9 with lower bound 0, the direction's 3e-7 tilt along the axis
+// making the diagonal's own ends the support points.)
+Vec3 across(const Vec3& x, const Vec3& edge) {
+  const double ee = edge.squaredNorm();
+  return ee > 0.0 ? Vec3(x - (x.dot(edge) / ee) * edge) : x;
+}
+
+// The normal of triangle t (unnormalized, either orientation), without its
+// rounding component along the longest edge (see search_direction).
+Vec3 face_direction(const std::array<Vec3, 4>& t) {
+  const Vec3 e0 = t[1] - t[0];
+  const Vec3 e1 = t[2] - t[0];
+  const Vec3 e2 = t[2] - t[1];
+  const double l0 = e0.squaredNorm();
+  const double l1 = e1.squaredNorm();
+  const double l2 = e2.squaredNorm();
+  const Vec3& longest = l0 >= l1 ? (l0 >= l2 ? e0 : e2) : (l1 >= l2 ? e1 : e2);
+  return across(e0.cross(e1), longest);
+}
+
+[[gnu::always_inline]] inline Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb,
+                                                    const Vec3& w, double d) {
+  Vec3 n;
+  if (fa.n == 1 && fb.n == 3) {
+    n = face_direction(fb.p);
+  } else if (fa.n == 3 && fb.n == 1) {
+    n = face_direction(fa.p);
+  } else if (fa.n == 2 && fb.n == 2) {
+    n = (fa.p[1] - fa.p[0]).cross(fb.p[1] - fb.p[0]);
+  } else if (fa.n + fb.n == 3) {
+    // Vertex-edge: the edge has length above the kernel's tolerance.
+    n = across(w, fa.n == 2 ? Vec3(fa.p[1] - fa.p[0]) : Vec3(fb.p[1] - fb.p[0]));
+  } else {
+    return w / d;
+  }
+  const double along = n.dot(w);
+  const double length = n.norm();
+  // Parallel edges (or a face seen edge-on): no better direction than w.
+  if (!(length > 0.0) || along == 0.0) return w / d;
+  return (along > 0.0 ? 1.0 : -1.0) / length * n;
+}
+
+// Loads a cached feature (ids range-checked, duplicates dropped). Returns
+// false when nothing usable is cached. Written out for the three slots: a
+// later id repeats an earlier one only if that one was valid and loaded.
+template <class MapPoint>
+bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f,
+                  MapPoint map_point) {
+  const std::int32_t v0 = cached[0];
+  const std::int32_t v1 = cached[1];
+  const std::int32_t v2 = cached[2];
+  int n = 0;
+  if (valid_id(v0, count)) {
+    f.id[0] = v0;
+    f.p[0] = map_point(v0);
+    n = 1;
+  }
+  if (valid_id(v1, count) && v1 != v0) {
+    f.id[static_cast<std::size_t>(n)] = v1;
+    f.p[static_cast<std::size_t>(n)] = map_point(v1);
+    ++n;
+  }
+  if (valid_id(v2, count) && v2 != v0 && v2 != v1) {
+    f.id[static_cast<std::size_t>(n)] = v2;
+    f.p[static_cast<std::size_t>(n)] = map_point(v2);
+    ++n;
+  }
+  f.n = n;
+  return n > 0;
+}
+
+// The cache's copy of a final feature: its first three ids, -1 where unused
+// (FeatureSet keeps unused slots at -1).
+void store_feature(const FeatureSet& f, std::array<std::int32_t, 4>& out) {
+  out = {f.id[0], f.id[1], f.id[2], -1};
+}
+
+// How far, in witness bands, the closest point x on a two-vertex feature
+// must be from both of its vertices in A's frame for rule 1 of the witness
+// rule (witness_features.h) to keep both in the hull's own frame too. There
+// the point is R^T (x - t) and the vertices y exact, while here they are
+// R y + t: the two distances differ by the rounding of both maps (about
+// 10 u R each) and by R's departure from orthonormality, |(I - R^T R) y|:
+// R = R_a^T R_b, two rotations within kOrthonormalUlps u of orthonormal
+// (pose.h) and a rounded product, so R^T R - I has entries below about
+// 70 u and that term stays below about 210 u R (R >= |y|, the algorithm's
+// bound). Against a band of 16 u R (witness_band), 64 bands (1024 u R)
+// leave all of it far behind, so the decision is the one the hull's frame
+// would make; nearer points take the general path, which makes it there.
+constexpr double kWitnessFarBands = 64.0;
+
+// Whether x is farther than `far` from both vertices of f (two of them),
+// at magnitudes where squaring does not underflow or overflow (the range in
+// which witness_feature's edge case runs).
+bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& x,
+                        double far) {
+  const double far2 = far * far;
+  return poly.scale() > 0x1p-300 && poly.scale() < 0x1p300 && (f.p[0] - x).squaredNorm() > far2 &&
+         (f.p[1] - x).squaredNorm() > far2;
+}
+
+// Whether B moved so far relative to A since the cache's query that its
+// feature pair says nothing any more (a planner sampling unrelated
+// configurations with one cache per pair): a bound on how far any point of
+// B moved, |t - t'| + ||R - R'||_F max|y|, beyond a share of the bodies'
+// size. Such a warm start would cost more than a cold one
+// (bench/distance_bench WarmRandom: 7.7 iterations against 1.2, 2.7 times
+// the cold query's instructions at N = 4096), so the cold start is taken.
+// A cache without a pose (rotation zero: cold, or filled by GJK) moved
+// far. About 50 instructions on every query (callgrind,
+// bench/tracked_instructions); a heuristic for speed only: any start ends
+// in the same certified answer.
+[[gnu::always_inline]] inline bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b,
+                                             const Pose& b_in_a, const DistanceCache& cache) {
+  const double turn2 = (b_in_a.rotation - cache.rotation).squaredNorm();
+  const double shift = (b_in_a.translation - cache.translation).norm();
+  const double size = a.bounding_radius() + b.bounding_radius();
+  const double reach = std::sqrt(3.0) * b.scale();  // >= max |y| over B
+  // A quiet comparison: a garbage cache may hold NaN (moved far, then).
+  return !std::islessequal(shift + std::sqrt(turn2) * reach, kStaleMotion * size);
+}
+
+// The algorithm on coordinates multiplied by `scale`, a power of two, when
+// kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
+// in the caller's units, like the result returned. The unscaled instance is
+// the hot path and multiplies by nothing.
+template <bool kScaled>
+[[gnu::always_inline]] inline DistanceResult run_hybrid(const ConvexPolytope& a,
+                                                        const ConvexPolytope& b, const Pose& b_in_a,
+                                                        const DistanceOptions& options, double band,
+                                                        DistanceCache& cache, double magnitude,
+                                                        double scale) {
+  const double contact_tolerance = kScaled ? band * scale : band;
+  const double r_local = kScaled ? magnitude * scale : magnitude;
+  const Mat3& rot = b_in_a.rotation;
+  const Vec3& tr = b_in_a.translation;
+  const auto b_point = [&](std::int32_t v) -> Vec3 {
+    if constexpr (kScaled) {
+      return (rot * b.vertex(v) + tr) * scale;
+    } else {
+      return rot * b.vertex(v) + tr;
+    }
+  };
+  const auto a_point = [&](std::int32_t v) -> Vec3 {
+    if constexpr (kScaled) {
+      return a.vertex(v) * scale;
+    } else {
+      return a.vertex(v);
+    }
+  };
+  const double ulp_r = kUnitRoundoff * r_local;
+  // Features shorter or flatter than a few u R are reduced (closest_point.h).
+  const KernelTolerance<double> tol = kernel_tolerance(r_local);
+
+  const int count_a = a.vertex_count();
+  const int count_b = b.vertex_count();
+  std::int32_t hint_a = valid_id(cache.hint_a, count_a) ? cache.hint_a : 0;
+  std::int32_t hint_b = valid_id(cache.hint_b, count_b) ? cache.hint_b : 0;
+
+  FeatureSet fa;
+  FeatureSet fb;
+  // A warm start from the cached pair, unless B moved far since (then the
+  // pair says nothing: moved_far). A cold cache fails the first load and
+  // skips the test of its pose (46 instructions a cold query, callgrind).
+  const bool warm = load_feature(cache.vertices_a, count_a, fa, a_point) &&
+                    load_feature(cache.vertices_b, count_b, fb, b_point) &&
+                    !moved_far(a, b, b_in_a, cache);
+  if (!warm) {
+    // Moved far: exactly the cold query (the stale hints are not used).
+    // Cold start: the support points along the line of centres.
+    // In scaled units too: its dot products with vertices must not overflow.
+    Vec3 towards_b = rot * b.centroid() + tr - a.centroid();
+    if constexpr (kScaled) towards_b *= scale;
+    const Vec3 dir = towards_b.squaredNorm() > 0.0 ? towards_b : Vec3::UnitX();
+    hint_a = support_without_hint(a, dir);
+    hint_b = support_without_hint(b, minus_transpose_times(rot, dir));
+    fa.clear();
+    fb.clear();
+    fa.push(hint_a, a_point(hint_a));
+    fb.push(hint_b, b_point(hint_b));
+  }
+
+  // After a cold start small bodies are scanned (kColdLoopScanVertices).
+  const bool scan_a = !warm && count_a <= kColdLoopScanVertices;
+  const bool scan_b = !warm && count_b <= kColdLoopScanVertices;
+  Local loc = local_distance(fa, fb, tol);
+  fa.reduce(loc.active_a);
+  fb.reduce(loc.active_b);
+
+  DistanceResult result;
+  double lower = 0.0;
+  Vec3 last_direction = Vec3::UnitX();
+  int iterations = 0;
+  bool contact = false;
+  for (;;) {
+    const double d = std::sqrt(loc.distance_squared);
+    if (d <= contact_tolerance) {
+      contact = true;
+      break;
+    }
+    const Vec3 w =
+        search_direction(fa, fb, loc.point_b - loc.point_a, d);  // unit, from A towards B
+    last_direction = w;
+    hint_a = support_point(a, w, hint_a, scan_a);
+    hint_b = support_point(b, minus_transpose_times(rot, w), hint_b, scan_b);
+    const Vec3 pa = a_point(hint_a);
+    const Vec3 pb = b_point(hint_b);
+    const double wa = w.dot(pa);
+    const double wb = w.dot(pb);
+    lower = std::max(lower, wb - wa);
+    if (d - lower <= options.relative_tolerance * d + kGapUlps * ulp_r) break;
+    if (iterations >= options.max_iterations) {
+      result.status = Status::iteration_cap;
+      break;
+    }
+    ++iterations;
+
+    // Try the body whose support point is further out first, then the other.
+    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.point_a);
+    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.point_b) - wb;
+    bool improved = false;
+    for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
+      const bool use_a = (attempt == 0) == (gain_a >= gain_b);
+      if ((use_a ? gain_a : gain_b) <= 0.0) continue;
+      // The support point joins its feature in place, and leaves it again
+      // if the pair does not improve (no copies of the feature sets).
+      FeatureSet& grown = use_a ? fa : fb;
+      grown.push(use_a ? hint_a : hint_b, use_a ? pa : pb);
+      const Local next = local_distance(fa, fb, tol);
+      if (!(next.distance_squared < loc.distance_squared)) {
+        grown.pop();
+        continue;  // unstable: no progress at this precision
+      }
+      fa.reduce(next.active_a);
+      fb.reduce(next.active_b);
+      loc = next;
+      improved = true;
+    }
+    if (!improved) break;  // the pair is optimal at machine precision
+  }
+
+  const double d = std::sqrt(loc.distance_squared);
+  result.iterations = iterations;
+  result.point_a = loc.point_a;
+  result.point_b = loc.point_b;
+  result.distance = d;
+  result.lower_bound = std::min(std::max(lower, 0.0), d);
+  result.normal = d > 0.0 ? Vec3((loc.point_b - loc.point_a) / d) : last_direction;
+  if (contact) {
+    // In contact at machine precision. Whether the bodies only touch or
+    // overlap is decided by the contact unit (hybrid_distance, contact.h).
+    result.status = Status::touching;
+    result.lower_bound = 0.0;
+  } else if (result.status != Status::iteration_cap) {
+    result.status = Status::separated;
+  }
+  const double unit = kScaled ? 1.0 / scale : 1.0;  // exact: a power of two
+  store_feature(fa, cache.vertices_a);
+  store_feature(fb, cache.vertices_b);
+  cache.hint_a = hint_a;
+  cache.hint_b = hint_b;
+  cache.rotation = rot;
+  cache.translation = tr;
+  if constexpr (kScaled) {
+    result.point_a *= unit;
+    result.point_b *= unit;
+    result.distance *= unit;
+    result.lower_bound *= unit;
+  }
+  // The hybrid reports contact without telling touching from overlapping:
+  // the contact unit (proxima/detail/narrowphase/contact.h) decides, in the caller's units,
+  // before the witness features, which an intersecting answer reports
+  // without rule 3's walk (witness_features.h).
+  if (result.status == Status::touching)
+    classify_contact(a, b, b_in_a, options, band, cache, result);
+  const bool locate = result.status != Status::intersecting;
+
+  // The witness features by the rule all algorithms share
+  // (witness_features.h), in each hull's own frame and units.
+  const double witness_band = detail::witness_band(r_local * unit);
+  // The tracked edge: rule 1 keeps both vertices when the closest point is
+  // farther than the band from each of them, and rule 2 needs their ids
+  // only. A's frame is A's own (unscaled: the same arithmetic as
+  // witness_feature's); B's point is tested in A's frame, with the margin
+  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
+  // and the whole rule applied there.
+  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
+                                      const Vec3& x, double bands, Feature& out) {
+    if constexpr (kScaled) {
+      return false;
+    } else {
+      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
+             detail::hull_edge(poly, f.id[0], f.id[1], out);
+    }
+  };
+  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
+    result.feature_a = detail::witness_feature(
+        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+        [&] {
+          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
+        },
+        locate);
+  }
+  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
+    result.feature_b = detail::witness_feature(
+        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+        [&] {
+          // The outward side only matters on a polygon.
+          return detail::WitnessPoint{
+              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
+              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+        },
+        locate);
+  }
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
+
+  // An answer the hybrid could not certify is cross-checked (contact.h).
+  if (needs_cross_check(result, options, magnitude)) [[unlikely]]
+    cross_check_separation(a, b, b_in_a, options, band, result);
+  return result;
+}
+
+// The hybrid on coordinates times the power of two that brings R in A's
+// frame near 1 (outside 2^-64..2^64 squares would overflow or underflow).
+DistanceResult run_scaled(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                          const DistanceOptions& options, double contact_tolerance,
+                          DistanceCache& cache, double r_local) {
+  const double scale = detail::power_of_two_unit(r_local).inverse;
+  return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance, cache, r_local, scale);
+}
+
+}  // namespace
+
+DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+                               const DistanceOptions& options, double contact_tolerance,
+                               DistanceCache& cache) {
+  // R in A's frame, B's coordinates bounded without mapping its vertices.
+  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
+  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
+      !std::isfinite(r_local)) [[likely]] {
+    return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
+  }
+  return run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
+}
+
+}  // namespace proxima

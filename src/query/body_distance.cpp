@@ -1,0 +1,485 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// Bodies of any kind (a convex, compound or mesh core plus a radius) and the
+// one distance call between two of them: the cores' query (convex, compound
+// or mesh), their penetration depth where convex cores overlap, and the
+// offset by the radii along the normal (proxima/query/body_distance.h says why that is
+// exact).
+#include "proxima/query/body_distance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "core/magnitude_limit.h"
+#include "proxima/query/distance.h"
+
+namespace proxima {
+namespace {
+
+// The largest coordinate magnitude of a rounded body (core plus radius)
+// accepted: the cores' query's own limit, so that no sum of radii, signed
+// distance or offset point can overflow.
+using detail::kMaxMagnitude;  // magnitude_limit.h
+
+// The cores' answer in the world frame as a signed value with its bounds:
+// the distance of the cores (>= 0), or minus their penetration depth when
+// they overlap.
+struct CoreAnswer {
+  Status status = Status::separated;
+  double value = 0.0;
+  double lower = 0.0;
+  double upper = 0.0;
+  Vec3 point_a = Vec3::Zero();
+  Vec3 point_b = Vec3::Zero();
+  Vec3 normal = Vec3::UnitX();
+  Feature feature_a;
+  Feature feature_b;
+  int iterations = 0;
+  bool second_algorithm = false;
+  bool overlap = false;
+  std::int32_t piece_a = -1;
+  std::int32_t piece_b = -1;
+};
+
+CoreAnswer from_distance(const DistanceResult& r) {
+  CoreAnswer c;
+  c.status = r.status;
+  c.value = r.distance;
+  c.lower = r.lower_bound;
+  c.upper = r.distance;
+  c.point_a = r.point_a;
+  c.point_b = r.point_b;
+  c.normal = r.normal;
+  c.feature_a = r.feature_a;
+  c.feature_b = r.feature_b;
+  c.iterations = r.iterations;
+  c.second_algorithm = r.second_algorithm;
+  return c;
+}
+
+// Whether the cores' answer needs their penetration query: when they
+// overlap (its depth is the signed value), and, for rounded bodies, when
+// they touch without a certified gap: the normal of a distance answer is
+// trusted only when the support gap along it, the lower bound, is above 0
+// (the cores are then apart along it, and the offset points are the rounded
+// bodies' closest points); below that it is a direction of a few roundings.
+bool needs_depth(const CoreAnswer& c, double radii) {
+  if (c.status == Status::intersecting) return true;
+  return c.status == Status::touching && radii > 0.0 && !(c.lower > 0.0);
+}
+
+// The answer for overlapping cores when the caller skipped the depth
+// (DistanceOptions::penetration false), as for a mesh overlap: signed value
+// 0 with the certificate [-infinity, 0]; points and normal stay the distance
+// query's.
+void without_depth(CoreAnswer& c) {
+  c.value = 0.0;
+  c.lower = -std::numeric_limits<double>::infinity();
+  c.upper = 0.0;
+  c.overlap = true;
+}
+
+// Replaces the answer's value, bounds, points, normal and features by the
+// penetration query's (in the frame `frame_a`), unless it found the cores
+// apart (a disagreement of the two queries at the band's edge): then the
+// distance query's answer stands, with a depth of 0 if it called them
+// intersecting.
+void take_depth(CoreAnswer& c, const PenetrationResult& p, const Pose& frame_a) {
+  if (p.status == PenetrationStatus::separated) {
+    if (c.status == Status::intersecting) {
+      c.value = c.lower = c.upper = 0.0;
+      c.overlap = true;
+    }
+    return;
+  }
+  c.value = -p.depth;
+  c.lower = -p.upper_bound;
+  c.upper = -p.lower_bound;
+  c.point_a = frame_a.apply(p.point_a);
+  c.point_b = frame_a.apply(p.point_b);
+  c.normal = frame_a.rotation * p.normal;
+  c.feature_a = p.feature_a;
+  c.feature_b = p.feature_b;
+  c.overlap = c.status == Status::intersecting;
+}
+
+// B's pose in A's frame under the pose contract (the product of two rigid
+// poses is rigid to a few u; re-orthonormalized if not).
+Pose relative(const Pose& pose_a, const Pose& pose_b) {
+  return checked_pose(pose_a.inverse() * pose_b, "distance: relative pose");
+}
+
+// The largest coordinate magnitude of a polytope's vertices placed at `pose`
+// (the exact R of the accuracy standard). O(N).
+double placed_magnitude(const ConvexPolytope& p, const Pose& pose) {
+  double r = 0.0;
+  for (const Vec3& v : p.vertices()) r = std::max(r, pose.apply(v).cwiseAbs().maxCoeff());
+  return r;
+}
+
+// The pieces (or convex bodies) that gave the answer, placed: the accuracy
+// standard's R is theirs, as for the compound query.
+struct Placed {
+  const ConvexPolytope* polytope;
+  Pose pose;
+};
+
+// The status of the rounded bodies from their signed value s: the contact
+// band of the rounded pieces (core R plus radius; the largest coordinate of
+// a ball of radius r about x is |x|_inf + r). First from the O(1) bound on
+// R; a value inside that band is decided with the exact R (O(N), only near
+// contact).
+Status rounded_status(double s, const Placed& a, double ra, const Placed& b, double rb,
+                      const DistanceOptions& options) {
+  const double bound = std::max(magnitude_bound(a.pose, a.polytope->scale()) + ra,
+                                magnitude_bound(b.pose, b.polytope->scale()) + rb);
+  double band = contact_band(bound, options.absolute_tolerance);
+  if (std::abs(s) <= band) {
+    band = contact_band(std::max(placed_magnitude(*a.polytope, a.pose) + ra,
+                                 placed_magnitude(*b.polytope, b.pose) + rb),
+                        options.absolute_tolerance);
+  }
+  return s > band ? Status::separated : s >= -band ? Status::touching : Status::intersecting;
+}
+
+// The rounded bodies' answer from the cores' one. `rounded` gives the
+// status of the rounded bodies from their signed value (used only when a
+// radius is not 0).
+template <class RoundedStatus>
+BodyDistance offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedStatus rounded) {
+  const double ra = a.radius();
+  const double rb = b.radius();
+  const double radii = ra + rb;
+  BodyDistance r;
+  const double value = c.value - radii;
+  const double lower = c.lower - radii;
+  const double upper = c.upper - radii;
+  if (c.status == Status::iteration_cap || radii == 0.0) {
+    r.status = c.status;
+  } else {
+    r.status = rounded(value);
+  }
+  // The signed values in DistanceResult's fields, so that its
+  // signed_distance(), signed_lower_bound() and signed_upper_bound() give
+  // them: distance - depth, lower_bound - depth_upper_bound and
+  // distance - depth_lower_bound.
+  if (value >= 0.0) {
+    r.distance = value;
+    r.depth = 0.0;
+    r.depth_lower_bound = value - upper;  // 0 when the upper bound is the distance
+  } else {
+    r.distance = 0.0;
+    r.depth = -value;
+    r.depth_lower_bound = -upper;  // negative when the overlap is not certified
+  }
+  r.lower_bound = std::max(lower, 0.0);
+  r.depth_upper_bound = r.lower_bound - lower;
+  r.normal = c.normal;
+  r.point_a = c.point_a + ra * c.normal;
+  r.point_b = c.point_b - rb * c.normal;
+  r.feature_a = c.feature_a;
+  r.feature_b = c.feature_b;
+  r.iterations = c.iterations;
+  r.second_algorithm = c.second_algorithm;
+  r.piece_a = c.piece_a;
+  r.piece_b = c.piece_b;
+  r.cores_overlap = c.overlap;
+  r.approximation_error = a.approximation_error() + b.approximation_error();
+  return r;
+}
+
+// `depth`: the caller's DistanceOptions::penetration (`options` are the
+// cores' options, without it).
+BodyDistance convex_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                         const DistanceOptions& options, bool depth, BodyCache& cache) {
+  const ConvexPolytope& ca = *a.convex();
+  const ConvexPolytope& cb = *b.convex();
+  CoreAnswer c = from_distance(
+      detail::distance_of_rigid_poses(ca, pose_a, cb, pose_b, options, &cache.convex));
+  if (!depth) {
+    if (c.status == Status::intersecting) without_depth(c);
+  } else if (needs_depth(c, a.radius() + b.radius())) {
+    take_depth(c, penetration_depth(ca, cb, relative(pose_a, pose_b), cache.penetration), pose_a);
+  }
+  return offset(c, a, b, [&](double value) {
+    return rounded_status(value, {&ca, pose_a}, a.radius(), {&cb, pose_b}, b.radius(), options);
+  });
+}
+
+// The deepest overlapping piece pair of two compounds whose cores overlap:
+// every piece pair whose bounding spheres meet, by a traversal of both
+// hierarchies, gets a cold convex query and, if it overlaps, a cold
+// penetration query. The signed value is the smallest over pairs of the
+// pair's (minus the largest depth); its bounds are the smallest of the
+// pairs' bounds.
+class DeepestPair {
+ public:
+  DeepestPair(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
+              const DistanceOptions& options)
+      : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options) {}
+
+  // Updates `c` (the compound query's intersecting answer) to the deepest pair.
+  void run(CoreAnswer& c) {
+    std::vector<std::pair<std::int32_t, std::int32_t>> stack = {{0, 0}};
+    while (!stack.empty()) {
+      const auto [ia, ib] = stack.back();
+      stack.pop_back();
+      const CompoundBody::Node& na = a_.nodes()[static_cast<std::size_t>(ia)];
+      const CompoundBody::Node& nb = b_.nodes()[static_cast<std::size_t>(ib)];
+      if (!spheres_meet(na.center, na.radius, nb.center, nb.radius)) continue;
+      const bool leaf_a = na.left < 0;
+      const bool leaf_b = nb.left < 0;
+      if (leaf_a && leaf_b) {
+        for (std::int32_t i = 0; i < na.count; ++i) {
+          for (std::int32_t j = 0; j < nb.count; ++j) {
+            test(a_.piece_order()[static_cast<std::size_t>(na.first + i)],
+                 b_.piece_order()[static_cast<std::size_t>(nb.first + j)]);
+          }
+        }
+      } else if (!leaf_a && (leaf_b || na.radius >= nb.radius)) {
+        stack.push_back({na.left, ib});
+        stack.push_back({na.right, ib});
+      } else {
+        stack.push_back({ia, nb.left});
+        stack.push_back({ia, nb.right});
+      }
+    }
+    if (!found_) return;  // the compound query's pair stands (depth 0)
+    const int iterations = c.iterations;
+    const bool second = c.second_algorithm;
+    c = best_;
+    c.iterations = iterations;
+    c.second_algorithm = second;
+    c.lower = lower_;
+    c.upper = upper_;
+  }
+
+ private:
+  // Whether two spheres (body frames) may meet, with a slack for the
+  // rounding of the placed centers and of the norm: a pair tested more is
+  // only slower.
+  bool spheres_meet(const Vec3& center_a, double radius_a, const Vec3& center_b,
+                    double radius_b) const {
+    const Vec3 ca = pose_a_.apply(center_a);
+    const Vec3 cb = pose_b_.apply(center_b);
+    const double reach = radius_a + radius_b;
+    const double slack =
+        256.0 * kUnitRoundoff * (ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + reach);
+    return !((ca - cb).norm() > reach + slack);
+  }
+
+  void test(std::int32_t pa, std::int32_t pb) {
+    const CompoundPiece& piece_a = a_.piece(pa);
+    const CompoundPiece& piece_b = b_.piece(pb);
+    const Pose place_a = pose_a_ * piece_a.pose;
+    const Pose place_b = pose_b_ * piece_b.pose;
+    const DistanceResult r = detail::distance_of_rigid_poses(
+        *piece_a.polytope, place_a, *piece_b.polytope, place_b, options_, nullptr);
+    if (r.status != Status::intersecting) return;
+    CoreAnswer c = from_distance(r);
+    PenetrationCache cold;
+    take_depth(
+        c,
+        penetration_depth(*piece_a.polytope, *piece_b.polytope, relative(place_a, place_b), cold),
+        place_a);
+    c.piece_a = pa;
+    c.piece_b = pb;
+    if (!found_ || c.value < best_.value) best_ = c;
+    lower_ = found_ ? std::min(lower_, c.lower) : c.lower;
+    upper_ = found_ ? std::min(upper_, c.upper) : c.upper;
+    found_ = true;
+  }
+
+  const CompoundBody& a_;
+  const CompoundBody& b_;
+  const Pose& pose_a_;
+  const Pose& pose_b_;
+  const DistanceOptions& options_;
+  bool found_ = false;
+  CoreAnswer best_;
+  double lower_ = 0.0;
+  double upper_ = 0.0;
+};
+
+BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                           const DistanceOptions& options, bool depth, BodyCache& cache) {
+  const std::shared_ptr<const CompoundBody> hold_a = a.compound();
+  const std::shared_ptr<const CompoundBody> hold_b = b.compound();
+  const CompoundBody& ca = *hold_a;
+  const CompoundBody& cb = *hold_b;
+  const CompoundResult cr = distance(ca, pose_a, cb, pose_b, options, &cache.compound);
+  CoreAnswer c = from_distance(cr);
+  c.piece_a = cr.piece_a;
+  c.piece_b = cr.piece_b;
+  if (c.status == Status::intersecting && !depth) {
+    without_depth(c);
+  } else if (c.status == Status::intersecting) {
+    c.overlap = true;
+    DeepestPair(ca, pose_a, cb, pose_b, options).run(c);
+  } else if (depth && needs_depth(c, a.radius() + b.radius())) {
+    const CompoundPiece& piece_a = ca.piece(c.piece_a);
+    const CompoundPiece& piece_b = cb.piece(c.piece_b);
+    const Pose place_a = pose_a * piece_a.pose;
+    PenetrationCache cold;
+    take_depth(c,
+               penetration_depth(*piece_a.polytope, *piece_b.polytope,
+                                 relative(place_a, pose_b * piece_b.pose), cold),
+               place_a);
+  }
+  const CompoundPiece& piece_a = ca.piece(c.piece_a);
+  const CompoundPiece& piece_b = cb.piece(c.piece_b);
+  BodyDistance r = offset(c, a, b, [&](double value) {
+    return rounded_status(value, {piece_a.polytope.get(), pose_a * piece_a.pose}, a.radius(),
+                          {piece_b.polytope.get(), pose_b * piece_b.pose}, b.radius(), options);
+  });
+  // A convex body met a compound as its one-piece wrapper: it has no pieces.
+  if (a.kind() == Body::Kind::convex) r.piece_a = -1;
+  if (b.kind() == Body::Kind::convex) r.piece_b = -1;
+  return r;
+}
+
+// The largest coordinate magnitude of a mesh's vertices placed at `pose`
+// (the exact R of the accuracy standard). O(V).
+double placed_magnitude(const TriangleMesh& m, const Pose& pose) {
+  double r = 0.0;
+  for (const Vec3& v : m.vertices()) r = std::max(r, pose.apply(v).cwiseAbs().maxCoeff());
+  return r;
+}
+
+// A pair with a mesh on at least one side: every pair of meshes of
+// Body::meshes() (one per convex piece, one for a mesh), each tracked by its
+// own MeshCache, the closest (or a crossing) pair kept. A pair is skipped
+// when a lower bound on its distance, from the pieces' bounding spheres, is
+// above the best distance found: only slower if the bound were loose, never
+// wrong.
+BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                       const DistanceOptions& options, BodyCache& cache) {
+  const std::vector<Body::MeshOfPiece>& ma = a.meshes();
+  const std::vector<Body::MeshOfPiece>& mb = b.meshes();
+  const std::size_t pairs = ma.size() * mb.size();
+  if (cache.mesh.size() != pairs) cache.mesh.assign(pairs, MeshCache{});
+  // Each piece's placed bounding sphere: the root box's center and half
+  // diagonal, placed.
+  const auto sphere = [](const Body::MeshOfPiece& m, const Pose& pose) {
+    return std::pair<Vec3, double>((pose * m.pose).apply(m.mesh->center()),
+                                   m.mesh->bounding_radius());
+  };
+  MeshResult best;
+  bool have = false;
+  std::size_t best_i = 0, best_j = 0;
+  // The last answer's pair first: its distance prunes the others.
+  const std::size_t first =
+      cache.mesh_closest >= 0 && static_cast<std::size_t>(cache.mesh_closest) < pairs
+          ? static_cast<std::size_t>(cache.mesh_closest)
+          : 0;
+  for (std::size_t n = 0; n < pairs; ++n) {
+    const std::size_t k = n == 0 ? first : n <= first ? n - 1 : n;
+    const std::size_t i = k / mb.size();
+    const std::size_t j = k % mb.size();
+    const Pose place_a = pose_a * ma[i].pose;
+    const Pose place_b = pose_b * mb[j].pose;
+    if (have && pairs > 1) {
+      const auto [ca, ra] = sphere(ma[i], pose_a);
+      const auto [cb, rb] = sphere(mb[j], pose_b);
+      const double gap = (ca - cb).norm() - ra - rb;
+      // Rounding of the placed centers and norm: a relative 1e-12 slack.
+      if (gap * (1.0 - 1e-12) - 1e-300 > best.distance) continue;
+    }
+    MeshResult r = distance(*ma[i].mesh, place_a, *mb[j].mesh, place_b, options, &cache.mesh[k]);
+    const bool better = !have ||
+                        (r.status == Status::intersecting && best.status != Status::intersecting) ||
+                        (best.status != Status::intersecting && r.distance < best.distance);
+    if (better) {
+      if (have) r.lower_bound = std::min(r.lower_bound, best.lower_bound);
+      best = r;
+      best_i = i;
+      best_j = j;
+      have = true;
+    } else {
+      best.lower_bound = std::min(best.lower_bound, r.lower_bound);
+    }
+  }
+  cache.mesh_closest = static_cast<std::int32_t>(best_i * mb.size() + best_j);
+  CoreAnswer c;
+  c.status = best.status;
+  c.point_a = best.point_a;
+  c.point_b = best.point_b;
+  c.normal = best.normal;
+  c.feature_a = best.feature_a;
+  c.feature_b = best.feature_b;
+  c.iterations = best.iterations;
+  if (best.status == Status::intersecting) {
+    c.value = 0.0;
+    c.lower = -std::numeric_limits<double>::infinity();
+    c.upper = 0.0;
+    c.overlap = true;
+  } else {
+    c.value = best.distance;
+    c.lower = best.lower_bound;
+    c.upper = best.distance;
+  }
+  // A convex core's features in its hull's terms: mesh vertex ids are hull
+  // vertex ids; a triangle's face is the hull face it came from.
+  const auto hull_face = [](Feature& f, const Body::MeshOfPiece& m) {
+    if (!m.faces.empty() && f.face >= 0) f.face = m.faces[static_cast<std::size_t>(f.face)];
+  };
+  hull_face(c.feature_a, ma[best_i]);
+  hull_face(c.feature_b, mb[best_j]);
+  if (a.kind() == Body::Kind::compound) c.piece_a = static_cast<std::int32_t>(best_i);
+  if (b.kind() == Body::Kind::compound) c.piece_b = static_cast<std::int32_t>(best_j);
+  const Pose place_a = pose_a * ma[best_i].pose;
+  const Pose place_b = pose_b * mb[best_j].pose;
+  BodyDistance r = offset(c, a, b, [&](double value) {
+    const double reach = std::max(placed_magnitude(*ma[best_i].mesh, place_a) + a.radius(),
+                                  placed_magnitude(*mb[best_j].mesh, place_b) + b.radius());
+    const double band = contact_band(reach, options.absolute_tolerance);
+    return value > band     ? Status::separated
+           : value >= -band ? Status::touching
+                            : Status::intersecting;
+  });
+  if (a.kind() == Body::Kind::mesh) r.triangle_a = best.triangle_a;
+  if (b.kind() == Body::Kind::mesh) r.triangle_b = best.triangle_b;
+  return r;
+}
+
+}  // namespace
+
+BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+                      const DistanceOptions& options, BodyCache* cache) {
+  BodyCache cold;
+  BodyCache& c = cache != nullptr ? *cache : cold;
+  const Pose pa = checked_pose(pose_a, "distance: pose_a");
+  const Pose pb = checked_pose(pose_b, "distance: pose_b");
+  // The cores' query refuses coordinates beyond kMaxMagnitude; radii that
+  // take the rounded bodies there are refused too (their sum, the signed
+  // distance or the offset points could overflow to infinity).
+  for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
+    const double reach = magnitude_bound(*pose, body->scale());
+    if (!(reach <= kMaxMagnitude)) {
+      char radius[64];
+      std::snprintf(radius, sizeof radius, "%.3g", body->radius());
+      throw InvalidInput(detail::beyond_magnitude(std::string("distance: body ") + name, reach,
+                                                  std::string("with its radius ") + radius));
+    }
+  }
+  // The cores' queries without their own depth: the depth of overlapping
+  // cores is taken here (take_depth, DeepestPair), once.
+  DistanceOptions cores = options;
+  cores.penetration = false;
+  if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
+    return convex_pair(a, pa, b, pb, cores, options.penetration, c);
+  }
+  if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
+    return mesh_pair(a, pa, b, pb, cores, c);
+  }
+  return compound_pair(a, pa, b, pb, cores, options.penetration, c);
+}
+
+}  // namespace proxima

@@ -1,0 +1,308 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// The branch-and-bound distance between two compound bodies (over the
+// bounding-sphere hierarchies of src/shape/compound.cpp) and its slow twin
+// over all piece pairs.
+//
+// Soundness of the pruning. A node pair is skipped only when its computed
+// lower bound, minus a slack for the rounding of that bound, exceeds the best
+// distance found so far. The exact lower bound is then above that best
+// distance, so every piece pair below is truly farther than an answer already
+// in hand: the pruned pairs can never hide a closer pair, and the answer is
+// the minimum over the tested pairs, each within the accuracy standard.
+#include "proxima/query/compound_distance.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <unordered_set>
+#include <utility>
+
+#include "core/power_of_two.h"
+#include "proxima/query/distance.h"
+
+namespace proxima {
+
+namespace {
+
+// Slack of a node pair's lower bound, in units of u times the two bodies'
+// world magnitude bounds: the centers in the query frame are a pose product
+// and a transformed point away from the stored doubles (a few u of the
+// translations and coordinates each), and the convex query itself places the
+// pieces through a differently rounded product. 256 u covers both with room.
+constexpr double kPruneSlackUlps = 256.0;
+// And relative to the bound's own terms (center distance plus radii): the
+// norm and the two subtractions round by at most 4 u of them.
+constexpr double kPruneRelativeUlps = 64.0;
+
+// The farthest entries the near list keeps: the tested piece pairs of the
+// last answer, closest first, up to this many. A tracked query re-tests
+// about the same pairs; 64 covers every near set the tests and benchmarks
+// produce (a few to a few dozen pairs) while bounding the cache's size.
+constexpr std::size_t kNearCapacity = 64;
+
+using detail::magnitude_exponent;
+
+
+// Upper bound on the largest world coordinate of a body placed at `pose`:
+// |R y + t|_inf <= |t|_inf + |y|_2 <= |t|_inf + sqrt(3) scale.
+double world_magnitude_bound(const CompoundBody& body, const Pose& pose) {
+  return magnitude_bound(pose, body.scale());
+}
+
+// Whether (signed distance, intersecting, pair) orders `r` before the
+// current best: the smaller signed distance (the distance when apart, minus
+// the depth when overlapping), then an intersecting pair before a touching
+// one at the same value, then the smaller (piece_a, piece_b).
+bool better(const DistanceResult& r, std::int32_t pa, std::int32_t pb, const CompoundResult& best) {
+  const double sr = r.signed_distance();
+  const double sb = best.signed_distance();
+  if (sr != sb) return sr < sb;
+  const bool ri = r.status == Status::intersecting;
+  const bool bi = best.status == Status::intersecting;
+  if (ri != bi) return ri;
+  return std::pair(pa, pb) < std::pair(best.piece_a, best.piece_b);
+}
+
+void take(CompoundResult& best, const DistanceResult& r, std::int32_t pa, std::int32_t pb) {
+  static_cast<DistanceResult&>(best) = r;
+  best.piece_a = pa;
+  best.piece_b = pb;
+}
+
+struct NearEntry {
+  CompoundCache::Entry entry;
+  double distance;
+};
+
+bool pair_less(const CompoundCache::Entry& x, const CompoundCache::Entry& y) {
+  return std::pair(x.piece_a, x.piece_b) < std::pair(y.piece_a, y.piece_b);
+}
+
+// One branch-and-bound query. Lower bounds are computed in A's frame on
+// copies scaled by 2^-e, e the exponent of the two bodies' magnitude bound,
+// so that no square overflows at any scale the polytopes accept.
+class Search {
+ public:
+  Search(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
+         const DistanceOptions& options, CompoundCache* cache)
+      : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options), cache_(cache) {
+    const double magnitude_a = world_magnitude_bound(a, pose_a);
+    const double magnitude_b = world_magnitude_bound(b, pose_b);
+    // The factor 2^-e as a double, clamped to [2^-1000, 2^1000] so that it
+    // is a normal number: products with it are exact (or underflow, which
+    // only lowers a bound: never a wrong prune) and cost one multiplication,
+    // not a call of ldexp per coordinate.
+    const int e = std::clamp(magnitude_exponent(std::max(magnitude_a, magnitude_b)), -1000, 1000);
+    factor_ = std::ldexp(1.0, -e);
+    rotation_ = pose_a.rotation.transpose() * pose_b.rotation;
+    translation_ =
+        pose_a.rotation.transpose() * (factor_ * pose_b.translation - factor_ * pose_a.translation);
+    slack_ = kPruneSlackUlps * kUnitRoundoff * (factor_ * magnitude_a + factor_ * magnitude_b);
+    // A near list the caller did not keep sorted is ignored (a binary search
+    // on it could miss entries): slower, never wrong.
+    if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
+      old_near_ = std::span<CompoundCache::Entry>(cache_->near);
+    }
+  }
+
+  CompoundResult run() {
+    if (cache_ != nullptr && cache_->piece_a >= 0 && cache_->piece_a < a_.piece_count() &&
+        cache_->piece_b >= 0 && cache_->piece_b < b_.piece_count()) {
+      hint_a_ = cache_->piece_a;
+      hint_b_ = cache_->piece_b;
+      test_pair(hint_a_, hint_b_);
+    }
+    if (!done()) traverse();
+    best_.pairs_tested = static_cast<int>(tested_.size());
+    if (cache_ != nullptr) update_cache();
+    return best_;
+  }
+
+ private:
+  struct StackEntry {
+    std::int32_t node_a;
+    std::int32_t node_b;
+    double key;  // lower bound minus slack, in scaled units
+  };
+
+  // An overlap ends the search only when the depth is not asked for: with
+  // it, a deeper piece pair may still come (the pruning keys below are
+  // lower bounds on the signed distance too: a piece pair inside two
+  // spheres is at most as deep as the spheres, whose depth is
+  // r_a + r_b - |c_a - c_b|, depth being monotone under inclusion).
+  bool done() const {
+    return have_best_ && best_.status == Status::intersecting && !options_.penetration;
+  }
+
+  // The pruning key of two spheres (body frames): their scaled lower bound
+  // minus its rounding slack. An overflowing distance cannot occur on scaled
+  // copies; the key is -inf (never pruned) should it anyway.
+  double key(const Vec3& center_a, double radius_a, const Vec3& center_b_in_a_scaled,
+             double radius_b) const {
+    const double d = (factor_ * center_a - center_b_in_a_scaled).norm();
+    if (!std::isfinite(d)) return -std::numeric_limits<double>::infinity();
+    const double ra = factor_ * radius_a;
+    const double rb = factor_ * radius_b;
+    return d - ra - rb - slack_ - kPruneRelativeUlps * kUnitRoundoff * (d + ra + rb);
+  }
+  Vec3 b_center_in_a(const Vec3& c) const { return rotation_ * (factor_ * c) + translation_; }
+  bool pruned(double k) const { return have_best_ && k > best_scaled_; }
+
+  void traverse() {
+    const auto& nodes_a = a_.nodes();
+    const auto& nodes_b = b_.nodes();
+    stack_.push_back({0, 0, -std::numeric_limits<double>::infinity()});
+    while (!stack_.empty() && !done()) {
+      const StackEntry e = stack_.back();
+      stack_.pop_back();
+      if (pruned(e.key)) continue;
+      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(e.node_a)];
+      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(e.node_b)];
+      const bool leaf_a = na.left < 0;
+      const bool leaf_b = nb.left < 0;
+      if (leaf_a && leaf_b) {
+        test_leaves(na, nb);
+        continue;
+      }
+      // Descend the larger sphere (a leaf cannot be split): it shrinks the
+      // bound the most per level.
+      const bool split_a = !leaf_a && (leaf_b || na.radius >= nb.radius);
+      StackEntry first{};
+      StackEntry second{};
+      if (split_a) {
+        const Vec3 cb = b_center_in_a(nb.center);
+        const CompoundBody::Node& l = nodes_a[static_cast<std::size_t>(na.left)];
+        const CompoundBody::Node& r = nodes_a[static_cast<std::size_t>(na.right)];
+        first = {na.left, e.node_b, key(l.center, l.radius, cb, nb.radius)};
+        second = {na.right, e.node_b, key(r.center, r.radius, cb, nb.radius)};
+      } else {
+        const CompoundBody::Node& l = nodes_b[static_cast<std::size_t>(nb.left)];
+        const CompoundBody::Node& r = nodes_b[static_cast<std::size_t>(nb.right)];
+        first = {e.node_a, nb.left, key(na.center, na.radius, b_center_in_a(l.center), l.radius)};
+        second = {e.node_a, nb.right, key(na.center, na.radius, b_center_in_a(r.center), r.radius)};
+      }
+      // The nearer child pair on top: visited first, it is the likelier to
+      // lower the best distance before its sibling is looked at.
+      if (first.key < second.key) std::swap(first, second);
+      if (!pruned(first.key)) stack_.push_back(first);
+      if (!pruned(second.key)) stack_.push_back(second);
+    }
+  }
+
+  void test_leaves(const CompoundBody::Node& na, const CompoundBody::Node& nb) {
+    const auto order_a = a_.piece_order();
+    const auto order_b = b_.piece_order();
+    for (std::int32_t i = 0; i < na.count && !done(); ++i) {
+      const std::int32_t pa = order_a[static_cast<std::size_t>(na.first + i)];
+      for (std::int32_t j = 0; j < nb.count && !done(); ++j) {
+        const std::int32_t pb = order_b[static_cast<std::size_t>(nb.first + j)];
+        if (pa == hint_a_ && pb == hint_b_) continue;  // tested first
+        if (na.count > 1 || nb.count > 1) {
+          const CompoundBody::PieceSphere& sa = a_.piece_sphere(pa);
+          const CompoundBody::PieceSphere& sb = b_.piece_sphere(pb);
+          if (pruned(key(sa.center, sa.radius, b_center_in_a(sb.center), sb.radius))) continue;
+        }
+        test_pair(pa, pb);
+      }
+    }
+  }
+
+  void test_pair(std::int32_t pa, std::int32_t pb) {
+    NearEntry& t = tested_.emplace_back();
+    t.entry.piece_a = pa;
+    t.entry.piece_b = pb;
+    const CompoundCache::Entry probe{pa, pb, {}};
+    const auto it = std::lower_bound(old_near_.begin(), old_near_.end(), probe, pair_less);
+    // Moved, not copied: the near list is rebuilt from the tested pairs,
+    // and a copy of a cache that holds penetration state is a deep copy.
+    if (it != old_near_.end() && it->piece_a == pa && it->piece_b == pb)
+      t.entry.cache = std::move(it->cache);
+    const CompoundPiece& piece_a = a_.piece(pa);
+    const CompoundPiece& piece_b = b_.piece(pb);
+    // Both factors are under the pose contract (checked where the body and
+    // this query took them), and so is their product: not checked again.
+    const DistanceResult r = detail::distance_of_rigid_poses(
+        *piece_a.polytope, pose_a_ * piece_a.pose, *piece_b.polytope, pose_b_ * piece_b.pose,
+        options_, &t.entry.cache);
+    t.distance = r.signed_distance();
+    if (!have_best_ || better(r, pa, pb, best_)) {
+      take(best_, r, pa, pb);
+      have_best_ = true;
+      best_scaled_ = factor_ * r.signed_distance();
+    }
+  }
+
+  // The next query's warm start: the best pair, and the feature caches of
+  // the closest tested pairs, sorted by pair for the binary search.
+  void update_cache() {
+    if (tested_.size() > kNearCapacity) {
+      std::nth_element(
+          tested_.begin(), tested_.begin() + static_cast<std::ptrdiff_t>(kNearCapacity) - 1,
+          tested_.end(),
+          [](const NearEntry& x, const NearEntry& y) { return x.distance < y.distance; });
+      tested_.resize(kNearCapacity);
+    }
+    std::sort(tested_.begin(), tested_.end(),
+              [](const NearEntry& x, const NearEntry& y) { return pair_less(x.entry, y.entry); });
+    cache_->near.clear();
+    for (NearEntry& t : tested_) cache_->near.push_back(std::move(t.entry));
+    cache_->piece_a = best_.piece_a;
+    cache_->piece_b = best_.piece_b;
+  }
+
+  const CompoundBody& a_;
+  const CompoundBody& b_;
+  const Pose& pose_a_;
+  const Pose& pose_b_;
+  const DistanceOptions& options_;
+  CompoundCache* cache_;
+  std::span<CompoundCache::Entry> old_near_;
+  double factor_ = 1.0;       // 2^-e, e the exponent of the magnitude bound
+  Mat3 rotation_;             // B's frame -> A's frame
+  Vec3 translation_;          // scaled by factor_
+  double best_scaled_ = 0.0;  // best_.signed_distance() * factor_
+  double slack_ = 0.0;        // scaled
+  std::int32_t hint_a_ = -1;
+  std::int32_t hint_b_ = -1;
+  bool have_best_ = false;
+  CompoundResult best_;
+  std::vector<NearEntry> tested_;
+  std::vector<StackEntry> stack_;
+};
+
+}  // namespace
+
+CompoundResult distance(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
+                        const Pose& pose_b, const DistanceOptions& options, CompoundCache* cache) {
+  return Search(a, checked_pose(pose_a, "distance: pose_a"), b,
+                checked_pose(pose_b, "distance: pose_b"), options, cache)
+      .run();
+}
+
+CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
+                                  const Pose& pose_b, const DistanceOptions& options) {
+  check_pose(pose_a, "distance_all_pairs: pose_a");
+  check_pose(pose_b, "distance_all_pairs: pose_b");
+  CompoundResult best;
+  bool have_best = false;
+  for (std::int32_t pa = 0; pa < a.piece_count(); ++pa) {
+    for (std::int32_t pb = 0; pb < b.piece_count(); ++pb) {
+      const DistanceResult r = distance(*a.piece(pa).polytope, pose_a * a.piece(pa).pose,
+                                        *b.piece(pb).polytope, pose_b * b.piece(pb).pose, options);
+      if (!have_best || better(r, pa, pb, best)) {
+        take(best, r, pa, pb);
+        have_best = true;
+      }
+    }
+  }
+  // Saturated: the product of two piece counts can exceed an int.
+  best.pairs_tested = static_cast<int>(std::min<std::int64_t>(
+      std::int64_t{a.piece_count()} * b.piece_count(), std::numeric_limits<int>::max()));
+  return best;
+}
+
+}  // namespace proxima
