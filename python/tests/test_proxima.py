@@ -286,7 +286,7 @@ def test_complex_arrays_are_refused_everywhere():
     with pytest.raises(ValueError, match="pose_b quaternion: " + words):
         proxima.distance(a, None, a, (np.array([1, 0, 0, 0], dtype=complex), (3, 0, 0)))
     with pytest.raises(ValueError, match="pose_b translation: " + words):
-        proxima.distance(a, None, a, proxima.Pose.from_translation((3 + 1j, 0, 0)))
+        proxima.distance(a, None, a, (np.eye(3), (3 + 1j, 0, 0)))
     with pytest.raises(ValueError, match="matrix: " + words):
         proxima.Pose.from_matrix(pose.astype(complex))
     with pytest.raises(ValueError, match="rotation: " + words):
@@ -1005,8 +1005,8 @@ def test_penetration_false_skips_the_depth_everywhere():
     y = proxima.distance(a, None, b, apart)
     assert x.signed_distance == y.signed_distance and np.array_equal(x.point_a, y.point_a)
     poses_b = np.tile(np.eye(4), (2, 1, 1))
-    poses_b[0, :3, 3] = over[1]
-    poses_b[1, :3, 3] = apart[1]
+    poses_b[0, :3, 3] = over.translation
+    poses_b[1, :3, 3] = apart.translation
     out = proxima.distance_batch(a, None, b, poses_b, penetration=False)
     assert list(out["signed_distance"]) == [0.0, y.signed_distance]
     batch = proxima.PairBatch([a, a], [b, b])

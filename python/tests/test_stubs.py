@@ -115,7 +115,7 @@ USE = textwrap.dedent('''
     point: npt.NDArray[np.float64] = r.point_a
     status: str = r.status
     body = proxima.capsule(0.5, 1.0)
-    d = proxima.distance(body, None, body, proxima.Pose.from_wxyzproxima.Pose.from_translation((3, 0, 0)))
+    d = proxima.distance(body, None, body, proxima.Pose.from_wxyz((1, 0, 0, 0), (3, 0, 0)))
     signed: float = d.signed_distance
     scene = proxima.Scene(margin=0.5)
 ''')
