@@ -89,6 +89,27 @@ class CMakeBuild(build_ext):
         cli = os.path.join(target_dir, "bin", "proxima")
         shutil.copyfile(os.path.join(build_dir, "cli", "proxima"), cli)
         os.chmod(cli, 0o755)
+        warn_if_no_viewer(build_dir)
+
+
+def warn_if_no_viewer(build_dir):
+    """Says loudly when the build has no viewer (three.js was not installed
+    by scripts/setup's npm step): proxima.view() and `proxima view` would then
+    refuse to run, which the build would otherwise not show."""
+    assets = os.path.join(build_dir, "viewer", "viewer_assets.cpp")
+    try:
+        with open(assets, encoding="utf-8", errors="replace") as f:
+            empty = "kThreeJs = \"\";" in f.read()
+    except OSError:
+        empty = True
+    if empty:
+        line = "=" * 78
+        sys.stderr.write(
+            f"\n{line}\nsetup.py: WARNING: this build of proxima has NO VIEWER: three.js was not "
+            "installed\n(run scripts/setup, whose `npm ci` in viewer/ installs it from the npm "
+            "registry,\nthen build again). proxima.view() and `proxima view` will refuse to run."
+            f"\n{line}\n\n"
+        )
 
 
 # setuptools' own build files go under the CMake build folder, not into the

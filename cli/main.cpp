@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,7 +53,7 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
 }
 
 int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads,
-                      proxima::QuaternionOrder order) {
+                      std::optional<proxima::QuaternionOrder> order) {
   // Answers go through std::cout only; untying it from C stdio lets it
   // buffer a whole answer line before the explicit flush.
   std::ios::sync_with_stdio(false);
@@ -91,11 +92,11 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
 int main(int argc, char** argv) {
   CLI::App app{
       "proxima: minimum distance, closest points and closest features between convex "
-      "polyhedra"};
+      "polyhedra, rounded bodies, compounds and triangle meshes"};
   app.require_subcommand(1);
   app.footer(
       "Examples:\n"
-      "  proxima distance a.obj b.stl --pose-b 0 0 2 1 0 0 0\n"
+      "  proxima distance a.obj b.stl --pose-b 0 0 2\n"
       "  proxima hull body.ply --out hull.obj\n"
       "  proxima query queries.jsonl --threads 2 > answers.jsonl\n"
       "Exit codes: 0 ok, 1 bad input (unreadable file, bad numbers), 2 usage.\n"
@@ -115,13 +116,16 @@ int main(int argc, char** argv) {
   proxima::DistanceOptions options;
   int threads = 1;
   // Four numbers in the wrong order are another rotation: the order is a
-  // named choice, the same flag on every command that reads quaternions.
+  // named choice, the same flag on every command that reads quaternions,
+  // and no default (unset: every quaternion must name its order itself, and
+  // a bare one is refused with both of its readings).
   const std::vector<std::string> orders = {"wxyz", "xyzw"};
-  const auto parse_order = [](const std::string& name) {
+  const auto parse_order = [](const std::string& name) -> std::optional<proxima::QuaternionOrder> {
+    if (name.empty()) return std::nullopt;
     return name == "xyzw" ? proxima::QuaternionOrder::xyzw : proxima::QuaternionOrder::wxyz;
   };
-  std::string query_order = "wxyz";
-  std::string distance_order = "wxyz";
+  std::string query_order;
+  std::string distance_order;
   query->footer(
       "Example:\n"
       "  echo '{\"id\":1,\"a\":{\"vertices\":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]]},"
@@ -137,10 +141,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   query
       ->add_option("--quaternion-order", query_order,
-                   "Order of a body's \"rotation\" numbers: wxyz (scalar first, the default) or "
-                   "xyzw (scalar last, as ROS and scipy write them)")
-      ->check(CLI::IsMember(orders))
-      ->capture_default_str();
+                   "Order of a body's bare \"rotation\" numbers: wxyz (scalar first) or xyzw "
+                   "(scalar last, as ROS and scipy write them). Without it a rotation must name "
+                   "its order: {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, z, w]}")
+      ->check(CLI::IsMember(orders));
   query
       ->add_option("--threads", threads,
                    "Threads answering blocks of queries; answers stay in input order")
@@ -149,30 +153,30 @@ int main(int argc, char** argv) {
 
   CLI::App* distance = app.add_subcommand(
       "distance",
-      "Distance, closest points, normal and witness features between the convex hulls of two "
-      "mesh files (OBJ, OFF, STL, PLY, XYZ)");
+      "Distance, closest points, normal and witness features between two mesh files (OBJ, "
+      "OFF, STL, PLY, XYZ), each read as its convex hull, a triangle mesh or a compound of "
+      "hulls (--as)");
   proxima::cli::DistanceCommand distance_command;
   std::string distance_algorithm = "hybrid";
   distance->add_option("A", distance_command.file_a, "First body's mesh file")->required();
   distance->add_option("B", distance_command.file_b, "Second body's mesh file")->required();
   distance
       ->add_option("--pose-a", distance_command.pose_a,
-                   "Pose of A: translation x y z, then rotation quaternion qw qx qy qz (or qx "
-                   "qy qz qw with --quaternion-order xyzw)")
-      ->expected(7)
-      ->type_name("x y z qw qx qy qz");
+                   "Pose of A: translation x y z, then optionally a rotation quaternion in the "
+                   "order --quaternion-order names (required with one)")
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
   distance
       ->add_option("--pose-b", distance_command.pose_b,
-                   "Pose of B: translation x y z, then rotation quaternion qw qx qy qz (or qx "
-                   "qy qz qw with --quaternion-order xyzw)")
-      ->expected(7)
-      ->type_name("x y z qw qx qy qz");
+                   "Pose of B: translation x y z, then optionally a rotation quaternion in the "
+                   "order --quaternion-order names (required with one)")
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
   distance
       ->add_option("--quaternion-order", distance_order,
-                   "Order of the quaternion in --pose-a/--pose-b: wxyz (qw qx qy qz, the "
-                   "default) or xyzw (qx qy qz qw, as ROS and scipy write them)")
-      ->check(CLI::IsMember(orders))
-      ->capture_default_str();
+                   "Order of the quaternion in --pose-a/--pose-b: wxyz (qw qx qy qz) or xyzw "
+                   "(qx qy qz qw, as ROS and scipy write them); no default")
+      ->check(CLI::IsMember(orders));
   distance->add_option("--algorithm", distance_algorithm, "Algorithm answering the query")
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
       ->capture_default_str();
@@ -194,7 +198,7 @@ int main(int argc, char** argv) {
   distance->footer(
       "Example:\n"
       "  proxima distance a.obj b.stl --pose-b 0 0 2 0.7071067811865476 0 0 0.7071067811865476 "
-      "--json");
+      "--quaternion-order wxyz --json");
 
   CLI::App* hull =
       app.add_subcommand("hull", "Hull statistics of a mesh file, and its export as OBJ or OFF");
@@ -221,19 +225,21 @@ int main(int argc, char** argv) {
       "their closest points, witness features, normal and certificate, or one scene step "
       "(docs/viewer.md)");
   proxima::cli::ViewCommand view_command;
-  std::string view_order = "wxyz";
+  std::string view_order;
   std::string view_algorithm = "hybrid";
-  view->add_option("A", view_command.file_a, "First body's mesh file (OBJ groups: a compound)");
+  view->add_option("A", view_command.file_a, "First body's mesh file");
   view->add_option("B", view_command.file_b, "Second body's mesh file");
   view->add_option("--pose-a", view_command.pose_a, "Pose of A, as for `proxima distance`")
-      ->expected(7)
-      ->type_name("x y z qw qx qy qz");
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
   view->add_option("--pose-b", view_command.pose_b, "Pose of B, as for `proxima distance`")
-      ->expected(7)
-      ->type_name("x y z qw qx qy qz");
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
   view->add_option("--as", view_command.as,
-                   "How A and B become bodies: mesh (the surface as given), hull or pieces (one "
-                   "hull per OBJ group); default: the groups as pieces")
+                   "How A and B become bodies, as for `proxima distance`: mesh (the surface as "
+                   "given), hull (the convex hull of every point) or pieces (one hull per OBJ "
+                   "group). Default: the hull of a convex file or a point cloud; a non-convex "
+                   "file with faces must be named")
       ->check(kinds);
   view->add_option("--query", view_command.query_file,
                    "A file ('-': standard input) holding one `proxima query` line, then "
@@ -246,9 +252,9 @@ int main(int argc, char** argv) {
                    "With --scene: pairs within this distance are drawn")
       ->capture_default_str();
   view->add_option("--quaternion-order", view_order,
-                   "Order of the quaternions (poses, query rotations): wxyz or xyzw")
-      ->check(CLI::IsMember(orders))
-      ->capture_default_str();
+                   "Order of the bare quaternions (poses, query rotations): wxyz or xyzw; no "
+                   "default")
+      ->check(CLI::IsMember(orders));
   view->add_option("--algorithm", view_algorithm, "Algorithm answering the query")
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
       ->capture_default_str();
@@ -259,7 +265,7 @@ int main(int argc, char** argv) {
       ->required();
   view->footer(
       "Examples:\n"
-      "  proxima view a.obj b.stl --pose-b 0 0 2 1 0 0 0 --out pair.html\n"
+      "  proxima view a.obj b.stl --pose-b 0 0 2 --out pair.html\n"
       "  proxima view --query query.jsonl --out query.html\n"
       "  proxima view --scene bodies.jsonl --margin 0.1 --out scene.html");
 

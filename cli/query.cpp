@@ -69,28 +69,58 @@ void read_numbers(const Json& v, const std::string& path, std::size_t n, const c
   }
 }
 
-// Reads body `name` ("a" or "b") of `query` into vertices, pose and radius,
-// its rotation's four numbers in `order`.
+// A "rotation" value, named `path` in errors: {"wxyz": [w, x, y, z]} or
+// {"xyzw": [x, y, z, w]}, which name their order, or four bare numbers,
+// read in the order the run names (--quaternion-order). Four bare numbers
+// in a run that names no order are refused with both of their readings:
+// the same numbers in the other order are another rotation (ROS's identity
+// [0, 0, 0, 1] read scalar first is a half turn), so no default is safe.
+Quat read_rotation(const Json& value, const std::string& path,
+                   std::optional<QuaternionOrder> run_order) {
+  double numbers[4];
+  std::optional<QuaternionOrder> order = run_order;
+  std::string where = path;
+  if (value.is_object()) {
+    const auto wxyz = value.find("wxyz");
+    const auto xyzw = value.find("xyzw");
+    if (value.size() != 1 || (wxyz == value.end() && xyzw == value.end())) {
+      fail(path + " is an object but not {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, z, w]}");
+    }
+    order = wxyz != value.end() ? QuaternionOrder::wxyz : QuaternionOrder::xyzw;
+    where = path + "." + to_string(*order);
+    read_numbers(wxyz != value.end() ? *wxyz : *xyzw, where, 4,
+                 *order == QuaternionOrder::wxyz ? "4 numbers [w, x, y, z]"
+                                                 : "4 numbers [x, y, z, w]",
+                 numbers);
+  } else {
+    read_numbers(value, path, 4,
+                 !order                            ? "4 numbers"
+                 : *order == QuaternionOrder::wxyz ? "4 numbers [w, x, y, z]"
+                                                   : "4 numbers [x, y, z, w] (--quaternion-order xyzw)",
+                 numbers);
+  }
+  // Normalized at any magnitude, a zero quaternion refused: the pose
+  // contract's own functions (proxima/core/pose.h), as in Python.
+  try {
+    if (!order) {
+      fail(path + " " + value.dump() + " does not name its quaternion order: " +
+           quaternion_readings(numbers, path) +
+           ". Write {\"wxyz\": [...]} or {\"xyzw\": [...]}, or run with --quaternion-order "
+           "wxyz or xyzw");
+    }
+    return unit_quaternion(quaternion_in_order(numbers, *order), where);
+  } catch (const InvalidInput& e) {
+    fail(e.what());
+  }
+}
+
 // A pose object's "rotation" and "translation" fields (absent or null:
 // identity), named `path` in errors.
-Pose read_pose(const Json& object, const std::string& path, QuaternionOrder order) {
+Pose read_pose(const Json& object, const std::string& path,
+               std::optional<QuaternionOrder> order) {
   Quat rotation = Quat::Identity();
   const auto q = object.find("rotation");
-  if (q != object.end() && !q->is_null()) {
-    double numbers[4];
-    read_numbers(*q, path + "rotation", 4,
-                 order == QuaternionOrder::wxyz
-                     ? "4 numbers [w, x, y, z]"
-                     : "4 numbers [x, y, z, w] (--quaternion-order xyzw)",
-                 numbers);
-    // Normalized at any magnitude, a zero quaternion refused: the pose
-    // contract's own function (proxima/core/pose.h), as in Python.
-    try {
-      rotation = unit_quaternion(quaternion_in_order(numbers, order), path + "rotation");
-    } catch (const InvalidInput& e) {
-      fail(e.what());
-    }
-  }
+  if (q != object.end() && !q->is_null()) rotation = read_rotation(*q, path + "rotation", order);
   Vec3 translation = Vec3::Zero();
   const auto t = object.find("translation");
   if (t != object.end() && !t->is_null()) {
@@ -105,7 +135,7 @@ Pose read_pose(const Json& object, const std::string& path, QuaternionOrder orde
 // motion (time of impact, proxima/motion/time_of_impact.h: "pose_end", or
 // "linear_velocity" and "angular_velocity" per unit t; none: no motion),
 // its rotations' four numbers in `order`.
-void read_body(const Json& query, const std::string& name, QuaternionOrder order,
+void read_body(const Json& query, const std::string& name, std::optional<QuaternionOrder> order,
                std::vector<Vec3>& vertices, std::vector<std::array<std::int32_t, 3>>& triangles,
                Pose& pose, double& radius, std::optional<Motion>& motion) {
   const auto body = query.find(name);
@@ -225,18 +255,23 @@ double read_nonnegative(const Json& query, const char* field, double otherwise) 
   return x;
 }
 
-// {"rotation":[4 numbers in `order`],"translation":[x,y,z]}.
-void append_pose(std::string& out, const Pose& pose, QuaternionOrder order) {
+// {"rotation":{"wxyz":[w,x,y,z]},"translation":[x,y,z]} (or "xyzw" when the
+// run reads that order): an answer's rotation names its order, so that it
+// reads back the same anywhere.
+void append_pose(std::string& out, const Pose& pose, std::optional<QuaternionOrder> run_order) {
+  const QuaternionOrder order = run_order.value_or(QuaternionOrder::wxyz);
   const Quat q(pose.rotation);
   const double wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
   const double xyzw[4] = {q.x(), q.y(), q.z(), q.w()};
   const double* numbers = order == QuaternionOrder::wxyz ? wxyz : xyzw;
-  out += "{\"rotation\":[";
+  out += "{\"rotation\":{\"";
+  out += to_string(order);
+  out += "\":[";
   for (int i = 0; i < 4; ++i) {
     if (i > 0) out += ',';
     append_number(out, numbers[i]);
   }
-  out += "],\"translation\":";
+  out += "]},\"translation\":";
   append_point(out, pose.translation);
   out += '}';
 }
@@ -281,7 +316,7 @@ ConvexPolytope build_hull(const std::vector<Vec3>& vertices, const std::string& 
 // Appends the answer to one query line to `out`; returns false for an error
 // answer.
 bool answer_line(const std::string& line, long line_number, const DistanceOptions& options,
-                 QuaternionOrder order, Workspace& work, std::string& out) {
+                 std::optional<QuaternionOrder> order, Workspace& work, std::string& out) {
   if (const std::size_t column = nesting_overflow_column(line); column != 0) {
     append_error_answer(out, nullptr, line_number,
                         "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
@@ -485,7 +520,7 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
 }  // namespace
 
 std::string answer_query_line(const std::string& line, const DistanceOptions& options,
-                              QuaternionOrder order) {
+                              std::optional<QuaternionOrder> order) {
   Workspace work;
   std::string out;
   answer_line(line, 1, options, order, work, out);
@@ -501,7 +536,7 @@ bool is_blank(std::string_view line) {
 }  // namespace
 
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads, QuaternionOrder order) {
+                            int threads, std::optional<QuaternionOrder> order) {
   QueryRunSummary summary;
   std::string line;
   long line_number = 0;

@@ -39,23 +39,25 @@ struct QueryRunSummary {
 // answered by `threads` threads, written in input order and flushed once per
 // block. The output is byte for byte the one of threads == 1.
 //
-// A body's "rotation" is four numbers in `order`: (w, x, y, z) by default,
-// (x, y, z, w) for ROS and scipy users (--quaternion-order xyzw).
+// A body's "rotation" names its order ({"wxyz": [w, x, y, z]} or
+// {"xyzw": [x, y, z, w]}), or is four bare numbers in the order the run
+// names (`order`, --quaternion-order); four bare numbers in a run that names
+// none are an error answer showing both readings.
 inline constexpr int kQueryBlockLines = 256;
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads = 1, QuaternionOrder order = QuaternionOrder::wxyz);
+                            int threads = 1, std::optional<QuaternionOrder> order = std::nullopt);
 
 // One line's answer, as run_queries writes it (without the newline); the
 // error answer names line 1. `proxima view` answers the query it draws.
 std::string answer_query_line(const std::string& line, const DistanceOptions& options,
-                              QuaternionOrder order = QuaternionOrder::wxyz);
+                              std::optional<QuaternionOrder> order = std::nullopt);
 
 // Reads body `name` ("a" or "b") of a parsed query line into its vertices,
 // triangles (empty: no "triangles", the hull of the vertices), pose, radius
-// and motion (none: no motion), rotations in `order`: the reader of
+// and motion (none: no motion), rotations as above: the reader of
 // run_queries, shared with `proxima view`. Throws QueryError with the field
 // named (`b.vertices[3][1] is not a finite number`).
-void read_body(const Json& query, const std::string& name, QuaternionOrder order,
+void read_body(const Json& query, const std::string& name, std::optional<QuaternionOrder> order,
                std::vector<Vec3>& vertices, std::vector<std::array<std::int32_t, 3>>& triangles,
                Pose& pose, double& radius, std::optional<Motion>& motion);
 

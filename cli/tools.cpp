@@ -376,14 +376,23 @@ ExportSummary write_hull(const ConvexPolytope& p, const std::string& path,
 
 }  // namespace
 
+Body load_body_named(const std::string& path, const std::string& as,
+                     std::uint64_t max_file_bytes) {
+  return *load_body_as(path, as, max_file_bytes).body;
+}
+
 namespace {
 
 double parse_number(const std::string& token, const std::string& option, int position,
-                    QuaternionOrder order) {
+                    std::optional<QuaternionOrder> order) {
   static constexpr std::array<const char*, 7> kScalarFirst = {"x",  "y",  "z", "qw",
                                                               "qx", "qy", "qz"};
   static constexpr std::array<const char*, 7> kScalarLast = {"x", "y", "z", "qx", "qy", "qz", "qw"};
-  const auto& kNames = order == QuaternionOrder::wxyz ? kScalarFirst : kScalarLast;
+  static constexpr std::array<const char*, 7> kUnnamed = {"x", "y", "z", "q[0]",
+                                                          "q[1]", "q[2]", "q[3]"};
+  const auto& kNames = !order                            ? kUnnamed
+                       : *order == QuaternionOrder::wxyz ? kScalarFirst
+                                                         : kScalarLast;
   double value = 0.0;
   const char* first = token.data();
   const char* last = token.data() + token.size();
@@ -400,22 +409,37 @@ double parse_number(const std::string& token, const std::string& option, int pos
 
 }  // namespace
 
-// x y z, then the quaternion in `order` (qw qx qy qz or qx qy qz qw); the
-// quaternion is normalized, so it only has to be non-zero (a zero
+// x y z, then optionally the quaternion in `order` (qw qx qy qz or qx qy qz
+// qw); the quaternion is normalized, so it only has to be non-zero (a zero
 // quaternion has no rotation to normalize to).
 Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option,
-                QuaternionOrder order) {
+                std::optional<QuaternionOrder> order) {
   if (tokens.empty()) return Pose::identity();
+  if (tokens.size() != 3 && tokens.size() != 7) {
+    throw BadArgument(option + " takes 3 numbers (x y z) or 7 (x y z and a quaternion), not " +
+                      std::to_string(tokens.size()));
+  }
   std::array<double, 7> v{};
-  for (std::size_t i = 0; i < v.size(); ++i)
+  for (std::size_t i = 0; i < tokens.size(); ++i)
     v[i] = parse_number(tokens[i], option, static_cast<int>(i), order);
+  const Vec3 translation(v[0], v[1], v[2]);
+  if (tokens.size() == 3) return Pose(Mat3::Identity(), translation);
   // The pose contract's quaternion (proxima/core/pose.h): normalized at any
-  // magnitude, a zero one refused in the same words as everywhere.
+  // magnitude, a zero one refused in the same words as everywhere. Four
+  // numbers whose order is not named are refused with both readings: in
+  // the other order they are another rotation.
   try {
-    const char* words = order == QuaternionOrder::wxyz ? " (qw qx qy qz)" : " (qx qy qz qw)";
+    if (!order) {
+      const std::string what = option + " quaternion";
+      throw BadArgument(option + ": the quaternion " + tokens[3] + " " + tokens[4] + " " +
+                        tokens[5] + " " + tokens[6] + " does not name its order: " +
+                        quaternion_readings(&v[3], what) +
+                        ". Add --quaternion-order wxyz or --quaternion-order xyzw");
+    }
+    const char* words = *order == QuaternionOrder::wxyz ? " (qw qx qy qz)" : " (qx qy qz qw)";
     return Pose(
-        unit_quaternion(quaternion_in_order(&v[3], order), option + words).toRotationMatrix(),
-        Vec3(v[0], v[1], v[2]));
+        unit_quaternion(quaternion_in_order(&v[3], *order), option + words).toRotationMatrix(),
+        translation);
   } catch (const InvalidInput& e) {
     throw BadArgument(e.what());
   }

@@ -20,12 +20,12 @@ namespace proxima::cli {
 struct DistanceCommand {
   std::string file_a;
   std::string file_b;
-  // Seven tokens each, x y z and the quaternion in `quaternion_order`
-  // (qw qx qy qz by default), as typed (parsed by the command so that a bad
-  // number is bad input, exit 1, not a usage error).
+  // Three tokens each (x y z), or seven: x y z and the quaternion in
+  // `quaternion_order`, which must then be named; as typed (parsed by the
+  // command so that a bad number is bad input, exit 1, not a usage error).
   std::vector<std::string> pose_a;
   std::vector<std::string> pose_b;
-  QuaternionOrder quaternion_order = QuaternionOrder::wxyz;
+  std::optional<QuaternionOrder> quaternion_order;
   DistanceOptions options;
   bool json = false;
   std::uint64_t max_file_bytes = kDefaultMaxFileBytes;  // per input file (ReadOptions)
@@ -52,12 +52,22 @@ struct HullCommand {
 // OBJ or OFF. Returns 0 or 1 like run_distance.
 int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err);
 
-// A --pose-a/--pose-b value: seven tokens x y z and the quaternion in
-// `order`, normalized; no tokens is the identity. Throws std::runtime_error
-// naming the option and the number ("--pose-b qw: 'x' is not a number").
-// Shared by `proxima distance` and `proxima view`.
+// A --pose-a/--pose-b value: three tokens x y z (no rotation), or seven: x
+// y z and the quaternion in `order`, normalized; no tokens is the identity.
+// Seven tokens with no order named are refused with both readings of the
+// quaternion. Throws std::runtime_error naming the option and the number
+// ("--pose-b qw: 'x' is not a number"). Shared by `proxima distance` and
+// `proxima view`.
 Pose parse_pose(const std::vector<std::string>& tokens, const std::string& option,
-                QuaternionOrder order);
+                std::optional<QuaternionOrder> order);
+
+// A mesh file as the body `as` names ("mesh", "hull", "pieces"), or by the
+// one default of every command ("": the hull of a convex file or of a point
+// cloud; a non-convex file with faces is refused, naming the choices).
+// Throws FileError naming the file. Shared by `proxima distance` and
+// `proxima view`, so that both read a file the same way.
+Body load_body_named(const std::string& path, const std::string& as,
+                     std::uint64_t max_file_bytes);
 
 // "obj" or "off" for a path with that extension (any case), empty otherwise.
 std::string export_format(const std::string& path);

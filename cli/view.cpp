@@ -8,6 +8,7 @@
 // the features come from proxima's own answer to the same query.
 #include "view.h"
 
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -45,24 +46,39 @@ class ViewError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Everything `in` holds, but no more than max_bytes: counted as read, so
+// that /dev/zero, a pipe or a device stops at the cap (the size of a
+// regular file is not trusted either), as the mesh readers do.
+std::string read_capped(std::istream& in, const std::string& name, std::uint64_t max_bytes) {
+  std::string text;
+  std::array<char, 1 << 16> buffer{};
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    const auto got = static_cast<std::uint64_t>(in.gcount());
+    if (got > max_bytes - text.size()) {
+      throw ViewError("'" + name + "' is larger than --max-file-size (" +
+                      std::to_string(max_bytes) + " bytes)");
+    }
+    text.append(buffer.data(), static_cast<std::size_t>(got));
+  }
+  if (in.bad()) throw ViewError("reading '" + name + "' failed");
+  return text;
+}
+
 // The non-blank lines of a text file ("-": standard input), each with its
 // line number, a trailing \r dropped.
 std::vector<std::pair<long, std::string>> read_lines(const std::string& path,
                                                      std::uint64_t max_bytes) {
   std::string text;
   if (path == "-") {
-    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    text = read_capped(std::cin, "standard input", max_bytes);
   } else {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec))
       throw ViewError("cannot open '" + path + "': it is a directory");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ViewError("cannot open '" + path + "': " + std::strerror(errno));
-    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  if (text.size() > max_bytes) {
-    throw ViewError("'" + path + "' is larger than --max-file-size (" + std::to_string(max_bytes) +
-                    " bytes)");
+    text = read_capped(in, path, max_bytes);
   }
   std::vector<std::pair<long, std::string>> lines;
   std::istringstream stream(text);
@@ -91,18 +107,12 @@ Json parse_object(const std::string& line, const std::string& where) {
   return j;
 }
 
-// A mesh file as a body: as the command names it (--as), or by default its
-// OBJ groups as the pieces of a compound, a file of one piece a convex body.
+// A mesh file as a body: as `proxima distance` reads it (load_body_named):
+// as --as names it, by default the hull of a convex file or point cloud,
+// and a non-convex file with faces refused until --as names how to read it
+// (the view once took its hull silently where distance refused it).
 Body load_body(const std::string& path, const std::string& as, std::uint64_t max_bytes) {
-  ReadOptions read;
-  read.max_file_bytes = max_bytes;
-  if (!as.empty()) return proxima::load_body(path, load_as_from_string(as), read);
-  LoadedCompound loaded = load_compound(path, read);
-  if (loaded.body.piece_count() == 1 && loaded.body.piece(0).pose.rotation.isIdentity() &&
-      loaded.body.piece(0).pose.translation.isZero()) {
-    return Body(loaded.body.piece(0).polytope);
-  }
-  return Body(std::make_shared<const CompoundBody>(std::move(loaded.body)));
+  return load_body_named(path, as, max_bytes);
 }
 
 std::string file_name(const std::string& path) {

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <ostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,10 +23,10 @@ struct ViewCommand {
   // Two mesh files (each file's OBJ groups are a compound's pieces) ...
   std::string file_a;
   std::string file_b;
-  std::vector<std::string> pose_a;  // seven tokens, as `proxima distance` takes them
+  std::vector<std::string> pose_a;  // as `proxima distance` takes them
   std::vector<std::string> pose_b;
-  // How the files become bodies: "mesh", "hull" or "pieces" (proxima::LoadAs);
-  // "" draws each OBJ group as a piece (one group: a convex body).
+  // How the files become bodies: "mesh", "hull" or "pieces", or "" for the
+  // default of `proxima distance` (load_body_named).
   std::string as;
   // ... or a file of JSON Lines: a query line (docs/query-format.md), then
   // optionally its answer line; without one, the query is answered here ...
@@ -35,7 +36,7 @@ struct ViewCommand {
   // margin.
   std::string scene_file;
   double margin = 0.0;
-  QuaternionOrder quaternion_order = QuaternionOrder::wxyz;
+  std::optional<QuaternionOrder> quaternion_order;  // none: quaternions name their order
   DistanceOptions options;
   std::uint64_t max_file_bytes = kDefaultMaxFileBytes;
   std::string out_file;  // "-" writes the page to `out`

@@ -13,16 +13,16 @@ a = proxima.ConvexPolytope(rng.normal(size=(40, 3)))  # the hull of 40 points
 b = proxima.ConvexPolytope(rng.uniform(-1, 1, size=(30, 3)))
 
 # Poses: None (identity), a 4x4 or 3x4 matrix, a scipy Rotation, a Pose, or
-# (rotation, translation) where a quaternion is (w, x, y, z), SCALAR FIRST.
-# ROS and scipy write (x, y, z, w): say so with Pose.from_xyzw(q, t).
-r = proxima.distance(a, None, b, ((1, 0, 0, 0), (4, 0, 0)))
+# (rotation matrix, translation). A quaternion names its order: ROS and scipy
+# write (x, y, z, w), Pose.from_xyzw(q, t); Eigen (w, x, y, z), Pose.from_wxyz.
+r = proxima.distance(a, None, b, proxima.Pose.from_translation((4, 0, 0)))
 r = proxima.distance(a, None, b, proxima.Pose.from_xyzw((0, 0, 0, 1), (4, 0, 0)))  # the same pose
 print(r.status, r.distance, r.point_a, r.point_b, r.feature_a, r.feature_b)
 
 # Tracking: keep one cache per pair and pass it to every query of that pair.
 cache = proxima.DistanceCache()
 for x in np.linspace(4.0, 3.0, 11):
-    r = proxima.distance(a, None, b, ((1, 0, 0, 0), (x, 0, 0)), cache=cache)
+    r = proxima.distance(a, None, b, proxima.Pose.from_translation((x, 0, 0)), cache=cache)
 print("tracked, after 11 steps:", r.distance, "in", r.iterations, "iterations")
 
 # A batch: 1000 poses of B, on all cores, without the GIL.
@@ -42,7 +42,7 @@ assert out["distance"][0] == proxima.distance(a, None, b, poses_b[0]).distance
 box = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
 ell = proxima.CompoundBody([box * [3, 1, 1], box * [1, 3, 1]])
 cache = proxima.CompoundCache()
-r = proxima.distance(ell, None, ell, ((1, 0, 0, 0), (2.5, 2.5, 0)), cache=cache)
+r = proxima.distance(ell, None, ell, proxima.Pose.from_translation((2.5, 2.5, 0)), cache=cache)
 print("compound:", r.status, r.distance, "pieces", r.piece_a, r.piece_b)
 assert abs(r.distance - 1.5) < 1e-12  # bar to bar, across the gap in y
 
@@ -50,7 +50,7 @@ assert abs(r.distance - 1.5) < 1e-12  # bar to bar, across the gap in y
 # margin, each tracked with its own cache across steps.
 scene = proxima.Scene(margin=0.1)
 positions = rng.uniform(0, 12, size=(200, 3))
-ids = np.array([scene.add(b if i % 2 else ell, ((1, 0, 0, 0), p))
+ids = np.array([scene.add(b if i % 2 else ell, proxima.Pose.from_translation(p))
                 for i, p in enumerate(positions)])
 poses = np.tile(np.eye(4), (200, 1, 1))
 for step in range(10):

@@ -168,8 +168,26 @@ inline Vec3 translation_or_zero(py::handle t_obj, const std::string& name) {
 }
 
 inline Pose pose_from_quaternion(py::handle q_obj, py::handle t_obj, const std::string& name,
-                                 QuaternionOrder order = QuaternionOrder::wxyz) {
+                                 QuaternionOrder order) {
   return {quaternion_rotation(q_obj, order, name), translation_or_zero(t_obj, name)};
+}
+
+// Four numbers that do not say their order (a bare quaternion in a
+// (rotation, translation) pair, Pose.from_quaternion without `order`) are
+// refused, with what they mean in each order: read in the other order they
+// are another rotation (ROS's identity (0, 0, 0, 1) read scalar first is a
+// half turn about z), so no default is safe.
+[[noreturn]] inline void refuse_unnamed_quaternion(py::handle q_obj, const std::string& name,
+                                                   const std::string& remedy) {
+  const DoubleArray q = as_double_array(q_obj, name + " quaternion");
+  if (q.ndim() != 1 || q.shape(0) != 4) {
+    value_error(name + ": the rotation must be a 3x3 matrix, a scipy Rotation or a quaternion " +
+                "whose order is named; got shape " + shape_of(q));
+  }
+  const double numbers[4] = {q.at(0), q.at(1), q.at(2), q.at(3)};
+  const std::string readings = quaternion_readings(numbers, name);
+  value_error(name + ": the quaternion (" + std::string(py::str(py::repr(q_obj))) +
+              ") does not name its order: " + readings + ". " + remedy);
 }
 
 // A scipy.spatial.transform.Rotation, recognized by its type without
@@ -197,8 +215,9 @@ inline Mat3 to_rotation(py::handle obj, const std::string& name) {
 }
 
 // A pose argument: None (identity), a proxima.Pose, a 4x4 or 3x4 matrix, a
-// scipy Rotation, or a (rotation, translation) pair whose rotation is a
-// quaternion (w, x, y, z), a 3x3 matrix or a scipy Rotation.
+// scipy Rotation, or a (rotation, translation) pair whose rotation is a 3x3
+// matrix or a scipy Rotation. A bare quaternion in a pair is refused
+// (refuse_unnamed_quaternion): Pose.from_wxyz / Pose.from_xyzw name it.
 inline Pose to_pose(py::handle obj, const std::string& name) {
   if (obj.is_none()) return Pose{};
   if (py::isinstance<Pose>(obj)) return obj.cast<Pose>();
@@ -211,15 +230,18 @@ inline Pose to_pose(py::handle obj, const std::string& name) {
     const py::array shaped = py::array::ensure(first);
     if (is_scipy_rotation(first) || (shaped && shaped.ndim() == 2))
       return {to_rotation(first, name + " rotation"), to_vec3(second, name + " translation")};
-    return pose_from_quaternion(first, second, name);
+    refuse_unnamed_quaternion(first, name,
+                              "Name it: Pose.from_wxyz(q, t) or Pose.from_xyzw(q, t) (ROS, "
+                              "scipy's as_quat()), or pass a scipy Rotation or a 3x3 matrix");
   }
   const DoubleArray m = as_double_array(obj, name);
   if (m.ndim() == 2 && m.shape(0) == 3 && m.shape(1) == 4) return pose_from_rows(m.data(), name);
   if (m.ndim() != 2 || m.shape(0) != 4 || m.shape(1) != 4) {
     value_error(name +
                 ": expected None, a 4x4 or 3x4 matrix, a scipy Rotation, a (rotation, "
-                "translation) pair (rotation: a quaternion w, x, y, z, a 3x3 matrix or a scipy "
-                "Rotation) or a proxima.Pose; got an array of shape " +
+                "translation) pair (rotation: a 3x3 matrix or a scipy Rotation) or a "
+                "proxima.Pose (Pose.from_wxyz / Pose.from_xyzw for a quaternion); got an array "
+                "of shape " +
                 shape_of(m));
   }
   return pose_from_matrix(m.data(), name);

@@ -49,14 +49,15 @@ const char* const kModuleDoc =
     a = proxima.ConvexPolytope(np.random.default_rng(1).normal(size=(50, 3)))
     b = proxima.ConvexPolytope.from_file("body.obj")
     cache = proxima.DistanceCache()                       # cold; keep it for tracking
-    r = proxima.distance(a, None, b, ((1, 0, 0, 0), (5, 0, 0)), cache=cache)
+    r = proxima.distance(a, None, b, proxima.Pose.from_translation((5, 0, 0)), cache=cache)
     r.status, r.distance, r.point_a, r.point_b
 
 Poses are None (identity), 4x4 or 3x4 rigid matrices, scipy Rotation objects,
-(rotation, translation) pairs or proxima.Pose objects. A quaternion in a pair
-is read (w, x, y, z), scalar first; ROS, scipy's as_quat() and PyBullet give
-(x, y, z, w): name the order with Pose.from_xyzw(q, t) / Pose.from_wxyz(q, t),
-or pass the scipy Rotation itself. Bad input raises proxima.InvalidInput (a
+(rotation, translation) pairs (rotation: a 3x3 matrix or a scipy Rotation) or
+proxima.Pose objects. A quaternion always names its order:
+Pose.from_wxyz(q, t) (scalar first) or Pose.from_xyzw(q, t) (ROS, scipy's
+as_quat(), PyBullet); a bare quaternion in a pair is refused with both of its
+readings, since in the other order it is another rotation. Bad input raises proxima.InvalidInput (a
 ValueError) with the C++ message; a missing file raises FileNotFoundError.
 )doc";
 
@@ -100,9 +101,8 @@ PYBIND11_MODULE(_proxima, m) {
             return pose_from_quaternion(q, t, "pose", QuaternionOrder::wxyz);
           },
           py::arg("quaternion"), py::arg("translation") = py::none(),
-          "From a quaternion in the order (w, x, y, z) (scalar first: Eigen, this library's "
-          "(quaternion, translation) pairs and the CLI's default), normalized here, and a "
-          "translation (default zero).")
+          "From a quaternion in the order (w, x, y, z) (scalar first: Eigen, the CLI's "
+          "{\"wxyz\": ...}), normalized here, and a translation (default zero).")
       .def_static(
           "from_xyzw",
           [](py::object q, py::object t) {
@@ -113,9 +113,25 @@ PYBIND11_MODULE(_proxima, m) {
           "PyBullet), normalized here, and a translation (default zero).")
       .def_static(
           "from_quaternion",
-          [](py::object q, py::object t) { return pose_from_quaternion(q, t, "pose"); },
-          py::arg("quaternion"), py::arg("translation"),
-          "Pose.from_wxyz under its older name: the quaternion is (w, x, y, z).")
+          [](py::object q, py::object t, py::object order) {
+            if (order.is_none()) {
+              refuse_unnamed_quaternion(q, "Pose.from_quaternion",
+                                        "Name it: order='wxyz' or order='xyzw' (ROS, scipy's "
+                                        "as_quat()), or Pose.from_wxyz / Pose.from_xyzw");
+            }
+            const std::string name = py::str(order);
+            if (name != "wxyz" && name != "xyzw") {
+              value_error("Pose.from_quaternion: order must be 'wxyz' or 'xyzw', not " +
+                          std::string(py::str(py::repr(order))));
+            }
+            return pose_from_quaternion(
+                q, t, "pose", name == "wxyz" ? QuaternionOrder::wxyz : QuaternionOrder::xyzw);
+          },
+          py::arg("quaternion"), py::arg("translation") = py::none(), py::kw_only(),
+          py::arg("order") = py::none(),
+          "From a quaternion in the order named by the keyword order ('wxyz' or 'xyzw', "
+          "required: without it the quaternion is refused with both of its readings), "
+          "normalized here, and a translation (default zero).")
       .def_static(
           "from_rotation",
           [](py::object r, py::object t) {
@@ -481,8 +497,8 @@ triangle mesh (no depth is defined for it: use the mesh's hull or convex pieces)
       R"doc(Minimum distance, closest points and features of hulls a and b placed at pose_a and pose_b.
 
 Poses: None (identity), a 4x4 or 3x4 rigid matrix, a scipy Rotation, a (rotation, translation)
-pair (rotation: a quaternion (w, x, y, z), a 3x3 matrix or a scipy Rotation) or a Pose. For a
-ROS/scipy quaternion (x, y, z, w) use Pose.from_xyzw(q, t).
+pair (rotation: a 3x3 matrix or a scipy Rotation) or a Pose. A quaternion names its order:
+Pose.from_wxyz(q, t) or Pose.from_xyzw(q, t) (ROS, scipy); a bare one in a pair is refused.
 cache: a DistanceCache updated in place (tracking) or None (cold).
 algorithm: 'hybrid' (the paper), 'gjk' or 'enhanced_gjk'. The tolerances and the iteration cap are
 DistanceOptions' fields. Returns a DistanceResult.)doc");

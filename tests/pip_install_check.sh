@@ -51,7 +51,7 @@ assert package.startswith(venv + os.sep), f"proxima imported from {package}, not
 cube = [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)]
 a = proxima.ConvexPolytope(cube)
 b = proxima.ConvexPolytope(cube)
-r = proxima.distance(a, None, b, ((1, 0, 0, 0), (3, 0, 0)))
+r = proxima.distance(a, None, b, proxima.Pose.from_translation((3, 0, 0)))
 assert r.status == "separated" and abs(r.distance - 2.0) < 1e-12, r
 
 for name in ("py.typed", "__init__.pyi", "_proxima.pyi"):
@@ -74,6 +74,12 @@ PY
   help=$("$venv/bin/python" -m proxima --help)
   grep -q "query" <<<"$help" || { echo "python -m proxima --help printed: $help" >&2; exit 1; }
   echo "python -m proxima --help: $(head -n 1 <<<"$help")"
+  # Issue 25: the README says `proxima` is on the venv's PATH after pip
+  # install; there was no console script, only `python -m proxima`.
+  [ -x "$venv/bin/proxima" ] || { echo "pip installed no $venv/bin/proxima" >&2; exit 1; }
+  help=$(PATH="$venv/bin:/usr/bin:/bin" proxima --help)
+  grep -q "query" <<<"$help" || { echo "proxima --help (the console script) printed: $help" >&2; exit 1; }
+  echo "proxima --help (console script): $(head -n 1 <<<"$help")"
 }
 
 # A copy of the checkout, as a clone would have it (plus uncommitted work);

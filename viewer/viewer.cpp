@@ -175,18 +175,43 @@ Json feature_json(const ShownBody& shown, std::int32_t piece, const Feature& fea
               {"face", std::move(face)}};
 }
 
-// The page: the template with its placeholders replaced. The data's "</"
-// is written "<\/" (the same string to JSON), so that no name in it can end
-// its <script> element.
+// The data as inert text for the inside of a <script> element. The HTML
+// parser looks into a script's text for "</script" (which ends it) and for
+// "<!--" followed by "<script" (which makes it swallow the scripts after it,
+// up to a later "-->"); JSON never needs '<', '>' or '&' outside its strings,
+// so each is written as its \uXXXX escape (the same string to JSON.parse)
+// and no sequence the parser reacts to can appear, whatever the names and
+// titles hold. U+2028 and U+2029 are escaped too: they end a line in a
+// JavaScript string literal, so the data stays inert if a page ever inlines
+// it as a script rather than JSON. Bytes that are not UTF-8 (a file name on
+// Linux is any bytes) become U+FFFD: the page shows the rest of the name.
+std::string inert_json(const Json& data) {
+  const std::string json = data.dump(-1, ' ', false, Json::error_handler_t::replace);
+  std::string safe;
+  safe.reserve(json.size() + json.size() / 16);
+  for (std::size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (c == '<') {
+      safe += "\\u003c";
+    } else if (c == '>') {
+      safe += "\\u003e";
+    } else if (c == '&') {
+      safe += "\\u0026";
+    } else if (c == '\xE2' && i + 2 < json.size() && json[i + 1] == '\x80' &&
+               (json[i + 2] == '\xA8' || json[i + 2] == '\xA9')) {
+      safe += json[i + 2] == '\xA8' ? "\\u2028" : "\\u2029";
+      i += 2;
+    } else {
+      safe += c;
+    }
+  }
+  return safe;
+}
+
+// The page: the template with its placeholders replaced.
 std::string fill_page(const Json& data) {
   if (!available()) throw ViewerUnavailable();
-  std::string json = data.dump();
-  std::string safe;
-  safe.reserve(json.size());
-  for (std::size_t i = 0; i < json.size(); ++i) {
-    safe += json[i];
-    if (json[i] == '<' && i + 1 < json.size() && json[i + 1] == '/') safe += '\\';
-  }
+  const std::string safe = inert_json(data);
   std::string page(assets::kPageHtml);
   const auto replace = [&page](std::string_view key, std::string_view value) {
     const std::size_t at = page.find(key);

@@ -29,7 +29,10 @@ def find_cli(bundled=BUNDLED):
     if _executable(bundled):
         return bundled, ""
     on_path = shutil.which("proxima")
-    if on_path:
+    # The console script `proxima` (pyproject.toml) is this module: running
+    # it again would loop.
+    running = os.path.realpath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    if on_path and os.path.realpath(on_path) != running:
         return on_path, ""
     return None, (
         f"the proxima tool was not found ({bundled} is missing, and there is no proxima on PATH): "

@@ -59,7 +59,7 @@ def test_any_two_body_kinds():
     convex = proxima.ConvexPolytope(points)
     compound = proxima.CompoundBody([convex])
     rounded = proxima.Body(convex)
-    pose = ((1, 0, 0, 0), (4, 0.5, 0))
+    pose = proxima.Pose.from_translation((4, 0.5, 0))
     reference = proxima.distance(convex, None, convex, pose).distance
     for a, b in itertools.product([convex, compound, rounded], repeat=2):
         r = proxima.distance(a, None, b, pose)

@@ -37,7 +37,7 @@ def tolerance(*bodies):
 def test_pieces_from_polytopes_points_and_posed_pairs():
     rng = np.random.default_rng(1)
     hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
-    body = proxima.CompoundBody([hull, rng.normal(size=(10, 3)), (hull, ((1, 0, 0, 0), (5, 0, 0)))])
+    body = proxima.CompoundBody([hull, rng.normal(size=(10, 3)), (hull, proxima.Pose.from_translation((5, 0, 0)))])
     assert body.piece_count == 3 and len(body) == 3
     polytope, pose = body.piece(2)
     assert polytope.vertex_count == hull.vertex_count
@@ -67,10 +67,10 @@ def test_bad_pieces_name_the_piece():
 def test_pieces_outlive_the_python_objects():
     rng = np.random.default_rng(3)
     hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
-    body = proxima.CompoundBody([hull, (hull, ((1, 0, 0, 0), (4, 0, 0)))])
+    body = proxima.CompoundBody([hull, (hull, proxima.Pose.from_translation((4, 0, 0)))])
     del hull
     gc.collect()
-    r = proxima.distance(body, None, body, ((1, 0, 0, 0), (20, 0, 0)))
+    r = proxima.distance(body, None, body, proxima.Pose.from_translation((20, 0, 0)))
     assert r.status == "separated" and r.distance > 0
 
 
@@ -85,7 +85,7 @@ def test_compound_distance_equals_its_twin_and_tracking_equals_cold():
     tested_tracked, tested_cold = 0, 0
     for _ in range(40):
         position += rng.normal(size=3) * 0.05
-        pose_b = (q_b, position)
+        pose_b = proxima.Pose.from_wxyz(q_b, position)
         tracked = proxima.distance(a, None, b, pose_b, cache=cache)
         cold = proxima.distance(a, None, b, pose_b)
         twin = proxima.distance_all_pairs(a, None, b, pose_b)
@@ -97,7 +97,7 @@ def test_compound_distance_equals_its_twin_and_tracking_equals_cold():
         # those two pieces gives the same distance.
         pa, pose_pa = a.piece(tracked.piece_a)
         pb, pose_pb = b.piece(tracked.piece_b)
-        world_b = proxima.Pose.from_quaternion(q_b, position) * pose_pb
+        world_b = proxima.Pose.from_wxyz(q_b, position) * pose_pb
         pair = proxima.distance(pa, pose_pa, pb, world_b)
         assert abs(pair.distance - tracked.distance) <= tolerance(a, b) + 1e-12 * pair.distance
         tested_tracked += tracked.pairs_tested
@@ -110,7 +110,7 @@ def test_compound_distance_equals_its_twin_and_tracking_equals_cold():
 def test_overlapping_compounds_are_intersecting():
     rng = np.random.default_rng(5)
     a = random_compound(rng, 5, spread=1.0)
-    r = proxima.distance(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
+    r = proxima.distance(a, None, a, proxima.Pose.from_translation((0.1, 0, 0)))
     assert r.status == "intersecting" and r.distance == 0.0
 
 
@@ -127,7 +127,7 @@ def test_load_compound_reports_each_group(tmp_path):
     assert loaded.body.piece_count == 2
     with pytest.warns(proxima.NonConvexInputWarning, match="group\\(s\\) 'left'"):
         body = proxima.CompoundBody.from_file(str(path))
-    r = proxima.distance(body, None, body, ((1, 0, 0, 0), (0, 0, 5)))
+    r = proxima.distance(body, None, body, proxima.Pose.from_translation((0, 0, 5)))
     assert abs(r.distance - 4.0) < 1e-12
     with pytest.raises(FileNotFoundError):
         proxima.load_compound(str(tmp_path / "missing.obj"))
@@ -146,7 +146,7 @@ def random_scene(rng, bodies, margin, threads=1, broad_phase="dynamic_aabb_tree"
     ids = []
     for i in range(bodies):
         body = compound if i % 10 == 0 else shapes[i % len(shapes)]
-        ids.append(scene.add(body, (quaternion(rng), positions[i])))
+        ids.append(scene.add(body, proxima.Pose.from_wxyz(quaternion(rng), positions[i])))
     return scene, np.array(ids), positions
 
 
@@ -191,11 +191,11 @@ def test_scene_add_remove_and_errors():
     hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
     scene = proxima.Scene(margin=0.1)
     a = scene.add(hull)
-    b = scene.add(hull, ((1, 0, 0, 0), (100, 0, 0)))
+    b = scene.add(hull, proxima.Pose.from_translation((100, 0, 0)))
     del hull
     gc.collect()
     assert scene.step() == []
-    scene.set_pose(b, ((1, 0, 0, 0), (0.5, 0, 0)))
+    scene.set_pose(b, proxima.Pose.from_translation((0.5, 0, 0)))
     pairs = scene.step()
     assert [(p.a, p.b) for p in pairs] == [(a, b)] and pairs[0].result.status == "intersecting"
     scene.remove(b)
@@ -203,7 +203,7 @@ def test_scene_add_remove_and_errors():
     with pytest.raises(proxima.InvalidInput, match=str(b)):
         scene.set_pose(b, None)
     with pytest.raises(proxima.InvalidInput):
-        scene.set_pose(a, ((1, 0, 0, 0), (np.nan, 0, 0)))
+        scene.set_pose(a, proxima.Pose.from_translation((np.nan, 0, 0)))
     with pytest.raises(proxima.InvalidInput):
         proxima.Scene(margin=-1.0)
     with pytest.raises(ValueError, match="broad_phase"):
@@ -219,10 +219,10 @@ def test_set_poses_is_all_or_nothing():
     rng = np.random.default_rng(9)
     hull = proxima.ConvexPolytope(rng.normal(size=(20, 3)))
     scene = proxima.Scene(margin=0.1)
-    a = scene.add(hull, ((1, 0, 0, 0), (0, 0, 0)))
-    b = scene.add(hull, ((1, 0, 0, 0), (10, 0, 0)))
+    a = scene.add(hull, proxima.Pose.from_translation((0, 0, 0)))
+    b = scene.add(hull, proxima.Pose.from_translation((10, 0, 0)))
     scene.remove(b)
-    c = scene.add(hull, ((1, 0, 0, 0), (20, 0, 0)))
+    c = scene.add(hull, proxima.Pose.from_translation((20, 0, 0)))
     before = {i: scene.pose(i).matrix() for i in scene.body_ids}
     moved = np.tile(np.eye(4), (3, 1, 1))
     moved[:, :3, 3] = [[1, 1, 1], [2, 2, 2], [3, 3, 3]]
@@ -309,22 +309,22 @@ def test_compound_and_scene_results_carry_the_signed_distance():
     # (the deepest overlapping pair); a scene's close pair carries it.
     rng = np.random.default_rng(5)
     a = random_compound(rng, 5, spread=1.0)
-    r = proxima.distance(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
+    r = proxima.distance(a, None, a, proxima.Pose.from_translation((0.1, 0, 0)))
     assert r.status == "intersecting" and r.signed_distance < 0
     assert r.signed_lower_bound <= r.signed_distance <= r.signed_upper_bound
-    twin = proxima.distance_all_pairs(a, None, a, ((1, 0, 0, 0), (0.1, 0, 0)))
+    twin = proxima.distance_all_pairs(a, None, a, proxima.Pose.from_translation((0.1, 0, 0)))
     assert abs(twin.signed_distance - r.signed_distance) <= 1e-12
     hull = proxima.ConvexPolytope(np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)]))
     # A scene skips the depth unless asked (its overlapping pairs would pay
     # for it every step).
     plain = proxima.Scene(margin=0.1)
     plain.add(hull)
-    plain.add(hull, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    plain.add(hull, proxima.Pose.from_translation((0.75, 0.1, 0.2)))
     pairs = plain.step()
     assert len(pairs) == 1 and pairs[0].result.signed_distance == 0.0
     scene = proxima.Scene(margin=0.1, penetration=True)
     scene.add(hull)
-    scene.add(hull, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    scene.add(hull, proxima.Pose.from_translation((0.75, 0.1, 0.2)))
     pairs = scene.step()
     assert len(pairs) == 1 and abs(pairs[0].result.signed_distance + 0.25) <= 1e-15
 
@@ -410,7 +410,7 @@ def test_scene_takes_bodies_meshes_and_padding_as_distance_of_bodies():
     entries = []
     for i in range(30):
         body = kinds[i % len(kinds)]
-        pose = (quaternion(rng), rng.uniform(0, 4, 3))
+        pose = proxima.Pose.from_wxyz(quaternion(rng), rng.uniform(0, 4, 3))
         padding = 0.1 if i % 4 == 0 else 0.0
         assert scene.add(body, pose, padding=padding) == i
         entries.append((proxima.Body(body) if not isinstance(body, proxima.Body) else body,
@@ -445,8 +445,8 @@ def test_scene_takes_bodies_meshes_and_padding_as_distance_of_bodies():
 def test_scene_padding_acts_as_a_radius_and_is_checked():
     ball = proxima.sphere(0.5)
     scene = proxima.Scene()
-    a = scene.add(ball, ((1, 0, 0, 0), (0, 0, 0)))
-    b = scene.add(ball, ((1, 0, 0, 0), (1.5, 0, 0)))  # 0.5 apart
+    a = scene.add(ball, proxima.Pose.from_translation((0, 0, 0)))
+    b = scene.add(ball, proxima.Pose.from_translation((1.5, 0, 0)))  # 0.5 apart
     assert scene.step() == []
     scene.set_padding(a, 0.3)
     assert scene.step() == []  # 0.2 apart
@@ -468,8 +468,8 @@ def test_scene_padding_acts_as_a_radius_and_is_checked():
 def test_scene_bodies_inside_a_closed_room_mesh_intersect_it_and_sweep_takes_it():
     scene = proxima.Scene()
     room = scene.add(box_mesh((-10, -10, 0), (10, 10, 10)))
-    inside = scene.add(proxima.sphere(0.5), ((1, 0, 0, 0), (0, 0, 5)), padding=0.2)
-    scene.add(proxima.sphere(0.5), ((1, 0, 0, 0), (30, 0, 5)))
+    inside = scene.add(proxima.sphere(0.5), proxima.Pose.from_translation((0, 0, 5)), padding=0.2)
+    scene.add(proxima.sphere(0.5), proxima.Pose.from_translation((30, 0, 5)))
     (pair,) = scene.step()
     assert (pair.a, pair.b) == (room, inside) and pair.result.status == "intersecting"
     hits = scene.sweep()  # a mesh sweeps too: the ball inside overlaps at t = 0

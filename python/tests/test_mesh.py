@@ -33,7 +33,7 @@ def test_mesh_against_any_body_equals_the_convex_query():
     rng = np.random.default_rng(12)
     other = proxima.ConvexPolytope(rng.normal(size=(20, 3)) * 0.3)
     for k in range(40):
-        pose = ((1, 0, 0, 0), tuple(rng.uniform(-3, 3, size=3)))
+        pose = proxima.Pose.from_translation(tuple(rng.uniform(-3, 3, size=3)))
         want = proxima.distance(box, None, other, pose)
         got = proxima.distance(mesh, None, other, pose)
         assert type(got) is proxima.BodyDistance
@@ -46,13 +46,13 @@ def test_mesh_against_any_body_equals_the_convex_query():
     assert body.kind == "mesh" and body.mesh is not None and body.compound is None
     assert "mesh" in repr(body)
     ball = proxima.sphere(0.2)
-    r = proxima.distance(body, None, ball, ((1, 0, 0, 0), (2, 0, 0)))
+    r = proxima.distance(body, None, ball, proxima.Pose.from_translation((2, 0, 0)))
     assert r.signed_distance == pytest.approx(2 - 0.5 - 0.1 - 0.2, abs=1e-12)
     # A ball inside the closed cube overlaps it; mesh against mesh too.
     assert proxima.distance(mesh, None, proxima.sphere(0.1), None).status == "intersecting"
     small = proxima.TriangleMesh(*cube(0.1))
     assert proxima.distance(mesh, None, small, None).status == "intersecting"
-    r = proxima.distance(mesh, None, small, ((1, 0, 0, 0), (3, 0, 0)))
+    r = proxima.distance(mesh, None, small, proxima.Pose.from_translation((3, 0, 0)))
     assert r.distance == pytest.approx(2.4, abs=1e-12)
     assert r.triangle_a >= 0 and r.triangle_b >= 0
 
@@ -101,7 +101,7 @@ def test_load_body_says_what_it_reads(tmp_path):
     assert (mesh.kind, hull.kind, pieces.kind) == ("mesh", "convex", "compound")
     assert pieces.radius == 0.01 and mesh.mesh.is_closed
     # In the notch: 0.5 from the L's surface, inside its hull.
-    at = ((1, 0, 0, 0), (1.5, 1.5, 0.5))
+    at = proxima.Pose.from_translation((1.5, 1.5, 0.5))
     ball = proxima.sphere(0.1)
     assert proxima.distance(mesh, None, ball, at).signed_distance == pytest.approx(0.4, abs=1e-12)
     assert proxima.distance(hull, None, ball, at).status == "intersecting"

@@ -71,7 +71,7 @@ def bodies():
 def test_unit_cubes_face_to_face():
     a = proxima.ConvexPolytope(cube())
     b = proxima.ConvexPolytope(cube())
-    r = proxima.distance(a, None, b, ((1, 0, 0, 0), (3, 0, 0)))
+    r = proxima.distance(a, None, b, proxima.Pose.from_translation((3, 0, 0)))
     assert r.status == "separated"
     assert r.distance == pytest.approx(2.0, rel=1e-15)
     assert r.lower_bound <= r.distance
@@ -100,8 +100,8 @@ def test_vertex_to_vertex_along_the_diagonal():
 def test_overlap_and_contact():
     a = proxima.ConvexPolytope(cube())
     b = proxima.ConvexPolytope(cube())
-    assert proxima.distance(a, None, b, ((1, 0, 0, 0), (0.5, 0.1, 0))).status == "intersecting"
-    touching = proxima.distance(a, None, b, ((1, 0, 0, 0), (1.0, 0.2, 0.1)))
+    assert proxima.distance(a, None, b, proxima.Pose.from_translation((0.5, 0.1, 0))).status == "intersecting"
+    touching = proxima.distance(a, None, b, proxima.Pose.from_translation((1.0, 0.2, 0.1)))
     assert touching.status == "touching"
     assert touching.distance <= 64 * 2.0**-53 * 2
 
@@ -173,9 +173,9 @@ def test_pose_formats_agree():
     q, rot = random_rotation(rng)
     t = np.array([3.0, -1.0, 0.5])
     as_matrix = proxima.distance(a, None, b, matrix(rot, t))
-    as_tuple = proxima.distance(a, None, b, (q, t))
-    as_list = proxima.distance(a, None, b, [list(q), list(t)])
-    as_pose = proxima.distance(a, None, b, proxima.Pose.from_quaternion(q, t))
+    as_tuple = proxima.distance(a, None, b, (rot, t))
+    as_list = proxima.distance(a, None, b, [rot.tolist(), list(t)])
+    as_pose = proxima.distance(a, None, b, proxima.Pose.from_wxyz(q, t))
     as_pose_rt = proxima.distance(a, proxima.Pose(), b, proxima.Pose(rot, t))
     # The quaternion path builds the matrix in C++ (Eigen): equal up to rounding.
     for r in (as_tuple, as_list, as_pose):
@@ -186,13 +186,14 @@ def test_pose_formats_agree():
     moved = proxima.ConvexPolytope(points_b @ rot.T + t)
     assert proxima.distance(a, None, moved, None).distance == pytest.approx(as_matrix.distance, rel=1e-12)
     # A non-unit quaternion is normalized, not a scale.
-    assert proxima.distance(a, None, b, (3 * q, t)).distance == pytest.approx(as_tuple.distance, rel=1e-13)
+    assert proxima.distance(a, None, b, proxima.Pose.from_wxyz(3 * q, t)).distance == pytest.approx(
+        as_pose.distance, rel=1e-13)
 
 
 def test_pose_object():
     rng = np.random.default_rng(5)
     q, rot = random_rotation(rng)
-    p = proxima.Pose.from_quaternion(q, [1, 2, 3])
+    p = proxima.Pose.from_wxyz(q, [1, 2, 3])
     np.testing.assert_allclose(p.rotation, rot, atol=1e-15)
     np.testing.assert_array_equal(p.translation, [1, 2, 3])
     m = p.matrix()
@@ -214,8 +215,8 @@ def test_pose_object():
         (np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0.5, 1.0]]), "bottom row"),
         (np.eye(3), "4x4"),
         (((0, 0, 0, 0), (1, 2, 3)), "quaternion is zero"),
-        (((1, 0, 0), (1, 2, 3)), "quaternion must be 4 numbers"),
-        (((1, 0, 0, 0), (1, 2)), "3 numbers"),
+        (((1, 0, 0), (1, 2, 3)), "rotation must be a 3x3 matrix, a scipy Rotation or a quaternion"),
+        ((np.eye(3), (1, 2)), "3 numbers"),
     ],
 )
 def test_bad_poses_are_value_errors(pose, words):
@@ -285,7 +286,7 @@ def test_complex_arrays_are_refused_everywhere():
     with pytest.raises(ValueError, match="pose_b quaternion: " + words):
         proxima.distance(a, None, a, (np.array([1, 0, 0, 0], dtype=complex), (3, 0, 0)))
     with pytest.raises(ValueError, match="pose_b translation: " + words):
-        proxima.distance(a, None, a, ((1, 0, 0, 0), (3 + 1j, 0, 0)))
+        proxima.distance(a, None, a, (np.eye(3), (3 + 1j, 0, 0)))
     with pytest.raises(ValueError, match="matrix: " + words):
         proxima.Pose.from_matrix(pose.astype(complex))
     with pytest.raises(ValueError, match="rotation: " + words):
@@ -319,22 +320,22 @@ def test_quaternion_of_any_magnitude_is_its_rotation(magnitude):
     # 0.84). Python and the CLI now both use proxima's unit_quaternion: the
     # rotation is that of (1, 0, 0, 1), a quarter turn about z, bit for bit.
     q = magnitude * np.array([1.0, 0.0, 0.0, 1.0])
-    unit = proxima.Pose.from_quaternion([1.0, 0.0, 0.0, 1.0], [0, 0, 0])
-    pose = proxima.Pose.from_quaternion(q, [0, 0, 0])
+    unit = proxima.Pose.from_wxyz([1.0, 0.0, 0.0, 1.0], [0, 0, 0])
+    pose = proxima.Pose.from_wxyz(q, [0, 0, 0])
     np.testing.assert_array_equal(pose.rotation, unit.rotation)
     np.testing.assert_allclose(pose.rotation, [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15)
     assert np.linalg.det(pose.rotation) == pytest.approx(1.0, abs=1e-15)
-    # The same through every path that takes a (quaternion, translation) pair.
+    # The same through every path that takes a pose.
     a = proxima.ConvexPolytope(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]]))
     b = proxima.ConvexPolytope(np.array([[0.0, 0, 0]]))
     # B's point at (0, 2, 0) is A's vertex (1, 0, 0) turned a quarter about z,
     # plus (0, 1, 0): distance 1 exactly when the rotation is right.
-    r = proxima.distance(a, (q, (0, 0, 0)), b, ((1, 0, 0, 0), (0, 2, 0)))
+    r = proxima.distance(a, proxima.Pose.from_wxyz(q), b, proxima.Pose.from_translation((0, 2, 0)))
     assert r.distance == pytest.approx(1.0, abs=1e-15)
     scene = proxima.Scene(margin=10.0)
-    i = scene.add(a, (q, (0, 0, 0)))
+    i = scene.add(a, proxima.Pose.from_wxyz(q))
     np.testing.assert_array_equal(scene.pose(i).rotation, unit.rotation)
-    body = proxima.CompoundBody([(a, (q, (0, 0, 0)))])
+    body = proxima.CompoundBody([(a, proxima.Pose.from_xyzw(np.roll(q, -1)))])
     np.testing.assert_array_equal(body.piece(0)[1].rotation, unit.rotation)
 
 
@@ -344,7 +345,7 @@ def test_quaternion_of_any_magnitude_is_its_rotation(magnitude):
      ((np.nan, 0, 0, 1), "not finite"), ((1, np.inf, 0, 0), "not finite")])
 def test_zero_or_non_finite_quaternion_is_refused(q, words):
     with pytest.raises(proxima.InvalidInput, match="pose: .*" + words):
-        proxima.Pose.from_quaternion(q, (0, 0, 0))
+        proxima.Pose.from_wxyz(q, (0, 0, 0))
     scene = proxima.Scene()
     with pytest.raises(proxima.InvalidInput, match=words):
         scene.add(proxima.ConvexPolytope(cube()), (q, (0, 0, 0)))
@@ -362,8 +363,8 @@ def test_cache_tracking(bodies):
     for step in range(50):
         t = (3.0 + 0.01 * step, 0.5, 0.0)
         q = (math.cos(0.005 * step), 0.0, math.sin(0.005 * step), 0.0)
-        tracked = proxima.distance(a, None, b, (q, t), cache=cache)
-        cold = proxima.distance(a, None, b, (q, t))
+        tracked = proxima.distance(a, None, b, proxima.Pose.from_wxyz(q, t), cache=cache)
+        cold = proxima.distance(a, None, b, proxima.Pose.from_wxyz(q, t))
         assert not cache.is_cold()
         assert tracked.distance == pytest.approx(cold.distance, rel=2.5e-12)
         if step > 0:
@@ -377,10 +378,10 @@ def test_cache_tracking(bodies):
 def test_cache_from_another_pair_is_harmless(bodies):
     a, b = bodies
     foreign = proxima.DistanceCache()
-    proxima.distance(b, None, b, ((1, 0, 0, 0), (5, 0, 0)), cache=foreign)
+    proxima.distance(b, None, b, proxima.Pose.from_translation((5, 0, 0)), cache=foreign)
     foreign.hint_a, foreign.vertices_b = 10**6, [10**6, -5, 3, 2]
-    r = proxima.distance(a, None, b, ((1, 0, 0, 0), (4, 1, 0)), cache=foreign)
-    assert r.distance == pytest.approx(proxima.distance(a, None, b, ((1, 0, 0, 0), (4, 1, 0))).distance, rel=2.5e-12)
+    r = proxima.distance(a, None, b, proxima.Pose.from_translation((4, 1, 0)), cache=foreign)
+    assert r.distance == pytest.approx(proxima.distance(a, None, b, proxima.Pose.from_translation((4, 1, 0))).distance, rel=2.5e-12)
 
 
 # --- batch --------------------------------------------------------------------
@@ -442,7 +443,7 @@ def test_batch_broadcasts_one_pose(bodies):
     pb[:, 0, 3] = np.linspace(3.0, 6.0, k)
     ident = proxima.distance_batch(a, None, b, pb)
     same = proxima.distance_batch(a, np.eye(4), b, pb)
-    tupled = proxima.distance_batch(a, ((1, 0, 0, 0), (0, 0, 0)), b, pb)
+    tupled = proxima.distance_batch(a, proxima.Pose.from_translation((0, 0, 0)), b, pb)
     np.testing.assert_array_equal(ident["distance"], same["distance"])
     np.testing.assert_array_equal(ident["distance"], tupled["distance"])
     swapped = proxima.distance_batch(b, pb, a, None)  # K from either side
@@ -630,6 +631,38 @@ def test_every_binding_has_a_docstring():
     assert not missing, missing
 
 
+# Issue 25: a bare quaternion still went through silently. proxima.distance
+# (a, None, b, (q, t)) read q as (w, x, y, z), so a ROS user's (x, y, z, w)
+# gave another rotation with no warning (0.0839 m where the right pose gives
+# 0.0778 m in the issue's case). Four numbers that do not name their order
+# are now refused wherever a pose is taken, with what they mean in each order.
+def test_a_bare_quaternion_is_refused_with_both_readings():
+    a = proxima.ConvexPolytope(cube())
+    ros_identity = (0.0, 0.0, 0.0, 1.0)
+    both = (r"does not name its order: as \(w, x, y, z\) it is a turn of 180 degrees about "
+            r"\(0, 0, 1\); as \(x, y, z, w\) \(ROS, scipy\) it is the identity")
+    with pytest.raises(ValueError, match="pose_b: the quaternion .*" + both + r".*Pose.from_xyzw"):
+        proxima.distance(a, None, a, (ros_identity, (3, 0, 0)))
+    with pytest.raises(ValueError, match=both):
+        proxima.Scene().add(a, (list(ros_identity), [3, 0, 0]))
+    with pytest.raises(ValueError, match=both):
+        proxima.CompoundBody([(a, (np.array(ros_identity), None))])
+    with pytest.raises(ValueError, match=both + r".*order='wxyz' or order='xyzw'"):
+        proxima.Pose.from_quaternion(ros_identity, (3, 0, 0))
+    with pytest.raises(ValueError, match="order must be 'wxyz' or 'xyzw'"):
+        proxima.Pose.from_quaternion(ros_identity, order="ros")
+    # Named, each order is read as named: the ROS identity is the identity.
+    np.testing.assert_array_equal(
+        proxima.Pose.from_quaternion(ros_identity, order="xyzw").rotation, np.eye(3))
+    r = proxima.distance(a, None, a, proxima.Pose.from_xyzw(ros_identity, (3, 0, 0)))
+    assert r.distance == pytest.approx(2.0, rel=1e-15)
+    # A quarter turn: the axis and angle of each reading.
+    with pytest.raises(ValueError, match=r"as \(w, x, y, z\) it is a turn of 90 degrees about "
+                                         r"\(0, 0, 1\); as \(x, y, z, w\) \(ROS, scipy\) it is a "
+                                         r"turn of 90 degrees about \(1, 0, 0\)"):
+        proxima.distance(a, None, a, ((1, 0, 0, 1), (3, 0, 0)))
+
+
 # Issue 11, rotations that cannot be misread: a ROS/scipy quaternion
 # (x, y, z, w) passed as a plain 4-tuple was read as (w, x, y, z): ROS's
 # identity (0, 0, 0, 1) became a half turn about z. The orders now have
@@ -653,8 +686,11 @@ def test_quaternion_orders_are_named():
     sign = np.sign(from_wxyz.as_wxyz()[0]) * np.sign(q_wxyz[0])
     np.testing.assert_allclose(from_wxyz.as_wxyz() * sign, q_wxyz, atol=1e-15)
     np.testing.assert_allclose(from_xyzw.as_xyzw() * sign, q_xyzw, atol=1e-15)
-    # The older name keeps its meaning.
-    np.testing.assert_array_equal(proxima.Pose.from_quaternion(q_wxyz, t).rotation, from_wxyz.rotation)
+    # The older name takes the order as a keyword.
+    np.testing.assert_array_equal(
+        proxima.Pose.from_quaternion(q_wxyz, t, order="wxyz").rotation, from_wxyz.rotation)
+    np.testing.assert_array_equal(
+        proxima.Pose.from_quaternion(q_xyzw, t, order="xyzw").rotation, from_wxyz.rotation)
     # The error names the order it expected.
     with pytest.raises(ValueError, match=r"4 numbers \(x, y, z, w\)"):
         proxima.Pose.from_xyzw((0.0, 0.0, 1.0))
@@ -897,14 +933,14 @@ def test_pair_batch_refuses_bad_poses_naming_the_index():
 def test_signed_distance_of_overlapping_and_separated_cubes():
     a = proxima.ConvexPolytope(cube())
     b = proxima.ConvexPolytope(cube())
-    over = proxima.distance(a, None, b, ((1, 0, 0, 0), (0.75, 0.1, 0.2)))
+    over = proxima.distance(a, None, b, proxima.Pose.from_translation((0.75, 0.1, 0.2)))
     assert over.status == "intersecting" and over.distance == 0.0
     assert math.isclose(over.signed_distance, -0.25, abs_tol=1e-15)
     assert math.isclose(over.depth, 0.25, abs_tol=1e-15)
     assert over.signed_lower_bound <= over.signed_distance <= over.signed_upper_bound
     np.testing.assert_allclose(over.normal, [1, 0, 0], atol=1e-15)
     np.testing.assert_allclose(over.point_b + over.depth * over.normal, over.point_a, atol=1e-15)
-    apart = proxima.distance(a, None, b, ((1, 0, 0, 0), (1.5, 0.1, 0.2)))
+    apart = proxima.distance(a, None, b, proxima.Pose.from_translation((1.5, 0.1, 0.2)))
     assert apart.signed_distance == apart.distance and apart.depth == 0.0
     assert apart.signed_lower_bound == apart.lower_bound
     assert "signed_distance=" in repr(over)
@@ -958,19 +994,19 @@ def test_penetration_false_skips_the_depth_everywhere():
     # are the same either way.
     a = proxima.ConvexPolytope(cube())
     b = proxima.ConvexPolytope(cube())
-    over = ((1, 0, 0, 0), (0.75, 0.1, 0.2))
+    over = proxima.Pose.from_translation((0.75, 0.1, 0.2))
     r = proxima.distance(a, None, b, over, penetration=False)
     assert r.status == "intersecting" and r.signed_distance == 0.0 and r.depth == 0.0
     assert r.signed_lower_bound == -math.inf and r.signed_upper_bound == 0.0
     with pytest.raises(proxima.InvalidInput, match="penetration"):
         proxima.signed_distance_gradient(r, None, over)
-    apart = ((1, 0, 0, 0), (1.5, 0.1, 0.2))
+    apart = proxima.Pose.from_translation((1.5, 0.1, 0.2))
     x = proxima.distance(a, None, b, apart, penetration=False)
     y = proxima.distance(a, None, b, apart)
     assert x.signed_distance == y.signed_distance and np.array_equal(x.point_a, y.point_a)
     poses_b = np.tile(np.eye(4), (2, 1, 1))
-    poses_b[0, :3, 3] = over[1]
-    poses_b[1, :3, 3] = apart[1]
+    poses_b[0, :3, 3] = over.translation
+    poses_b[1, :3, 3] = apart.translation
     out = proxima.distance_batch(a, None, b, poses_b, penetration=False)
     assert list(out["signed_distance"]) == [0.0, y.signed_distance]
     batch = proxima.PairBatch([a, a], [b, b])

@@ -110,7 +110,7 @@ USE = textwrap.dedent('''
     cube = np.array([(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)], dtype=float)
     a = proxima.ConvexPolytope(cube)
     cache = proxima.DistanceCache()
-    r = proxima.distance(a, None, a, ((1, 0, 0, 0), (3, 0, 0)), cache=cache)
+    r = proxima.distance(a, None, a, proxima.Pose.from_translation((3, 0, 0)), cache=cache)
     gap: float = r.distance
     point: npt.NDArray[np.float64] = r.point_a
     status: str = r.status

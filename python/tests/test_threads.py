@@ -59,7 +59,7 @@ SCENE_RACE = """
                                      for c in ((0, 0, 0), (0.8, 0, 0), (0, 0.8, 0))])
     scene = proxima.Scene(margin=0.3, threads=__THREADS__)
     ids = np.array([scene.add(compound if i % 10 == 0 else shapes[i % 4],
-                              ((1, 0, 0, 0), rng.uniform(0, 9, 3))) for i in range(n)])
+                              proxima.Pose.from_translation(rng.uniform(0, 9, 3))) for i in range(n)])
     stop = threading.Event()
     counts = {"moves": 0, "refused": 0, "steps": 0, "step_refused": 0}
     unexpected = []
@@ -148,7 +148,7 @@ COMPOUND_RACE = """
                     cache.reset()
                     cache.near_pairs
                 else:
-                    proxima.distance(a, None, b, ((1, 0, 0, 0), local.uniform(3, 5, 3)), cache=cache)
+                    proxima.distance(a, None, b, proxima.Pose.from_translation(local.uniform(3, 5, 3)), cache=cache)
             except RuntimeError as e:
                 if BUSY not in str(e):
                     unexpected.append(repr(e))
@@ -163,7 +163,7 @@ COMPOUND_RACE = """
     try:
         while refused[1] < 50 and time.monotonic() < deadline and not unexpected:
             try:
-                proxima.distance(a, None, b, ((1, 0, 0, 0), local.uniform(3, 5, 3)), cache=cache)
+                proxima.distance(a, None, b, proxima.Pose.from_translation(local.uniform(3, 5, 3)), cache=cache)
             except RuntimeError as e:
                 if BUSY not in str(e):
                     unexpected.append(repr(e))
@@ -174,7 +174,7 @@ COMPOUND_RACE = """
     assert not unexpected, unexpected
     assert refused[1] >= 50, refused
     # The cache still tracks right: a warm query equals a cold one.
-    pose = ((1, 0, 0, 0), (4.0, 0.5, 0.0))
+    pose = proxima.Pose.from_translation((4.0, 0.5, 0.0))
     warm = proxima.distance(a, None, b, pose, cache=cache)
     cold = proxima.distance(a, None, b, pose)
     assert abs(warm.distance - cold.distance) <= 1e-9 and warm.status == cold.status

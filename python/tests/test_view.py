@@ -27,7 +27,7 @@ def data_of(page):
 
 def test_view_writes_the_pair_page(tmp_path):
     a, b = cube(), cube()
-    pose_b = ([0.9, 0.1, 0.3, 0.2], [2.0, 0.3, 0.1])
+    pose_b = proxima.Pose.from_wxyz([0.9, 0.1, 0.3, 0.2], [2.0, 0.3, 0.1])
     path = tmp_path / "pair.html"
     page = proxima.view(a, b, pose_b=pose_b, path=path, name_a="left", name_b="right", inline=False)
     assert path.read_text(encoding="utf-8") == page
@@ -53,7 +53,7 @@ def test_view_of_compounds_draws_every_piece():
 
 def test_view_scene_draws_the_close_pairs(tmp_path):
     bodies = [cube() for _ in range(4)]
-    poses = [([1, 0, 0, 0], [1.1 * i, 0, 0]) for i in range(4)]
+    poses = [proxima.Pose.from_translation([1.1 * i, 0, 0]) for i in range(4)]
     page = proxima.view_scene(bodies, poses, margin=0.2, path=str(tmp_path / "s.html"), inline=False)
     data = data_of(page)
     assert data["kind"] == "scene" and len(data["bodies"]) == 4
@@ -83,7 +83,7 @@ def test_in_a_notebook_the_page_shows_inline(monkeypatch):
     ipython.display = display
     monkeypatch.setitem(sys.modules, "IPython", ipython)
     monkeypatch.setitem(sys.modules, "IPython.display", display)
-    page = proxima.view(cube(), cube(), pose_b=([1, 0, 0, 0], [3, 0, 0]))
+    page = proxima.view(cube(), cube(), pose_b=proxima.Pose.from_translation([3, 0, 0]))
     assert len(shown) == 1 and shown[0][0] == "HTML"
     assert shown[0][1].startswith("<iframe srcdoc=\"&lt;!doctype html&gt;")
     # Outside a kernel (a terminal IPython), nothing is shown.
@@ -94,9 +94,26 @@ def test_in_a_notebook_the_page_shows_inline(monkeypatch):
 
 
 def test_names_cannot_end_the_data_script():
-    # The data sits in a <script> element, which the first "</script" ends:
-    # the writer writes "</" as "<\/" (the same JSON string).
+    # The data sits in a <script> element, which the first "</script" ends.
     name = "</script><script>alert(1)</script>"
-    data = data_of(proxima.view(cube(), cube(), pose_b=([1, 0, 0, 0], [2, 0, 0]), name_a=name,
+    data = data_of(proxima.view(cube(), cube(), pose_b=proxima.Pose.from_translation([2, 0, 0]), name_a=name,
                                 inline=False))
     assert data["bodies"][0]["name"] == name
+
+
+def test_titles_and_names_are_inert_in_the_page():
+    # Issue 25: only "</" was escaped, so a title or name holding
+    # "<!--<script>" put the HTML parser in its "script data double escaped"
+    # state and the data element swallowed three.js and the viewer code (the
+    # page never rendered). No '<', '>', '&', U+2028 or U+2029 is written raw
+    # in the data now; the browser test renders such pages.
+    hostile = "<!--<script>&\u2028\u2029-->"
+    page = proxima.view(cube(), cube(), pose_b=proxima.Pose.from_translation([2, 0, 0]), title=hostile,
+                        name_a=hostile, inline=False)
+    inside = re.search(r'<script id="proxima-data" type="application/json">(.*?)</script>', page, re.S).group(1)
+    assert not re.search("[<>&\u2028\u2029]", inside), inside[:200]
+    data = json.loads(inside)
+    assert data["title"] == hostile and data["bodies"][0]["name"] == hostile
+    scene = proxima.view_scene([cube(), cube()], [None, proxima.Pose.from_translation([2, 0, 0])], margin=1.0,
+                               title=hostile, inline=False)
+    assert data_of(scene)["title"] == hostile and "<!--<script>" not in scene.split("proxima-data")[1][:4000]

@@ -27,7 +27,7 @@ namespace proxima::detail {
 // both sides of the limit; BodyRefusals.BadPosesAreNamed the rounded body's). A rounded body's
 // core plus radius is held to the same limit, so that no sum of radii,
 // signed distance or offset point can overflow either.
-inline constexpr double kMaxMagnitude = 0x1p1018;
+using proxima::kMaxMagnitude;  // defined in proxima/core/types.h
 
 // The largest coordinate magnitude of vertex y placed at `pose`.
 double placed_magnitude(const Vec3& y, const Pose& pose);

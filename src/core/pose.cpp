@@ -6,7 +6,9 @@
 #include "proxima/core/pose.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 namespace proxima {
@@ -27,6 +29,32 @@ Quat unit_quaternion(const Quat& q, std::string_view what) {
   // matters (a component below 2^-1022 of the largest is 0 to the rotation).
   const Quat scaled(Eigen::Vector4d(c / largest));
   return scaled.normalized();
+}
+
+namespace {
+
+// "the identity" or "a turn of A degrees about (x, y, z)", for a unit q. The
+// angle is taken in [0, 180] (q and -q are one rotation).
+std::string rotation_words(const Quat& q) {
+  const double w = std::abs(q.w());
+  const Vec3 v = q.w() < 0.0 ? Vec3(-q.vec()) : Vec3(q.vec());
+  const double s = v.norm();
+  if (s == 0.0) return "the identity";
+  const Vec3 axis = v / s;
+  const double degrees = 2.0 * std::atan2(s, w) * (180.0 / std::numbers::pi);
+  char text[160];
+  std::snprintf(text, sizeof text, "a turn of %.6g degrees about (%.6g, %.6g, %.6g)", degrees,
+                axis.x() + 0.0, axis.y() + 0.0, axis.z() + 0.0);
+  return text;
+}
+
+}  // namespace
+
+std::string quaternion_readings(const double* q, std::string_view what) {
+  const Quat scalar_first = unit_quaternion(quaternion_in_order(q, QuaternionOrder::wxyz), what);
+  const Quat scalar_last = unit_quaternion(quaternion_in_order(q, QuaternionOrder::xyzw), what);
+  return "as (w, x, y, z) it is " + rotation_words(scalar_first) +
+         "; as (x, y, z, w) (ROS, scipy) it is " + rotation_words(scalar_last);
 }
 
 namespace detail {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/accuracy.h"
+#include "core/magnitude_limit.h"
 #include "proxima/query/distance.h"
 
 namespace proxima {
@@ -456,13 +457,11 @@ BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Po
   // distance or the offset points could overflow to infinity).
   for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
     const double reach = magnitude_bound(*pose, body->scale());
-    if (!(reach <= detail::kMaxMagnitude)) {
-      char message[200];
-      std::snprintf(message, sizeof message,
-                    "distance: body %s with radius %g reaches coordinates of magnitude %g, beyond "
-                    "the supported %g",
-                    name, body->radius(), reach, detail::kMaxMagnitude);
-      throw InvalidInput(message);
+    if (!(reach <= kMaxMagnitude)) {
+      char radius[64];
+      std::snprintf(radius, sizeof radius, "%.3g", body->radius());
+      throw InvalidInput(detail::beyond_magnitude(std::string("distance: body ") + name, reach,
+                                                  std::string("with its radius ") + radius));
     }
   }
   // The cores' queries without their own depth: the depth of overlapping

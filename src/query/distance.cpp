@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/magnitude_limit.h"
 #include "proxima/detail/narrowphase/gjk.h"
 #include "proxima/detail/narrowphase/hybrid.h"
 #include "core/accuracy.h"
@@ -153,15 +154,11 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   // cache with the exact band, so that "separated" means d > 64 u R exactly
   // (finish_query).
   const double r_bound = detail::magnitude_bound_pair(pose_a, a.scale(), pose_b, b.scale());
-  if (!(r_bound <= detail::kMaxMagnitude)) [[unlikely]] {
-    char what[200];
-    std::snprintf(
-        what, sizeof what,
-        "distance: body %s reaches coordinates of magnitude %.3g (vertices and pose translation), "
-        "beyond the supported %.3g where differences of coordinates may overflow",
-        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "a" : "b", r_bound,
-        detail::kMaxMagnitude);
-    throw InvalidInput(what);
+  if (!(r_bound <= kMaxMagnitude)) [[unlikely]] {
+    throw InvalidInput(detail::beyond_magnitude(
+        world_magnitude_bound(a, pose_a) >= world_magnitude_bound(b, pose_b) ? "distance: body a"
+                                                                              : "distance: body b",
+        r_bound, "vertices and pose translation"));
   }
   const Pose b_in_a = detail::relative_pose(pose_a, pose_b);
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);

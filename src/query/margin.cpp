@@ -24,10 +24,6 @@
 namespace proxima {
 namespace {
 
-// Largest coordinate magnitude accepted: the distance query's own limit
-// (distance.cpp says why: beyond it differences of coordinates overflow).
-constexpr double kMaxMagnitude = 0x1p1018;
-
 // Slack of a sphere gap, in units of u times the magnitudes involved (the
 // centers' coordinates, the radii, the gap's norm): the placed centers are
 // a rotation and a translation away from stored doubles (a few u of their

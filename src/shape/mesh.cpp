@@ -8,21 +8,24 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <string>
 
+#include "core/magnitude_limit.h"
 #include "core/power_of_two.h"
 #include "proxima/detail/geometry/exact_predicates.h"
 
 namespace proxima {
 namespace {
 
-// Coordinates beyond this are refused: the query scales both meshes by a
-// power of two of their magnitude and forms sums of a few coordinates, so
-// that 1e300 leaves a factor of 1e8 before overflow.
-constexpr double kMaxCoordinate = 1e300;
+// Coordinates beyond the one limit of every body (magnitude_limit.h) are
+// refused: the queries scale both meshes by a power of two of their
+// magnitude, and the inside test's rays reach 4 times it.
+using detail::kMaxMagnitude;
 
 std::atomic<std::uint64_t> next_mesh_id{1};
 
@@ -206,6 +209,72 @@ bool coplanar_point_in_triangle(const Vec3& a, const Vec3& b, const Vec3& c, con
   return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
 }
 
+// The triangles that the hierarchy holds: all but repeats. A triangle whose
+// three corners are, as a set, the same points as an earlier triangle's
+// (by index or by coordinates, in any order or orientation) is the same
+// surface: it changes no distance, closest point or crossing, only the
+// work. Left in, N coincident copies on each side of an overlapping pair
+// are N^2 triangle pairs within the contact band that no bound can prune
+// (each is at distance 0 and none crosses). The first copy (the smallest
+// id) is kept, so the witness triangle is the one an all-pairs scan finds
+// first. O(n log n): the corners' bits hashed, then sorted by hash.
+std::vector<std::int32_t> distinct_triangles(std::span<const Vec3> vertices,
+                                             std::span<const TriangleMesh::Triangle> triangles) {
+  using Corners = std::array<std::array<std::uint64_t, 3>, 3>;
+  const auto corners = [&](std::size_t t) {
+    Corners c;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec3& v = vertices[triangles[t][k]];
+      // +0.0 so that -0.0 and 0.0, the same point, have the same bits.
+      c[k] = {std::bit_cast<std::uint64_t>(v.x() + 0.0), std::bit_cast<std::uint64_t>(v.y() + 0.0),
+              std::bit_cast<std::uint64_t>(v.z() + 0.0)};
+    }
+    std::sort(c.begin(), c.end());
+    return c;
+  };
+  struct Keyed {
+    std::uint64_t hash;
+    std::int32_t triangle;
+  };
+  std::vector<Keyed> keyed(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+    for (const auto& corner : corners(t)) {
+      for (const std::uint64_t bits : corner) {
+        h ^= bits + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+        h *= 0xff51afd7ed558ccdULL;
+      }
+    }
+    keyed[t] = {h, static_cast<std::int32_t>(t)};
+  }
+  std::sort(keyed.begin(), keyed.end(), [](const Keyed& x, const Keyed& y) {
+    return x.hash < y.hash || (x.hash == y.hash && x.triangle < y.triangle);
+  });
+  std::vector<char> repeat(triangles.size(), 0);
+  for (std::size_t i = 0; i < keyed.size();) {
+    std::size_t end = i + 1;
+    while (end < keyed.size() && keyed[end].hash == keyed[i].hash) ++end;
+    // Equal hashes: compare the corners themselves (a collision is not a
+    // repeat). Runs are short unless the triangles really repeat.
+    for (std::size_t a = i; a < end; ++a) {
+      const auto ta = static_cast<std::size_t>(keyed[a].triangle);
+      if (repeat[ta] != 0) continue;
+      const Corners ca = corners(ta);
+      for (std::size_t b = a + 1; b < end; ++b) {
+        const auto tb = static_cast<std::size_t>(keyed[b].triangle);
+        if (repeat[tb] == 0 && corners(tb) == ca) repeat[tb] = 1;
+      }
+    }
+    i = end;
+  }
+  std::vector<std::int32_t> kept;
+  kept.reserve(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    if (repeat[t] == 0) kept.push_back(static_cast<std::int32_t>(t));
+  }
+  return kept;
+}
+
 }  // namespace
 
 TriangleMesh::TriangleMesh(std::span<const Vec3> vertices, std::span<const Triangle> triangles)
@@ -246,9 +315,9 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
     if (!is_finite_bits(v.x()) || !is_finite_bits(v.y()) || !is_finite_bits(v.z()))
       throw InvalidInput(vertex_problem(i, v));
     const double m = v.cwiseAbs().maxCoeff();
-    if (m > kMaxCoordinate) {
-      throw InvalidInput("TriangleMesh: vertex " + std::to_string(i) + " has a coordinate of " +
-                         "magnitude " + std::to_string(m) + " (at most 1e300 is accepted)");
+    if (!(m <= kMaxMagnitude)) {
+      throw InvalidInput(
+          detail::beyond_magnitude("TriangleMesh: vertex " + std::to_string(i), m, ""));
     }
     scale_ = std::max(scale_, m);
   }
@@ -320,21 +389,23 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
   // The hierarchy.
   const double inv_unit = 1.0 / unit_;
   Builder builder{vertices_, triangles_, {}, nodes_, {}, inv_unit};
-  builder.items.resize(triangles_.size());
-  for (std::size_t t = 0; t < triangles_.size(); ++t) {
+  const std::vector<std::int32_t> distinct = distinct_triangles(vertices_, triangles_);
+  builder.items.resize(distinct.size());
+  for (std::size_t i = 0; i < distinct.size(); ++i) {
+    const auto t = static_cast<std::size_t>(distinct[i]);
     const Triangle& tri = triangles_[t];
     const Vec3 p0 = vertices_[tri[0]] * inv_unit, p1 = vertices_[tri[1]] * inv_unit,
                p2 = vertices_[tri[2]] * inv_unit;
-    builder.items[t] = {((p0 + p1 + p2) / 3.0).cast<float>(), static_cast<std::int32_t>(t),
+    builder.items[i] = {((p0 + p1 + p2) / 3.0).cast<float>(), static_cast<std::int32_t>(t),
                         p0.cwiseMin(p1).cwiseMin(p2).cast<float>(),
                         p0.cwiseMax(p1).cwiseMax(p2).cast<float>()};
   }
-  nodes_.reserve(2 * (triangles_.size() + TriangleMesh::kLeafSize - 1) / TriangleMesh::kLeafSize *
+  nodes_.reserve(2 * (distinct.size() + TriangleMesh::kLeafSize - 1) / TriangleMesh::kLeafSize *
                  2);
   Vec3 lo, hi;
-  builder.build(0, static_cast<std::int32_t>(triangles_.size()), lo, hi);
+  builder.build(0, static_cast<std::int32_t>(distinct.size()), lo, hi);
   nodes_.shrink_to_fit();
-  order_.resize(triangles_.size());
+  order_.resize(distinct.size());
   for (std::size_t k = 0; k < order_.size(); ++k) order_[k] = builder.items[k].triangle;
   Vec3 root_lo, root_hi;
   box(0, root_lo, root_hi);

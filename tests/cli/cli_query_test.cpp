@@ -221,18 +221,18 @@ TEST(CliQuery, RotatedInputIsPlacedInTheWorldFrame) {
   // Two cubes turned 45 degrees about z face each other edge to edge along
   // x: the edges are at x = sqrt(1/2) and x = 3 - sqrt(1/2).
   queries.push_back({{"id", 0},
-                     {"a", {{"vertices", points_json(cube)}, {"rotation", {c, 0, 0, s}}}},
+                     {"a", {{"vertices", points_json(cube)}, {"rotation", {{"wxyz", {c, 0, 0, s}}}}}},
                      {"b",
                       {{"vertices", points_json(cube)},
-                       {"rotation", {c, 0, 0, s}},
+                       {"rotation", {{"wxyz", {c, 0, 0, s}}}},
                        {"translation", {3, 0, 0}}}}});
   // The same with quaternions of length 3 and -1 (q and -q are the same
   // rotation): normalized by the tool, same answer.
   queries.push_back({{"id", 1},
-                     {"a", {{"vertices", points_json(cube)}, {"rotation", {3 * c, 0, 0, 3 * s}}}},
+                     {"a", {{"vertices", points_json(cube)}, {"rotation", {{"wxyz", {3 * c, 0, 0, 3 * s}}}}}},
                      {"b",
                       {{"vertices", points_json(cube)},
-                       {"rotation", {-c, 0, 0, -s}},
+                       {"rotation", {{"wxyz", {-c, 0, 0, -s}}}},
                        {"translation", {3, 0, 0}}}}});
   // A segment along x turned 90 degrees about z lies along y; moved up by
   // 1 it spans (0,0,1)..(0,1,1). Its closest point to (0.5, 2, 1) is
@@ -240,7 +240,7 @@ TEST(CliQuery, RotatedInputIsPlacedInTheWorldFrame) {
   queries.push_back({{"id", 2},
                      {"a",
                       {{"vertices", {{0, 0, 0}, {1, 0, 0}}},
-                       {"rotation", {2, 0, 0, 2}},
+                       {"rotation", {{"wxyz", {2, 0, 0, 2}}}},
                        {"translation", {0, 0, 1}}}},
                      {"b", {{"vertices", {{0.5, 2, 1}}}}}});
   const TempFile file(lines_of(queries));
@@ -425,7 +425,7 @@ TEST(CliQuery, BadFieldsAreNamedAndTheRunGoesOn) {
       {R"({"a": {"vertices": [[0,0,0]], "rotation": [0,0,0,0]}, "b": {"vertices": [[1,0,0]]}})",
        "a.rotation: the quaternion is zero: it is not a rotation"},
       {R"({"a": {"vertices": [[0,0,0]], "rotation": [1,0,0]}, "b": {"vertices": [[1,0,0]]}})",
-       "a.rotation is not an array of 4 numbers [w, x, y, z] (it has 3 elements)"},
+       "a.rotation is not an array of 4 numbers (it has 3 elements)"},
       {R"({"a": {"vertices": [[0,0,0]]}, "b": {"vertices": [[1,0,0]], "translation": [0,null,0]}})",
        "b.translation[1] is not a number (it is null)"},
       {R"([1, 2, 3])", "the line is not a JSON object (it is an array)"},
@@ -588,11 +588,11 @@ TEST(CliQuery, AlgorithmsAgreeOnRandomPosedHulls) {
         {{"id", i},
          {"a",
           {{"vertices", points_json(a.local)},
-           {"rotation", {a.rotation.w(), a.rotation.x(), a.rotation.y(), a.rotation.z()}},
+           {"rotation", {{"wxyz", {a.rotation.w(), a.rotation.x(), a.rotation.y(), a.rotation.z()}}}},
            {"translation", {a.translation.x(), a.translation.y(), a.translation.z()}}}},
          {"b",
           {{"vertices", points_json(b.local)},
-           {"rotation", {b.rotation.w(), b.rotation.x(), b.rotation.y(), b.rotation.z()}},
+           {"rotation", {{"wxyz", {b.rotation.w(), b.rotation.x(), b.rotation.y(), b.rotation.z()}}}},
            {"translation", {b.translation.x(), b.translation.y(), b.translation.z()}}}}});
     pairs.push_back(pair);
   }
@@ -885,7 +885,7 @@ TEST(CliQuery, MotionMakesATimeOfImpactQuery) {
   EXPECT_LE(t, 0.3);
   EXPECT_GE(t, 0.3 - 1e-9);
   EXPECT_NEAR(answers[0].at("pose_b").at("translation")[0].get<double>(), 2.0, 1e-8);
-  EXPECT_EQ(answers[0].at("pose_b").at("rotation")[0], 1.0);  // w first by default
+  EXPECT_EQ(answers[0].at("pose_b").at("rotation").at("wxyz")[0], 1.0);  // named, w first
   EXPECT_LE(answers[0].at("distance").get<double>(), 1e-9);
   EXPECT_EQ(answers[1].at("status"), "contact");
   EXPECT_NEAR(answers[1].at("t").get<double>(), 0.25, 1e-9);
@@ -959,8 +959,9 @@ TEST(CliQuery, VelocitiesTurnThroughAnyAngleAndLimitsAreNamed) {
 
 // Issue 11, rotations that cannot be misread: ROS's identity quaternion
 // (0, 0, 0, 1) written scalar last was read scalar first, a half turn about
-// z. With --quaternion-order xyzw the same line is the identity; the default
-// stays (w, x, y, z); a wrong count names the order expected.
+// z. With --quaternion-order xyzw the same line is the identity, with
+// --quaternion-order wxyz the half turn; a wrong count names the order
+// expected.
 TEST(CliQuery, QuaternionOrderIsANamedChoice) {
   REQUIRE_CLI();
   const std::vector<Vec3> unit = box(Vec3(0, 0, 0), Vec3(1, 1, 1));
@@ -976,8 +977,8 @@ TEST(CliQuery, QuaternionOrderIsANamedChoice) {
   const std::vector<Json> ros_answers = parse_answers(ros.out);
   ASSERT_EQ(ros_answers.size(), 1U) << ros.out;
   EXPECT_NEAR(check_answer_fields(ros_answers[0]), 2.0, accuracy_bound(2.0, 4.0));
-  // Scalar first (the default): a half turn about z, B spans x in [2, 3].
-  const CliRun eigen = run_cli("query " + shell_quote(file.path()));
+  // Scalar first: a half turn about z, B spans x in [2, 3].
+  const CliRun eigen = run_cli("query --quaternion-order wxyz " + shell_quote(file.path()));
   ASSERT_EQ(eigen.exit_code, 0);
   const std::vector<Json> eigen_answers = parse_answers(eigen.out);
   ASSERT_EQ(eigen_answers.size(), 1U) << eigen.out;
@@ -992,4 +993,46 @@ TEST(CliQuery, QuaternionOrderIsANamedChoice) {
       << refused.out;
   const CliRun unknown = run_cli("query --quaternion-order zyx " + shell_quote(file.path()), true);
   EXPECT_EQ(unknown.exit_code, 2);
+}
+
+// Issue 25: the CLI still read a bare rotation [0, 0, 0, 1] (ROS's identity)
+// scalar first by default, a half turn about z, without a word. A run that
+// names no order now refuses four bare numbers with both of their readings;
+// {"wxyz": [...]} and {"xyzw": [...]} name the order in the line itself, and
+// an answer's poses name theirs.
+TEST(CliQuery, ABareQuaternionIsRefusedWithBothReadings) {
+  REQUIRE_CLI();
+  const std::vector<Vec3> unit = box(Vec3(0, 0, 0), Vec3(1, 1, 1));
+  const auto line = [&unit](const Json& rotation) {
+    return Json{{"a", {{"vertices", points_json(unit)}}},
+                {"b",
+                 {{"vertices", points_json(unit)},
+                  {"translation", {3, 0, 0}},
+                  {"rotation", rotation}}}};
+  };
+  const TempFile file(lines_of({line({0, 0, 0, 1}), line({{"xyzw", {0, 0, 0, 1}}}),
+                                line({{"wxyz", {0, 0, 0, 1}}}), line({{"xyzw", {0, 0, 1}}}),
+                                line({{"zyx", {0, 0, 0, 1}}})}));
+  const CliRun run = run_cli("query " + shell_quote(file.path()));
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  const std::vector<Json> answers = parse_answers(run.out);
+  ASSERT_EQ(answers.size(), 5U) << run.out;
+  EXPECT_EQ(answers[0].at("error"),
+            "line 1: b.rotation [0,0,0,1] does not name its quaternion order: as (w, x, y, z) it "
+            "is a turn of 180 degrees about (0, 0, 1); as (x, y, z, w) (ROS, scipy) it is the "
+            "identity. Write {\"wxyz\": [...]} or {\"xyzw\": [...]}, or run with "
+            "--quaternion-order wxyz or xyzw");
+  EXPECT_NEAR(check_answer_fields(answers[1]), 2.0, accuracy_bound(2.0, 4.0));  // the identity
+  EXPECT_NEAR(check_answer_fields(answers[2]), 1.0, accuracy_bound(1.0, 4.0));  // the half turn
+  EXPECT_EQ(answers[3].at("error"),
+            "line 4: b.rotation.xyzw is not an array of 4 numbers [x, y, z, w] (it has 3 "
+            "elements)");
+  EXPECT_EQ(answers[4].at("error"),
+            "line 5: b.rotation is an object but not {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, "
+            "z, w]}");
+  // A named rotation wins over the run's order: the same answer either way.
+  const CliRun named = run_cli("query --quaternion-order wxyz " + shell_quote(file.path()));
+  const std::vector<Json> named_answers = parse_answers(named.out);
+  ASSERT_EQ(named_answers.size(), 5U) << named.out;
+  EXPECT_EQ(named_answers[1].at("distance"), answers[1].at("distance"));
 }

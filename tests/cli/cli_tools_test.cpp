@@ -235,7 +235,7 @@ TEST(CliDistance, PoseFlagsMatchTheLibrary) {
     const proxima::DistanceResult r = proxima::distance(a, pose_a, b, pose_b, options);
 
     const CliRun run = run_cli("distance " + fa.quoted() + " " + fb.quoted() + flags +
-                               " --algorithm " + algorithm + " --json");
+                               " --algorithm " + algorithm + " --quaternion-order wxyz --json");
     ASSERT_EQ(run.exit_code, 0) << flags;
     const Json j = parse_json(run);
     EXPECT_EQ(j.at("status"), proxima::to_string(r.status)) << flags;
@@ -503,15 +503,15 @@ TEST(CliTools, BadInputExitsOneNamingTheFile) {
 
   // Bad pose numbers are bad input too, named by option.
   run =
-      run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-b 0 0 x 1 0 0 0", true);
+      run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-b 0 0 x", true);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.out.find("--pose-b z: 'x' is not a number"), std::string::npos) << run.out;
   run =
-      run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 0 0 0 0 0 0", true);
+      run_cli("distance " + good.quoted() + " " + good.quoted() +
+                  " --pose-a 0 0 0 0 0 0 0 --quaternion-order wxyz", true);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.out.find("--pose-a"), std::string::npos) << run.out;
-  run = run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 nan 0 1 0 0 0",
-                true);
+  run = run_cli("distance " + good.quoted() + " " + good.quoted() + " --pose-a 0 nan 0", true);
   EXPECT_EQ(run.exit_code, 1);
 
   // An unwritable export path.
@@ -572,7 +572,6 @@ TEST(CliTools, UsageErrorsExitTwo) {
   const std::string g = good.quoted();
   for (const std::string& args : std::vector<std::string>{
            "", "nonsense", "distance", "distance " + g, "distance " + g + " " + g + " --bogus",
-           "distance " + g + " " + g + " --pose-a 1 2 3",
            "distance " + g + " " + g + " --algorithm best", "hull", "hull " + g + " --out hull.stl",
            "hull " + g + " --frobnicate", "query --threads 0", "query --threads two"}) {
     EXPECT_EQ(run_cli(args, true).exit_code, 2) << args;
@@ -659,7 +658,8 @@ TEST(CliDistance, QuaternionOrderFlag) {
     const proxima::DistanceResult r =
         proxima::distance(hull, proxima::Pose{}, hull, proxima::Pose(q, Vec3(3, 0, 0)));
     const CliRun run = run_cli("distance " + file.quoted() + " " + file.quoted() + pose_b +
-                               (scalar_last ? " --quaternion-order xyzw" : "") + " --json");
+                               (scalar_last ? " --quaternion-order xyzw" : " --quaternion-order wxyz") +
+                               " --json");
     ASSERT_EQ(run.exit_code, 0) << run.out;
     const Json j = parse_json(run);
     EXPECT_EQ(j.at("distance").get<double>(), r.distance) << scalar_last;
@@ -669,4 +669,34 @@ TEST(CliDistance, QuaternionOrderFlag) {
                                  " --quaternion-order xyzw --pose-b 0 0 0 0 0 0 x",
                              true);
   EXPECT_NE(bad.out.find("--pose-b qw: 'x' is not a number"), std::string::npos) << bad.out;
+}
+
+// Issue 25: `proxima distance --pose-b 3 0 0 0 0 0 1` read ROS's identity
+// scalar first, a half turn about z, without a word. Seven numbers now need
+// --quaternion-order (refused otherwise, with both readings); three are a
+// translation and need none.
+TEST(CliDistance, AnUnnamedPoseQuaternionIsRefused) {
+  REQUIRE_CLI();
+  std::vector<Vec3> cube;
+  for (int i = 0; i < 8; ++i) cube.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const TempPath file(".obj");
+  write_obj(file.path(), cube);
+  const std::string files = "distance " + file.quoted() + " " + file.quoted();
+  const CliRun refused = run_cli(files + " --pose-b 3 0 0 0 0 0 1 --json", true);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.out.find("--pose-b: the quaternion 0 0 0 1 does not name its order: as (w, x, "
+                             "y, z) it is a turn of 180 degrees about (0, 0, 1); as (x, y, z, w) "
+                             "(ROS, scipy) it is the identity. Add --quaternion-order wxyz or "
+                             "--quaternion-order xyzw"),
+            std::string::npos)
+      << refused.out;
+  const CliRun moved = run_cli(files + " --pose-b 3 0 0 --json");
+  ASSERT_EQ(moved.exit_code, 0) << moved.out;
+  EXPECT_EQ(parse_json(moved).at("distance").get<double>(), 2.0);
+  const CliRun ros = run_cli(files + " --pose-b 3 0 0 0 0 0 1 --quaternion-order xyzw --json");
+  ASSERT_EQ(ros.exit_code, 0) << ros.out;
+  EXPECT_EQ(parse_json(ros).at("distance").get<double>(), 2.0);
+  const CliRun four = run_cli(files + " --pose-b 3 0 0 1 --json", true);
+  EXPECT_EQ(four.exit_code, 1);
+  EXPECT_NE(four.out.find("--pose-b takes 3 numbers (x y z) or 7"), std::string::npos) << four.out;
 }

@@ -166,6 +166,16 @@ def check_bad_input(proxima, w):
         ([], 2, "exactly one of them"),
         (["--query", w("pair.jsonl"), "--scene", w("scene.jsonl")], 2, "exactly one of them"),
         (["--scene", w("pair.jsonl"), "--margin", "-1"], 1, "--margin"),
+        # Issue 25: `view` took the hull of a non-convex file that `distance`
+        # refuses; both now read files the same way (--as).
+        ([w("l.obj"), w("cube.obj")], 1, "l.obj: not convex (its surface is not its hull's boundary)"),
+        # Issue 25 (view_devzero.sh): --query and --scene read their file
+        # whole with no cap, so /dev/zero grew to std::bad_alloc. The cap
+        # counts the bytes as they are read.
+        (["--query", "/dev/zero", "--max-file-size", "1000000"], 1,
+         "'/dev/zero' is larger than --max-file-size (1000000 bytes)"),
+        (["--scene", "/dev/zero", "--max-file-size", "2000000"], 1,
+         "'/dev/zero' is larger than --max-file-size (2000000 bytes)"),
     ]:
         r = subprocess.run([proxima, "view", *args, "--out", w("bad.html")], capture_output=True,
                            text=True, timeout=60)
@@ -187,7 +197,7 @@ def main():
 
     # 1. A convex pair: the query line alone, answered by `proxima view`.
     query = {"id": "pair", "a": {"vertices": box_points([-1, -1, -1], [1, 1, 1])},
-             "b": {"vertices": tetrahedron([0, 0, 0], 1.5), "rotation": [0.9, 0.2, 0.3, 0.1],
+             "b": {"vertices": tetrahedron([0, 0, 0], 1.5), "rotation": {"wxyz": [0.9, 0.2, 0.3, 0.1]},
                    "translation": [2.2, 0.6, 0.9]}}
     line = json.dumps(query)
     open(w("pair.jsonl"), "w").write(line + "\n")
@@ -199,7 +209,7 @@ def main():
     # 2. An intersecting pair, its answer line given: the label is the depth.
     query = {"id": 3, "a": {"vertices": box_points([0, 0, 0], [2, 2, 2])},
              "b": {"vertices": box_points([0, 0, 0], [1, 1, 1]), "translation": [1.6, 0.5, 0.4],
-                   "rotation": [0.95, 0.1, 0.2, 0.0]}}
+                   "rotation": {"wxyz": [0.95, 0.1, 0.2, 0.0]}}}
     open(w("overlap.jsonl"), "w").write(json.dumps(query) + "\n")
     answer_line = run([proxima, "query", w("overlap.jsonl")])
     answer = json.loads(answer_line)
@@ -216,7 +226,7 @@ def main():
     big = 1e39
     query = {"id": "huge", "a": {"vertices": [[big * c for c in p] for p in box_points([-1, -1, -1], [1, 1, 1])]},
              "b": {"vertices": [[big * c for c in p] for p in tetrahedron([0, 0, 0], 1.5)],
-                   "translation": [2.5 * big, 0.4 * big, 0.2 * big], "rotation": [0.9, 0.2, 0.3, 0.1]}}
+                   "translation": [2.5 * big, 0.4 * big, 0.2 * big], "rotation": {"wxyz": [0.9, 0.2, 0.3, 0.1]}}}
     open(w("huge.jsonl"), "w").write(json.dumps(query) + "\n")
     answer = json.loads(run([proxima, "query", w("huge.jsonl")]))
     run([proxima, "view", "--query", w("huge.jsonl"), "--out", w("huge.html")])
@@ -237,9 +247,10 @@ def main():
             for _, pb in bracket:
                 f.write(json.dumps({"a": {"vertices": pa}, "b": {
                     "vertices": pb, "translation": [float(t) for t in pose_b[:3]],
-                    "rotation": [float(q) for q in pose_b[3:]]}}) + "\n")
+                    "rotation": {"wxyz": [float(q) for q in pose_b[3:]]}}}) + "\n")
     expected = min(json.loads(l)["distance"] for l in run([proxima, "query", w("pieces.jsonl")]).splitlines())
-    run([proxima, "view", w("table.obj"), w("bracket.obj"), "--pose-b", *pose_b, "--out", w("compound.html")])
+    run([proxima, "view", w("table.obj"), w("bracket.obj"), "--as", "pieces", "--pose-b", *pose_b,
+         "--quaternion-order", "wxyz", "--out", w("compound.html")])
     data = page_data(w("compound.html"))
     assert [len(b["pieces"]) for b in data["bodies"]] == [5, 2], "the compounds lost pieces"
     assert data["pair"]["status"] == "separated", data["pair"]
@@ -265,7 +276,7 @@ def main():
         f.writelines("v %r %r %r\n" % tuple(p) for p in cube)
         f.writelines(f"f {a} {b} {c}\n" for a, b, c in cube_faces)
     run([proxima, "view", w("l.obj"), w("cube.obj"), "--as", "mesh", "--pose-b", "1.5", "1.5", "0.5",
-         "1", "0", "0", "0", "--out", w("mesh.html")])
+         "--out", w("mesh.html")])
     data = page_data(w("mesh.html"))
     assert [len(b["pieces"][0]["triangles"]) // 3 for b in data["bodies"]] == [20, 12], "the meshes lost triangles"
     assert data["pair"]["status"] == "separated", data["pair"]
@@ -278,14 +289,46 @@ def main():
             x, y = i % 4, i // 4
             angle = 0.37 * i
             f.write(json.dumps({"vertices": box_points([-0.35, -0.35, -0.35], [0.35, 0.35, 0.35]),
-                                "rotation": [math.cos(angle / 2), 0.3 * math.sin(angle / 2), 0.0,
-                                             math.sin(angle / 2)],
+                                "rotation": {"wxyz": [math.cos(angle / 2), 0.3 * math.sin(angle / 2), 0.0,
+                                                      math.sin(angle / 2)]},
                                 "translation": [x * (1.0 + 0.04 * y), y * 1.02, 0.05 * x * y]}) + "\n")
     run([proxima, "view", "--scene", w("scene.jsonl"), "--margin", "0.45", "--out", w("scene.html")])
     data = page_data(w("scene.html"))
     assert len(data["bodies"]) == 16 and len(data["pairs"]) > 0, "the scene has no close pair"
     assert all(p["distance"] <= 0.45 for p in data["pairs"])
     pages.append(("scene", w("scene.html"), None))
+
+    # 6. Hostile text (issue 25): the page once escaped only "</" in its
+    # data, so an id, a file name or a title holding "<!--<script>" put the
+    # HTML parser in its "script data double escaped" state, the data element
+    # swallowed three.js and the viewer code, and the page stayed at "loading
+    # three.js..." with no error. Every string from input must be inert: the
+    # data element holds no '<', '>' or '&' at all, and the pages render.
+    hostile = "<!--<script></script><script>document.body.dataset.rendered='pwned'</script>-->&\u2028\u2029"
+    query = {"id": hostile, "a": {"vertices": tetrahedron([0, 0, 0])},
+             "b": {"vertices": tetrahedron([2, 0, 0])}}
+    open(w("hostile.jsonl"), "w", encoding="utf-8").write(json.dumps(query, ensure_ascii=False) + "\n")
+    answer = json.loads(run([proxima, "query", w("hostile.jsonl")]))
+    run([proxima, "view", "--query", w("hostile.jsonl"), "--out", w("hostile-id.html")])
+    assert hostile in page_data(w("hostile-id.html"))["title"], page_data(w("hostile-id.html"))["title"]
+    pages.append(("hostile-id", w("hostile-id.html"), answer["distance"]))
+    # File names: any bytes but '/' and NUL, so also bytes that are not
+    # UTF-8 (which once failed with json type_error.316).
+    names = [os.fsencode(w("<!--<script>&\u2028a.xyz")), os.fsencode(w("b")) + b"\xff<!--<script>.xyz"]
+    for name, offset in zip(names, ([0, 0, 0], [2, 0, 0])):
+        with open(name, "w") as f:
+            f.writelines("%r %r %r\n" % tuple(p) for p in tetrahedron(offset))
+    r = subprocess.run([os.fsencode(proxima), b"view", *names, b"--out", os.fsencode(w("hostile-names.html"))],
+                       capture_output=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    data = page_data(w("hostile-names.html"))
+    assert data["bodies"][0]["name"] == "<!--<script>&\u2028a.xyz", data["bodies"][0]["name"]
+    assert data["bodies"][1]["name"] == "b\ufffd<!--<script>.xyz", data["bodies"][1]["name"]
+    pages.append(("hostile-names", w("hostile-names.html"), data["pair"]["distance"]))
+    for name in ("hostile-id", "hostile-names"):
+        text = open(w(name + ".html"), encoding="utf-8").read()
+        inside = re.search(r'<script id="proxima-data" type="application/json">(.*?)</script>', text, re.S)
+        assert not re.search("[<>&\u2028\u2029]", inside.group(1)), f"{name}: the data holds raw markup"
 
     check_bad_input(proxima, w)
 

@@ -29,6 +29,7 @@
 #include <concepts>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -102,6 +103,13 @@ inline Quat quaternion_in_order(const double* q, QuaternionOrder order) {
   return order == QuaternionOrder::wxyz ? Quat(q[0], q[1], q[2], q[3])
                                         : Quat(q[3], q[0], q[1], q[2]);
 }
+
+// What four numbers q[0..3] mean in each order, for the refusal of a bare
+// quaternion that does not name its order: "as (w, x, y, z) a turn of 180
+// degrees about (0, 0, 1); as (x, y, z, w) (ROS, scipy) the identity".
+// Throws InvalidInput naming `what` for a zero or non-finite q (as
+// unit_quaternion), so that such a q is refused for what it is.
+std::string quaternion_readings(const double* q, std::string_view what);
 
 // A rigid motion x -> rotation x + translation.
 struct Pose {

@@ -61,9 +61,9 @@ class TriangleMesh {
   };
 
   // The mesh as given: vertices and triangles are copied, nothing is
-  // merged, removed or reoriented. Throws InvalidInput naming the index: no
+  // merged, removed or reoriented (the hierarchy skips repeats, below). Throws InvalidInput naming the index: no
   // vertices, no triangles, a non-finite coordinate ("vertex 7 has a NaN
-  // coordinate"), a coordinate beyond 1e300 in magnitude, a vertex index
+  // coordinate"), a coordinate beyond 2^1018 (2.8e306) in magnitude, a vertex index
   // out of range ("triangle 12 refers to vertex 40, but there are 38
   // vertices"), more than 2^31 - 1 vertices or triangles.
   TriangleMesh(std::span<const Vec3> vertices, std::span<const Triangle> triangles);
@@ -100,7 +100,10 @@ class TriangleMesh {
   const Vec3& center() const { return center_; }
   double bounding_radius() const { return bounding_radius_; }
 
-  // The hierarchy: nodes()[0] is the root.
+  // The hierarchy: nodes()[0] is the root. It holds every triangle but
+  // repeats: a triangle whose corners are the same points as an earlier
+  // one's (by index or coordinates, any order) is left out, as the same
+  // surface (triangle_order() then has fewer ids than triangle_count()).
   std::span<const Node> nodes() const { return nodes_; }
   std::span<const std::int32_t> triangle_order() const { return order_; }
   // Node boxes are stored divided by unit(), a power of two >= scale().
