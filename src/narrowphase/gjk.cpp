@@ -192,7 +192,7 @@ Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, d
     // (GjkTouching.NeedlesSideBySideTouch). The next round then finds no
     // decrease and leaves the answer uncertified.
     if (v_norm - lower <=
-        options.relative_tolerance * v_norm + kGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
+        options.relative_tolerance * v_norm + kTerminationGapUlps * kUnitRoundoff * std::sqrt(w_max2)) {
       out.certified = true;
       return out;
     }

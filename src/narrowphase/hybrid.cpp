@@ -401,7 +401,7 @@ template <bool kScaled, bool kMargin = false>
   // witness pair at most margin + band apart, or a support gap above the
   // margin by more than its rounding.
   const double yes_at = kScaled ? (margin + band) * scale : margin + band;
-  const double no_above = (kScaled ? margin * scale : margin) + kGapUlps * ulp_r;
+  const double no_above = (kScaled ? margin * scale : margin) + kTerminationGapUlps * ulp_r;
   // Features shorter or flatter than a few u R are reduced (closest_point.h).
   const KernelTolerance<double> tol = kernel_tolerance(r_local);
 
@@ -531,7 +531,7 @@ template <bool kScaled, bool kMargin = false>
   if constexpr (kMargin) {
     // The support gap with its rounding slack taken off: certified. The
     // faces of the last distance answer no longer describe the cached pair.
-    result.lower_bound = std::max(0.0, (lower - kGapUlps * ulp_r) * unit);
+    result.lower_bound = std::max(0.0, (lower - kTerminationGapUlps * ulp_r) * unit);
     cache.face_a = -1;
     cache.face_b = -1;
     return result;

@@ -455,7 +455,8 @@ class MarginSearch {
   MarginSearch(const Query& q, double margin) : q_(q), margin_(margin) {
     margin_s_ = std::ldexp(margin, -q.exponent);
     yes_s_ = margin_s_ + q.band_s;
-    prune_s_ = margin_s_ + kPruneSlackUlps * kUnitRoundoff;
+    slack_s_ = detail::prune_slack(std::ldexp(q.magnitude, -q.exponent));
+    prune_s_ = margin_s_ + slack_s_;
     lower_s_ = std::numeric_limits<double>::infinity();
   }
 
@@ -531,7 +532,7 @@ class MarginSearch {
       const int near = lb2[0] <= lb2[1] ? 0 : 1;
       for (const int c : {1 - near, near}) {
         if (lb2[c] > prune2) {
-          lower_s_ = std::min(lower_s_, std::sqrt(lb2[c]) - kPruneSlackUlps * kUnitRoundoff);
+          lower_s_ = std::min(lower_s_, std::sqrt(lb2[c]) - slack_s_);
         } else {
           stack_.push_back({child_a[c], child_b[c]});
         }
@@ -550,7 +551,7 @@ class MarginSearch {
  private:
   const Query& q_;
   double margin_;
-  double margin_s_ = 0.0, yes_s_ = 0.0, prune_s_ = 0.0, lower_s_ = 0.0;
+  double margin_s_ = 0.0, yes_s_ = 0.0, prune_s_ = 0.0, lower_s_ = 0.0, slack_s_ = 0.0;
   int tested_ = 0;
   int nodes_tested_ = 0;
   std::int32_t witness_a_ = -1, witness_b_ = -1;
