@@ -17,7 +17,7 @@ import proxima
 DATA = pathlib.Path(sys.argv[1]) if len(sys.argv) > 1 else pathlib.Path(__file__).parent / "data" / "panda"
 
 robot = proxima.Robot(str(DATA / "panda.urdf"), srdf=str(DATA / "panda.srdf"))
-robot.set_environment([(proxima.box((0.25, 0.5, 0.02)), ((1, 0, 0, 0), (0.75, 0, 0.18)))])
+robot.set_environment([(proxima.box((0.25, 0.5, 0.02)), proxima.Pose.from_translation((0.75, 0, 0.18)))])
 print(f"{robot.name}: joints {robot.joint_names}")
 
 q = np.array([0, -0.785, 0, -2.356, 0, 1.571, 0.785, 0.01])

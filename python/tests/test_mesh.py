@@ -61,7 +61,7 @@ def test_gradient_of_a_mesh_overlap_names_the_real_reason():
     # Issue 26: the refusal blamed the penetration option (which was on); no
     # depth is defined for an overlap with a mesh, and the message says so.
     mesh = proxima.TriangleMesh(*cube(1.0))
-    at = ((1, 0, 0, 0), (0.9, 0, 0))
+    at = proxima.Pose.from_translation((0.9, 0, 0))
     r = proxima.distance(mesh, None, proxima.sphere(0.5), at)
     assert r.status == "intersecting"
     with pytest.raises(proxima.InvalidInput, match="triangle mesh"):

@@ -48,8 +48,8 @@ def test_panda_loads_with_names_and_the_hand_checked_flange():
 @needs_robots
 def test_distances_and_gradients_against_finite_differences_and_the_batch():
     robot = load_panda()
-    robot.set_environment([(proxima.box((0.6, 0.6, 0.02)), ((1, 0, 0, 0), (0.3, 0, -0.021))),
-                           (proxima.box((0.2, 0.4, 0.01)), ((1, 0, 0, 0), (0.5, 0, 0.4)))])
+    robot.set_environment([(proxima.box((0.6, 0.6, 0.02)), proxima.Pose.from_translation((0.3, 0, -0.021))),
+                           (proxima.box((0.2, 0.4, 0.01)), proxima.Pose.from_translation((0.5, 0, 0.4)))])
     rng = np.random.default_rng(7)
     qs = np.array([random_q(robot, rng) for _ in range(50)])
     checked = 0
