@@ -72,7 +72,13 @@ void sin_cos_quadrant(double x, double& sine, double& cosine) {
 
 namespace {
 
-bool finite(const Vec3& v) { return v.allFinite(); }
+// By classification, not Eigen's allFinite: that computes x - x, which
+// raises FE_INVALID on an infinity, and a caller's trap would turn the
+// refusal of an overflowing motion into SIGFPE
+// (TimeOfImpact.VelocitiesNearTheLargestDoubleAreAnsweredOrRefusedByName).
+bool finite(const Vec3& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
 
 // Norms here and below without overflow or underflow of their squares
 // (stableNorm, fast_norm): speeds and sizes near 1e-300 and 1e300 are
@@ -686,6 +692,13 @@ void check_impact_options(const ImpactOptions& options, const char* who) {
 
 }  // namespace detail
 
+// The fastest turn followed, radians per unit t: beyond it consecutive
+// doubles of the angle t |w| are more than a radian apart (u |w| > 1/2),
+// so the pose at t is not defined by the motion, only by rounding; below
+// it |w|^2 and its products with the bodies' sizes stay far from
+// overflowing in the bounds.
+constexpr double kMaxTurnRate = 0x1p52;
+
 Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& angular,
                              double duration) {
   if (!finite(linear) || !finite(angular) || !std::isfinite(duration) || !(duration > 0.0)) {
@@ -696,11 +709,11 @@ Motion Motion::from_velocity(const Pose& pose, const Vec3& linear, const Vec3& a
   // turns the body made, nor which way past a half turn.
   Motion m{pose, pose, Vec3(duration * angular)};
   m.end.translation = pose.translation + duration * linear;
-  if (!finite(*m.angular) || !std::isfinite(m.angular->stableNorm()) ||
+  if (!finite(*m.angular) || !(m.angular->stableNorm() <= kMaxMagnitude) ||
       !finite(m.end.translation)) {
     throw InvalidInput(
-        "Motion::from_velocity: the turn or the end translation over the duration overflows "
-        "doubles (duration * velocity beyond about 1.8e308)");
+        "Motion::from_velocity: the turn or the end translation over the duration is beyond "
+        "the supported magnitude 2^1018 (about 2.8e306)");
   }
   m.end.rotation = Sweep(m).turned(1.0);
   return m;
@@ -716,12 +729,6 @@ Pose Motion::at(double t) const { return Sweep(*this).at(t); }
 
 namespace {
 
-// The fastest turn followed, radians per unit t: beyond it consecutive
-// doubles of the angle t |w| are more than a radian apart (u |w| > 1/2),
-// so the pose at t is not defined by the motion, only by rounding; below
-// it |w|^2 and its products with the bodies' sizes stay far from
-// overflowing in the bounds.
-constexpr double kMaxTurnRate = 0x1p52;
 
 // checked_sweep's checks after the pose contract's, on rigid poses.
 Sweep limited_sweep(const Motion& m, double scale, const char* name) {
