@@ -346,7 +346,7 @@ std::optional<Referee> referee(const ConvexPolytope& a, const ConvexPolytope& b,
   }
   const PenetrationResult slow = penetration_depth_brute_force(a, b, pose);
   if (slow.status == PenetrationStatus::separated) return separated_or_touching();
-  r.sign = slow.status == PenetrationStatus::penetrating ? -1 : 0;
+  r.sign = slow.status == PenetrationStatus::intersecting ? -1 : 0;
   r.magnitude_squared = mpq_class(slow.depth) * mpq_class(slow.depth);
   r.value = -slow.depth;
   r.exact = false;

@@ -270,7 +270,7 @@ void mesh_section(int count, const std::string& dir) {
     proxima::ImpactResult r;
     const double ns =
         best_of_three_ns([&] { r = proxima::time_of_impact(mesh, still, convex, mb); });
-    if (r.status == proxima::ImpactStatus::overlapping) {
+    if (r.status == proxima::ImpactStatus::intersecting) {
       ++overlapping;
       continue;
     }
@@ -338,7 +338,7 @@ int main(int argc, char** argv) {
       proxima::ImpactResult r;
       ours_ns.push_back(best_of_three_ns([&] { r = proxima::time_of_impact(a, c.a, b, c.b); }));
       const bool ours_hit = r.status == proxima::ImpactStatus::contact ||
-                            r.status == proxima::ImpactStatus::overlapping;
+                            r.status == proxima::ImpactStatus::intersecting;
       if (ours_hit) {
         ++contacts;
         steps += r.iterations;

@@ -339,7 +339,7 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   const Json* id = id_it != query.end() ? &*id_it : nullptr;
 
   DistanceResult r;
-  std::optional<BodyDistance> mesh_answer;  // a query with a mesh body
+  std::optional<BodyResult> mesh_answer;  // a query with a mesh body
   bool capped = false;
   try {
     Pose pose_a;
@@ -393,7 +393,7 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
     }
     if ((!work.triangles_a.empty() || !work.triangles_b.empty()) && !motion_a && !motion_b) {
       // A mesh on either side: the one call for any two bodies.
-      const BodyDistance m = distance(
+      const BodyResult m = distance(
           query_body(work.vertices_a, work.triangles_a, radius_a, "a"), pose_a,
           query_body(work.vertices_b, work.triangles_b, radius_b, "b"), pose_b, options, nullptr);
       mesh_answer = m;
@@ -467,7 +467,7 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   // rather than print an invalid line.
   // An overlap with a mesh has no depth: its signed lower bound is
   // -infinity, written as null.
-  const bool no_depth = mesh_answer && mesh_answer->cores_overlap;
+  const bool no_depth = mesh_answer && mesh_answer->intersecting;
   if (!std::isfinite(r.distance) || !std::isfinite(r.signed_distance()) ||
       (!std::isfinite(r.signed_lower_bound()) && !no_depth) ||
       !std::isfinite(r.signed_upper_bound()) || !r.point_a.allFinite() || !r.point_b.allFinite() ||

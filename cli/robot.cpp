@@ -68,7 +68,7 @@ std::vector<double> read_q(const Robot& robot, const Json& query) {
   fail("q is neither an array nor an object " + kind(*it));
 }
 
-Json pair_json(const Robot& robot, const RobotPairDistance& pair, bool gradients) {
+Json pair_json(const Robot& robot, const RobotPairResult& pair, bool gradients) {
   const auto& geometries = robot.geometries();
   const RobotGeometry& a = geometries[static_cast<std::size_t>(pair.geometry_a)];
   Json out;
@@ -133,7 +133,7 @@ int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, 
         answer["closest"] = pair_json(*robot, r.closest, command.gradients);
       }
       Json pairs = Json::array();
-      for (const RobotPairDistance& pair : r.close_pairs) {
+      for (const RobotPairResult& pair : r.close_pairs) {
         pairs.push_back(pair_json(*robot, pair, command.gradients));
       }
       answer["pairs"] = std::move(pairs);

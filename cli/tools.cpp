@@ -460,7 +460,7 @@ std::string export_format(const std::string& path) {
 int print_body_distance(const DistanceCommand& command, const LoadedBody& a, const LoadedBody& b,
                         const Pose& pose_a, const Pose& pose_b, std::ostream& out,
                         std::ostream& err) {
-  const BodyDistance r = distance(*a.body, pose_a, *b.body, pose_b, command.options, nullptr);
+  const BodyResult r = distance(*a.body, pose_a, *b.body, pose_b, command.options, nullptr);
   if (!std::isfinite(r.distance) || !r.point_a.allFinite() || !r.point_b.allFinite()) {
     err << "proxima distance: the result is not finite: the coordinates are too large for double "
            "arithmetic\n";

@@ -139,7 +139,7 @@ std::string view_files(const ViewCommand& command) {
                             load_body(command.file_a, command.as, command.max_file_bytes), pose_a};
   const viewer::ShownBody b{file_name(command.file_b),
                             load_body(command.file_b, command.as, command.max_file_bytes), pose_b};
-  const BodyDistance r = distance(a.body, a.pose, b.body, b.pose, command.options);
+  const BodyResult r = distance(a.body, a.pose, b.body, b.pose, command.options);
   return viewer::pair_page(a, b, r, viewer::answer_of(r), a.name + " and " + b.name);
 }
 
@@ -274,7 +274,7 @@ std::string view_query(const ViewCommand& command) {
   };
   const viewer::ShownBody a{"a", build(vertices_a, triangles_a, radius_a, "a"), pose_a};
   const viewer::ShownBody b{"b", build(vertices_b, triangles_b, radius_b, "b"), pose_b};
-  const BodyDistance witness = distance(a.body, a.pose, b.body, b.pose, command.options);
+  const BodyResult witness = distance(a.body, a.pose, b.body, b.pose, command.options);
   return viewer::pair_page(a, b, witness, shown, "query " + id.dump());
 }
 

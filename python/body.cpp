@@ -2,7 +2,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // Layer 7: the Python side of bodies with a radius and of the primitives
-// (Body, BodyCache, BodyDistance, box, sphere, capsule, cylinder, cone,
+// (Body, BodyCache, BodyResult, box, sphere, capsule, cylinder, cone,
 // polygon_sides) and the distance overload for any two bodies: a
 // ConvexPolytope, a CompoundBody or a Body on either side. Same conventions
 // as module.cpp: names one for one with C++ (the primitives without the
@@ -173,25 +173,25 @@ void bind_bodies(py::module_& m) {
         return std::string("proxima.BodyCache(") + (c.is_cold() ? "cold" : "warm") + ")";
       });
 
-  py::class_<BodyDistance, DistanceResult>(
-      m, "BodyDistance",
+  py::class_<BodyResult, DistanceResult>(
+      m, "BodyResult",
       "The answer for two bodies with radii: distance, points (on the rounded surfaces), "
       "normal, status and signed distance (with its bounds) of the rounded bodies; features of "
       "the cores.")
-      .def_readonly("piece_a", &BodyDistance::piece_a, "Piece of A (compound), else -1.")
-      .def_readonly("piece_b", &BodyDistance::piece_b, "Piece of B (compound), else -1.")
-      .def_readonly("triangle_a", &BodyDistance::triangle_a,
+      .def_readonly("piece_a", &BodyResult::piece_a, "Piece of A (compound), else -1.")
+      .def_readonly("piece_b", &BodyResult::piece_b, "Piece of B (compound), else -1.")
+      .def_readonly("triangle_a", &BodyResult::triangle_a,
                     "Closest triangle of A (mesh), else -1.")
-      .def_readonly("triangle_b", &BodyDistance::triangle_b,
+      .def_readonly("triangle_b", &BodyResult::triangle_b,
                     "Closest triangle of B (mesh), else -1.")
-      .def_readonly("cores_overlap", &BodyDistance::cores_overlap,
+      .def_readonly("intersecting", &BodyResult::intersecting,
                     "Whether the cores themselves overlap (the value is then from their "
                     "penetration depth).")
-      .def_readonly("approximation_error", &BodyDistance::approximation_error,
+      .def_readonly("approximation_error", &BodyResult::approximation_error,
                     "Both bodies' approximation_error: the answer is within this of the true "
                     "shapes' answer.")
-      .def("__repr__", [](const BodyDistance& r) {
-        return std::string("proxima.BodyDistance(status='") + to_string(r.status) +
+      .def("__repr__", [](const BodyResult& r) {
+        return std::string("proxima.BodyResult(status='") + to_string(r.status) +
                "', signed_distance=" +
                py::repr(py::float_(r.signed_distance())).cast<std::string>() + ")";
       });
@@ -222,7 +222,7 @@ void bind_bodies(py::module_& m) {
       "Any two bodies: a ConvexPolytope, a CompoundBody, a TriangleMesh or a Body on either side "
       "(two polytopes "
       "or two compounds take the overloads above). cache: a BodyCache or None. Returns a "
-      "BodyDistance. penetration=False skips the depth of overlapping cores: their signed value "
+      "BodyResult. penetration=False skips the depth of overlapping cores: their signed value "
       "is then 0 with bounds [-inf, 0] (signed distance minus the radii). A ConvexPolytope met "
       "with a compound is wrapped on every call (O(N)): for "
       "tracked queries, wrap it once as a Body.");

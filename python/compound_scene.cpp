@@ -659,7 +659,7 @@ void bind_compound_and_scene(py::module_& m) {
           py::arg("max_iterations") = ImpactOptions{}.max_iterations,
           "Continuous collision: every body moves from its pose to its end pose over t in [0, "
           "1]; returns the ImpactPair of every pair that comes within target_separation on the "
-          "way (status 'contact' at t, 'overlapping' at t = 0, or 'iteration_cap'), sorted by "
+          "way (status 'contact' at t, 'intersecting' at t = 0, or 'iteration_cap'), sorted by "
           "(a, b). No pair is missed, however fast or thin the bodies (the broad phase boxes the "
           "whole motion) and no t is after the true first contact; the filters apply. Poses are "
           "not changed. tolerance: as time_of_impact (0: 1e-6 of the bodies' size). The scene's "

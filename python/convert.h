@@ -626,7 +626,7 @@ std::vector<char32_t> padded_names(const std::array<std::string_view, M>& names,
 }
 
 // Writes the K results into the columns; the pieces when Result has them
-// (BodyDistance: -1 for a convex body).
+// (BodyResult: -1 for a convex body).
 template <class Result>
 void write_batch_rows(std::span<const Result> results, const BatchColumnData& data) {
   const auto& columns = batch_columns();
@@ -670,7 +670,7 @@ void write_batch_rows(std::span<const Result> results, const BatchColumnData& da
     name(type_a, type_padded.data(), type_width, r.feature_a.type);
     name(type_b, type_padded.data(), type_width, r.feature_b.type);
   }
-  if constexpr (std::is_same_v<Result, BodyDistance>) {
+  if constexpr (std::is_same_v<Result, BodyResult>) {
     std::int32_t *piece_a = i32(kPieceA), *piece_b = i32(kPieceB);
     for (std::size_t i = 0; i < results.size(); ++i) {
       piece_a[i] = results[i].piece_a;
@@ -685,7 +685,7 @@ template <class Result>
 py::dict batch_dict(const std::vector<Result>& results) {
   py::dict out;
   const BatchColumnData data = new_batch_columns(static_cast<py::ssize_t>(results.size()),
-                                                 std::is_same_v<Result, BodyDistance>, out);
+                                                 std::is_same_v<Result, BodyResult>, out);
   write_batch_rows(std::span<const Result>(results), data);
   return out;
 }

@@ -4,7 +4,7 @@
 // Python bindings: TriangleMesh (from (V, 3) and (F, 3) numpy arrays or a
 // file), and load_body, which reads a file as the kind of body the caller
 // names (mesh, hull or pieces). A mesh meets any body through distance()
-// (body.cpp), which answers a BodyDistance with the closest triangles.
+// (body.cpp), which answers a BodyResult with the closest triangles.
 #include "proxima/query/mesh_distance.h"
 
 #include <pybind11/numpy.h>

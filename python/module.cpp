@@ -450,8 +450,8 @@ PYBIND11_MODULE(_proxima, m) {
         // A Body answer through its own overload: a mesh overlap is refused
         // with its reason (no depth is defined for it).
         const SignedDistanceGradient g =
-            py::isinstance<BodyDistance>(result)
-                ? signed_distance_gradient(result.cast<const BodyDistance&>(), pa, pb)
+            py::isinstance<BodyResult>(result)
+                ? signed_distance_gradient(result.cast<const BodyResult&>(), pa, pb)
                 : signed_distance_gradient(result.cast<const DistanceResult&>(), pa, pb);
         py::array_t<double> out({py::ssize_t{2}, py::ssize_t{6}});
         auto o = out.mutable_unchecked<2>();

@@ -34,7 +34,7 @@ struct PairBatchState {
   std::vector<Body> bodies;
   std::vector<BodyPair> body_pairs;
   std::vector<BodyCache> body_caches;
-  std::vector<BodyDistance> body_results;
+  std::vector<BodyResult> body_results;
   // The poses of the last call, converted; kept so that a call allocates
   // nothing for them.
   std::vector<Pose> poses_a;
@@ -155,7 +155,7 @@ void bind_pair_batch(py::module_& m) {
             }
             if (out.is_none()) return bodies ? batch_dict(s.body_results) : batch_dict(s.results);
             if (bodies) {
-              write_batch_rows(std::span<const BodyDistance>(s.body_results), columns);
+              write_batch_rows(std::span<const BodyResult>(s.body_results), columns);
             } else {
               write_batch_rows(std::span<const DistanceResult>(s.results), columns);
             }

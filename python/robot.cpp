@@ -84,27 +84,27 @@ RobotQueryOptions make_robot_options(double margin, bool gradients, bool self, b
 }  // namespace
 
 void bind_robot(py::module_& m) {
-  py::class_<RobotPairDistance>(m, "RobotPair", "One pair of a robot query (Robot.distances).")
-      .def_readonly("geometry_a", &RobotPairDistance::geometry_a,
+  py::class_<RobotPairResult>(m, "RobotPair", "One pair of a robot query (Robot.distances).")
+      .def_readonly("geometry_a", &RobotPairResult::geometry_a,
                     "The robot geometry (index into Robot.geometry_names).")
-      .def_readonly("geometry_b", &RobotPairDistance::geometry_b,
+      .def_readonly("geometry_b", &RobotPairResult::geometry_b,
                     "Another robot geometry, or for an environment pair the obstacle's index.")
-      .def_readonly("environment", &RobotPairDistance::environment,
+      .def_readonly("environment", &RobotPairResult::environment,
                     "Whether B is an obstacle of the environment.")
-      .def_readonly("result", &RobotPairDistance::result,
-                    "The pair's BodyDistance (world frame, A the robot's geometry).")
-      .def_property_readonly("signed_distance", &RobotPairDistance::signed_distance,
+      .def_readonly("result", &RobotPairResult::result,
+                    "The pair's BodyResult (world frame, A the robot's geometry).")
+      .def_property_readonly("signed_distance", &RobotPairResult::signed_distance,
                              "The pair's signed distance (negative: overlap depth).")
       .def_property_readonly(
           "gradient",
-          [](const RobotPairDistance& p) -> py::object {
+          [](const RobotPairResult& p) -> py::object {
             if (p.gradient.size() == 0) return py::none();
             return vector_array(p.gradient);
           },
           "d signed_distance / d q (dof,), or None when gradients were not asked for.")
-      .def_readonly("has_gradient", &RobotPairDistance::has_gradient,
+      .def_readonly("has_gradient", &RobotPairResult::has_gradient,
                     "False for an overlap whose depth is not computed (a mesh's): gradient zero.")
-      .def("__repr__", [](const RobotPairDistance& p) {
+      .def("__repr__", [](const RobotPairResult& p) {
         return "RobotPair(" + std::to_string(p.geometry_a) + ", " + std::to_string(p.geometry_b) +
                (p.environment ? ", environment" : "") +
                ", signed_distance=" + std::to_string(p.signed_distance()) + ")";

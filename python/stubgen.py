@@ -176,7 +176,7 @@ def emit_class(out, cls, name):
         bases = ", ".join(b.__name__ for b in cls.__bases__)
         out.append(f"class {name}({bases}):\n" + (docstring(cls.__doc__ or "", "    ") or "    ...\n") + "\n")
         return
-    # Bases of this module (BodyDistance(DistanceResult)); pybind11's own base is left out.
+    # Bases of this module (BodyResult(DistanceResult)); pybind11's own base is left out.
     bases = [b.__name__ for b in cls.__bases__ if b.__module__ in ("proxima", "proxima._proxima")]
     out.append(f"class {name}({', '.join(bases)}):\n" if bases else f"class {name}:\n")
     doc = cls.__doc__ or ""

@@ -79,7 +79,7 @@ void bind_time_of_impact(py::module_& m) {
   py::class_<ImpactResult>(m, "ImpactResult", "The answer of time_of_impact.")
       .def_property_readonly(
           "status", [](const ImpactResult& r) { return to_string(r.status); },
-          "'separated' (no contact over [0, 1]), 'contact' (at t), 'overlapping' (already at t = "
+          "'separated' (no contact over [0, 1]), 'contact' (at t), 'intersecting' (already at t = "
           "0) or 'iteration_cap' (stopped; t is still safe).")
       .def_readonly("t", &ImpactResult::t,
                     "Time reached: the time of impact for 'contact', never after the true first "

@@ -81,7 +81,7 @@ void bind_view(py::module_& m) {
         std::string page;
         {
           py::gil_scoped_release release;
-          const BodyDistance r = distance(shown_a.body, shown_a.pose, shown_b.body, shown_b.pose);
+          const BodyResult r = distance(shown_a.body, shown_a.pose, shown_b.body, shown_b.pose);
           page = viewer::pair_page(shown_a, shown_b, r, viewer::answer_of(r),
                                    title.empty() ? name_a + " and " + name_b : title);
         }

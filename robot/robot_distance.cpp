@@ -58,9 +58,9 @@ const void* core_of(const Body& body) {
   return body.compound().get();
 }
 
-void fill_gradient(const Robot& robot, std::span<const Pose> poses, RobotPairDistance& pair) {
+void fill_gradient(const Robot& robot, std::span<const Pose> poses, RobotPairResult& pair) {
   pair.gradient = Eigen::VectorXd::Zero(robot.dof());
-  const BodyDistance& r = pair.result;
+  const BodyResult& r = pair.result;
   // An overlap whose depth was not computed (a mesh's) has the certificate
   // [-infinity, 0] and no normal to differentiate along.
   pair.has_gradient = std::isfinite(r.signed_lower_bound());
@@ -77,7 +77,7 @@ void fill_gradient(const Robot& robot, std::span<const Pose> poses, RobotPairDis
   }
 }
 
-bool by_geometries(const RobotPairDistance& x, const RobotPairDistance& y) {
+bool by_geometries(const RobotPairResult& x, const RobotPairResult& y) {
   return x.geometry_a != y.geometry_a ? x.geometry_a < y.geometry_a : x.geometry_b < y.geometry_b;
 }
 
@@ -140,7 +140,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
   }
 
   RobotDistances out;
-  const auto report = [&](RobotPairDistance&& pair, double& category_min, std::int32_t index,
+  const auto report = [&](RobotPairResult&& pair, double& category_min, std::int32_t index,
                           std::int32_t& last) {
     const double sd = pair.result.signed_distance();
     const bool closest = sd < out.min_signed_distance;
@@ -186,7 +186,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
           bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b], spheres[b].radius));
       if (bound > threshold) continue;
       ++out.pairs_queried;
-      RobotPairDistance result;
+      RobotPairResult result;
       result.geometry_a = pair.a;
       result.geometry_b = pair.b;
       result.result =
@@ -216,7 +216,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       bound = std::max(bound, box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
       if (bound > threshold) continue;
       ++out.pairs_queried;
-      RobotPairDistance result;
+      RobotPairResult result;
       result.geometry_a = static_cast<std::int32_t>(g);
       result.geometry_b = static_cast<std::int32_t>(o);
       result.environment = true;

@@ -251,7 +251,7 @@ PairAnswer answer_of(const DistanceResult& r) {
   return a;
 }
 
-std::string pair_page(const ShownBody& a, const ShownBody& b, const BodyDistance& witness,
+std::string pair_page(const ShownBody& a, const ShownBody& b, const BodyResult& witness,
                       const PairAnswer& answer, const std::string& title) {
   if (!available()) throw ViewerUnavailable();
   Json pair{{"status", answer.status},

@@ -62,7 +62,7 @@ PairAnswer answer_of(const DistanceResult& r);
 // compounds, the pieces) to highlight: the answer of
 // distance(a.body, a.pose, b.body, b.pose); `answer` the numbers shown.
 // Throws ViewerUnavailable, or InvalidInput for a feature id outside its hull.
-std::string pair_page(const ShownBody& a, const ShownBody& b, const BodyDistance& witness,
+std::string pair_page(const ShownBody& a, const ShownBody& b, const BodyResult& witness,
                       const PairAnswer& answer, const std::string& title);
 
 // One close pair of a scene step; a and b index the `bodies` of scene_page.

@@ -17,7 +17,7 @@ import proxima
 def test_sphere_sphere_closed_form():
     r = proxima.distance(proxima.sphere(0.5), None, proxima.sphere(0.25),
                          proxima.Pose.from_translation((3, 4, 0)))
-    assert isinstance(r, proxima.BodyDistance)
+    assert isinstance(r, proxima.BodyResult)
     assert isinstance(r, proxima.DistanceResult)
     assert r.status == "separated"
     assert r.signed_distance == pytest.approx(5 - 0.75, abs=1e-14)
@@ -26,7 +26,7 @@ def test_sphere_sphere_closed_form():
     np.testing.assert_allclose(r.point_a, [0.3, 0.4, 0], atol=1e-15)
     np.testing.assert_allclose(r.point_b, [3 - 0.15, 4 - 0.2, 0], atol=1e-15)
     assert r.piece_a == -1 and r.piece_b == -1
-    assert not r.cores_overlap
+    assert not r.intersecting
 
 
 def test_overlapping_rounded_bodies_have_a_negative_signed_distance():
@@ -47,7 +47,7 @@ def test_overlapping_cores_give_minus_depth_minus_radii():
     # A point 0.3 inside a box's face, both rounded.
     r = proxima.distance(proxima.box((1, 1, 1), 0.1), None, proxima.sphere(0.2),
                          proxima.Pose.from_translation((0.7, 0, 0)))
-    assert r.cores_overlap
+    assert r.intersecting
     assert r.status == "intersecting"
     assert r.signed_distance == pytest.approx(-0.3 - 0.1 - 0.2, abs=1e-14)
     np.testing.assert_allclose(np.abs(r.normal), [1, 0, 0], atol=1e-14)
@@ -67,7 +67,7 @@ def test_any_two_body_kinds():
     # Two polytopes and two compounds keep their own overloads and types.
     assert type(proxima.distance(convex, None, convex, pose)) is proxima.DistanceResult
     assert type(proxima.distance(compound, None, compound, pose)) is proxima.CompoundResult
-    assert type(proxima.distance(convex, None, compound, pose)) is proxima.BodyDistance
+    assert type(proxima.distance(convex, None, compound, pose)) is proxima.BodyResult
     assert proxima.distance(convex, None, compound, pose).piece_b == 0
 
 

@@ -473,4 +473,4 @@ def test_scene_bodies_inside_a_closed_room_mesh_intersect_it_and_sweep_takes_it(
     (pair,) = scene.step()
     assert (pair.a, pair.b) == (room, inside) and pair.result.status == "intersecting"
     hits = scene.sweep()  # a mesh sweeps too: the ball inside overlaps at t = 0
-    assert [(h.a, h.b, h.result.status) for h in hits] == [(room, inside, "overlapping")]
+    assert [(h.a, h.b, h.result.status) for h in hits] == [(room, inside, "intersecting")]

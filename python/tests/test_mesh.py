@@ -36,8 +36,8 @@ def test_mesh_against_any_body_equals_the_convex_query():
         pose = proxima.Pose.from_translation(tuple(rng.uniform(-3, 3, size=3)))
         want = proxima.distance(box, None, other, pose)
         got = proxima.distance(mesh, None, other, pose)
-        assert type(got) is proxima.BodyDistance
-        if want.cores_overlap:
+        assert type(got) is proxima.BodyResult
+        if want.intersecting:
             assert got.status == "intersecting"
             continue
         assert got.signed_distance == pytest.approx(want.signed_distance, abs=1e-12)

@@ -56,7 +56,7 @@ def test_every_public_name_has_a_stub():
     assert set(proxima.__all__) <= top, sorted(set(proxima.__all__) - top)
     for name in ("ConvexPolytope", "Pose", "DistanceCache", "DistanceResult", "Feature", "distance",
                  "distance_batch", "CompoundBody", "CompoundCache", "Scene", "PairBatch", "Body",
-                 "BodyCache", "BodyDistance", "box", "sphere", "capsule", "cylinder", "cone", "Motion",
+                 "BodyCache", "BodyResult", "box", "sphere", "capsule", "cylinder", "cone", "Motion",
                  "ImpactResult", "time_of_impact", "load_convex", "read_points"):
         assert name in proxima.__all__, name
     classes = {node.name: node for node in tree.body if isinstance(node, ast.ClassDef)}

@@ -55,7 +55,7 @@ def test_separated_overlapping_and_cache():
     r = proxima.time_of_impact(a, still, a, away)
     assert r.status == "separated" and r.t == 1.0
     start_inside = proxima.Motion(T((1.5, 0, 0)), T((9, 0, 0)))
-    assert proxima.time_of_impact(a, still, a, start_inside).status == "overlapping"
+    assert proxima.time_of_impact(a, still, a, start_inside).status == "intersecting"
     cache = proxima.DistanceCache()
     toward = proxima.Motion(T((6, 0.2, 0)), T((-6, 0.2, 0)))
     tracked = proxima.time_of_impact(a, still, a, toward, cache=cache)

@@ -864,7 +864,7 @@ ImpactResult advance(const Poses& poses, const ImpactOptions& options, double to
       // the offset; touching (or at the offset) is a contact at t = 0.
       return stop_here(t == 0.0 &&
                                (r.status == Status::intersecting || r.signed_distance() < target)
-                           ? ImpactStatus::overlapping
+                           ? ImpactStatus::intersecting
                            : ImpactStatus::contact);
     }
     if (out.iterations >= options.max_iterations) return stop_here(ImpactStatus::iteration_cap);
@@ -1501,7 +1501,7 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
   // The better of two answers at the same time: overlapping, then contact,
   // then the iteration cap.
   const auto rank = [](ImpactStatus s) {
-    return s == ImpactStatus::overlapping ? 0 : s == ImpactStatus::contact ? 1 : 2;
+    return s == ImpactStatus::intersecting ? 0 : s == ImpactStatus::contact ? 1 : 2;
   };
 
   std::priority_queue<Candidate, std::vector<Candidate>, std::greater<>> queue;
@@ -1589,7 +1589,7 @@ ImpactResult pieces_time_of_impact(const Body& a, const Sweep& ma, const Body& b
   }
   const Pose pose_a = ma.at(best.t);
   const Pose pose_b = mb.at(best.t);
-  const BodyDistance at = distance(a, pose_a, b, pose_b, options.distance, &c);
+  const BodyResult at = distance(a, pose_a, b, pose_b, options.distance, &c);
   ImpactResult out;
   out.t = best.t;
   out.status = best.status;
@@ -1660,11 +1660,11 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
   if (closed(a) || closed(b)) {
     const Pose pa = ma.at(0.0);
     const Pose pb = mb.at(0.0);
-    const BodyDistance at = distance(a, pa, b, pb, options.distance, &c);
+    const BodyResult at = distance(a, pa, b, pb, options.distance, &c);
     const double target = options.target_separation;
     if (at.status == Status::intersecting || at.signed_distance() < target) {
       ImpactResult out;
-      out.status = ImpactStatus::overlapping;
+      out.status = ImpactStatus::intersecting;
       out.t = 0.0;
       out.pose_a = pa;
       out.pose_b = pb;

@@ -1130,7 +1130,7 @@ bool same_face(const MinkowskiFaceId& x, const MinkowskiFaceId& y) {
     r.depth = r.lower_bound = r.upper_bound = 0.0;
     return r;
   }
-  r.status = depth > band ? PenetrationStatus::penetrating : PenetrationStatus::touching;
+  r.status = depth > band ? PenetrationStatus::intersecting : PenetrationStatus::touching;
   r.depth = std::max(depth, 0.0);
   r.upper_bound = r.depth;
   r.lower_bound = std::max(0.0, std::min(lower_scaled, value) * q.unit - contact_band(q.magnitude));
@@ -1511,7 +1511,7 @@ PenetrationResult refine(const Query& q, std::span<const Candidate> candidates,
   if (out.status == PenetrationStatus::separated) return out;
   // The exact value is within 4 u of `least`; the bounds say so.
   const double depth = std::max(least, 0.0) * q.unit;
-  out.status = touching ? PenetrationStatus::touching : PenetrationStatus::penetrating;
+  out.status = touching ? PenetrationStatus::touching : PenetrationStatus::intersecting;
   out.depth = depth;
   out.upper_bound = depth * (1.0 + 8.0 * kUnitRoundoff);
   out.lower_bound = depth * (1.0 - 8.0 * kUnitRoundoff);

@@ -114,7 +114,7 @@ void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, cons
 }
 
 void distance_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
-                    std::span<const Pose> poses_b, std::span<BodyDistance> results,
+                    std::span<const Pose> poses_b, std::span<BodyResult> results,
                     std::span<BodyCache> caches, const DistanceOptions& options, int threads) {
   run_batch(
       pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b, results, caches,

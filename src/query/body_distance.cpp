@@ -141,11 +141,11 @@ Status rounded_status(double s, const Placed& a, double ra, const Placed& b, dou
 // status of the rounded bodies from their signed value (used only when a
 // radius is not 0).
 template <class RoundedStatus>
-BodyDistance offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedStatus rounded) {
+BodyResult offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedStatus rounded) {
   const double ra = a.radius();
   const double rb = b.radius();
   const double radii = ra + rb;
-  BodyDistance r;
+  BodyResult r;
   const double value = c.value - radii;
   const double lower = c.lower - radii;
   const double upper = c.upper - radii;
@@ -178,14 +178,14 @@ BodyDistance offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedSt
   r.second_algorithm = c.second_algorithm;
   r.piece_a = c.piece_a;
   r.piece_b = c.piece_b;
-  r.cores_overlap = c.overlap;
+  r.intersecting = c.overlap;
   r.approximation_error = a.approximation_error() + b.approximation_error();
   return r;
 }
 
 // `depth`: the caller's DistanceOptions::penetration (`options` are the
 // cores' options, without it).
-BodyDistance convex_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+BodyResult convex_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                          const DistanceOptions& options, bool depth, BodyCache& cache) {
   const ConvexPolytope& ca = *a.convex();
   const ConvexPolytope& cb = *b.convex();
@@ -297,7 +297,7 @@ class DeepestPair {
   double upper_ = 0.0;
 };
 
-BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+BodyResult compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                            const DistanceOptions& options, bool depth, BodyCache& cache) {
   const std::shared_ptr<const CompoundBody> hold_a = a.compound();
   const std::shared_ptr<const CompoundBody> hold_b = b.compound();
@@ -324,7 +324,7 @@ BodyDistance compound_pair(const Body& a, const Pose& pose_a, const Body& b, con
   }
   const CompoundPiece& piece_a = ca.piece(c.piece_a);
   const CompoundPiece& piece_b = cb.piece(c.piece_b);
-  BodyDistance r = offset(c, a, b, [&](double value) {
+  BodyResult r = offset(c, a, b, [&](double value) {
     return rounded_status(value, {piece_a.polytope.get(), pose_a * piece_a.pose}, a.radius(),
                           {piece_b.polytope.get(), pose_b * piece_b.pose}, b.radius(), options);
   });
@@ -347,7 +347,7 @@ double placed_size(const Pose& pose, const Body::MeshOfPiece& m) {
 // when a lower bound on its distance, from the pieces' bounding spheres, is
 // above the best distance found: only slower if the bound were loose, never
 // wrong.
-BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+BodyResult mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                        const DistanceOptions& options, BodyCache& cache) {
   const std::vector<Body::MeshOfPiece>& ma = a.meshes();
   const std::vector<Body::MeshOfPiece>& mb = b.meshes();
@@ -431,7 +431,7 @@ BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const P
   if (b.kind() == Body::Kind::compound) c.piece_b = static_cast<std::int32_t>(best_j);
   const Pose place_a = pose_a * ma[best_i].pose;
   const Pose place_b = pose_b * mb[best_j].pose;
-  BodyDistance r = offset(c, a, b, [&](double value) {
+  BodyResult r = offset(c, a, b, [&](double value) {
     const double reach = std::max(detail::placed_magnitude(ma[best_i].mesh->vertices(), place_a) + a.radius(),
                                   detail::placed_magnitude(mb[best_j].mesh->vertices(), place_b) + b.radius());
     const double band = contact_band(reach, options.absolute_tolerance);
@@ -446,7 +446,7 @@ BodyDistance mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const P
 
 }  // namespace
 
-BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+BodyResult distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options, BodyCache* cache) {
   BodyCache cold;
   BodyCache& c = cache != nullptr ? *cache : cold;

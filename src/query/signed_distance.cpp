@@ -178,7 +178,7 @@ bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pos
   PenetrationCache* depth_cache = cache.penetration.get();
   PenetrationResult p;
   if (!penetration_depth_tracked(a, b, b_in_a, *depth_cache, p) ||
-      p.status != PenetrationStatus::penetrating || !(p.lower_bound > band)) {
+      p.status != PenetrationStatus::intersecting || !(p.lower_bound > band)) {
     // Not certified here: distance()'s algorithm decides, and the depth is
     // asked again (penetration_depth) only if it finds an overlap.
     depth_cache->last_status = PenetrationStatus::separated;
@@ -214,11 +214,11 @@ SignedDistanceGradient signed_distance_gradient(const MeshResult& result, const 
   return signed_distance_gradient(static_cast<const DistanceResult&>(result), pose_a, pose_b);
 }
 
-SignedDistanceGradient signed_distance_gradient(const BodyDistance& result, const Pose& pose_a,
+SignedDistanceGradient signed_distance_gradient(const BodyResult& result, const Pose& pose_a,
                                                 const Pose& pose_b) {
   // A pair with a mesh side reports that side's closest triangle.
   const bool mesh_pair = result.triangle_a >= 0 || result.triangle_b >= 0;
-  if (mesh_pair && result.cores_overlap &&
+  if (mesh_pair && result.intersecting &&
       result.depth_upper_bound == std::numeric_limits<double>::infinity()) {
     refuse_mesh_overlap();
   }

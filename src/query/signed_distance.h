@@ -36,7 +36,7 @@ void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const C
 // since pays only this test (not a call that fails).
 inline bool overlap_trackable(const DistanceOptions& options, const DistanceCache& cache) {
   const PenetrationCache* depth_cache = cache.penetration.get();
-  return depth_cache != nullptr && depth_cache->last_status == PenetrationStatus::penetrating &&
+  return depth_cache != nullptr && depth_cache->last_status == PenetrationStatus::intersecting &&
          options.penetration && options.algorithm == Algorithm::hybrid;
 }
 

@@ -310,7 +310,7 @@ struct Scene::Impl {
   // The answer of distance(Body, Body) on two padded bodies in the scene's
   // terms (ClosePair): pieces 0 for a convex body, one query.
   static ClosePair body_answer(BodyId ia, const Body& a, BodyId ib, const Body& b,
-                               const BodyDistance& d) {
+                               const BodyResult& d) {
     ClosePair p{ia, ib, {}, d.triangle_a, d.triangle_b};
     static_cast<DistanceResult&>(p.result) = d;
     p.result.piece_a = a.convex ? 0 : d.piece_a;

@@ -149,7 +149,7 @@ TEST(TimeOfImpact, OverlappingAtTheStartSaysSo) {
   const Motion ma = Motion::fixed(Pose::identity());
   const Motion mb{Pose::from_translation(Vec3(1.5, 0, 0)), Pose::from_translation(Vec3(9, 0, 0))};
   const ImpactResult r = time_of_impact(cube, ma, cube, mb);
-  EXPECT_EQ(r.status, ImpactStatus::overlapping);
+  EXPECT_EQ(r.status, ImpactStatus::intersecting);
   EXPECT_EQ(r.t, 0.0);
   EXPECT_EQ(r.at_t.status, Status::intersecting);
 }
@@ -193,7 +193,7 @@ TEST(TimeOfImpact, RandomMotionsNeverReportContactLate) {
     options.target_separation = trial % 3 == 0 ? 0.2 * u(rng) : 0.0;
     options.tolerance = 1e-7;
     const ImpactResult r = time_of_impact(a, ma, b, mb, options);
-    if (r.status == ImpactStatus::overlapping) continue;
+    if (r.status == ImpactStatus::intersecting) continue;
     ASSERT_NE(r.status, ImpactStatus::iteration_cap) << "trial " << trial;
     contacts += r.status == ImpactStatus::contact ? 1 : 0;
     SCOPED_TRACE("trial " + std::to_string(trial));
@@ -263,7 +263,7 @@ TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {
     options.tolerance = 1e-9;
     const ImpactResult r = time_of_impact(a, ma, b, mb, options);
     SCOPED_TRACE("trial " + std::to_string(trial));
-    if (r.status == ImpactStatus::overlapping) continue;
+    if (r.status == ImpactStatus::intersecting) continue;
     // A near miss while turning fast can stall the advancement (steps
     // shrink with the gap, which stays): the cap, with t still safe.
     capped += r.status == ImpactStatus::iteration_cap ? 1 : 0;
@@ -358,7 +358,7 @@ TEST(TimeOfImpact, TurningBarsCrossingEdgeOnNeverOvershoot) {
     options.tolerance = 1e-9;
     const ImpactResult r = time_of_impact(a, ma, b, mb, options);
     SCOPED_TRACE("trial " + std::to_string(trial));
-    if (r.status == ImpactStatus::overlapping) continue;
+    if (r.status == ImpactStatus::intersecting) continue;
     EXPECT_NE(r.status, ImpactStatus::iteration_cap);
     if (r.status == ImpactStatus::contact) {
       ++contacts;
@@ -527,7 +527,7 @@ TEST(TimeOfImpact, PureTranslationAgreesWithTheExactRayAgainstTheMinkowskiHull) 
       options.tolerance = 1e-10 * s;
       const ImpactResult r = time_of_impact(a, ma, b, mb, options);
       ASSERT_NE(r.status, ImpactStatus::iteration_cap);
-      ASSERT_NE(r.status, ImpactStatus::overlapping);
+      ASSERT_NE(r.status, ImpactStatus::intersecting);
       if (t_star) {
         ASSERT_EQ(r.status, ImpactStatus::contact) << "missed the contact at t* = " << *t_star;
         EXPECT_LE(r.t, *t_star * (1 + 1e-12));
@@ -663,7 +663,7 @@ ImpactResult every_pair_time_of_impact(const Body& a, const Motion& ma, const Bo
       const ImpactResult r = time_of_impact(x, ma, y, mb, options);
       if (r.status == ImpactStatus::separated) continue;
       const bool first = best.status == ImpactStatus::separated || r.t < best.t ||
-                         (r.t == best.t && r.status == ImpactStatus::overlapping);
+                         (r.t == best.t && r.status == ImpactStatus::intersecting);
       if (first) best = r;
     }
   }
@@ -722,7 +722,7 @@ TEST(TimeOfImpact, CompoundsPrunedAnswerIsTheEarliestOfEveryPiecePair) {
     ASSERT_EQ(got.status, want.status);
     if (got.status == ImpactStatus::separated) continue;
     EXPECT_NEAR(got.t, want.t, 1e-6);
-    const BodyDistance at = distance(a, got.pose_a, b, got.pose_b);
+    const BodyResult at = distance(a, got.pose_a, b, got.pose_b);
     expect_within_target(at, options);
     EXPECT_EQ(got.piece_a, at.piece_a);
     EXPECT_EQ(got.piece_b, at.piece_b);
@@ -793,7 +793,7 @@ TEST(TimeOfImpact, CompoundContactsAtTheEndsAndNoMotion) {
     for (Vec3& p : two[1]) p.x() += 0.75 * (1.0 - first);
     const ImpactResult start =
         time_of_impact(Body(CompoundBody::from_point_sets(two)), still, make_sphere(0.25), up);
-    EXPECT_EQ(start.status, ImpactStatus::overlapping) << first;
+    EXPECT_EQ(start.status, ImpactStatus::intersecting) << first;
     EXPECT_EQ(start.t, 0.0);
     EXPECT_EQ(start.piece_a, first == 0.0 ? 1 : 0);
   }
@@ -855,7 +855,7 @@ TEST(TimeOfImpact, MeshBodies) {
   const ImpactResult both = time_of_impact(mesh, spin_in, mesh, still, options);
   EXPECT_EQ(both.status, ImpactStatus::contact);
   const ImpactResult around = time_of_impact(mesh, still, ball, still, options);
-  EXPECT_EQ(around.status, ImpactStatus::overlapping);
+  EXPECT_EQ(around.status, ImpactStatus::intersecting);
 }
 
 TEST(TimeOfImpact, BadInputIsRefusedByName) {
@@ -1179,7 +1179,7 @@ TEST(TimeOfImpact, MeshPrunedAnswerIsTheEarliestOfEveryTriangle) {
     const ImpactResult r = time_of_impact(ground, ma, body, mb, options);
     SCOPED_TRACE("trial " + std::to_string(trial));
     ASSERT_NE(r.status, ImpactStatus::iteration_cap);
-    ASSERT_NE(r.status, ImpactStatus::overlapping);
+    ASSERT_NE(r.status, ImpactStatus::intersecting);
 
     double every = 2.0;
     for (int i = 0; i < mesh->triangle_count(); ++i) {

@@ -66,7 +66,7 @@ double band_of(const Points& a, const Points& b) {
     if (!within_bound(r.depth, exact.depth_squared, kRel, tol))
       return fail("depth outside the standard");
     const bool deep = !within_bound(0.0, exact.depth_squared, 0.0, tol);
-    if (deep && r.status != PenetrationStatus::penetrating)
+    if (deep && r.status != PenetrationStatus::intersecting)
       return fail("deep pair not penetrating");
   }
   const double d_exact = exact.origin == OriginInM::inside && !exact.flat ? exact.depth() : 0.0;
@@ -109,7 +109,7 @@ TEST(PenetrationHand, CubesOverlappingAlongX) {
   const Points a = cube(1.0);
   const Points b = translated(cube(1.0), Vec3(0.75, 0.1, 0.2));
   for (const PenetrationResult& r : {fast(a, b), slow(a, b)}) {
-    EXPECT_EQ(r.status, PenetrationStatus::penetrating);
+    EXPECT_EQ(r.status, PenetrationStatus::intersecting);
     EXPECT_DOUBLE_EQ(r.depth, 0.25);
     EXPECT_NEAR((r.normal - Vec3::UnitX()).norm(), 0.0, 1e-15);
     EXPECT_NEAR(r.point_a.x(), 0.5, 1e-15);
@@ -192,7 +192,7 @@ TEST(PenetrationOracle, RandomOverlapsFromGrazingToContainment) {
     ASSERT_TRUE(meets_standard(a, b, rf, oracle)) << "fast, trial " << trial;
     ASSERT_TRUE(meets_standard(a, b, rs, oracle)) << "slow, trial " << trial;
     EXPECT_EQ(rf.status, rs.status) << trial;
-    if (rf.status == PenetrationStatus::penetrating) {
+    if (rf.status == PenetrationStatus::intersecting) {
       ++penetrating;
       shallow += rf.depth < 1e-6;
       contained += mode == 0;
@@ -243,7 +243,7 @@ TEST(PenetrationOracle, ManyFacedAndSliverHullsAgainstTheExactDepth) {
     cache.rotation(0, 0) = 2.0;
     const PenetrationResult again = penetration_depth(pa, pb, Pose::identity(), cache);
     ASSERT_TRUE(meets_standard(a, b, again, oracle)) << "re-enumerated, trial " << trial;
-    penetrating += cold.status == PenetrationStatus::penetrating;
+    penetrating += cold.status == PenetrationStatus::intersecting;
   }
   EXPECT_GE(penetrating, 24);
 }
@@ -400,7 +400,7 @@ TEST(PenetrationDegenerate, ScalesFrom1e300To1e300AndFarFromTheOrigin) {
       const Points a = scaled(a0, scale), b = scaled(b0, scale);
       const PenetrationResult r = fast(a, b);
       EXPECT_TRUE(meets_standard(a, b, r, oracle)) << scale;
-      EXPECT_EQ(r.status, PenetrationStatus::penetrating) << scale;
+      EXPECT_EQ(r.status, PenetrationStatus::intersecting) << scale;
       const PenetrationResult unit = fast(a0, b0);
       EXPECT_NEAR(r.depth / scale, unit.depth, 1e-13 * unit.depth) << scale;
     }
@@ -478,8 +478,8 @@ TEST(PenetrationRegression, PrismsWithCoplanarFacetsAtSmallScale) {
   const PenetrationResult rf = fast(a, b), rs = slow(a, b);
   EXPECT_TRUE(meets_standard(a, b, rf, oracle));
   EXPECT_TRUE(meets_standard(a, b, rs, oracle));
-  EXPECT_EQ(rf.status, PenetrationStatus::penetrating);
-  EXPECT_EQ(rs.status, PenetrationStatus::penetrating);
+  EXPECT_EQ(rf.status, PenetrationStatus::intersecting);
+  EXPECT_EQ(rs.status, PenetrationStatus::intersecting);
 }
 
 TEST(PenetrationRegression, SliverWithNearlyCoplanarFaces) {
@@ -498,8 +498,8 @@ TEST(PenetrationRegression, SliverWithNearlyCoplanarFaces) {
   const PenetrationResult rf = fast(a, b), rs = slow(a, b);
   EXPECT_TRUE(meets_standard(a, b, rf, oracle));
   EXPECT_TRUE(meets_standard(a, b, rs, oracle));
-  EXPECT_EQ(rf.status, PenetrationStatus::penetrating);
-  EXPECT_EQ(rs.status, PenetrationStatus::penetrating);
+  EXPECT_EQ(rf.status, PenetrationStatus::intersecting);
+  EXPECT_EQ(rs.status, PenetrationStatus::intersecting);
 }
 
 TEST(PenetrationRegression, DepthJustAboveTheBandIsPenetrating) {
@@ -512,7 +512,7 @@ TEST(PenetrationRegression, DepthJustAboveTheBandIsPenetrating) {
   ExactOracle oracle;
   for (const PenetrationResult& r : {fast(a, b), slow(a, b)}) {
     EXPECT_TRUE(meets_standard(a, b, r, oracle));
-    EXPECT_EQ(r.status, PenetrationStatus::penetrating);
+    EXPECT_EQ(r.status, PenetrationStatus::intersecting);
     EXPECT_NEAR(r.depth, 7.662212386177775e-15, 1e-28);
     EXPECT_LE(r.lower_bound, 7.662212386177775e-15);
     EXPECT_GE(r.upper_bound, 7.662212386177775e-15);
@@ -548,7 +548,7 @@ TEST(PenetrationOracle, PrismsOverlappingThroughNearlyCoplanarCaps) {
     for (int v = 0; v < pb.vertex_count() && !trapped; ++v)
       trapped = w.dot(pb.vertex(support_hill_climb(pb, w, v))) < best - 0.01 * s;
     stuck += trapped;
-    penetrating += fast(a, b).status == PenetrationStatus::penetrating;
+    penetrating += fast(a, b).status == PenetrationStatus::intersecting;
   }
   EXPECT_GE(penetrating, 55);
   EXPECT_GE(stuck, 5);
@@ -713,7 +713,7 @@ TEST(PenetrationTracking, SweepThroughAndBackIsContinuousAndMatchesCold) {
     ASSERT_EQ(r.status, cold.status) << i;
     ASSERT_NEAR(r.depth, cold.depth, kRel * cold.depth + tol) << i;
     ASSERT_TRUE(r.normal.allFinite() && r.point_a.allFinite() && r.point_b.allFinite()) << i;
-    if (r.status == PenetrationStatus::penetrating) {
+    if (r.status == PenetrationStatus::intersecting) {
       // The tracked witnesses meet the definition too.
       ASSERT_LE((r.point_b + r.depth * r.normal - r.point_a).norm(), 4 * tol) << i;
     }
@@ -849,7 +849,7 @@ TEST(PenetrationTracking, WitnessFeaturesOfBoxesTranslatedAndTurned) {
         const double tol = 1e-12;
         ASSERT_EQ(r.status, slow_twin.status) << trial << " " << turn << " " << i;
         ASSERT_NEAR(r.depth, slow_twin.depth, tol) << trial << " " << turn << " " << i;
-        if (r.status != PenetrationStatus::penetrating) continue;
+        if (r.status != PenetrationStatus::intersecting) continue;
         ++penetrating;
         const Points b_placed = transformed(b_local, pose);
         ASSERT_LE((r.point_b + r.depth * r.normal - r.point_a).norm(), tol)
@@ -891,7 +891,7 @@ TEST(PenetrationTracking, WitnessesReadFromTheCacheAreTheColdOnesBitForBit) {
         PenetrationCache fresh;
         const PenetrationResult cold = penetration_depth(pa, pb, pose, fresh);
         ++queries;
-        if (!r.tracked || r.status != PenetrationStatus::penetrating ||
+        if (!r.tracked || r.status != PenetrationStatus::intersecting ||
             r.face.kind != cold.face.kind || r.face.a0 != cold.face.a0 ||
             r.face.a1 != cold.face.a1 || r.face.b0 != cold.face.b0 || r.face.b1 != cold.face.b1 ||
             !same_bits(r.normal, cold.normal) || !same_bits(r.depth, cold.depth))
@@ -973,7 +973,7 @@ TEST(PenetrationTracking, ExpandedCacheMatchesBruteForceOnALongSweep) {
     ASSERT_NEAR(r.depth, slow_twin.depth, kRel * slow_twin.depth + tol) << i;
     ASSERT_LE(r.lower_bound, slow_twin.depth + tol) << i;
     ASSERT_GE(r.upper_bound, slow_twin.depth - tol) << i;
-    penetrating += r.status == PenetrationStatus::penetrating;
+    penetrating += r.status == PenetrationStatus::intersecting;
   }
   EXPECT_GE(penetrating, steps / 2);
   EXPECT_GE(cache.expansions, 1);

@@ -349,18 +349,18 @@ TEST(Batch, BodyPairsEqualSequentialBitForBit) {
     bool overlaps = false;
     bool apart = false;
     for (int frame = 0; frame < 3; ++frame) {
-      std::vector<BodyDistance> batch(n);
+      std::vector<BodyResult> batch(n);
       distance_batch(pairs, pa, pb, batch, batch_caches, {}, threads);
-      std::vector<BodyDistance> cold(n);
+      std::vector<BodyResult> cold(n);
       distance_batch(pairs, pa, pb, cold, {}, {}, threads);
       for (std::size_t k = 0; k < n; ++k) {
-        const BodyDistance loop =
+        const BodyResult loop =
             distance(*pairs[k].a, pa[k], *pairs[k].b, pb[k], {}, &loop_caches[k]);
         expect_same_result(batch[k], loop, k);
         EXPECT_TRUE(same_bits(batch[k].depth, loop.depth)) << "pair " << k;
         EXPECT_EQ(batch[k].piece_a, loop.piece_a) << "pair " << k;
         EXPECT_EQ(batch[k].piece_b, loop.piece_b) << "pair " << k;
-        const BodyDistance once = distance(*pairs[k].a, pa[k], *pairs[k].b, pb[k]);
+        const BodyResult once = distance(*pairs[k].a, pa[k], *pairs[k].b, pb[k]);
         expect_same_result(cold[k], once, k);
         overlaps = overlaps || loop.signed_distance() < 0;
         apart = apart || loop.signed_distance() > 0;
@@ -373,7 +373,7 @@ TEST(Batch, BodyPairsEqualSequentialBitForBit) {
   // A null body is refused with its index, before anything is written.
   std::vector<BodyPair> bad = pairs;
   bad[7].b = nullptr;
-  std::vector<BodyDistance> results(n);
+  std::vector<BodyResult> results(n);
   EXPECT_EQ(
       invalid_input_message([&] { distance_batch(bad, poses_a, poses_b, results, {}, {}, 2); }),
       "distance_batch: pairs[7].b is null");

@@ -95,12 +95,12 @@ TEST(BodyMesh, MeshOfAConvexShapeAgreesWithTheConvexQuery) {
     const Body b(std::make_shared<const ConvexPolytope>(other), radius);
     const Pose pa = random_pose(rng, 0.5);
     const Pose pb = random_pose(rng, 2.0);
-    const BodyDistance want = distance(box_as_polytope, pa, b, pb);
-    const BodyDistance got = distance(box_as_mesh, pa, b, pb);
-    if (want.cores_overlap) {
+    const BodyResult want = distance(box_as_polytope, pa, b, pb);
+    const BodyResult got = distance(box_as_mesh, pa, b, pb);
+    if (want.intersecting) {
       // The mesh answer has no depth: intersecting, signed <= -radius.
       EXPECT_EQ(got.status, Status::intersecting) << k;
-      EXPECT_TRUE(got.cores_overlap) << k;
+      EXPECT_TRUE(got.intersecting) << k;
       EXPECT_LE(got.signed_upper_bound(), -radius) << k;
       EXPECT_EQ(got.signed_lower_bound(), -std::numeric_limits<double>::infinity()) << k;
       continue;
@@ -125,10 +125,10 @@ TEST(BodyMesh, InsideAClosedMeshIsIntersectingInsideAnOpenOneIsNot) {
   const Body open_room(box_mesh(2.0, false));
   const Body ball = make_sphere(0.5);
   const Pose at(Mat3::Identity(), Vec3(0.3, -0.2, 0.1));
-  const BodyDistance closed = distance(room, Pose::identity(), ball, at);
+  const BodyResult closed = distance(room, Pose::identity(), ball, at);
   EXPECT_EQ(closed.status, Status::intersecting);
   EXPECT_LT(closed.signed_distance(), 0.0);
-  const BodyDistance open = distance(open_room, Pose::identity(), ball, at);
+  const BodyResult open = distance(open_room, Pose::identity(), ball, at);
   EXPECT_EQ(open.status, Status::separated);
   // The nearest wall of the open room: x = 2 (1.7 away) or y = -2 (1.8) ...
   // the ball's center at x = 0.3: 2 - 0.3 - 0.5 = 1.2 to x = 2; 1.3 to
@@ -216,7 +216,7 @@ TEST(BodyMesh, NonConvexMeshAgainstARoundedPointEqualsTheTwin) {
   for (int k = 0; k < 100; ++k) {
     const Pose pb(Mat3::Identity(), Vec3(test::uniform(rng, 1.2, 3), test::uniform(rng, 1.2, 3),
                                          test::uniform(rng, -0.5, 1.5)));
-    const BodyDistance got = distance(body, Pose::identity(), ball, pb);
+    const BodyResult got = distance(body, Pose::identity(), ball, pb);
     const MeshResult twin = distance_all_pairs(*l, Pose::identity(), point, pb);
     if (twin.status == Status::intersecting) continue;
     EXPECT_NEAR(got.signed_distance(), twin.distance - 0.2, 1e-12) << k;
@@ -224,7 +224,7 @@ TEST(BodyMesh, NonConvexMeshAgainstARoundedPointEqualsTheTwin) {
   }
   // In the notch, at (1.5, 1.5, 0.5): 0.5 from the L (its inner corner
   // edge at x = 1 or y = 1), while the hull contains the point.
-  const BodyDistance notch =
+  const BodyResult notch =
       distance(body, Pose::identity(), ball, Pose(Mat3::Identity(), Vec3(1.5, 1.5, 0.5)));
   EXPECT_EQ(notch.status, Status::separated);
   EXPECT_NEAR(notch.signed_distance(), 0.5 - 0.2, 1e-12);
@@ -244,13 +244,13 @@ TEST(BodyMesh, CompoundAgainstAMeshIsTheNearestPiece) {
   const Body mesh(box_mesh(0.5));
   for (int k = 0; k < 50; ++k) {
     const Pose pm = random_pose(rng, 6.0);
-    const BodyDistance got = distance(body, Pose::identity(), mesh, pm);
+    const BodyResult got = distance(body, Pose::identity(), mesh, pm);
     double nearest = std::numeric_limits<double>::infinity();
     int piece = -1;
     bool overlap = false;
     for (int i = 0; i < 4; ++i) {
       const Body one(pieces[static_cast<std::size_t>(i)].polytope);
-      const BodyDistance r = distance(one, pieces[static_cast<std::size_t>(i)].pose, mesh, pm);
+      const BodyResult r = distance(one, pieces[static_cast<std::size_t>(i)].pose, mesh, pm);
       overlap = overlap || r.status == Status::intersecting;
       if (r.distance < nearest) {
         nearest = r.distance;
@@ -284,8 +284,8 @@ TEST(BodyMesh, TrackedEqualsColdAndBatchEqualsLoop) {
     const double t = 0.02 * step;
     const Pose pb(Eigen::AngleAxisd(t, Vec3(0, 0, 1)).toRotationMatrix(),
                   Vec3(3.0 - t, 0.5 + 0.3 * std::sin(t), 0.5));
-    const BodyDistance tracked = distance(l, Pose::identity(), room, pb, {}, &cache);
-    const BodyDistance cold = distance(l, Pose::identity(), room, pb);
+    const BodyResult tracked = distance(l, Pose::identity(), room, pb, {}, &cache);
+    const BodyResult cold = distance(l, Pose::identity(), room, pb);
     EXPECT_EQ(tracked.status, cold.status) << step;
     EXPECT_NEAR(tracked.signed_distance(), cold.signed_distance(), 1e-12) << step;
     pairs.push_back(step % 2 ? BodyPair{&l, &room} : BodyPair{&capsule, &l});
@@ -293,10 +293,10 @@ TEST(BodyMesh, TrackedEqualsColdAndBatchEqualsLoop) {
     poses_b.push_back(pb);
   }
   EXPECT_FALSE(cache.is_cold());
-  std::vector<BodyDistance> batch(pairs.size());
+  std::vector<BodyResult> batch(pairs.size());
   distance_batch(pairs, poses_a, poses_b, batch, {}, {}, 2);
   for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const BodyDistance one = distance(*pairs[k].a, poses_a[k], *pairs[k].b, poses_b[k]);
+    const BodyResult one = distance(*pairs[k].a, poses_a[k], *pairs[k].b, poses_b[k]);
     EXPECT_EQ(batch[k].signed_distance(), one.signed_distance()) << k;
     EXPECT_EQ(batch[k].status, one.status) << k;
   }
@@ -319,7 +319,7 @@ TEST(BodyMesh, GradientOfAMeshOverlapNamesTheRealReason) {
   const Body room(box_mesh(1.0));
   const Body ball = make_sphere(0.5);
   const Pose at(Mat3::Identity(), Vec3(0.9, 0.0, 0.0));
-  const BodyDistance r = distance(room, Pose::identity(), ball, at);
+  const BodyResult r = distance(room, Pose::identity(), ball, at);
   ASSERT_EQ(r.status, Status::intersecting);
   try {
     signed_distance_gradient(r, Pose::identity(), at);

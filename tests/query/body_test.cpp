@@ -51,7 +51,7 @@ double bound(double d, double magnitude) { return 1e-12 * std::abs(d) + kBand * 
 // Checks what every answer must hold: |point_a - point_b| = |signed|,
 // point_b - point_a along the normal with the sign of signed, distance and
 // lower bound from the signed values, the bounds around the value.
-void expect_consistent(const BodyDistance& r, double magnitude) {
+void expect_consistent(const BodyResult& r, double magnitude) {
   const double tol = bound(r.signed_distance(), magnitude);
   EXPECT_NEAR((r.point_b - r.point_a).norm(), std::abs(r.signed_distance()), tol);
   EXPECT_NEAR((r.point_b - r.point_a - r.signed_distance() * r.normal).norm(), 0.0, tol);
@@ -76,12 +76,12 @@ TEST(BodyClosedForm, SphereSphere) {
     // A rotation of a sphere changes nothing.
     const Pose pa(test::random_quaternion(rng), ca);
     const Pose pb(test::random_quaternion(rng), cb);
-    const BodyDistance r = distance(a, pa, b, pb);
+    const BodyResult r = distance(a, pa, b, pb);
     const double exact = (cb - ca).norm() - ra - rb;
     const double magnitude = std::max(ca.cwiseAbs().maxCoeff() + ra, cb.cwiseAbs().maxCoeff() + rb);
     EXPECT_NEAR(r.signed_distance(), exact, bound(exact, magnitude)) << i;
     EXPECT_EQ(r.status, exact > 0 ? Status::separated : Status::intersecting) << i;
-    EXPECT_FALSE(r.cores_overlap);
+    EXPECT_FALSE(r.intersecting);
     const Vec3 n = (cb - ca).normalized();
     EXPECT_NEAR((r.normal - n).norm(), 0.0, 1e-12);
     EXPECT_NEAR((r.point_a - (ca + ra * n)).norm(), 0.0, bound(0, magnitude));
@@ -93,7 +93,7 @@ TEST(BodyClosedForm, SphereSphere) {
 TEST(BodyClosedForm, ConcentricSpheresOverlapByTheirRadii) {
   // The cores are one point: touching at distance 0, no direction from the
   // closest points; the penetration query supplies a normal.
-  const BodyDistance r = distance(make_sphere(1.0), Pose::identity(), make_sphere(0.5),
+  const BodyResult r = distance(make_sphere(1.0), Pose::identity(), make_sphere(0.5),
                                   Pose::from_translation(Vec3::Zero()));
   EXPECT_EQ(r.status, Status::intersecting);
   EXPECT_DOUBLE_EQ(r.signed_distance(), -1.5);
@@ -136,7 +136,7 @@ TEST(BodyClosedForm, CapsuleCapsuleIsSegmentsMinusRadii) {
     const Vec3 a0 = pa.apply(Vec3(0, 0, -ha)), a1 = pa.apply(Vec3(0, 0, ha));
     const Vec3 b0 = pb.apply(Vec3(0, 0, -hb)), b1 = pb.apply(Vec3(0, 0, hb));
     const double core = segment_segment(a0, a1 - a0, b0, b1 - b0);
-    const BodyDistance r = distance(make_capsule(ha, ra), pa, make_capsule(hb, rb), pb);
+    const BodyResult r = distance(make_capsule(ha, ra), pa, make_capsule(hb, rb), pb);
     if (core <= 1e-9) continue;  // crossing cores: the depth cases below
     const double exact = core - ra - rb;
     EXPECT_NEAR(r.signed_distance(), exact, 1e-9) << i;
@@ -162,7 +162,7 @@ TEST(BodyClosedForm, AxisAlignedBoxes) {
     for (int k = 0; k < 3; ++k) gap[k] = std::max(0.0, std::abs(c[k]) - ha[k] - hb[k]);
     if (gap.norm() == 0.0) continue;  // overlapping cores: the depth cases below
     const double exact = gap.norm() - ra - rb;
-    const BodyDistance r =
+    const BodyResult r =
         distance(make_box(ha, ra), Pose::identity(), make_box(hb, rb), Pose::from_translation(c));
     EXPECT_NEAR(r.signed_distance(), exact, bound(exact, 9.0)) << i;
     expect_consistent(r, 9.0);
@@ -186,12 +186,12 @@ TEST(BodyOracle, RoundedHullsAreTheConvexOracleOffsetByTheRadii) {
     if (exact->is_zero()) continue;
     ++checked;
     const double d = exact->distance();
-    const BodyDistance r =
+    const BodyResult r =
         distance(Body(hull(a), ra), Pose::identity(), Body(hull(b), rb), Pose::identity());
     const double magnitude =
         std::max(test::max_abs_coordinate(a) + ra, test::max_abs_coordinate(b) + rb);
     EXPECT_NEAR(r.signed_distance(), d - ra - rb, bound(d, magnitude)) << i;
-    EXPECT_FALSE(r.cores_overlap);
+    EXPECT_FALSE(r.intersecting);
     expect_consistent(r, magnitude);
     // The points lie on the rounded bodies: within the radius of the core.
     const auto da = oracle.point_distance_squared(r.point_a, a);
@@ -213,7 +213,7 @@ TEST(BodyOracle, PosesMoveTheRoundedBodiesAsTheirCores) {
     const Pose pa(test::random_quaternion(rng), 3.0 * test::random_unit_vector(rng));
     const Pose pb(test::random_quaternion(rng), 3.0 * test::random_unit_vector(rng));
     const double ra = test::uniform(rng, 0, 1), rb = test::uniform(rng, 0, 1);
-    const BodyDistance r = distance(Body(hull(a), ra), pa, Body(hull(b), rb), pb);
+    const BodyResult r = distance(Body(hull(a), ra), pa, Body(hull(b), rb), pb);
     const DistanceResult core = distance(*hull(a), pa, *hull(b), pb);
     if (core.status != Status::separated) continue;
     EXPECT_NEAR(r.signed_distance(), core.distance - ra - rb, 1e-13) << i;
@@ -237,11 +237,11 @@ TEST(BodyOracle, OverlappingCoresGiveMinusTheExactDepthMinusTheRadii) {
     const double ra = i % 3 == 0 ? 0.0 : test::uniform(rng, 0.0, 0.4);
     const double rb = test::uniform(rng, 0.0, 0.4);
     BodyCache cache;
-    const BodyDistance r = distance(Body(hull(a), ra), Pose::identity(), Body(hull(b), rb),
+    const BodyResult r = distance(Body(hull(a), ra), Pose::identity(), Body(hull(b), rb),
                                     Pose::identity(), {}, &cache);
     const double depth = exact.depth();
     EXPECT_EQ(r.status, Status::intersecting) << i;
-    EXPECT_TRUE(r.cores_overlap) << i;
+    EXPECT_TRUE(r.intersecting) << i;
     EXPECT_NEAR(r.signed_distance(), -depth - ra - rb, bound(depth, 2.5)) << i;
     EXPECT_LE(r.signed_lower_bound(), -depth - ra - rb + bound(depth, 2.5)) << i;
     EXPECT_GE(r.signed_upper_bound(), -depth - ra - rb - bound(depth, 2.5)) << i;
@@ -276,7 +276,7 @@ TEST(BodyOracle, TouchingCoresTakeTheNormalOfTheirContact) {
     c[axis] = ha[axis] + hb[axis];
     c[(axis + 1) % 3] = 0.25;
     const double ra = 0.1, rb = 0.2;
-    const BodyDistance r =
+    const BodyResult r =
         distance(make_box(ha, ra), Pose::identity(), make_box(hb, rb), Pose::from_translation(c));
     EXPECT_EQ(r.status, Status::intersecting) << i;
     EXPECT_NEAR(r.signed_distance(), -ra - rb, 1e-14) << i;
@@ -308,10 +308,10 @@ TEST(BodyCompound, RoundedCompoundIsItsClosestRoundedPiece) {
     const Body b = make_capsule(0.3, rs);
     const Pose pa(test::random_quaternion(rng), Vec3::Zero());
     const Pose pb(test::random_quaternion(rng), 4.0 * test::random_unit_vector(rng));
-    const BodyDistance r = distance(a, pa, b, pb);
+    const BodyResult r = distance(a, pa, b, pb);
     double best = std::numeric_limits<double>::infinity();
     for (int p = 0; p < compound->piece_count(); ++p) {
-      const BodyDistance piece =
+      const BodyResult piece =
           distance(Body(compound->piece(p).polytope, rc), pa * compound->piece(p).pose, b, pb);
       best = std::min(best, piece.signed_distance());
     }
@@ -333,9 +333,9 @@ TEST(BodyCompound, OverlappingCompoundReportsItsDeepestPiecePair) {
   const Body ball = make_sphere(0.5);
   // The core point (origin) is 0.2 inside piece 0 (face at x = -0.2) and
   // 0.4 inside piece 1 (face at x = 0.4): the deeper pair is piece 1.
-  const BodyDistance r = distance(compound, Pose::identity(), ball, Pose::identity());
+  const BodyResult r = distance(compound, Pose::identity(), ball, Pose::identity());
   EXPECT_EQ(r.status, Status::intersecting);
-  EXPECT_TRUE(r.cores_overlap);
+  EXPECT_TRUE(r.intersecting);
   EXPECT_EQ(r.piece_a, 1);
   EXPECT_NEAR(r.signed_distance(), -0.4 - 0.1 - 0.5, 1e-14);
   expect_consistent(r, 2.0);
@@ -354,15 +354,15 @@ TEST(BodyDepth, PenetrationOffSkipsTheDepthOfOverlappingCores) {
   const Body ball = make_sphere(0.5);
   const Pose inside = Pose::from_translation(Vec3(0.7, 0.1, 0));
   BodyCache cache;
-  const BodyDistance r = distance(box, Pose::identity(), ball, inside, status_only, &cache);
+  const BodyResult r = distance(box, Pose::identity(), ball, inside, status_only, &cache);
   EXPECT_EQ(r.status, Status::intersecting);
-  EXPECT_TRUE(r.cores_overlap);
+  EXPECT_TRUE(r.intersecting);
   EXPECT_TRUE(cache.penetration.is_cold());
   EXPECT_EQ(r.distance, 0.0);
   EXPECT_DOUBLE_EQ(r.signed_upper_bound(), -0.75);
   EXPECT_EQ(r.signed_lower_bound(), -std::numeric_limits<double>::infinity());
   // The default takes the depth: the core point is 0.3 inside the box.
-  const BodyDistance deep = distance(box, Pose::identity(), ball, inside);
+  const BodyResult deep = distance(box, Pose::identity(), ball, inside);
   EXPECT_NEAR(deep.signed_distance(), -0.3 - 0.75, 1e-14);
   EXPECT_GE(r.signed_upper_bound(), deep.signed_distance());
 
@@ -371,17 +371,17 @@ TEST(BodyDepth, PenetrationOffSkipsTheDepthOfOverlappingCores) {
   pieces.push_back({make_box(Vec3(1, 1, 1)).convex(), Pose::from_translation(Vec3(0.8, 0, 0))});
   pieces.push_back({make_box(Vec3(1, 1, 1)).convex(), Pose::from_translation(Vec3(-0.6, 0, 0))});
   const Body compound(std::make_shared<const CompoundBody>(std::move(pieces)), 0.1);
-  const BodyDistance c = distance(compound, Pose::identity(), ball, Pose::identity(), status_only);
+  const BodyResult c = distance(compound, Pose::identity(), ball, Pose::identity(), status_only);
   EXPECT_EQ(c.status, Status::intersecting);
-  EXPECT_TRUE(c.cores_overlap);
+  EXPECT_TRUE(c.intersecting);
   EXPECT_DOUBLE_EQ(c.signed_upper_bound(), -0.6);
   EXPECT_EQ(c.signed_lower_bound(), -std::numeric_limits<double>::infinity());
 
   // Cores apart: the option changes nothing.
   const Pose apart = Pose::from_translation(Vec3(2.0, 0, 0));
-  const BodyDistance far = distance(box, Pose::identity(), ball, apart, status_only);
+  const BodyResult far = distance(box, Pose::identity(), ball, apart, status_only);
   EXPECT_EQ(far.status, Status::separated);  // cores 1 apart, radii 0.75
-  EXPECT_FALSE(far.cores_overlap);
+  EXPECT_FALSE(far.intersecting);
   EXPECT_NEAR(far.signed_distance(), 1.0 - 0.75, 1e-14);
 }
 
@@ -410,7 +410,7 @@ TEST(BodyCompound, DeepestPairIsTheAllPairsTwins) {
     const Pose pa(test::random_quaternion(rng), Vec3::Zero());
     const Pose pb(test::random_quaternion(rng),
                   test::uniform(rng, 0, 2) * test::random_unit_vector(rng));
-    const BodyDistance r = distance(Body(ca, ra), pa, Body(cb, rb), pb);
+    const BodyResult r = distance(Body(ca, ra), pa, Body(cb, rb), pb);
     double twin = std::numeric_limits<double>::infinity();
     for (int x = 0; x < ca->piece_count(); ++x) {
       for (int y = 0; y < cb->piece_count(); ++y) {
@@ -429,7 +429,7 @@ TEST(BodyCompound, DeepestPairIsTheAllPairsTwins) {
     }
     EXPECT_NEAR(r.signed_distance(), twin - ra - rb, 1e-12) << i;
     expect_consistent(r, 6.0);
-    if (r.cores_overlap) ++overlapping;
+    if (r.intersecting) ++overlapping;
   }
   EXPECT_GT(overlapping, count(60) / 4);
 }
@@ -446,8 +446,8 @@ TEST(BodyCompound, MixedKindsAgreeWithTheirOnePieceCompounds) {
     const Pose pa(test::random_quaternion(rng), Vec3::Zero());
     const Pose pb(test::random_quaternion(rng),
                   test::uniform(rng, 0.5, 3.0) * test::random_unit_vector(rng));
-    const BodyDistance convex = distance(convex_a, pa, convex_b, pb);
-    const BodyDistance mixed = distance(convex_a, pa, compound_b, pb);
+    const BodyResult convex = distance(convex_a, pa, convex_b, pb);
+    const BodyResult mixed = distance(convex_a, pa, compound_b, pb);
     EXPECT_EQ(convex.status, mixed.status) << i;
     EXPECT_NEAR(convex.signed_distance(), mixed.signed_distance(),
                 bound(convex.signed_distance(), 4.0))
@@ -471,14 +471,14 @@ TEST(BodyTracking, TrackedAnswersAreTheColdAnswers) {
     const Pose pa = Pose::identity();
     const Pose pb(Quat(Eigen::AngleAxisd(0.01 * step, Vec3::UnitY())), Vec3(t, 0.3, 0));
     const Pose pc(Quat(Eigen::AngleAxisd(0.02 * step, Vec3::UnitZ())), Vec3(0, t, 0.1));
-    const BodyDistance tracked_b = distance(a, pa, b, pb, {}, &ab);
-    const BodyDistance cold_b = distance(a, pa, b, pb);
+    const BodyResult tracked_b = distance(a, pa, b, pb, {}, &ab);
+    const BodyResult cold_b = distance(a, pa, b, pb);
     EXPECT_EQ(tracked_b.status, cold_b.status) << step;
     EXPECT_NEAR(tracked_b.signed_distance(), cold_b.signed_distance(),
                 bound(cold_b.signed_distance(), 4.0))
         << step;
-    const BodyDistance tracked_c = distance(a, pa, c, pc, {}, &ac);
-    const BodyDistance cold_c = distance(a, pa, c, pc);
+    const BodyResult tracked_c = distance(a, pa, c, pc, {}, &ac);
+    const BodyResult cold_c = distance(a, pa, c, pc);
     EXPECT_EQ(tracked_c.status, cold_c.status) << step;
     EXPECT_NEAR(tracked_c.signed_distance(), cold_c.signed_distance(),
                 bound(cold_c.signed_distance(), 6.0))
@@ -565,7 +565,7 @@ TEST(Primitives, ShapesAreTheirDefinitions) {
   EXPECT_EQ(make_box(Vec3(1, 2, 3)).approximation_error(), 0.0);
   // Rounded boxes face to face, centers 7 apart: minus 2 (half extents) and
   // 2 (radii).
-  const BodyDistance r =
+  const BodyResult r =
       distance(make_box(Vec3(1, 1, 1), 1.0), Pose::identity(), make_box(Vec3(1, 1, 1), 1.0),
                Pose::from_translation(Vec3(7, 0, 0)));
   EXPECT_DOUBLE_EQ(r.signed_distance(), 3.0);

@@ -65,7 +65,7 @@ struct Twin {
   bool contact;
 };
 Twin twin_of(const Body& a, const Pose& pa, const Body& b, const Pose& pb) {
-  const BodyDistance r = distance(a, pa, b, pb);
+  const BodyResult r = distance(a, pa, b, pb);
   return {r.distance, r.status != Status::separated};
 }
 

@@ -347,7 +347,7 @@ TEST(SignedDistanceOracle, OverlapsAtTheBandHaveTheExactStatus) {
     ASSERT_NEAR(r.signed_distance(), -d, deep ? band : 2 * band) << trial;
     PenetrationCache cache;
     const PenetrationResult p = penetration_depth(pa, pb, Pose::identity(), cache);
-    ASSERT_EQ(p.status, deep ? PenetrationStatus::penetrating : PenetrationStatus::touching)
+    ASSERT_EQ(p.status, deep ? PenetrationStatus::intersecting : PenetrationStatus::touching)
         << trial << ": exact depth " << d << ", band " << band << ", depth " << p.depth;
   }
   EXPECT_GE(above, 10);

@@ -304,7 +304,7 @@ TEST(RobotDistance, EveryQueryMatchesTheSlowPathAlongATrajectory) {
     // The same close pairs, up to pairs at the margin within the agreement.
     std::size_t matched = 0;
     for (const SlowAnswer::Close& c : slow.close) {
-      for (const proxima::RobotPairDistance& pair : fast.close_pairs) {
+      for (const proxima::RobotPairResult& pair : fast.close_pairs) {
         if (pair.geometry_a == c.a && pair.geometry_b == c.b && pair.environment == c.environment &&
             std::abs(pair.signed_distance() - c.signed_distance) <= kAgreement) {
           ++matched;
@@ -344,7 +344,7 @@ TEST(RobotDistance, PairGradientsMatchCentralDifferences) {
   for (int trial = 0; trial < 40; ++trial) {
     const std::vector<double> q = random_q(robot, rng);
     const proxima::RobotDistances r = proxima::robot_distances(robot, q, obstacles, options);
-    for (const proxima::RobotPairDistance& pair : r.close_pairs) {
+    for (const proxima::RobotPairResult& pair : r.close_pairs) {
       ASSERT_TRUE(pair.has_gradient);
       const auto pair_at = [&](const std::vector<double>& at) {
         const std::vector<Pose> poses = robot.forward_kinematics(at);
@@ -360,8 +360,8 @@ TEST(RobotDistance, PairGradientsMatchCentralDifferences) {
         return proxima::distance(a.body, pose_a, b.body,
                                  poses[static_cast<std::size_t>(b.link)] * b.origin);
       };
-      const auto same_features = [](const proxima::BodyDistance& x,
-                                    const proxima::BodyDistance& y) {
+      const auto same_features = [](const proxima::BodyResult& x,
+                                    const proxima::BodyResult& y) {
         return x.status == y.status && x.feature_a.vertices == y.feature_a.vertices &&
                x.feature_b.vertices == y.feature_b.vertices &&
                x.feature_a.type == y.feature_a.type && x.feature_b.type == y.feature_b.type;
@@ -372,7 +372,7 @@ TEST(RobotDistance, PairGradientsMatchCentralDifferences) {
         std::vector<double> up = q, down = q;
         up[static_cast<std::size_t>(v)] += kStep;
         down[static_cast<std::size_t>(v)] -= kStep;
-        const proxima::BodyDistance u = pair_at(up), d = pair_at(down);
+        const proxima::BodyResult u = pair_at(up), d = pair_at(down);
         smooth = same_features(u, pair.result) && same_features(d, pair.result);
         difference[v] = (u.signed_distance() - d.signed_distance()) / (2 * kStep);
       }

@@ -151,7 +151,7 @@ bool same_answer(const ClosePair& x, const ClosePair& y) {
 ClosePair direct(const std::vector<Entry>& e, BodyId a, BodyId b, const DistanceOptions& options) {
   const Entry& ea = e[static_cast<std::size_t>(a)];
   const Entry& eb = e[static_cast<std::size_t>(b)];
-  const BodyDistance d = distance(ea.padded(), ea.pose, eb.padded(), eb.pose, options);
+  const BodyResult d = distance(ea.padded(), ea.pose, eb.padded(), eb.pose, options);
   ClosePair p{a, b, {}, d.triangle_a, d.triangle_b};
   static_cast<DistanceResult&>(p.result) = d;
   p.result.piece_a = ea.body.kind() == Body::Kind::convex ? 0 : d.piece_a;
@@ -460,7 +460,7 @@ TEST(SceneBodies, SweepTakesThePaddingAsARadius) {
     EXPECT_EQ(hits.size(), p > 1.5 ? 1u : 0u) << "padding " << p;
     EXPECT_EQ(scene.sweep_stats().candidate_pairs, p > 1.5 ? 1 : 0) << "padding " << p;
     if (!hits.empty()) {
-      EXPECT_EQ(hits[0].result.status, ImpactStatus::overlapping);
+      EXPECT_EQ(hits[0].result.status, ImpactStatus::intersecting);
     }
   }
   // Moving towards each other: the padded contact time, bit for bit the

@@ -96,7 +96,7 @@ struct Motion {
 enum class ImpactStatus : std::uint8_t {
   separated,      // no contact over [0, 1]: the distance stays above the target
   contact,        // the distance reaches the target (within tolerance) at t
-  overlapping,    // already intersecting (or strictly within the target) at t = 0
+  intersecting,   // already intersecting (or strictly within the target) at t = 0
   iteration_cap,  // stopped at options.max_iterations; t is still safe
 };
 
@@ -106,8 +106,8 @@ inline const char* to_string(ImpactStatus s) {
       return "separated";
     case ImpactStatus::contact:
       return "contact";
-    case ImpactStatus::overlapping:
-      return "overlapping";
+    case ImpactStatus::intersecting:
+      return "intersecting";
     case ImpactStatus::iteration_cap:
       return "iteration_cap";
   }
@@ -146,7 +146,7 @@ struct ImpactResult {
   int iterations = 0;  // advancement steps (distance queries)
   // Bodies with compounds or meshes: the pieces of at_t's closest pair, a
   // compound's piece index or a mesh's triangle index (at_t's features are
-  // theirs: BodyDistance's piece_a / triangle_a), -1 for a convex body; and
+  // theirs: BodyResult's piece_a / triangle_a), -1 for a convex body; and
   // the piece pairs (a mesh's pieces being its triangles) whose convex
   // advancement ran (the others were pruned by their bounding balls).
   std::int32_t piece_a = -1;
@@ -176,7 +176,7 @@ ImpactResult time_of_impact(const ConvexPolytope& a, const Motion& motion_a,
 // The same for Bodies of any kinds (proxima/query/body_distance.h): a rounded body's
 // radius adds to the target separation (the cores' distance must stay
 // above the target plus both radii), and at_t describes the rounded bodies
-// (BodyDistance's conventions, sliced to a DistanceResult: points on the
+// (BodyResult's conventions, sliced to a DistanceResult: points on the
 // rounded surfaces). Compounds and meshes: the earliest over pairs of
 // convex pieces (a compound's pieces, a convex body as its one piece, each
 // triangle of a mesh as the flat hull of its corners) of their convex

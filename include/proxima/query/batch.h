@@ -87,7 +87,7 @@ struct BodyPair {
 // bit for bit. Same sizes, errors and threads as the polytope batch above; a
 // Body's lazily built one-piece compound (Body::compound()) is thread-safe.
 void distance_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
-                    std::span<const Pose> poses_b, std::span<BodyDistance> results,
+                    std::span<const Pose> poses_b, std::span<BodyResult> results,
                     std::span<BodyCache> caches, const DistanceOptions& options = {},
                     int threads = 0);
 

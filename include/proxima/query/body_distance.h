@@ -61,7 +61,7 @@ struct BodyCache {
 //                 pieces piece_a, piece_b for compounds; mesh vertex ids
 //                 and, for a face, the triangle index for a mesh)
 // and beyond them:
-struct BodyDistance : DistanceResult {
+struct BodyResult : DistanceResult {
   // The signed distance of the rounded bodies and its certificate are
   // DistanceResult's signed_distance(), signed_lower_bound() and
   // signed_upper_bound() (distance - depth ...): negative when the rounded
@@ -76,7 +76,7 @@ struct BodyDistance : DistanceResult {
   std::int32_t triangle_b = -1;
   // Whether the cores overlap (then signed_distance <= -(r_a + r_b), from
   // their penetration depth).
-  bool cores_overlap = false;
+  bool intersecting = false;
   // approximation_error() of A plus that of B: the answer's distance to the
   // true shapes' answer (distance, signed distance, and the bounds) is at
   // most this, on top of the accuracy standard.
@@ -106,7 +106,7 @@ struct BodyDistance : DistanceResult {
 // have the signed value 0 with certificate [-infinity, 0] (as a mesh
 // overlap), status intersecting, and the distance query's points and normal
 // (which do not separate them).
-BodyDistance distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
+BodyResult distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options = {}, BodyCache* cache = nullptr);
 
 }  // namespace proxima

@@ -64,7 +64,7 @@ SignedDistanceGradient signed_distance_gradient(const DistanceResult& result, co
 // intersecting answer of a mesh pair is refused with that reason.
 SignedDistanceGradient signed_distance_gradient(const MeshResult& result, const Pose& pose_a,
                                                 const Pose& pose_b);
-SignedDistanceGradient signed_distance_gradient(const BodyDistance& result, const Pose& pose_a,
+SignedDistanceGradient signed_distance_gradient(const BodyResult& result, const Pose& pose_a,
                                                 const Pose& pose_b);
 
 }  // namespace proxima

@@ -79,12 +79,12 @@ struct RobotQueryOptions {
   DistanceOptions distance;
 };
 
-struct RobotPairDistance {
+struct RobotPairResult {
   std::int32_t geometry_a = -1;  // a robot geometry (Robot::geometries())
   // Another robot geometry, or for an environment pair the obstacle's index.
   std::int32_t geometry_b = -1;
   bool environment = false;
-  BodyDistance result;  // world frame, A the robot's geometry
+  BodyResult result;  // world frame, A the robot's geometry
   // d signed_distance / d q (length dof) when asked for; empty otherwise,
   // and zero for an overlap whose depth is not computed (a mesh's, see
   // proxima/query/body_distance.h), which has no gradient (has_gradient false).
@@ -101,10 +101,10 @@ struct RobotDistances {
   double min_environment = std::numeric_limits<double>::infinity();
   // The pair of min_signed_distance (geometry_a -1 when there is no pair),
   // with its gradient when asked for.
-  RobotPairDistance closest;
+  RobotPairResult closest;
   // Every pair within the margin: self pairs in self_pairs() order, then
   // environment pairs by geometry and obstacle.
-  std::vector<RobotPairDistance> close_pairs;
+  std::vector<RobotPairResult> close_pairs;
   // How many pairs got a distance query (the others were pruned by their
   // bounding spheres).
   int pairs_queried = 0;

@@ -103,7 +103,7 @@ struct CollisionFilter {
 //
 // A pair with a rounded or padded body or a mesh (Scene::add of a Body) is
 // answered by distance(Body, Body) (proxima/query/body_distance.h) on the padded bodies:
-// `result` is that BodyDistance's DistanceResult part (distance, signed
+// `result` is that BodyResult's DistanceResult part (distance, signed
 // distance and bounds, points on the padded surfaces, normal, features),
 // piece_a/piece_b its pieces (0 for a convex body, -1 for a mesh),
 // pairs_tested 1, and triangle_a/triangle_b its closest triangles of mesh

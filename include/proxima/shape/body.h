@@ -92,7 +92,7 @@ class Body {
   // Largest deviation of the core (plus radius) from the true shape it
   // approximates; 0 for exact bodies (all but cylinders and cones). Every
   // answer against this body is exact for the approximation, and within
-  // this of the answer for the true shape (BodyDistance::approximation_error).
+  // this of the answer for the true shape (BodyResult::approximation_error).
   double approximation_error() const { return approximation_error_; }
 
   // Largest absolute coordinate of the core in its own frame, plus the

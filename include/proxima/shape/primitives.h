@@ -14,7 +14,7 @@
 // contains the true solid and whose every point is within
 // Body::approximation_error() of it: the answer is exact for the polytope,
 // never above the true distance, and at most the approximation error below
-// it (the same for the signed distance; BodyDistance::approximation_error
+// it (the same for the signed distance; BodyResult::approximation_error
 // adds both bodies'). The error is the caller's `tolerance` or less; the
 // number of sides is the smallest that meets it (polygon_sides).
 //

@@ -70,15 +70,15 @@
 namespace proxima {
 
 enum class PenetrationStatus : std::uint8_t {
-  penetrating,  // depth > 64 u R: the interiors overlap
+  intersecting,  // depth > 64 u R: the interiors overlap
   touching,     // depth <= 64 u R (flat M included): in contact at machine precision
   separated,    // the hulls do not meet (depth reported as 0): use distance()
 };
 
 inline const char* to_string(PenetrationStatus s) {
   switch (s) {
-    case PenetrationStatus::penetrating:
-      return "penetrating";
+    case PenetrationStatus::intersecting:
+      return "intersecting";
     case PenetrationStatus::touching:
       return "touching";
     case PenetrationStatus::separated:
