@@ -127,7 +127,7 @@ struct FeatureSet {
     id[static_cast<std::size_t>(n)] = -1;
   }
   // Keeps the vertices whose bit is set in `active`, in order.
-  [[gnu::always_inline]] void reduce(std::uint8_t active) {
+  void reduce(std::uint8_t active) {
     if (active == (1u << n) - 1u) return;  // all kept: the tracked case
     int k = 0;
     for (int i = 0; i < n; ++i) {
@@ -207,7 +207,7 @@ using Local = ClosestPoints<double>;
 // Closest points of conv(fa) and conv(fb). Sizes 1..3 (every query's first
 // call, and all of a tracked one) go straight to the closed-form kernels,
 // whose result is the answer.
-[[gnu::always_inline]] inline Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
+inline Local local_distance(const FeatureSet& fa, const FeatureSet& fb,
                             const KernelTolerance<double>& tol) {
   if (fa.n <= 3 && fb.n <= 3) [[likely]]
     return closest_points<double>(fa.p.data(), fa.n, fb.p.data(), fb.n, tol);
@@ -288,7 +288,7 @@ Vec3 face_direction(const std::array<Vec3, 4>& t) {
 // false when nothing usable is cached. Written out for the three slots: a
 // later id repeats an earlier one only if that one was valid and loaded.
 template <class MapPoint>
-[[gnu::always_inline]] inline bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f,
+bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureSet& f,
                   MapPoint map_point) {
   const std::int32_t v0 = cached[0];
   const std::int32_t v1 = cached[1];
@@ -361,59 +361,6 @@ bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const V
   const double reach = std::sqrt(3.0) * b.scale();  // >= max |y| over B
   // A quiet comparison: a garbage cache may hold NaN (moved far, then).
   return !std::islessequal(shift + std::sqrt(turn2) * reach, kStaleMotion * size);
-}
-
-// The witness features of the final pair (fa, fb) with closest points
-// `loc` (local units; `unit` turns them into the caller's), by the rule all
-// algorithms share (witness_features.h), in each hull's own frame and
-// units; their faces go to the cache. One definition for the loop's answer
-// and the certified tracked pair's (certify_tracked_pair), so that the two
-// report the same features for the same pair.
-template <bool kScaled>
-[[gnu::always_inline]] inline void assign_witness_features(
-    const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a, const FeatureSet& fa,
-    const FeatureSet& fb, const Local& loc, double r_local, double unit, DistanceCache& cache,
-    DistanceResult& result) {
-  const Mat3& rot = b_in_a.rotation;
-  const Vec3& tr = b_in_a.translation;
-  const bool locate = result.status != Status::intersecting;
-  const double witness_band = detail::witness_band(r_local * unit);
-  // The tracked edge: rule 1 keeps both vertices when the closest point is
-  // farther than the band from each of them, and rule 2 needs their ids
-  // only. A's frame is A's own (unscaled: the same arithmetic as
-  // witness_feature's); B's point is tested in A's frame, with the margin
-  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
-  // and the whole rule applied there.
-  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
-                                      const Vec3& x, double bands, Feature& out) {
-    if constexpr (kScaled) {
-      return false;
-    } else {
-      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
-             detail::hull_edge(poly, f.id[0], f.id[1], out);
-    }
-  };
-  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
-    result.feature_a = detail::witness_feature(
-        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
-        [&] {
-          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
-        },
-        locate);
-  }
-  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
-    result.feature_b = detail::witness_feature(
-        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
-        [&] {
-          // The outward side only matters on a polygon.
-          return detail::WitnessPoint{
-              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
-              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-        },
-        locate);
-  }
-  cache.face_a = result.feature_a.face;
-  cache.face_b = result.feature_b.face;
 }
 
 // The algorithm on coordinates multiplied by `scale`, a power of two, when
@@ -595,85 +542,52 @@ template <bool kScaled, bool kMargin = false>
   // without rule 3's walk (witness_features.h).
   if (result.status == Status::touching)
     classify_contact(a, b, b_in_a, options, band, cache, result);
-  assign_witness_features<kScaled>(a, b, b_in_a, fa, fb, loc, r_local, unit, cache, result);
+  const bool locate = result.status != Status::intersecting;
+
+  // The witness features by the rule all algorithms share
+  // (witness_features.h), in each hull's own frame and units.
+  const double witness_band = detail::witness_band(r_local * unit);
+  // The tracked edge: rule 1 keeps both vertices when the closest point is
+  // farther than the band from each of them, and rule 2 needs their ids
+  // only. A's frame is A's own (unscaled: the same arithmetic as
+  // witness_feature's); B's point is tested in A's frame, with the margin
+  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
+  // and the whole rule applied there.
+  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
+                                      const Vec3& x, double bands, Feature& out) {
+    if constexpr (kScaled) {
+      return false;
+    } else {
+      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
+             detail::hull_edge(poly, f.id[0], f.id[1], out);
+    }
+  };
+  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
+    result.feature_a = detail::witness_feature(
+        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+        [&] {
+          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
+        },
+        locate);
+  }
+  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
+    result.feature_b = detail::witness_feature(
+        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+        [&] {
+          // The outward side only matters on a polygon.
+          return detail::WitnessPoint{
+              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
+              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+        },
+        locate);
+  }
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
 
   // An answer the hybrid could not certify is cross-checked (contact.h).
   if (needs_cross_check(result, options, magnitude)) [[unlikely]]
     cross_check_separation(a, b, b_in_a, options, band, result);
   return result;
-}
-
-// The certified tracked pair (issue 28): the loop's first pass, alone, for
-// a warm cache at ordinary magnitudes (unscaled). The cached pair's closed-
-// form distance d and closest points, the direction w of that pass, and
-// each body's support along w climbed from its cached hint: when the
-// support gap lower = w.b* - w.a* (the slab between the two support planes,
-// the loop's certificate) is within the termination test of d, no other
-// feature pair is closer by more than that test allows, and the loop would
-// stop right there with iterations 0. Then the answer is the loop's own,
-// bit for bit (the same kernels on the same inputs, the same witness rule,
-// the same cache), and it is written to `result` and true returned. Any
-// other case (a cold or stale cache, a contact, a support point off the
-// cached pair, a gap too wide) returns false with `cache` and `result`
-// untouched, and the loop runs from the same cached pair. What it saves is
-// the loop's generality: no iteration bookkeeping, no gains, no growth of
-// the feature sets. HybridFastPath.* compares it with the loop.
-[[gnu::always_inline]] inline bool certify_tracked_pair(const ConvexPolytope& a,
-                                                        const ConvexPolytope& b,
-                                                        const Pose& b_in_a,
-                                                        const DistanceOptions& options, double band,
-                                                        DistanceCache& cache, double r_local,
-                                                        DistanceResult& result) {
-  const Mat3& rot = b_in_a.rotation;
-  const Vec3& tr = b_in_a.translation;
-  const int count_a = a.vertex_count();
-  const int count_b = b.vertex_count();
-  FeatureSet fa;
-  FeatureSet fb;
-  if (!load_feature(cache.vertices_a, count_a, fa, [&](std::int32_t v) { return a.vertex(v); }) ||
-      !load_feature(cache.vertices_b, count_b, fb,
-                    [&](std::int32_t v) -> Vec3 { return rot * b.vertex(v) + tr; }) ||
-      moved_far(a, b, b_in_a, cache)) [[unlikely]] {
-    return false;
-  }
-  const Local loc = local_distance(fa, fb, kernel_tolerance(r_local));
-  const double d = std::sqrt(loc.distance_squared);
-  // A contact is classified by the loop's caller (contact.h).
-  if (!(d > band)) [[unlikely]]
-    return false;
-  fa.reduce(loc.active_a);
-  fb.reduce(loc.active_b);
-  const Vec3 w = search_direction(fa, fb, loc.point_b - loc.point_a, d);
-  const std::int32_t hint_a =
-      support_hill_climb(a, w, valid_id(cache.hint_a, count_a) ? cache.hint_a : 0);
-  const std::int32_t hint_b = support_hill_climb(b, minus_transpose_times(rot, w),
-                                                 valid_id(cache.hint_b, count_b) ? cache.hint_b : 0);
-  const double wa = w.dot(a.vertex(hint_a));
-  const double wb = w.dot(Vec3(rot * b.vertex(hint_b) + tr));
-  const double lower = std::max(0.0, wb - wa);
-  // The loop's termination test, with its rounding slack (kTerminationGapUlps).
-  if (!(d - lower <= options.relative_tolerance * d +
-                         kTerminationGapUlps * (kUnitRoundoff * r_local))) [[unlikely]] {
-    return false;
-  }
-  result.status = Status::separated;
-  result.iterations = 0;
-  result.point_a = loc.point_a;
-  result.point_b = loc.point_b;
-  result.distance = d;
-  result.lower_bound = std::min(lower, d);
-  result.normal = (loc.point_b - loc.point_a) / d;
-  store_feature(fa, cache.vertices_a);
-  store_feature(fb, cache.vertices_b);
-  cache.hint_a = hint_a;
-  cache.hint_b = hint_b;
-  cache.rotation = rot;
-  cache.translation = tr;
-  assign_witness_features<false>(a, b, b_in_a, fa, fb, loc, r_local, 1.0, cache, result);
-  // The gap passed the termination test, within Re d + kTerminationGapUlps
-  // u R: inside the cross-check's kCertificateUlps u R, so none is needed
-  // (needs_cross_check is false for this answer).
-  return true;
 }
 
 // The hybrid on coordinates times the power of two that brings R in A's
@@ -685,15 +599,6 @@ DistanceResult run_scaled(const ConvexPolytope& a, const ConvexPolytope& b, cons
   return run_hybrid<true>(a, b, b_in_a, options, contact_tolerance, cache, r_local, scale);
 }
 
-// The loop on unscaled coordinates, out of line: the tracked query's
-// common case is the certified pair above, inlined in hybrid_distance.
-[[gnu::noinline]] DistanceResult run_unscaled(const ConvexPolytope& a, const ConvexPolytope& b,
-                                              const Pose& b_in_a, const DistanceOptions& options,
-                                              double contact_tolerance, DistanceCache& cache,
-                                              double r_local) {
-  return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
-}
-
 }  // namespace
 
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
@@ -703,41 +608,10 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
   const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
   if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
       !std::isfinite(r_local)) [[likely]] {
-    DistanceResult result;
-    if (r_local >= kMinUnscaled && r_local <= kMaxUnscaled &&
-        certify_tracked_pair(a, b, b_in_a, options, contact_tolerance, cache, r_local, result))
-        [[likely]] {
-      return result;
-    }
-    result = run_unscaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
-    return result;
+    return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
   }
   return run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
 }
-
-namespace detail {
-
-bool certified_tracked_distance(const ConvexPolytope& a, const ConvexPolytope& b,
-                                const Pose& b_in_a, const DistanceOptions& options,
-                                double contact_tolerance, DistanceCache& cache,
-                                DistanceResult& result) {
-  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
-  return r_local >= kMinUnscaled && r_local <= kMaxUnscaled &&
-         certify_tracked_pair(a, b, b_in_a, options, contact_tolerance, cache, r_local, result);
-}
-
-DistanceResult hybrid_distance_by_search(const ConvexPolytope& a, const ConvexPolytope& b,
-                                         const Pose& b_in_a, const DistanceOptions& options,
-                                         double contact_tolerance, DistanceCache& cache) {
-  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
-  if ((r_local >= kMinUnscaled && r_local <= kMaxUnscaled) || !(r_local > 0.0) ||
-      !std::isfinite(r_local)) {
-    return run_unscaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
-  }
-  return run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
-}
-
-}  // namespace detail
 
 DistanceResult hybrid_within(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                              const DistanceOptions& options, double contact_tolerance,

@@ -58,10 +58,7 @@ int support_without_hint(const ConvexPolytope& polytope, const Vec3& dir);
 // than the first improving one) shortens the walk from a cold hint on round
 // bodies. Both twins round d.x the same way, so they agree exactly except
 // where exact values differ by less than the rounding of d.x (see the test).
-// Always inlined: a tracked query's two climbs are most of its work, and a
-// call each (with the spills around it) a large share of the rest.
-[[gnu::always_inline]] inline int support_hill_climb(const ConvexPolytope& polytope,
-                                                     const Vec3& dir, int hint) {
+inline int support_hill_climb(const ConvexPolytope& polytope, const Vec3& dir, int hint) {
   const int n = polytope.vertex_count();
   const Vec3* vertices = polytope.vertices().data();
   const std::int32_t* offsets = polytope.adjacency_offsets().data();

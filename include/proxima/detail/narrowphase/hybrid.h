@@ -33,29 +33,4 @@ DistanceResult hybrid_within(const ConvexPolytope& a, const ConvexPolytope& b, c
                              const DistanceOptions& options, double contact_tolerance,
                              double margin, DistanceCache& cache);
 
-namespace detail {
-
-// The two halves of hybrid_distance, for the tests that compare them
-// (HybridFastPath.*) and the benchmarks that measure them.
-//
-// The certified tracked pair: when `cache` holds a pair (at ordinary
-// magnitudes, 2^-64 < R < 2^64 in A's frame) whose closed-form distance the
-// support gap along its own direction certifies within the loop's
-// termination test, writes the loop's answer (bit for bit the one
-// hybrid_distance_by_search would give from the same cache), updates the
-// cache as the loop would, and returns true. Otherwise returns false and
-// touches neither. O(1) but for the two support climbs from the cached hints.
-bool certified_tracked_distance(const ConvexPolytope& a, const ConvexPolytope& b,
-                                const Pose& b_in_a, const DistanceOptions& options,
-                                double contact_tolerance, DistanceCache& cache,
-                                DistanceResult& result);
-
-// hybrid_distance without the certified tracked pair: the loop, from the
-// cached pair or cold.
-DistanceResult hybrid_distance_by_search(const ConvexPolytope& a, const ConvexPolytope& b,
-                                         const Pose& b_in_a, const DistanceOptions& options,
-                                         double contact_tolerance, DistanceCache& cache);
-
-}  // namespace detail
-
 }  // namespace proxima
