@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "answer_writer.h"
+#include "line_reader.h"
 #include "json_errors.h"
 #include "proxima/motion/time_of_impact.h"
 #include "proxima/query/body_distance.h"
@@ -536,15 +537,36 @@ bool is_blank(std::string_view line) {
 }  // namespace
 
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads, std::optional<QuaternionOrder> order) {
+                            int threads, std::optional<QuaternionOrder> order,
+                            std::uint64_t max_line_bytes) {
   QueryRunSummary summary;
   std::string line;
   long line_number = 0;
+  // A line past the limit gets its error answer, and the run stops there
+  // (read_line: its rest cannot be skipped safely).
+  const auto refuse_long_line = [&] {
+    summary.too_long_line = line_number;
+    std::string answer;
+    append_error_answer(answer, nullptr, line_number,
+                        "longer than the limit of " + std::to_string(max_line_bytes) +
+                            " bytes (--max-line-size)");
+    answer += '\n';
+    out.write(answer.data(), static_cast<std::streamsize>(answer.size()));
+    out.flush();
+    ++summary.answered;
+    ++summary.errors;
+  };
   if (threads <= 1) {
     Workspace work;
     std::string answer;
-    while (std::getline(in, line)) {
+    for (;;) {
+      const LineRead read = read_line(in, line, max_line_bytes);
+      if (read == LineRead::end) break;
       ++line_number;
+      if (read == LineRead::too_long) {
+        refuse_long_line();
+        break;
+      }
       if (is_blank(line)) continue;
       answer.clear();
       if (!answer_line(line, line_number, options, order, work, answer)) ++summary.errors;
@@ -571,14 +593,21 @@ QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceO
   std::vector<Pending> block(block_size);
   std::vector<Workspace> work(static_cast<std::size_t>(threads));
   bool more = true;
+  bool too_long = false;
   while (more) {
     std::size_t count = 0;
     while (count < block_size) {
-      if (!std::getline(in, line)) {
+      const LineRead read = read_line(in, line, max_line_bytes);
+      if (read == LineRead::end) {
         more = false;
         break;
       }
       ++line_number;
+      if (read == LineRead::too_long) {
+        more = false;
+        too_long = true;
+        break;
+      }
       if (!is_blank(line)) {
         Pending& p = block[count++];
         p.line.swap(line);
@@ -626,6 +655,7 @@ QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceO
     }
     out.flush();
   }
+  if (too_long) refuse_long_line();
   summary.read_failed = in.bad();
   return summary;
 }
