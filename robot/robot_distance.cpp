@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "query/parallel_ranges.h"
@@ -36,20 +37,69 @@ double sphere_bound(const Vec3& center_a, double radius_a, const Vec3& center_b,
   return (center_a - center_b).norm() - radius_a - radius_b;
 }
 
-double box_bound(const Vec3& center, double radius, const Obstacle& obstacle) {
+double obstacle_box_bound(const Vec3& center, double radius, const Obstacle& obstacle) {
   const Vec3 local = obstacle.pose.rotation.transpose() * (center - obstacle.pose.translation);
   const Vec3 outside =
       ((local - obstacle.box.center).cwiseAbs() - obstacle.box.half_extents).cwiseMax(0.0);
   return outside.norm() - radius - obstacle.body.radius();
 }
 
+// A body's box in the world: its core's box (centre, the columns of `axes`
+// and the half extents), every point of the body within `radius` of it.
+// Its support along a unit n is n.center + sum_i |n.axes_i| half_i + radius.
+struct WorldBox {
+  Vec3 center;
+  const Mat3* axes;
+  const Vec3* half_extents;
+  double radius;
+  double reach() const { return center.norm() + half_extents->norm() + radius; }
+};
+
+// The rounding of the box bound below, relative to the boxes' reach (the
+// magnitudes it adds): its few dot products err by a few u of it, and a
+// normal read from a result is unit within a few u. The same margin as the
+// bounding spheres' (kBoundingSphereSlack in robot.cpp), far above both.
+constexpr double kBoxBoundSlack = 1e-9;
+
+// A lower bound on the signed distance of two bodies within boxes a and b:
+// for any unit n, A lies in the half-space n.x <= h_A(n) and B in n.x >=
+// -h_B(-n), so their distance is at least the gap n.(c_b - c_a) - (A's
+// extent along n) - (B's), and when they overlap their depth (the least
+// overlap over all directions) is at most minus that gap.
+double box_gap(const WorldBox& a, const WorldBox& b, const Vec3& n) {
+  const double extent_a = (a.axes->transpose() * n).cwiseAbs().dot(*a.half_extents) + a.radius;
+  const double extent_b = (b.axes->transpose() * n).cwiseAbs().dot(*b.half_extents) + b.radius;
+  return n.dot(b.center - a.center) - extent_a - extent_b;
+}
+
+// The box gap along the centres' line and along the pair's last normal
+// (zero before the first query), whichever is larger. The gap is a bound
+// only along a unit axis: both are normalized here, whatever a result held.
+double box_bound(const WorldBox& a, const WorldBox& b, const Vec3& last_normal) {
+  double bound = -kInfinity;
+  const Vec3 line = b.center - a.center;
+  const double length = line.norm();
+  if (length > 0) bound = box_gap(a, b, line / length);
+  const double norm = last_normal.norm();
+  if (norm > 0.5 && norm < 2) bound = std::max(bound, box_gap(a, b, last_normal / norm));
+  return bound - kBoxBoundSlack * (a.reach() + b.reach());
+}
+
+// A margin on |R_after - R_before|_2 for rotations that are orthonormal to
+// a few u (poses are re-orthonormalized by checked_pose, and forward
+// kinematics multiplies a few of them): the identity below holds for exact
+// rotations, and this covers the departure of rounded ones many times over.
+constexpr double kRotationSlack = 1e-9;
+
 // How far any point within `radius` of a body's sphere centre (`local`, in
 // the frame that moved from `before` to `after`) has moved: the centre's
-// displacement plus |R_after - R_before|_2 radius, bounded by the Frobenius
-// norm.
+// displacement plus |R_after - R_before|_2 radius. For two rotations,
+// R_after - R_before = R_before (R - I), R a turn by some angle t, whose
+// singular values are 2 sin(t/2) twice and 0: the spectral norm is the
+// Frobenius norm over sqrt(2).
 double motion(const Pose& before, const Pose& after, const Vec3& local, double radius) {
-  return (after.apply(local) - before.apply(local)).norm() +
-         (after.rotation - before.rotation).norm() * radius;
+  const double turn = (after.rotation - before.rotation).norm() * std::numbers::sqrt2 / 2;
+  return (after.apply(local) - before.apply(local)).norm() + (turn + kRotationSlack) * radius;
 }
 
 const void* core_of(const Body& body) {
@@ -109,6 +159,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
     s.obstacle_cores_.assign(obstacles.size(), nullptr);
     s.obstacle_radii_.assign(obstacles.size(), 0.0);
     s.obstacle_motion_.assign(obstacles.size(), kInfinity);
+    s.self_normal_.assign(pairs.size(), Vec3::Zero());
+    s.environment_normal_.assign(n_geometries * obstacles.size(), Vec3::Zero());
   }
   std::swap(s.link_poses_, s.previous_link_poses_);
   robot.forward_kinematics(q, options.base, s.link_poses_);
@@ -116,9 +168,12 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
   const auto& spheres = robot.geometry_spheres();
   s.geometry_poses_.resize(n_geometries);
   s.centers_.resize(n_geometries);
+  s.box_centers_.resize(n_geometries);
+  const auto& boxes = robot.geometry_boxes();
   for (std::size_t g = 0; g < n_geometries; ++g) {
     const auto link = static_cast<std::size_t>(geometries[g].link);
     s.geometry_poses_[g] = s.link_poses_[link] * geometries[g].origin;
+    s.box_centers_[g] = s.geometry_poses_[g].apply(boxes[g].center);
     s.centers_[g] = s.link_poses_[link].apply(spheres[g].center);
     s.motion_[g] = moved_before ? motion(s.previous_link_poses_[link], s.link_poses_[link],
                                          spheres[g].center, spheres[g].radius)
@@ -138,6 +193,14 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
     }
     s.obstacle_poses_[o] = obstacles[o].pose;
   }
+  s.obstacle_box_centers_.resize(obstacles.size());
+  for (std::size_t o = 0; o < obstacles.size(); ++o) {
+    s.obstacle_box_centers_[o] = obstacles[o].pose.apply(obstacles[o].box.center);
+  }
+  const auto geometry_box = [&](std::size_t g) {
+    return WorldBox{s.box_centers_[g], &s.geometry_poses_[g].rotation, &boxes[g].half_extents,
+                    geometries[g].body.radius()};
+  };
 
   RobotDistances out;
   const auto report = [&](RobotPairResult&& pair, double& category_min, std::int32_t index,
@@ -185,6 +248,9 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       bound = std::max(
           bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b], spheres[b].radius));
       if (bound > threshold) continue;
+      Vec3& normal = s.self_normal_[static_cast<std::size_t>(p)];
+      bound = std::max(bound, box_bound(geometry_box(a), geometry_box(b), normal));
+      if (bound > threshold) continue;
       ++out.pairs_queried;
       RobotPairResult result;
       result.geometry_a = pair.a;
@@ -193,6 +259,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
           distance(geometries[a].body, s.geometry_poses_[a], geometries[b].body,
                    s.geometry_poses_[b], options.distance, &s.self_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
+      normal = result.result.normal;
       report(std::move(result), out.min_self, p, last);
     }
     if (last >= 0) s.last_self_ = last;
@@ -213,7 +280,12 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       double& bound = s.environment_bound_[static_cast<std::size_t>(p)];
       const double threshold = std::max(options.margin, out.min_environment);
       if (bound > threshold) continue;
-      bound = std::max(bound, box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
+      bound = std::max(bound, obstacle_box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
+      if (bound > threshold) continue;
+      Vec3& normal = s.environment_normal_[static_cast<std::size_t>(p)];
+      const WorldBox obstacle_box{s.obstacle_box_centers_[o], &obstacles[o].pose.rotation,
+                                  &obstacles[o].box.half_extents, obstacles[o].body.radius()};
+      bound = std::max(bound, box_bound(geometry_box(g), obstacle_box, normal));
       if (bound > threshold) continue;
       ++out.pairs_queried;
       RobotPairResult result;
@@ -224,6 +296,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
           distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body, obstacles[o].pose,
                    options.distance, &s.environment_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
+      normal = result.result.normal;
       report(std::move(result), out.min_environment, p, last);
     }
     if (last >= 0) s.last_environment_ = last;
