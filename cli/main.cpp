@@ -31,6 +31,7 @@
 #include "proxima/core/types.h"
 #include "query.h"
 #include "robot.h"
+#include "robot_srdf.h"
 #include "tools.h"
 #include "view.h"
 
@@ -298,6 +299,9 @@ int main(int argc, char** argv) {
       "    proxima robot --urdf panda.urdf --srdf panda.srdf --package-dir NAME=DIR --gradients\n"
       "Each line: {\"id\": any, \"q\": [numbers] or {\"joint name\": number, ...}}.");
 
+  proxima::cli::RobotSrdfCommand robot_srdf_command;
+  CLI::App* robot_srdf = proxima::cli::add_robot_srdf(app, robot_srdf_command);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -332,6 +336,9 @@ int main(int argc, char** argv) {
         return kExitFailure;
       }
       return proxima::cli::run_robot(robot_command, in, std::cout, std::cerr);
+    }
+    if (*robot_srdf) {
+      return proxima::cli::run_robot_srdf(robot_srdf_command, std::cout, std::cerr);
     }
     if (*view) {
       // Exactly one input: two files, a query file or a scene file.

@@ -136,7 +136,8 @@ bool by_geometries(const RobotPairResult& x, const RobotPairResult& y) {
 RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
                                std::span<const Obstacle> obstacles,
                                const RobotQueryOptions& options, RobotQueryState* state) {
-  if (!(options.margin >= 0) || std::isinf(options.margin)) {
+  // std::isfinite first: an ordered comparison with NaN raises FE_INVALID.
+  if (!std::isfinite(options.margin) || options.margin < 0) {
     throw InvalidInput("robot query: margin " + std::to_string(options.margin) +
                        " is not a finite value >= 0");
   }

@@ -4,6 +4,7 @@
 // on. Skips when ../shared/robots (from the repository root) is absent.
 #include <gtest/gtest.h>
 #include <proxima/robot/robot_distance.h>
+#include <proxima/robot/srdf_proposal.h>
 #include <proxima/robot/urdf.h>
 
 #include <filesystem>
@@ -84,6 +85,44 @@ TEST(CliRobot, AnUnreadableRobotIsAnErrorNamingTheFile) {
       run_cli("robot --urdf /nonexistent/robot.urdf < /dev/null", true);
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.out.find("/nonexistent/robot.urdf"), std::string::npos) << run.out;
+}
+
+}  // namespace
+
+namespace {
+
+// `proxima robot-srdf` (cli/robot_srdf.cpp) on the Panda shipped with the
+// examples: the SRDF it writes is the library's proposal for the same
+// options, load_robot reads it back, and a bad option or URDF is an error
+// naming it.
+TEST(CliRobotSrdf, WritesTheLibrarysProposalAsAnSrdfThatLoads) {
+  const std::string urdf = std::string(PROXIMA_SOURCE_DIR) + "/examples/data/panda/panda.urdf";
+  const TempPath srdf(".srdf");
+  const proxima::test::CliRun run =
+      run_cli("robot-srdf --urdf " + shell_quote(urdf) + " --samples 100 --margin 0.01 --seed 3 -o " +
+                  shell_quote(srdf.path()),
+              true);
+  ASSERT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("link pairs disabled"), std::string::npos) << run.out;
+
+  const proxima::Robot robot = proxima::load_robot(urdf);
+  proxima::SrdfProposalOptions options;
+  options.samples = 100;
+  options.margin = 0.01;
+  options.seed = 3;
+  const proxima::SrdfProposal proposal = proxima::propose_disabled_pairs(robot, options);
+  std::ifstream file(srdf.path());
+  const std::string written((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(written, proxima::write_srdf(robot, proposal));
+  const proxima::Robot reloaded = proxima::load_robot(urdf, srdf.path());
+  EXPECT_LT(reloaded.self_pairs().size(), robot.self_pairs().size());
+
+  const proxima::test::CliRun bad = run_cli("robot-srdf --urdf /nonexistent.urdf", true);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.out.find("nonexistent.urdf"), std::string::npos) << bad.out;
+  const proxima::test::CliRun no_samples =
+      run_cli("robot-srdf --urdf " + shell_quote(urdf) + " --samples 0", true);
+  EXPECT_EQ(no_samples.exit_code, 2) << no_samples.out;
 }
 
 }  // namespace

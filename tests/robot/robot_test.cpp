@@ -545,6 +545,12 @@ TEST(RobotDistance, BadQueriesAreRefusedNamingTheProblem) {
   q[3] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(error_of(q, 0).find("panda_joint4"), std::string::npos);
   EXPECT_NE(error_of(std::vector<double>(8, 0.0), -1).find("margin"), std::string::npos);
+  // Regression: a NaN margin reached the check !(margin >= 0), whose ordered
+  // comparison raises FE_INVALID, so under the test main's traps the query
+  // died of SIGFPE instead of refusing the margin by name.
+  EXPECT_NE(error_of(std::vector<double>(8, 0.0), std::numeric_limits<double>::quiet_NaN())
+                .find("margin"),
+            std::string::npos);
 }
 
 // A mimic chain composes its maps: c = 2 b + 1 and b = -a + 0.5 make
