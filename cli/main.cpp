@@ -293,6 +293,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   robot->add_flag("--gradients", robot_command.gradients,
                   "Answer each pair's gradient with respect to the joint vector");
+  robot->add_option("--environment", robot_command.environment,
+                    "JSON Lines of obstacles, one body per line as a query's (\"vertices\", "
+                    "\"triangles\", \"radius\", \"pose\") with an optional \"name\"");
+  robot->add_option("--view", robot_command.view_out,
+                    "Write a viewer page of the last configuration (close pairs drawn, excluded "
+                    "pairs never shown as collisions)");
   robot->footer(
       "Example:\n"
       "  echo '{\"id\":1,\"q\":[0,-0.78,0,-2.36,0,1.57,0.78,0.01]}' |\n"
