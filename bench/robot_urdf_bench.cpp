@@ -267,7 +267,11 @@ int main(int argc, char** argv) {
   proxima::RobotQueryOptions with_gradients = distance_only;
   with_gradients.gradients = true;
   double sink = 0;
-  std::vector<PassStats> queried(8);  // the proxima variants, in the order below
+  proxima::RobotQueryOptions minimum_only;
+  minimum_only.minimum_only = true;
+  proxima::RobotQueryOptions minimum_gradients = minimum_only;
+  minimum_gradients.gradients = true;
+  std::vector<PassStats> queried(10);  // the proxima variants, in the order below
   const Configs mesh_path(path.begin(), path.begin() + 200);
   std::vector<Variant> panda_variants = {
       {"hulls, trajectory, tracked, distance only",
@@ -303,6 +307,12 @@ int main(int argc, char** argv) {
        200.0,
        {}},
   };
+  panda_variants.push_back({"hulls, trajectory, tracked, minimum only",
+                            pass(panda, path, obstacles, minimum_only, true, &sink, &queried[8]),
+                            2000.0, {}});
+  panda_variants.push_back(
+      {"hulls, trajectory, tracked, minimum only, with its gradient",
+       pass(panda, path, obstacles, minimum_gradients, true, &sink, &queried[9]), 2000.0, {}});
   proxima::bench::FclRobot fcl_hulls(panda, obstacles), fcl_meshes(panda_meshes, obstacles);
   panda_variants.push_back({"FCL, hulls (fcl::Convex), trajectory, every pair",
                             fcl_pass(fcl_hulls, path, &sink), 2000.0, {}});
@@ -319,7 +329,8 @@ int main(int argc, char** argv) {
   std::printf(
       "  FCL's time over proxima's (tracked, distance only): hulls trajectory %.1fx, hulls random "
       "%.1fx, meshes trajectory %.1fx\n",
-      ratio(8, 0), ratio(9, 3), ratio(10, 6));
+      ratio(10, 0), ratio(11, 3), ratio(12, 6));
+  std::printf("  FCL's time over proxima's minimum only (hulls trajectory): %.1fx\n", ratio(10, 8));
   std::printf("Panda against the exact referee:\n");
   compare_with_referee("hulls, trajectory", panda, path, obstacles, fcl_hulls);
   compare_with_referee("hulls, random", panda, random, obstacles, fcl_hulls);
@@ -333,7 +344,9 @@ int main(int argc, char** argv) {
   std::printf("Talos: %d variables, %zu geometries, %zu enabled self pairs\n", talos.dof(),
               talos.geometries().size(), talos.self_pairs().size());
   proxima::RobotQueryOptions talos_options;
-  std::vector<PassStats> talos_queried(3);
+  proxima::RobotQueryOptions talos_minimum;
+  talos_minimum.minimum_only = true;
+  std::vector<PassStats> talos_queried(4);
   std::vector<Variant> talos_variants = {
       {"hulls, self, trajectory, tracked",
        pass(talos, talos_path, {}, talos_options, true, &sink, &talos_queried[0]),
@@ -345,6 +358,10 @@ int main(int argc, char** argv) {
        {}},
       {"hulls, self, random, tracked",
        pass(talos, talos_random, {}, talos_options, true, &sink, &talos_queried[2]),
+       2000.0,
+       {}},
+      {"hulls, self, trajectory, tracked, minimum only",
+       pass(talos, talos_path, {}, talos_minimum, true, &sink, &talos_queried[3]),
        2000.0,
        {}},
   };

@@ -31,17 +31,20 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // Lower bounds on a signed distance. Two spheres: |c_a - c_b| - r_a - r_b
 // (the bodies' overlap is at most the spheres'). A sphere against a box
-// (in the box's frame, the body's radius around it): the distance from the
-// centre to the box, minus both radii.
+// (in the box's frame, the body's radius around it): the signed distance
+// from the centre to the box, minus both radii. Signed: with the centre
+// inside the box, the overlap can be as deep as the centre's distance to
+// the box's boundary plus the radii (moving the sphere out through the
+// nearest face separates them), so that distance is subtracted too.
 double sphere_bound(const Vec3& center_a, double radius_a, const Vec3& center_b, double radius_b) {
   return (center_a - center_b).norm() - radius_a - radius_b;
 }
 
 double obstacle_box_bound(const Vec3& center, double radius, const Obstacle& obstacle) {
   const Vec3 local = obstacle.pose.rotation.transpose() * (center - obstacle.pose.translation);
-  const Vec3 outside =
-      ((local - obstacle.box.center).cwiseAbs() - obstacle.box.half_extents).cwiseMax(0.0);
-  return outside.norm() - radius - obstacle.body.radius();
+  const Vec3 excess = (local - obstacle.box.center).cwiseAbs() - obstacle.box.half_extents;
+  const double to_box = excess.maxCoeff() < 0 ? excess.maxCoeff() : excess.cwiseMax(0.0).norm();
+  return to_box - radius - obstacle.body.radius();
 }
 
 // A body's box in the world: its core's box (centre, the columns of `axes`
@@ -212,13 +215,14 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       category_min = sd;
       last = index;
     }
-    if (!closest && sd > options.margin) return;
+    const bool within = !options.minimum_only && sd <= options.margin;
+    if (!closest && !within) return;
     if (options.gradients) fill_gradient(robot, s.link_poses_, pair);
     if (closest) {
       out.min_signed_distance = sd;
       out.closest = pair;
     }
-    if (sd <= options.margin) out.close_pairs.push_back(std::move(pair));
+    if (within) out.close_pairs.push_back(std::move(pair));
   };
   // Each pair's bound decays by the motion first (every pair, queried or
   // not, whatever options.self and options.environment say), so that it
@@ -244,7 +248,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       const GeometryPair& pair = pairs[static_cast<std::size_t>(p)];
       const auto a = static_cast<std::size_t>(pair.a), b = static_cast<std::size_t>(pair.b);
       double& bound = s.self_bound_[static_cast<std::size_t>(p)];
-      const double threshold = std::max(options.margin, out.min_self);
+      const double threshold = options.minimum_only ? out.min_self
+                                                    : std::max(options.margin, out.min_self);
       if (bound > threshold) continue;
       bound = std::max(
           bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b], spheres[b].radius));
@@ -279,7 +284,9 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       const auto g = static_cast<std::size_t>(p / n_obstacles);
       const auto o = static_cast<std::size_t>(p % n_obstacles);
       double& bound = s.environment_bound_[static_cast<std::size_t>(p)];
-      const double threshold = std::max(options.margin, out.min_environment);
+      const double threshold = options.minimum_only
+                                   ? out.min_environment
+                                   : std::max(options.margin, out.min_environment);
       if (bound > threshold) continue;
       bound = std::max(bound, obstacle_box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
       if (bound > threshold) continue;
@@ -320,7 +327,7 @@ RobotBatchDistances robot_distances_batch(const Robot& robot, const RowMatrixXd&
   out.min_signed_distance.resize(q.rows());
   if (options.gradients) out.gradient = RowMatrixXd::Zero(q.rows(), robot.dof());
   RobotQueryOptions run_options = options;
-  run_options.margin = 0.0;
+  run_options.minimum_only = true;
   // Runs long enough that tracking pays along a trajectory, short enough
   // that two threads share a batch of a few thousand evenly.
   constexpr std::size_t kRun = 64;

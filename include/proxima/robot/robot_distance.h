@@ -73,6 +73,14 @@ struct RobotQueryOptions {
   double margin = 0.0;
   // Whether each reported pair (and the closest) carries its gradient.
   bool gradients = false;
+  // Only the minimum (a collision check, an optimizer's one constraint):
+  // close_pairs stays empty and the margin is not read, so a pair is
+  // queried only while its lower bound is below the smallest signed
+  // distance of its category found so far (an overlapping pair whose
+  // bounds show it cannot be the deepest costs no penetration depth).
+  // min_signed_distance, min_self, min_environment and closest are those
+  // of the full query.
+  bool minimum_only = false;
   // Which pairs are tested.
   bool self = true;
   bool environment = true;
