@@ -4,7 +4,7 @@
 configurations (for learned collision checkers and distance fields), computed
 on a Dask cluster: the configurations are a chunked Dask array, each chunk a
 partition that one worker process turns into minima and gradients with
-proxima's batch query. Run by `make test` on a small K.
+proxima's batch query (docs/robotics.md). Run by `make test` on a small K.
 
     python3 examples/robot_dataset_dask.py [--samples K] [--workers W]
         [--partitions P] [--scheduler ADDRESS] [--out dataset.npz]
