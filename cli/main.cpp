@@ -31,6 +31,7 @@
 #include "proxima/core/types.h"
 #include "query.h"
 #include "robot.h"
+#include "robot_srdf.h"
 #include "tools.h"
 #include "view.h"
 
@@ -305,11 +306,20 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   robot->add_flag("--gradients", robot_command.gradients,
                   "Answer each pair's gradient with respect to the joint vector");
+  robot->add_option("--environment", robot_command.environment,
+                    "JSON Lines of obstacles, one body per line as a query's (\"vertices\", "
+                    "\"triangles\", \"radius\", \"pose\") with an optional \"name\"");
+  robot->add_option("--view", robot_command.view_out,
+                    "Write a viewer page of the last configuration (close pairs drawn, excluded "
+                    "pairs never shown as collisions)");
   robot->footer(
       "Example:\n"
       "  echo '{\"id\":1,\"q\":[0,-0.78,0,-2.36,0,1.57,0.78,0.01]}' |\n"
       "    proxima robot --urdf panda.urdf --srdf panda.srdf --package-dir NAME=DIR --gradients\n"
       "Each line: {\"id\": any, \"q\": [numbers] or {\"joint name\": number, ...}}.");
+
+  proxima::cli::RobotSrdfCommand robot_srdf_command;
+  CLI::App* robot_srdf = proxima::cli::add_robot_srdf(app, robot_srdf_command);
 
   try {
     app.parse(argc, argv);
@@ -345,6 +355,9 @@ int main(int argc, char** argv) {
         return kExitFailure;
       }
       return proxima::cli::run_robot(robot_command, in, std::cout, std::cerr);
+    }
+    if (*robot_srdf) {
+      return proxima::cli::run_robot_srdf(robot_srdf_command, std::cout, std::cerr);
     }
     if (*view) {
       // Exactly one input: two files, a query file or a scene file.
