@@ -61,6 +61,7 @@
 #include <vector>
 
 #include "core/power_of_two.h"
+#include "penetration/expanding_polytope.h"
 #include "proxima/detail/geometry/exact_predicates.h"
 #include "proxima/geometry/closest_point.h"
 #include "proxima/shape/support.h"
@@ -1532,6 +1533,35 @@ bool witnesses_meet(const Query& q, const PenetrationResult& r) {
   return (r.point_b + r.depth * r.normal - r.point_a).norm() <= contact_band(q.magnitude);
 }
 
+// Writes the faces of A - B a cold query evaluated into the cache, with
+// `pruned` (scaled) the least lower bound of every face it did not keep,
+// the answer's face `best`; `record`: the pruned groups were recorded.
+void remember_faces(const Query& q, PenetrationCache& cache, const Pose& b_in_a,
+                    std::span<const Candidate> candidates, std::size_t best, double pruned,
+                    bool record) {
+  cache.a = &q.a;
+  cache.b = &q.b;
+  cache.fingerprint = fingerprint(q.a, q.b);
+  cache.rotation = b_in_a.rotation;
+  cache.facets.resize(candidates.size());
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    cache.facets[i] = {candidates[i].id, candidates[i].normal, candidates[i].value * q.unit,
+                       candidates[i].support_a, candidates[i].support_b};
+  cache.enumerated_translation = b_in_a.translation;
+  cache.pruned = pruned * q.unit;
+  cache.bounded = record;
+  cache.expanded = 0;
+  // B's rotation may have changed: its supporting features with it.
+  cache.witnesses.a.clear();
+  cache.witnesses.b.clear();
+  // The trees are built by the first tracked query (a rotating B, which
+  // enumerates every query, never pays for it); until then `last` is the
+  // answer's face.
+  cache.nodes.clear();
+  cache.roots.clear();
+  cache.last = cache.facets[best];
+}
+
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
@@ -1619,28 +1649,9 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
   if (needs_refinement(q, r))
     r = refine(q, std::span<const Candidate>(candidates.data(), candidates.size()), *best, r, count);
   if (cache != nullptr) {
-    cache->a = &q.a;
-    cache->b = &q.b;
-    cache->fingerprint = fingerprint(q.a, q.b);
-    cache->rotation = b_in_a.rotation;
-    cache->facets.resize(candidates.size());
-    for (std::size_t i = 0; i < candidates.size(); ++i)
-      cache->facets[i] = {candidates[i].id, candidates[i].normal, candidates[i].value * q.unit,
-                          candidates[i].support_a, candidates[i].support_b};
-    cache->enumerated_translation = b_in_a.translation;
-    cache->pruned = q.pruned * q.unit;
-    cache->bounded = record;
-    cache->expanded = 0;
+    remember_faces(q, *cache, b_in_a, candidates, static_cast<std::size_t>(best - candidates.begin()),
+                   q.pruned, record);
     ++cache->enumerations;
-    // B's rotation may have changed: its supporting features with it.
-    cache->witnesses.a.clear();
-    cache->witnesses.b.clear();
-    // The trees are built by the first tracked query (a rotating B, which
-    // enumerates every query, never pays for it); until then `last` is the
-    // answer's face.
-    cache->nodes.clear();
-    cache->roots.clear();
-    cache->last = cache->facets[static_cast<std::size_t>(best - candidates.begin())];
   }
   return r;
 }
@@ -1954,6 +1965,92 @@ bool track_or_expand(Query& q, PenetrationCache& cache, const Pose& b_in_a, Pene
   return false;
 }
 
+// The cold query's fast path (issue 29): a polytope expanding inside
+// A - B gives a certified lower bound on the depth and the normal of the
+// facet of A - B that realizes it (expanding_polytope.h); the candidates
+// of that facet are the faces of A at A's support along it, the faces of
+// B at B's, and the pairs of their edges, of which those whose normals are
+// the expansion's (kFacetCosine) are evaluated as the enumeration
+// evaluates them: an honest upper bound each. The least of them is the
+// answer when it is within kAcceptUlps u R and kAcceptRelative of the
+// certified lower bound (both within the accuracy standard); anything
+// else (an expansion that did not certify, a depth near the band, the
+// facet not among the candidates, witnesses that do not meet) leaves the
+// answer to the enumeration.
+//
+// The expansion's iteration cap: past it, the enumeration is cheaper (a B
+// near A's centre, where many facets of A - B are near the depth).
+constexpr int kExpansionIterations = 256;
+// A face or edge pair is a candidate when its normal's cosine with the
+// expansion's is at least 1 - this: the facet's normal is within rounding
+// of the expansion's (a few hundred u for a well-shaped triangle), and
+// candidates kept by mistake only add upper bounds.
+constexpr double kFacetCosine = 1e-9;
+// The answer's upper bound may exceed the certified lower bound by this
+// relative part and this many u (scaled R): half of the standard's.
+constexpr double kAcceptRelative = 5e-13;
+constexpr double kAcceptUlps = 0.5 * kContactBandUlps;
+
+std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cache,
+                                                 const Pose& b_in_a) {
+  if (q.a.dimension() != 3 || q.b.dimension() != 3) return std::nullopt;
+  const detail::MinkowskiSupport m{q.a, q.b, q.rotation, q.rotation_t, q.translation, q.inverse};
+  const detail::ExpansionResult e = detail::expand_polytope(m, kExpansionIterations);
+  if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;
+  const Vec3& n = e.normal;
+  std::array<Candidate, 48> kept;
+  std::size_t count = 0;
+  const auto consider = [&](const MinkowskiFaceId& id, const Vec3& normal, int hint_a, int hint_b) {
+    if (count < kept.size() && normal.dot(n) >= 1.0 - kFacetCosine)
+      kept[count++] = evaluate(q, id, normal, hint_a, hint_b);
+  };
+  const auto ring = [](const ConvexPolytope& p, int v) {
+    const auto offsets = p.adjacency_offsets();
+    return std::pair<std::int32_t, std::int32_t>{offsets[static_cast<std::size_t>(v)],
+                                                 offsets[static_cast<std::size_t>(v) + 1]};
+  };
+  const int sa = e.support_a, sb = e.support_b;
+  const auto [a_begin, a_end] = ring(q.a, sa);
+  const auto [b_begin, b_end] = ring(q.b, sb);
+  for (std::int32_t k = a_begin; k < a_end; ++k) {
+    const int f = q.a.adjacency_faces()[static_cast<std::size_t>(k)];
+    consider({MinkowskiFace::face_vertex, f, -1, sb, -1}, q.a.face_plane(f).normal, sa, sb);
+  }
+  for (std::int32_t k = b_begin; k < b_end; ++k) {
+    const int g = q.b.adjacency_faces()[static_cast<std::size_t>(k)];
+    consider({MinkowskiFace::vertex_face, sa, -1, g, -1},
+             Vec3(-(q.rotation * q.b.face_plane(g).normal)), sa, sb);
+  }
+  for (std::int32_t k = a_begin; k < a_end; ++k) {
+    const int w = q.a.adjacency()[static_cast<std::size_t>(k)];
+    const Vec3 ea = q.point_a(w) - q.point_a(sa);
+    for (std::int32_t l = b_begin; l < b_end; ++l) {
+      const int x = q.b.adjacency()[static_cast<std::size_t>(l)];
+      Vec3 normal = ea.cross(q.point_b(x) - q.point_b(sb));
+      const double length = normal.norm();
+      if (!(length > 0.0)) continue;
+      normal /= length;
+      if (normal.dot(n) < 0.0) normal = -normal;
+      consider({MinkowskiFace::edge_edge, std::min(sa, w), std::max(sa, w), std::min(sb, x),
+                std::max(sb, x)},
+               normal, sa, sb);
+    }
+  }
+  if (count == 0) return std::nullopt;
+  const std::span<const Candidate> candidates(kept.data(), count);
+  const auto best =
+      std::min_element(candidates.begin(), candidates.end(),
+                       [](const Candidate& x, const Candidate& y) { return x.value < y.value; });
+  const double slack = kAcceptUlps * kUnitRoundoff * q.magnitude * q.inverse;
+  if (!(best->value - e.lower <= kAcceptRelative * best->value + slack)) return std::nullopt;
+  PenetrationResult r = finish(q, *best, e.lower, static_cast<int>(count), false);
+  if (!witnesses_meet(q, r) || needs_refinement(q, r)) return std::nullopt;
+  // Every face of A - B has a value of at least the certified bound.
+  remember_faces(q, cache, b_in_a, candidates, static_cast<std::size_t>(best - candidates.begin()),
+                 e.lower, false);
+  return r;
+}
+
 bool same_pair(const PenetrationCache& cache, const ConvexPolytope& a, const ConvexPolytope& b) {
   return cache.a == &a && cache.b == &b && cache.fingerprint == fingerprint(a, b);
 }
@@ -1983,6 +2080,8 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
   // use them, bench/penetration_bench's Cold), whose first tracked
   // query certifies with their least bound, as an unrecorded cache does.
   const bool has_start = same_polytopes && !cache.facets.empty();
+  if (!has_start)
+    if (std::optional<PenetrationResult> r = solve_expanding(q, cache, b_in_a)) return *r;
   const bool turned = has_start && cache.rotation != b_in_a.rotation;
   if (turned) cache.prune_margin *= 0.5;
   const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
