@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <memory_resource>
 #include <utility>
 #include <vector>
 
@@ -51,10 +52,20 @@ struct Triangle {
 
 class Expansion {
  public:
-  explicit Expansion(const MinkowskiSupport& m) : m_(m) {
-    vertices_.reserve(128);
-    triangles_.reserve(256);
-    heap_.reserve(256);
+  Expansion(const MinkowskiSupport& m, std::pmr::memory_resource* memory)
+      : m_(m),
+        vertices_(memory),
+        triangles_(memory),
+        heap_(memory),
+        horizon_(memory),
+        stack_(memory),
+        starts_(memory) {
+    vertices_.reserve(64);
+    triangles_.reserve(128);
+    heap_.reserve(128);
+    horizon_.reserve(32);
+    stack_.reserve(32);
+    starts_.reserve(64);
   }
 
   // The octahedron on the supports along +-x, +-y, +-z; false when two of
@@ -72,21 +83,24 @@ class Expansion {
     // Octant (sx, sy, sz), sign bit 1 for minus: vertices 2 * axis + bit.
     // (+x, +y, +z) is counter-clockwise seen from outside; each minus sign
     // mirrors the octant, flipping the orientation.
-    std::array<int, 8> index{};
     for (int o = 0; o < 8; ++o) {
       const int sx = o & 1, sy = (o >> 1) & 1, sz = (o >> 2) & 1;
       std::array<int, 3> t = {0 + sx, 2 + sy, 4 + sz};
       if ((sx + sy + sz) % 2 == 1) std::swap(t[1], t[2]);
-      index[static_cast<std::size_t>(o)] = add_triangle(t);
+      add_triangle(t);
     }
     // Adjacency: the triangle across an edge is the one holding the edge
-    // reversed.
-    for (Triangle& t : triangles_)
+    // reversed (owner[u][w]: the triangle holding u -> w).
+    std::array<std::array<int, 6>, 6> owner{};
+    for (int g = 0; g < 8; ++g)
       for (int i = 0; i < 3; ++i) {
-        const int u = t.v[static_cast<std::size_t>(i)], w = t.v[static_cast<std::size_t>((i + 1) % 3)];
-        for (int g = 0; g < static_cast<int>(triangles_.size()); ++g)
-          if (edge_index(g, w, u) >= 0) t.adjacent[static_cast<std::size_t>(i)] = g;
+        const Triangle& t = triangles_[static_cast<std::size_t>(g)];
+        owner[static_cast<std::size_t>(t.v[static_cast<std::size_t>(i)])]
+             [static_cast<std::size_t>(t.v[static_cast<std::size_t>((i + 1) % 3)])] = g;
       }
+    for (Triangle& t : triangles_)
+      for (std::size_t i = 0; i < 3; ++i)
+        t.adjacent[i] = owner[static_cast<std::size_t>(t.v[(i + 1) % 3])][static_cast<std::size_t>(t.v[i])];
     return true;
   }
 
@@ -229,23 +243,27 @@ class Expansion {
   }
 
   const MinkowskiSupport& m_;
-  std::vector<Vertex> vertices_;
-  std::vector<Triangle> triangles_;
-  std::vector<std::pair<double, int>> heap_;
+  std::pmr::vector<Vertex> vertices_;
+  std::pmr::vector<Triangle> triangles_;
+  std::pmr::vector<std::pair<double, int>> heap_;
   // A boundary edge u -> w of a removed triangle, the kept triangle
   // across it and the edge's index there.
   struct Edge {
     int u, w, outside, at;
   };
-  std::vector<Edge> horizon_;
-  std::vector<int> stack_;
-  std::vector<int> starts_;
+  std::pmr::vector<Edge> horizon_;
+  std::pmr::vector<int> stack_;
+  std::pmr::vector<int> starts_;
 };
 
 }  // namespace
 
 ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations) {
-  Expansion e(m);
+  // The scratch lists on the stack: a cold query's expansion is a few
+  // dozen iterations, and heap allocations would cost as much as they.
+  std::array<std::byte, 24576> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  Expansion e(m, &memory);
   if (!e.start()) return {};
   return e.run(max_iterations);
 }

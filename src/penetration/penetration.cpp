@@ -1986,6 +1986,11 @@ constexpr int kExpansionIterations = 256;
 // of the expansion's (a few hundred u for a well-shaped triangle), and
 // candidates kept by mistake only add upper bounds.
 constexpr double kFacetCosine = 1e-9;
+// The same for a face's rough normal (the cross product of its first two
+// edges, rounded: within 1e-6 of the exact one unless the face's first
+// corner is a sliver of angle below about 1e-9, where face_plane picks
+// better-shaped corners), as a cheap filter before face_plane.
+constexpr double kRoughCosine = 1e-6;
 // The answer's upper bound may exceed the certified lower bound by this
 // relative part and this many u (scaled R): half of the standard's.
 constexpr double kAcceptRelative = 5e-13;
@@ -2012,14 +2017,27 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
   const int sa = e.support_a, sb = e.support_b;
   const auto [a_begin, a_end] = ring(q.a, sa);
   const auto [b_begin, b_end] = ring(q.b, sb);
+  // A face's rough normal (its first three vertices) first: face_plane's
+  // only for the faces it leaves near n.
+  // In the query's scaled units (the products of raw coordinates near
+  // 1e300 would overflow).
+  const auto near_face = [&](const ConvexPolytope& p, int f, const Vec3& d) {
+    const auto cycle = p.face(f);
+    const Vec3 v0 = p.vertex(cycle[0]) * q.inverse;
+    const Vec3 c = (p.vertex(cycle[1]) * q.inverse - v0).cross(p.vertex(cycle[2]) * q.inverse - v0);
+    return c.dot(d) >= (1.0 - kRoughCosine) * c.norm();
+  };
+  const Vec3 n_in_b = q.rotation_t * (-n);
   for (std::int32_t k = a_begin; k < a_end; ++k) {
     const int f = q.a.adjacency_faces()[static_cast<std::size_t>(k)];
-    consider({MinkowskiFace::face_vertex, f, -1, sb, -1}, q.a.face_plane(f).normal, sa, sb);
+    if (near_face(q.a, f, n))
+      consider({MinkowskiFace::face_vertex, f, -1, sb, -1}, q.a.face_plane(f).normal, sa, sb);
   }
   for (std::int32_t k = b_begin; k < b_end; ++k) {
     const int g = q.b.adjacency_faces()[static_cast<std::size_t>(k)];
-    consider({MinkowskiFace::vertex_face, sa, -1, g, -1},
-             Vec3(-(q.rotation * q.b.face_plane(g).normal)), sa, sb);
+    if (near_face(q.b, g, n_in_b))
+      consider({MinkowskiFace::vertex_face, sa, -1, g, -1},
+               Vec3(-(q.rotation * q.b.face_plane(g).normal)), sa, sb);
   }
   for (std::int32_t k = a_begin; k < a_end; ++k) {
     const int w = q.a.adjacency()[static_cast<std::size_t>(k)];
