@@ -140,9 +140,14 @@ class Expansion {
   }
 
  private:
+  // Without hints (-1): support_without_hint's seeded climb, which on a
+  // large round hull starts near the support where a climb from vertex 0
+  // crosses half of it.
   Vertex support(const Vec3& n, int hint_a, int hint_b) const {
-    const int i = support_hill_climb(m_.a, n, hint_a);
-    const int j = support_hill_climb(m_.b, m_.rotation_t * (-n), hint_b);
+    const Vec3 n_b = m_.rotation_t * (-n);
+    const int i = hint_a < 0 ? support_without_hint(m_.a, n) : support_hill_climb(m_.a, n, hint_a);
+    const int j =
+        hint_b < 0 ? support_without_hint(m_.b, n_b) : support_hill_climb(m_.b, n_b, hint_b);
     return {m_.point_a(i) - m_.point_b(j), i, j};
   }
 
@@ -187,11 +192,12 @@ class Expansion {
 
   // Replaces the triangles whose planes s is beyond, from f on, by the fan
   // from s to their boundary. False (P left as it was only in part: the
-  // caller stops) when s is a vertex already or the boundary is not
-  // simple (a vertex starting two boundary edges).
+  // caller stops) when the boundary is not simple (a vertex starting two
+  // boundary edges). An s that is a vertex already (P not convex through
+  // rounding) needs no check: on the boundary it makes a triangle of zero
+  // area, whose key (-infinity) stops the expansion uncertified; elsewhere
+  // P stays a closed surface of points of M.
   bool expand(int f, const Vertex& s) {
-    for (const Vertex& v : vertices_)
-      if (v.a == s.a && v.b == s.b) return false;
     const int apex = static_cast<int>(vertices_.size());
     vertices_.push_back(s);
     horizon_.clear();
@@ -220,10 +226,18 @@ class Expansion {
       return !triangles_[static_cast<std::size_t>(e.outside)].alive;
     });
     if (horizon_.size() < 3) return false;
-    starts_.assign(vertices_.size(), -1);
+    // starts_[v]: the fan triangle whose boundary edge starts at v, -1
+    // outside this call (reset below for the boundary's vertices).
+    starts_.resize(vertices_.size(), -1);
+    const auto clear_starts = [&] {
+      for (const Edge& e : horizon_) starts_[static_cast<std::size_t>(e.u)] = -1;
+    };
     const int first = static_cast<int>(triangles_.size());
     for (const Edge& e : horizon_) {
-      if (e.at < 0 || starts_[static_cast<std::size_t>(e.u)] >= 0) return false;
+      if (e.at < 0 || starts_[static_cast<std::size_t>(e.u)] >= 0) {
+        clear_starts();
+        return false;
+      }
       const int g = add_triangle({e.u, e.w, apex});
       starts_[static_cast<std::size_t>(e.u)] = g;
       triangles_[static_cast<std::size_t>(g)].adjacent[0] = e.outside;
@@ -233,10 +247,14 @@ class Expansion {
       triangles_[static_cast<std::size_t>(e.outside)].adjacent[static_cast<std::size_t>(e.at)] = g;
       // Edge w -> apex of g is apex -> w of the fan triangle starting at w.
       const int next = starts_[static_cast<std::size_t>(e.w)];
-      if (next < 0) return false;
+      if (next < 0) {
+        clear_starts();
+        return false;
+      }
       triangles_[static_cast<std::size_t>(g)].adjacent[1] = next;
       triangles_[static_cast<std::size_t>(next)].adjacent[2] = g;
     }
+    clear_starts();
     for (int g = first; g < static_cast<int>(triangles_.size()); ++g)
       if (triangles_[static_cast<std::size_t>(g)].adjacent[2] < 0) return false;
     return true;
