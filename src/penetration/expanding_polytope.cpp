@@ -192,8 +192,8 @@ class Expansion {
 
   // Replaces the triangles whose planes s is beyond, from f on, by the fan
   // from s to their boundary. False (P left as it was only in part: the
-  // caller stops) when the boundary is not simple (a vertex starting two
-  // boundary edges). An s that is a vertex already (P not convex through
+  // caller stops) when the boundary is not simple (a vertex starting or
+  // ending two boundary edges). An s that is a vertex already (P not convex through
   // rounding) needs no check: on the boundary it makes a triangle of zero
   // area, whose key (-infinity) stops the expansion uncertified; elsewhere
   // P stays a closed surface of points of M.
@@ -255,8 +255,14 @@ class Expansion {
       triangles_[static_cast<std::size_t>(next)].adjacent[2] = g;
     }
     clear_starts();
-    for (int g = first; g < static_cast<int>(triangles_.size()); ++g)
-      if (triangles_[static_cast<std::size_t>(g)].adjacent[2] < 0) return false;
+    // Each fan edge apex -> w once in each direction: a vertex ending two
+    // boundary edges (distinct starts do not exclude it) would leave an
+    // edge held twice the same way, P no longer a closed surface, and the
+    // certificate void.
+    for (int g = first; g < static_cast<int>(triangles_.size()); ++g) {
+      const int next = triangles_[static_cast<std::size_t>(g)].adjacent[1];
+      if (triangles_[static_cast<std::size_t>(next)].adjacent[2] != g) return false;
+    }
     return true;
   }
 
