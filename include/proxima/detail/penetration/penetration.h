@@ -126,8 +126,10 @@ struct PenetrationResult {
   Feature feature_a;
   Feature feature_b;
   // Work of this query in Minkowski faces: evaluated (F_A + F_B + the
-  // crossing edge pairs) for a cold query; faces and tree nodes visited,
-  // and faces an expansion evaluated, for a tracked one.
+  // crossing edge pairs) for an enumeration, the candidates of the facet
+  // along the expanding polytope's normal for a cold query it answered;
+  // faces and tree nodes visited, and faces an expansion evaluated, for a
+  // tracked one.
   int candidates = 0;
   // True when the cache certified the answer (no enumeration of M).
   bool tracked = false;
@@ -290,8 +292,12 @@ struct PenetrationCache {
 };
 
 // Penetration depth of hulls a and b, B placed by b_in_a (checked by the
-// caller against the pose contract; rigid). The fast algorithm: an
-// enumeration walks the overlay of the two Gauss maps (for each edge of A,
+// caller against the pose contract; rigid). A cold cache (solids) first
+// tries a polytope expanding inside A - B on support points, whose lower
+// bound is certified (src/penetration/expanding_polytope.h), and takes the
+// facet of A - B along its normal when its value is within half the
+// accuracy standard of that bound; the cache then holds that facet and the
+// bound. Otherwise (and for a warm cache) the enumeration: it walks the overlay of the two Gauss maps (for each edge of A,
 // the cells of B its arc crosses, found by hill climbing and stepping
 // across B's edges), O(F_A + F_B + E_A + E_B + crossings), and skips every
 // face of A - B (and every edge of A with all its edge pairs) whose lower

@@ -1,0 +1,295 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// penetration layer: the expanding polytope (see expanding_polytope.h for
+// the certificate).
+#include "penetration/expanding_polytope.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <memory_resource>
+#include <utility>
+#include <vector>
+
+#include "proxima/shape/support.h"
+
+namespace proxima::detail {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Rounding of a triangle's offset n.v0, n the normalized rounded cross
+// product c of its rounded edges e1 = v1 - v0, e2 = v2 - v0: each edge is
+// within u of the exact one componentwise (a subtraction), so c is within
+// about 8 u |e1||e2| of the exact cross product and the unit normal within
+// 8 u |e1||e2| / |c| plus the normalization's few u of the exact one; the
+// dot product with v0 adds a few u |v0|. Doubled: 16 for both terms,
+// |v0| read as its 1-norm (no square root, at least the 2-norm).
+constexpr double kOffsetAngleUlps = 16.0;
+constexpr double kOffsetUlps = 16.0;
+
+// A support s is not beyond a triangle when n.s exceeds its offset by at
+// most the offset's rounding bound plus this many u |s|_1 (the rounding of
+// n.s): s is then on the triangle's plane up to rounding, and the triangle
+// on M's supporting plane along n.
+constexpr double kBeyondUlps = 8.0;
+
+struct Vertex {
+  Vec3 p;
+  int a, b;
+};
+
+struct Triangle {
+  std::array<int, 3> v;
+  std::array<int, 3> adjacent;  // across the edge v[i] -> v[i + 1]
+  Vec3 normal;
+  double offset;
+  double error;  // bound on the offset's rounding
+  bool alive;
+};
+
+class Expansion {
+ public:
+  Expansion(const MinkowskiSupport& m, std::pmr::memory_resource* memory)
+      : m_(m),
+        vertices_(memory),
+        triangles_(memory),
+        heap_(memory),
+        horizon_(memory),
+        stack_(memory),
+        starts_(memory) {
+    vertices_.reserve(64);
+    triangles_.reserve(128);
+    heap_.reserve(128);
+    horizon_.reserve(32);
+    stack_.reserve(32);
+    starts_.reserve(64);
+  }
+
+  // The octahedron on the supports along +-x, +-y, +-z; false when two of
+  // them are the same point of M (then the octahedron is not a surface of
+  // six distinct vertices: M is small or thin along an axis).
+  bool start() {
+    for (int k = 0; k < 6; ++k) {
+      Vec3 d = Vec3::Zero();
+      d[k / 2] = k % 2 == 0 ? 1.0 : -1.0;
+      vertices_.push_back(support(d, -1, -1));
+    }
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < i; ++j)
+        if (vertices_[i].a == vertices_[j].a && vertices_[i].b == vertices_[j].b) return false;
+    // Octant (sx, sy, sz), sign bit 1 for minus: vertices 2 * axis + bit.
+    // (+x, +y, +z) is counter-clockwise seen from outside; each minus sign
+    // mirrors the octant, flipping the orientation.
+    for (int o = 0; o < 8; ++o) {
+      const int sx = o & 1, sy = (o >> 1) & 1, sz = (o >> 2) & 1;
+      std::array<int, 3> t = {0 + sx, 2 + sy, 4 + sz};
+      if ((sx + sy + sz) % 2 == 1) std::swap(t[1], t[2]);
+      add_triangle(t);
+    }
+    // Adjacency: the triangle across an edge is the one holding the edge
+    // reversed (owner[u][w]: the triangle holding u -> w).
+    std::array<std::array<int, 6>, 6> owner{};
+    for (int g = 0; g < 8; ++g)
+      for (int i = 0; i < 3; ++i) {
+        const Triangle& t = triangles_[static_cast<std::size_t>(g)];
+        owner[static_cast<std::size_t>(t.v[static_cast<std::size_t>(i)])]
+             [static_cast<std::size_t>(t.v[static_cast<std::size_t>((i + 1) % 3)])] = g;
+      }
+    for (Triangle& t : triangles_)
+      for (std::size_t i = 0; i < 3; ++i)
+        t.adjacent[i] = owner[static_cast<std::size_t>(t.v[(i + 1) % 3])][static_cast<std::size_t>(t.v[i])];
+    return true;
+  }
+
+  ExpansionResult run(int max_iterations) {
+    ExpansionResult r;
+    for (; r.iterations < max_iterations; ++r.iterations) {
+      const int f = pop();
+      if (f < 0) return r;
+      const Triangle& t = triangles_[static_cast<std::size_t>(f)];
+      const double key = t.offset - t.error;
+      if (!std::isfinite(key)) return r;
+      const Vertex s = support(t.normal, vertices_[static_cast<std::size_t>(t.v[0])].a,
+                               vertices_[static_cast<std::size_t>(t.v[0])].b);
+      const double h = t.normal.dot(s.p);
+      if (h < r.upper) r.upper = h;
+      r.normal = t.normal;
+      r.support_a = s.a;
+      r.support_b = s.b;
+      r.lower = key;
+      if (h - t.offset <= t.error + kBeyondUlps * kUnitRoundoff * s.p.lpNorm<1>()) {
+        // On M's supporting plane: the least key is final.
+        r.certified = key > 0.0;
+        r.converged = true;
+        return r;
+      }
+      if (!expand(f, s)) return r;
+    }
+    // The cap: certified with the least key so far when it is positive.
+    const int f = pop();
+    if (f >= 0) {
+      const Triangle& t = triangles_[static_cast<std::size_t>(f)];
+      r.lower = t.offset - t.error;
+      r.normal = t.normal;
+      r.certified = r.lower > 0.0;
+    }
+    return r;
+  }
+
+ private:
+  // Without hints (-1): support_without_hint's seeded climb, which on a
+  // large round hull starts near the support where a climb from vertex 0
+  // crosses half of it.
+  Vertex support(const Vec3& n, int hint_a, int hint_b) const {
+    const Vec3 n_b = m_.rotation_t * (-n);
+    const int i = hint_a < 0 ? support_without_hint(m_.a, n) : support_hill_climb(m_.a, n, hint_a);
+    const int j =
+        hint_b < 0 ? support_without_hint(m_.b, n_b) : support_hill_climb(m_.b, n_b, hint_b);
+    return {m_.point_a(i) - m_.point_b(j), i, j};
+  }
+
+  int edge_index(int g, int u, int w) const {
+    const Triangle& t = triangles_[static_cast<std::size_t>(g)];
+    for (int i = 0; i < 3; ++i)
+      if (t.v[static_cast<std::size_t>(i)] == u && t.v[static_cast<std::size_t>((i + 1) % 3)] == w)
+        return i;
+    return -1;
+  }
+
+  int add_triangle(const std::array<int, 3>& v) {
+    const Vec3& p0 = vertices_[static_cast<std::size_t>(v[0])].p;
+    const Vec3 e1 = vertices_[static_cast<std::size_t>(v[1])].p - p0;
+    const Vec3 e2 = vertices_[static_cast<std::size_t>(v[2])].p - p0;
+    const Vec3 c = e1.cross(e2);
+    const double length = c.norm();
+    Triangle t{v, {-1, -1, -1}, Vec3::Zero(), -kInfinity, 0.0, true};
+    if (length > 0.0 && std::isfinite(length)) {
+      t.normal = c / length;
+      t.offset = t.normal.dot(p0);
+      const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
+      t.error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff * p0.lpNorm<1>();
+    }
+    const int index = static_cast<int>(triangles_.size());
+    triangles_.push_back(t);
+    heap_.push_back({t.offset - t.error, index});
+    std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
+    return index;
+  }
+
+  // The live triangle of least key, or -1.
+  int pop() {
+    while (!heap_.empty()) {
+      std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
+      const int f = heap_.back().second;
+      heap_.pop_back();
+      if (triangles_[static_cast<std::size_t>(f)].alive) return f;
+    }
+    return -1;
+  }
+
+  // Replaces the triangles whose planes s is beyond, from f on, by the fan
+  // from s to their boundary. False (P left as it was only in part: the
+  // caller stops) when the boundary is not simple (a vertex starting or
+  // ending two boundary edges). An s that is a vertex already (P not convex through
+  // rounding) needs no check: on the boundary it makes a triangle of zero
+  // area, whose key (-infinity) stops the expansion uncertified; elsewhere
+  // P stays a closed surface of points of M.
+  bool expand(int f, const Vertex& s) {
+    const int apex = static_cast<int>(vertices_.size());
+    vertices_.push_back(s);
+    horizon_.clear();
+    stack_.assign(1, f);
+    triangles_[static_cast<std::size_t>(f)].alive = false;
+    while (!stack_.empty()) {
+      const int g = stack_.back();
+      stack_.pop_back();
+      for (int i = 0; i < 3; ++i) {
+        const Triangle& t = triangles_[static_cast<std::size_t>(g)];
+        const int across = t.adjacent[static_cast<std::size_t>(i)];
+        Triangle& n = triangles_[static_cast<std::size_t>(across)];
+        if (!n.alive) continue;
+        if (n.normal.dot(s.p) > n.offset) {
+          n.alive = false;
+          stack_.push_back(across);
+        } else {
+          const int u = t.v[static_cast<std::size_t>(i)], w = t.v[static_cast<std::size_t>((i + 1) % 3)];
+          horizon_.push_back({u, w, across, edge_index(across, w, u)});
+        }
+      }
+    }
+    // Boundary edges whose triangle across was removed after the edge was
+    // recorded are inside the removed region: drop them.
+    std::erase_if(horizon_, [&](const Edge& e) {
+      return !triangles_[static_cast<std::size_t>(e.outside)].alive;
+    });
+    if (horizon_.size() < 3) return false;
+    // starts_[v]: the fan triangle whose boundary edge starts at v, -1
+    // outside this call (reset below for the boundary's vertices).
+    starts_.resize(vertices_.size(), -1);
+    const auto clear_starts = [&] {
+      for (const Edge& e : horizon_) starts_[static_cast<std::size_t>(e.u)] = -1;
+    };
+    const int first = static_cast<int>(triangles_.size());
+    for (const Edge& e : horizon_) {
+      if (e.at < 0 || starts_[static_cast<std::size_t>(e.u)] >= 0) {
+        clear_starts();
+        return false;
+      }
+      const int g = add_triangle({e.u, e.w, apex});
+      starts_[static_cast<std::size_t>(e.u)] = g;
+      triangles_[static_cast<std::size_t>(g)].adjacent[0] = e.outside;
+    }
+    for (const Edge& e : horizon_) {
+      const int g = starts_[static_cast<std::size_t>(e.u)];
+      triangles_[static_cast<std::size_t>(e.outside)].adjacent[static_cast<std::size_t>(e.at)] = g;
+      // Edge w -> apex of g is apex -> w of the fan triangle starting at w.
+      const int next = starts_[static_cast<std::size_t>(e.w)];
+      if (next < 0) {
+        clear_starts();
+        return false;
+      }
+      triangles_[static_cast<std::size_t>(g)].adjacent[1] = next;
+      triangles_[static_cast<std::size_t>(next)].adjacent[2] = g;
+    }
+    clear_starts();
+    // Each fan edge apex -> w once in each direction: a vertex ending two
+    // boundary edges (distinct starts do not exclude it) would leave an
+    // edge held twice the same way, P no longer a closed surface, and the
+    // certificate void.
+    for (int g = first; g < static_cast<int>(triangles_.size()); ++g) {
+      const int next = triangles_[static_cast<std::size_t>(g)].adjacent[1];
+      if (triangles_[static_cast<std::size_t>(next)].adjacent[2] != g) return false;
+    }
+    return true;
+  }
+
+  const MinkowskiSupport& m_;
+  std::pmr::vector<Vertex> vertices_;
+  std::pmr::vector<Triangle> triangles_;
+  std::pmr::vector<std::pair<double, int>> heap_;
+  // A boundary edge u -> w of a removed triangle, the kept triangle
+  // across it and the edge's index there.
+  struct Edge {
+    int u, w, outside, at;
+  };
+  std::pmr::vector<Edge> horizon_;
+  std::pmr::vector<int> stack_;
+  std::pmr::vector<int> starts_;
+};
+
+}  // namespace
+
+ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations) {
+  // The scratch lists on the stack: a cold query's expansion is a few
+  // dozen iterations, and heap allocations would cost as much as they.
+  std::array<std::byte, 24576> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  Expansion e(m, &memory);
+  if (!e.start()) return {};
+  return e.run(max_iterations);
+}
+
+}  // namespace proxima::detail
