@@ -20,6 +20,7 @@
 #include "geometry/triangle_distance.h"
 #include "proxima/detail/geometry/exact_predicates.h"
 #include "proxima/geometry/closest_point.h"
+#include "proxima/query/distance.h"
 #include "proxima/query/margin.h"
 
 namespace proxima {
@@ -62,6 +63,26 @@ struct Query {
   double box_unit_a = 1, box_unit_b = 1;  // box floats -> scaled units
   Mat3 abs_rotation;
   KernelTolerance<double> tol;
+  Pose pose_a, pose_b;  // the world poses, checked
+  // A unit direction n from A towards B (the hulls' normal) that bounds
+  // every node pair by the gap of their projections on n (slab_gap), when
+  // `slab`: n in A's frame and in B's, and n . translation_s.
+  bool slab = false;
+  Vec3 n_a = Vec3::Zero(), abs_n_a = Vec3::Zero();
+  Vec3 n_b = Vec3::Zero(), abs_n_b = Vec3::Zero();
+  double n_offset = 0.0;
+
+  // Aim the slab bound along `direction` (A's frame, any length > 0).
+  void set_slab(const Vec3& direction) {
+    const double length = direction.norm();
+    if (!(length > 0.0) || !std::isfinite(length)) return;
+    n_a = direction / length;
+    abs_n_a = n_a.cwiseAbs();
+    n_b = rotation.transpose() * n_a;
+    abs_n_b = n_b.cwiseAbs();
+    n_offset = n_a.dot(translation_s);
+    slab = true;
+  }
 
   Vec3 a_vertex(std::uint32_t v) const { return a.vertex(static_cast<int>(v)) * factor; }
   Vec3 b_vertex(std::uint32_t v) const {
@@ -75,7 +96,7 @@ Query make_query(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& 
   const Pose pb = checked_pose(pose_b, "mesh distance: pose_b");
   detail::check_distance_options(options, "mesh distance: options");
   const Pose rel = pa.inverse() * pb;
-  Query q{a, b, rel.rotation, rel.translation, {}, 1.0, 0, 0.0, 0.0, 1.0, 1.0, {}, {}};
+  Query q{a, b, rel.rotation, rel.translation, {}, 1.0, 0, 0.0, 0.0, 1.0, 1.0, {}, {}, {}, {}};
   q.magnitude = std::max({magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale()), a.scale(),
                           magnitude_bound(rel, b.scale())});
   q.exponent = detail::clamped_magnitude_exponent(q.magnitude);
@@ -87,6 +108,8 @@ Query make_query(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& 
   q.box_unit_b = std::ldexp(1.0, magnitude_exponent(b.unit()) - 1 - q.exponent);
   q.abs_rotation = rel.rotation.cwiseAbs();
   q.tol = kernel_tolerance(std::ldexp(q.magnitude, -q.exponent));
+  q.pose_a = pa;
+  q.pose_b = pb;
   return q;
 }
 
@@ -121,12 +144,31 @@ double sum_of_squared_gaps(const Vec3& d, const Vec3& half, const Vec3& extent) 
   return sum;
 }
 
+// The squared gap of box a's and box b's projections on the query's slab
+// direction n (0 without one): |x - y| >= n . (y - x) >= min over b of
+// n . y - max over a of n . x for any unit n, and a box's extreme
+// projection is its center's plus or minus its half extents against |n|.
+// Along the hulls' normal it prunes every node farther than the best
+// pair's excess over the hulls' distance from the hulls' supporting
+// planes: the search keeps to the thin slabs where the closest pair can
+// be. Its rounding (a few u of the scaled magnitudes, n unit within a few
+// u) is far below the prune slack.
+double squared_slab_gap(const Query& q, const Box& a, const Box& b) {
+  if (!q.slab) return 0.0;
+  const double a_max = a.center.dot(q.n_a) + a.half.dot(q.abs_n_a);
+  const double b_min = b.center.dot(q.n_b) + q.n_offset - b.half.dot(q.abs_n_b);
+  const double gap = b_min - a_max;
+  return gap > 0.0 ? gap * gap : 0.0;
+}
+
 // a: A's child box; b: B's box, whose center and extents in A's frame are
 // cb and extent_b.
 double lower_bound_on_a_axes(const Query& q, const Box& a, const Box& b, const Vec3& cb,
                              const Vec3& extent_b, double prune2) {
+  const double slab = squared_slab_gap(q, a, b);
+  if (slab > prune2) return slab;
   const Vec3 d = a.center - cb;
-  const double sa = sum_of_squared_gaps(d, a.half, extent_b);
+  const double sa = std::max(slab, sum_of_squared_gaps(d, a.half, extent_b));
   if (sa > prune2) return sa;
   const Vec3 db = q.rotation.transpose() * d;
   return std::max(sa, sum_of_squared_gaps(db, b.half, q.abs_rotation.transpose() * a.half));
@@ -136,7 +178,9 @@ double lower_bound_on_a_axes(const Query& q, const Box& a, const Box& b, const V
 // ca and extent_a.
 double lower_bound_on_b_axes(const Query& q, const Box& a, const Box& b, const Vec3& ca,
                              const Vec3& extent_a, double prune2) {
-  const double sb = sum_of_squared_gaps(b.center - ca, b.half, extent_a);
+  const double slab = squared_slab_gap(q, a, b);
+  if (slab > prune2) return slab;
+  const double sb = std::max(slab, sum_of_squared_gaps(b.center - ca, b.half, extent_a));
   if (sb > prune2) return sb;
   const Vec3 d = a.center - (q.rotation * b.center + q.translation_s);
   return std::max(sb, sum_of_squared_gaps(d, a.half, q.abs_rotation * b.half));
@@ -445,6 +489,44 @@ bool contained_point(const Query& q, Vec3& point) {
   return false;
 }
 
+// The stop rule of a search against the hulls' lower bound L: a triangle
+// pair whose kernel distance d is at most L (1 + kHullStopRelative) +
+// kHullStopUlps u R is the answer, since no pair is closer than L. Its
+// exact distance is then within the accuracy standard of the meshes'
+// (DESIGN.md: 1e-12 relative plus 64 u R, of which the kernel's error
+// kLowerBoundUlps takes half).
+constexpr double kHullStopRelative = 1e-12;
+constexpr double kHullStopUlps = 32.0;
+
+// What the meshes' hulls (TriangleMesh::hull()) tell a query.
+struct HullBound {
+  bool apart = false;   // the hulls are separated: no surface crosses or holds the other
+  double lower = 0.0;   // certified lower bound on the meshes' distance (unscaled)
+  double stop2 = -1.0;  // squared scaled distance that ends a search (-1: none)
+};
+
+HullBound hull_bound(Query& q, const DistanceOptions& options, DistanceCache* cache) {
+  // Meshes are accepted up to coordinates of kMaxMagnitude, the convex
+  // query up to placed magnitudes (|t| + sqrt(3) scale) of it: beyond, no
+  // hull bound (the search alone answers).
+  if (!(q.magnitude <= kMaxMagnitude)) return {};
+  DistanceOptions hull_options;
+  hull_options.absolute_tolerance = options.absolute_tolerance;
+  hull_options.penetration = false;
+  DistanceCache local;
+  const DistanceResult r = detail::distance_of_rigid_poses(
+      q.a.hull(), q.pose_a, q.b.hull(), q.pose_b, hull_options, cache != nullptr ? cache : &local);
+  HullBound h;
+  if (r.status != Status::separated || !(r.lower_bound > 0.0)) return h;
+  h.apart = true;
+  q.set_slab(q.pose_a.rotation.transpose() * r.normal);
+  h.lower = r.lower_bound;
+  const double stop = std::ldexp(r.lower_bound, -q.exponent) * (1.0 + kHullStopRelative) +
+                      kHullStopUlps * kUnitRoundoff * std::ldexp(q.magnitude, -q.exponent);
+  h.stop2 = stop * stop;
+  return h;
+}
+
 // The margin query between two meshes (proxima/query/margin.h), in the scaled
 // frame of the distance query: depth first over node pairs, the nearer
 // child on top, a node pair pruned when its box bound exceeds the margin by
@@ -578,9 +660,31 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     r.lower_bound = gap;
     return r;
   }
-  const Query q = make_query(a, pa, b, pb, options);
+  Query q = make_query(a, pa, b, pb, options);
+  if (cache != nullptr && (cache->mesh_a != a.id() || cache->mesh_b != b.id())) {
+    cache->reset();
+    cache->mesh_a = a.id();
+    cache->mesh_b = b.id();
+  }
+  // The hulls hold the surfaces: hulls beyond the margin prove the meshes
+  // beyond it, and otherwise the hulls' closest points aim the slab bound
+  // of the traversal.
+  double hull_lower = 0.0;
+  if (q.magnitude <= kMaxMagnitude) {  // the convex query's range (hull_bound)
+    DistanceCache local;
+    const MarginResult hull = detail::within_margin_of_rigid_poses(
+        a.hull(), q.pose_a, b.hull(), q.pose_b, margin, options,
+        cache != nullptr ? cache->hull : local);
+    if (hull.status == MarginStatus::beyond) {
+      r.lower_bound = hull.lower_bound;
+      r.upper_bound = std::numeric_limits<double>::infinity();
+      return r;
+    }
+    hull_lower = hull.lower_bound;
+    if (hull.upper_bound > 0.0) q.set_slab(q.pose_a.rotation.transpose() * (hull.point_b - hull.point_a));
+  }
   MarginSearch search(q, margin);
-  const bool same_pair = cache != nullptr && cache->mesh_a == a.id() && cache->mesh_b == b.id();
+  const bool same_pair = cache != nullptr;
   // The last witness (or closest) pair first: a colliding pair often still
   // collides there.
   bool found = same_pair && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count() &&
@@ -601,11 +705,6 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     r.triangle_b = search.witness_b();
     r.lower_bound = 0.0;
     if (cache != nullptr) {
-      if (!same_pair) {
-        cache->reset();
-        cache->mesh_a = a.id();
-        cache->mesh_b = b.id();
-      }
       cache->triangle_a = r.triangle_a;
       cache->triangle_b = r.triangle_b;
     }
@@ -622,7 +721,7 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     r.lower_bound = 0.0;
     return r;
   }
-  r.lower_bound = std::max(0.0, std::ldexp(search.lower_scaled(), q.exponent));
+  r.lower_bound = std::max({0.0, std::ldexp(search.lower_scaled(), q.exponent), hull_lower});
   r.status = r.lower_bound > margin ? MarginStatus::beyond : MarginStatus::undecided;
   return r;
 }
@@ -650,14 +749,44 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const T
 
 MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
                     const Pose& pose_b, const DistanceOptions& options, MeshCache* cache) {
-  const Query q = make_query(a, pose_a, b, pose_b, options);
+  Query q = make_query(a, pose_a, b, pose_b, options);
   const double slack_s = detail::prune_slack(std::ldexp(q.magnitude, -q.exponent));
   const double unscaled_slack = std::ldexp(slack_s, q.exponent);
   Best best;
   int tested = 0;
   int nodes_tested = 0;
 
-  const bool same_pair = cache != nullptr && cache->mesh_a == a.id() && cache->mesh_b == b.id();
+  // A cache of another pair starts over (its hull state and triangles
+  // belong to other meshes).
+  if (cache != nullptr && (cache->mesh_a != a.id() || cache->mesh_b != b.id())) {
+    cache->reset();
+    cache->mesh_a = a.id();
+    cache->mesh_b = b.id();
+  }
+  const bool same_pair = cache != nullptr;
+  const HullBound hull = hull_bound(q, options, cache != nullptr ? &cache->hull : nullptr);
+  const auto remember = [&] {
+    cache->triangle_a = best.ta;
+    cache->triangle_b = best.tb;
+    cache->last_rotation = q.rotation;
+    cache->last_translation = q.translation;
+  };
+
+  // The last closest pair: an upper bound before any search, and the
+  // answer when it reaches the hulls' lower bound.
+  if (same_pair && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count() &&
+      cache->triangle_b >= 0 && cache->triangle_b < b.triangle_count()) {
+    test_pair(q, a_triangle(q, cache->triangle_a), b_triangle(q, cache->triangle_b), best, tested);
+    if (best.d2 <= hull.stop2) {
+      MeshResult r = finish(q, pose_a, best, Containment{});
+      r.lower_bound = std::min(r.lower_bound, hull.lower);
+      r.pairs_tested = tested;
+      r.tracked = true;
+      remember();
+      return r;
+    }
+  }
+
   double last_step = std::numeric_limits<double>::infinity();
   if (same_pair && cache->triangle_a >= 0) {
     last_step =
@@ -687,7 +816,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
       // B moved less than the surfaces' distance then: the contained vertex
       // cannot have crossed the other surface.
       Containment inside;
-      if (!best.crossing) {
+      if (!best.crossing && !hull.apart) {
         inside = moved + unscaled_slack < cache->base_distance && cache->inside >= 0
                      ? Containment{cache->inside, cache->inside_vertex}
                      : contained(q);
@@ -695,18 +824,9 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
       MeshResult r = finish(q, pose_a, best, inside);
       r.pairs_tested = tested;
       r.tracked = true;
-      cache->triangle_a = best.ta;
-      cache->triangle_b = best.tb;
-      cache->last_rotation = q.rotation;
-      cache->last_translation = q.translation;
+      remember();
       return r;
     }
-  }
-
-  // The last closest pair: an upper bound before any traversal.
-  if (same_pair && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count() &&
-      cache->triangle_b >= 0 && cache->triangle_b < b.triangle_count()) {
-    test_pair(q, a_triangle(q, cache->triangle_a), b_triangle(q, cache->triangle_b), best, tested);
   }
 
   // The margin of a new candidate list (scaled), 0 for none.
@@ -788,7 +908,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     }
     return slot;
   };
-  while (!heap.empty() && !best.crossing) {
+  // Stopped when the best pair reaches the hulls' lower bound: every pair
+  // left is at least as far as that bound.
+  bool reached_hull = best.d2 <= hull.stop2;
+  while (!heap.empty() && !best.crossing && !reached_hull) {
     std::pop_heap(heap.begin(), heap.end(), later);
     Entry e = heap.back();
     heap.pop_back();
@@ -830,6 +953,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
           }
         }
         prune2 = threshold2();
+        reached_hull = best.d2 <= hull.stop2;
         break;
       }
       // Split the larger node (an inner node against a leaf: the inner one).
@@ -871,22 +995,18 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     }
   }
 
-  const Containment inside = best.crossing ? Containment{} : contained(q);
+  // Hulls apart: no surface crosses or holds the other.
+  const Containment inside = best.crossing || hull.apart ? Containment{} : contained(q);
   MeshResult r = finish(q, pose_a, best, inside);
+  if (reached_hull) r.lower_bound = std::min(r.lower_bound, hull.lower);
   r.pairs_tested = tested;
   r.nodes_tested = nodes_tested;
   if (cache != nullptr) {
-    if (!same_pair) {
-      cache->reset();
-      cache->mesh_a = a.id();
-      cache->mesh_b = b.id();
-    }
-    cache->triangle_a = best.ta;
-    cache->triangle_b = best.tb;
-    cache->last_rotation = q.rotation;
-    cache->last_translation = q.translation;
+    remember();
     cache->near.clear();
-    if (margin > 0.0 && !overflow && !best.crossing) {
+    // A search stopped at the hulls' bound did not meet every pair within
+    // the margin: no list from it.
+    if (margin > 0.0 && !overflow && !best.crossing && !reached_hull) {
       // Keep the tested pairs within the margin of the final best: every
       // pair left out is farther than best + 2 margin (pruned by its
       // node pair's bound, or by its own distance here).

@@ -56,6 +56,10 @@ struct MeshCache {
   std::uint16_t list_uses = 0;  // queries the current list has answered
   std::uint8_t list_backoff = 0;
   std::uint8_t list_wait = 0;
+  // The tracking state of the query between the meshes' hulls
+  // (TriangleMesh::hull()), whose lower bound certifies the closest
+  // triangle pair of a tracked query when that pair reaches it.
+  DistanceCache hull;
 
   bool is_cold() const { return triangle_a < 0; }
   void reset() { *this = MeshCache{}; }
