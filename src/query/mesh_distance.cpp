@@ -830,8 +830,16 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
   }
 
   // The margin of a new candidate list (scaled), 0 for none.
+  // Hulls apart: no list. The hulls' bound and the last pair already make
+  // the tracked search the cold one with a tight first upper bound, and a
+  // list's wider search costs more than it saves there (on a planner's
+  // steps the closest pair wanders over near-parallel faces, whose pairs
+  // within the margin overflow the list). Lists serve the pairs whose
+  // hulls overlap (a body moving inside or around another).
   double margin = 0.0;
-  if (cache != nullptr && same_pair && cache->list_wait > 0) {
+  if (hull.apart) {
+    // no list
+  } else if (cache != nullptr && same_pair && cache->list_wait > 0) {
     --cache->list_wait;
   } else if (cache != nullptr && same_pair && std::isfinite(last_step) &&
              kMarginSteps * last_step <= kMarginRadiusFraction * b_radius(b)) {
