@@ -764,7 +764,18 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMes
     cache->mesh_b = b.id();
   }
   const bool same_pair = cache != nullptr;
-  const HullBound hull = hull_bound(q, options, cache != nullptr ? &cache->hull : nullptr);
+  HullBound hull;
+  if (cache != nullptr && cache->hull_wait > 0) {
+    --cache->hull_wait;
+  } else {
+    hull = hull_bound(q, options, cache != nullptr ? &cache->hull : nullptr);
+    if (cache != nullptr && hull.apart) {
+      cache->hull_backoff = 0;
+    } else if (cache != nullptr) {
+      cache->hull_backoff = static_cast<std::uint8_t>(std::min(2 * cache->hull_backoff + 1, 32));
+      cache->hull_wait = cache->hull_backoff;
+    }
+  }
   const auto remember = [&] {
     cache->triangle_a = best.ta;
     cache->triangle_b = best.tb;
