@@ -53,13 +53,14 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
 }
 
 int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads,
-                      std::optional<proxima::QuaternionOrder> order) {
+                      std::optional<proxima::QuaternionOrder> order, std::uint64_t max_line_bytes) {
   // Answers go through std::cout only; untying it from C stdio lets it
   // buffer a whole answer line before the explicit flush.
   std::ios::sync_with_stdio(false);
   proxima::cli::QueryRunSummary summary;
   if (file == "-") {
-    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads, order);
+    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads, order,
+                                           max_line_bytes);
   } else {
     // An ifstream opens a directory without complaint and then reads
     // nothing; that would look like an empty, successful run.
@@ -73,7 +74,12 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
       std::cerr << "proxima query: cannot open '" << file << "': " << std::strerror(errno) << "\n";
       return kExitFailure;
     }
-    summary = proxima::cli::run_queries(in, std::cout, options, threads, order);
+    summary = proxima::cli::run_queries(in, std::cout, options, threads, order, max_line_bytes);
+  }
+  if (summary.too_long_line != 0) {
+    std::cerr << "proxima query: "
+              << proxima::cli::too_long_message(summary.too_long_line, max_line_bytes) << "\n";
+    return kExitFailure;
   }
   if (summary.read_failed) {
     std::cerr << "proxima query: reading the input failed after " << summary.answered
@@ -145,6 +151,13 @@ int main(int argc, char** argv) {
                    "(scalar last, as ROS and scipy write them). Without it a rotation must name "
                    "its order: {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, z, w]}")
       ->check(CLI::IsMember(orders));
+  std::uint64_t max_line_bytes = proxima::cli::kDefaultMaxLineBytes;
+  query
+      ->add_option("--max-line-size", max_line_bytes,
+                   "Refuse a query line longer than this many bytes (its error answer is the "
+                   "last: reading stops there)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   query
       ->add_option("--threads", threads,
                    "Threads answering blocks of queries; answers stay in input order")
@@ -310,7 +323,7 @@ int main(int argc, char** argv) {
     if (*demo) return proxima::cli::run_demo();
     if (*query) {
       options.algorithm = parse_algorithm(algorithm);
-      return run_query_command(file, options, threads, parse_order(query_order));
+      return run_query_command(file, options, threads, parse_order(query_order), max_line_bytes);
     }
     if (*distance) {
       distance_command.options.algorithm = parse_algorithm(distance_algorithm);

@@ -8,6 +8,8 @@
 #include <iostream>
 #include <string>
 
+#include "line_reader.h"
+
 #include "json_errors.h"
 #include "proxima/robot/robot_distance.h"
 #include "proxima/robot/urdf.h"
@@ -109,8 +111,16 @@ int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, 
   RobotQueryState state;
   std::string line;
   long line_number = 0;
-  while (std::getline(in, line)) {
+  for (;;) {
+    const LineRead read = read_line(in, line, kDefaultMaxLineBytes);
+    if (read == LineRead::end) break;
     ++line_number;
+    if (read == LineRead::too_long) {
+      // Its rest cannot be skipped safely (read_line): the run stops here.
+      out.flush();
+      err << "proxima robot: " << too_long_message(line_number, kDefaultMaxLineBytes) << "\n";
+      return 1;
+    }
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     Json answer;
     try {

@@ -19,10 +19,4 @@ inline constexpr double kDefaultImpactTolerance = 1e-6;
 // (Scene::sweep).
 void check_impact_options(const ImpactOptions& options, const char* who);
 
-// sin x and cos x as a sweep's poses take them: a few ulps of std::sin and
-// std::cos on [0, pi/2] (the half angles of a turn the shorter way) at a
-// quarter of their cost, std::sin and std::cos elsewhere. Exposed for its
-// twin test.
-void sin_cos_quadrant(double x, double& sine, double& cosine);
-
 }  // namespace proxima::detail

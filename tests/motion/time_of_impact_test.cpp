@@ -22,6 +22,7 @@
 #include "proxima/query/distance.h"
 #include "proxima/query/mesh_distance.h"
 #include "proxima/shape/primitives.h"
+#include "motion/sweep.h"
 #include "motion/time_of_impact.h"
 #include "support/penetration_oracle.h"
 
