@@ -150,29 +150,31 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     r.lower_bound = gap;
     return r;
   }
-  Query q = make_query(a, pa, b, pb, options);
   if (cache != nullptr && (cache->mesh_a != a.id() || cache->mesh_b != b.id())) {
     cache->reset();
     cache->mesh_a = a.id();
     cache->mesh_b = b.id();
   }
   // The hulls hold the surfaces: hulls beyond the margin prove the meshes
-  // beyond it, and otherwise the hulls' closest points aim the slab bound
-  // of the traversal.
+  // beyond it, before the hierarchies' query is set up; otherwise the
+  // hulls' closest points aim the slab bound of the traversal. Only within
+  // the convex query's range of placed magnitudes (as hull_bound).
   double hull_lower = 0.0;
-  if (q.magnitude <= kMaxMagnitude) {  // the convex query's range (hull_bound)
+  Vec3 hull_direction = Vec3::Zero();  // world frame
+  if (std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())) <= kMaxMagnitude) {
+    detail::check_distance_options(options, "within_margin: options");
     DistanceCache local;
     const MarginResult hull = detail::within_margin_of_rigid_poses(
-        a.hull(), q.pose_a, b.hull(), q.pose_b, margin, options,
-        cache != nullptr ? cache->hull : local);
+        a.hull(), pa, b.hull(), pb, margin, options, cache != nullptr ? cache->hull : local);
     if (hull.status == MarginStatus::beyond) {
       r.lower_bound = hull.lower_bound;
-      r.upper_bound = std::numeric_limits<double>::infinity();
       return r;
     }
     hull_lower = hull.lower_bound;
-    if (hull.upper_bound > 0.0) q.set_slab(q.pose_a.rotation.transpose() * (hull.point_b - hull.point_a));
+    if (hull.upper_bound > 0.0) hull_direction = hull.point_b - hull.point_a;
   }
+  Query q = make_query(a, pa, b, pb, options);
+  if (hull_direction != Vec3::Zero()) q.set_slab(q.pose_a.rotation.transpose() * hull_direction);
   MarginSearch search(q, margin);
   const bool same_pair = cache != nullptr;
   // The last witness (or closest) pair first: a colliding pair often still
