@@ -411,6 +411,15 @@ void TriangleMesh::build(std::span<const Vec3> vertices) {
   box(0, root_lo, root_hi);
   center_ = 0.5 * (root_lo + root_hi);
   bounding_radius_ = 0.5 * (root_hi - root_lo).stableNorm();
+  // The hull of the vertices the triangles use (an unused vertex would
+  // only loosen the bound).
+  std::vector<char> used(vertices_.size(), 0);
+  for (const Triangle& tri : triangles_)
+    for (const std::uint32_t v : tri) used[v] = 1;
+  std::vector<Vec3> corners;
+  for (std::size_t v = 0; v < vertices_.size(); ++v)
+    if (used[v] != 0) corners.push_back(vertices_[v]);
+  hull_ = std::make_shared<const ConvexPolytope>(corners);
 }
 
 void TriangleMesh::box(int i, Vec3& lo, Vec3& hi) const {
@@ -425,7 +434,8 @@ std::size_t TriangleMesh::memory_bytes() const {
   return sizeof(*this) + vertices_.capacity() * sizeof(Vec3) +
          triangles_.capacity() * sizeof(Triangle) + nodes_.capacity() * sizeof(Node) +
          (order_.capacity() + degenerate_.capacity() + component_vertices_.capacity()) *
-             sizeof(std::int32_t);
+             sizeof(std::int32_t) +
+         hull_->memory_bytes();
 }
 
 bool TriangleMesh::contains(const Vec3& p) const {

@@ -220,7 +220,16 @@ TEST(BodyMesh, NonConvexMeshAgainstARoundedPointEqualsTheTwin) {
     const MeshResult twin = distance_all_pairs(*l, Pose::identity(), point, pb);
     if (twin.status == Status::intersecting) continue;
     EXPECT_NEAR(got.signed_distance(), twin.distance - 0.2, 1e-12) << k;
-    EXPECT_EQ(got.triangle_a, twin.triangle_a) << k;
+    // A closest triangle: the twin's, or one at its distance (the point
+    // is often closest to a vertex or an edge that several triangles share,
+    // and the search stops at the first that reaches the hulls' bound).
+    ASSERT_GE(got.triangle_a, 0) << k;
+    const auto& tri = l->triangle(got.triangle_a);
+    const std::vector<TriangleMesh::Triangle> just = {tri};
+    const TriangleMesh alone(l->vertices(), std::span<const TriangleMesh::Triangle>(just));
+    EXPECT_NEAR(distance_all_pairs(alone, Pose::identity(), point, pb).distance, twin.distance,
+                1e-12)
+        << k;
   }
   // In the notch, at (1.5, 1.5, 0.5): 0.5 from the L (its inner corner
   // edge at x = 1 or y = 1), while the hull contains the point.

@@ -56,6 +56,16 @@ struct MeshCache {
   std::uint16_t list_uses = 0;  // queries the current list has answered
   std::uint8_t list_backoff = 0;
   std::uint8_t list_wait = 0;
+  // The tracking state of the query between the meshes' hulls
+  // (TriangleMesh::hull()), whose lower bound certifies the closest
+  // triangle pair of a tracked query when that pair reaches it.
+  DistanceCache hull;
+  // Hulls that overlap give no bound: after such an answer the next
+  // distance queries skip the hulls for `hull_wait` queries, a wait that
+  // doubles with each overlap (up to 32) and ends when the hulls are apart
+  // (a body moving inside another's hull pays no hull query per step).
+  std::uint8_t hull_backoff = 0;
+  std::uint8_t hull_wait = 0;
 
   bool is_cold() const { return triangle_a < 0; }
   void reset() { *this = MeshCache{}; }

@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -123,7 +124,17 @@ class TriangleMesh {
   // on the surface. O(log n) typical through the hierarchy.
   bool contains(const Vec3& p) const;
 
-  // Bytes held by the mesh (vertices, triangles, hierarchy, order, lists).
+  // The convex hull of the triangles' vertices (mesh frame), built once
+  // with the mesh. It holds the surface, so the distance between two hulls
+  // is a certified lower bound on the distance between the meshes, and an
+  // exact one when the hulls' closest points lie on both surfaces (convex
+  // regions facing each other, the common case between a robot's links):
+  // the mesh queries use it to stop as soon as a triangle pair reaches it,
+  // and to prove pairs of meshes apart without their hierarchies.
+  const ConvexPolytope& hull() const { return *hull_; }
+
+  // Bytes held by the mesh (vertices, triangles, hierarchy, order, lists,
+  // hull).
   std::size_t memory_bytes() const;
 
   // An id of this mesh's content, distinct for meshes built separately
@@ -139,6 +150,8 @@ class TriangleMesh {
   std::vector<Node> nodes_;
   std::vector<std::int32_t> order_;
   std::vector<std::int32_t> component_vertices_;
+  // Shared by copies (immutable).
+  std::shared_ptr<const ConvexPolytope> hull_;
   double scale_ = 0.0;
   double unit_ = 1.0;
   // The root box's center and half diagonal, computed once (every margin

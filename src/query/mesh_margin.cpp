@@ -1,0 +1,221 @@
+// proxima: minimum distance between convex polyhedra.
+// SPDX-License-Identifier: BSD-3-Clause
+//
+// query layer: the margin query between two triangle meshes
+// (proxima/query/margin.h): the hulls first, then a depth-first search
+// over node pairs that stops at the first triangle pair within the margin.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "proxima/query/margin.h"
+#include "query/mesh_pair.h"
+
+namespace proxima {
+namespace {
+
+using namespace detail::mesh_pair;
+
+// The margin query between two meshes (proxima/query/margin.h), in the scaled
+// frame of the distance query: depth first over node pairs, the nearer
+// child on top, a node pair pruned when its box bound exceeds the margin by
+// the bound's rounding slack, and the first triangle pair within margin +
+// band (test_pair's filters and kernel, limited there) ends the search.
+class MarginSearch {
+ public:
+  MarginSearch(const Query& q, double margin) : q_(q), margin_(margin) {
+    margin_s_ = std::ldexp(margin, -q.exponent);
+    yes_s_ = margin_s_ + q.band_s;
+    slack_s_ = detail::prune_slack(std::ldexp(q.magnitude, -q.exponent));
+    prune_s_ = margin_s_ + slack_s_;
+    lower_s_ = std::numeric_limits<double>::infinity();
+  }
+
+  // Whether triangle pair (ta, tb) is within; tested pairs lower the bound.
+  bool test(const Triangles& ta, const Triangles& tb) {
+    Best unused;
+    const double d2 = test_pair(q_, ta, tb, unused, tested_, yes_s_);
+    if (d2 <= yes_s_ * yes_s_) {
+      witness_a_ = ta.id;
+      witness_b_ = tb.id;
+      return true;
+    }
+    // Skipped by the filters or the kernel's limit: farther than yes_s_ up
+    // to their rounding (a few u, below half the band); tested: the
+    // kernel's distance less its error.
+    lower_s_ = std::min(lower_s_, std::isfinite(d2) ? std::sqrt(d2) - kLowerBoundUlps * kUnitRoundoff
+                                                    : yes_s_ - 0.5 * q_.band_s);
+    return false;
+  }
+
+  bool traverse() {
+    const auto nodes_a = q_.a.nodes();
+    const auto nodes_b = q_.b.nodes();
+    const auto order_a = q_.a.triangle_order();
+    const auto order_b = q_.b.triangle_order();
+    const double prune2 = prune_s_ * prune_s_;
+    std::array<Triangles, TriangleMesh::kLeafSize> leaf_a, leaf_b;
+    stack_.clear();
+    stack_.push_back({0, 0});
+    while (!stack_.empty()) {
+      const auto [ia, ib] = stack_.back();
+      stack_.pop_back();
+      const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(ia)];
+      const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(ib)];
+      if (na.is_leaf() && nb.is_leaf()) {
+        for (std::int32_t i = 0; i < na.count; ++i)
+          leaf_a[static_cast<std::size_t>(i)] =
+              a_triangle(q_, order_a[static_cast<std::size_t>(na.first_or_right + i)]);
+        for (std::int32_t j = 0; j < nb.count; ++j)
+          leaf_b[static_cast<std::size_t>(j)] =
+              b_triangle(q_, order_b[static_cast<std::size_t>(nb.first_or_right + j)]);
+        for (std::int32_t i = 0; i < na.count; ++i)
+          for (std::int32_t j = 0; j < nb.count; ++j)
+            if (test(leaf_a[static_cast<std::size_t>(i)], leaf_b[static_cast<std::size_t>(j)]))
+              return true;
+        continue;
+      }
+      const Box ba = node_box(na, q_.box_unit_a);
+      const Box bb = node_box(nb, q_.box_unit_b);
+      const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
+      std::array<std::int32_t, 2> child_a = {ia, ia};
+      std::array<std::int32_t, 2> child_b = {ib, ib};
+      std::array<double, 2> lb2;
+      if (split_a) {
+        const Vec3 cb = q_.rotation * bb.center + q_.translation_s;
+        const Vec3 extent_b = q_.abs_rotation * bb.half;
+        child_a = {ia + 1, na.first_or_right};
+        for (int c = 0; c < 2; ++c) {
+          const Box box = node_box(nodes_a[static_cast<std::size_t>(child_a[c])], q_.box_unit_a);
+          lb2[c] = lower_bound_on_a_axes(q_, box, bb, cb, extent_b, prune2);
+        }
+      } else {
+        const Vec3 ca = q_.rotation.transpose() * (ba.center - q_.translation_s);
+        const Vec3 extent_a = q_.abs_rotation.transpose() * ba.half;
+        child_b = {ib + 1, nb.first_or_right};
+        for (int c = 0; c < 2; ++c) {
+          const Box box = node_box(nodes_b[static_cast<std::size_t>(child_b[c])], q_.box_unit_b);
+          lb2[c] = lower_bound_on_b_axes(q_, ba, box, ca, extent_a, prune2);
+        }
+      }
+      nodes_tested_ += 2;
+      // The nearer child on top (pushed last).
+      const int near = lb2[0] <= lb2[1] ? 0 : 1;
+      for (const int c : {1 - near, near}) {
+        if (lb2[c] > prune2) {
+          lower_s_ = std::min(lower_s_, std::sqrt(lb2[c]) - slack_s_);
+        } else {
+          stack_.push_back({child_a[c], child_b[c]});
+        }
+      }
+    }
+    return false;
+  }
+
+  double margin() const { return margin_; }
+  double lower_scaled() const { return lower_s_; }
+  int tested() const { return tested_; }
+  int nodes_tested() const { return nodes_tested_; }
+  std::int32_t witness_a() const { return witness_a_; }
+  std::int32_t witness_b() const { return witness_b_; }
+
+ private:
+  const Query& q_;
+  double margin_;
+  double margin_s_ = 0.0, yes_s_ = 0.0, prune_s_ = 0.0, lower_s_ = 0.0, slack_s_ = 0.0;
+  int tested_ = 0;
+  int nodes_tested_ = 0;
+  std::int32_t witness_a_ = -1, witness_b_ = -1;
+  std::vector<std::array<std::int32_t, 2>> stack_;
+};
+
+}  // namespace
+
+MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
+                           const Pose& pose_b, double margin, const DistanceOptions& options,
+                           MeshCache* cache) {
+  detail::check_margin(margin, "within_margin");
+  const Pose pa = checked_pose(pose_a, "within_margin: pose_a");
+  const Pose pb = checked_pose(pose_b, "within_margin: pose_b");
+  MarginResult r;
+  r.margin = margin;
+  // Far apart: the root boxes' balls prove it without the hierarchies (the
+  // options are checked first, as every query checks them).
+  if (!is_finite_bits(options.absolute_tolerance) || !(options.absolute_tolerance >= 0.0))
+    throw InvalidInput("within_margin: absolute_tolerance must be finite and >= 0");
+  const double gap = detail::sphere_gap_lower_bound(pa.apply(a.center()), a.bounding_radius(),
+                                                    pb.apply(b.center()), b.bounding_radius());
+  if (gap > margin) {
+    r.lower_bound = gap;
+    return r;
+  }
+  if (cache != nullptr && (cache->mesh_a != a.id() || cache->mesh_b != b.id())) {
+    cache->reset();
+    cache->mesh_a = a.id();
+    cache->mesh_b = b.id();
+  }
+  // The hulls hold the surfaces: hulls beyond the margin prove the meshes
+  // beyond it, before the hierarchies' query is set up; otherwise the
+  // hulls' closest points aim the slab bound of the traversal. Only within
+  // the convex query's range of placed magnitudes (as hull_bound).
+  double hull_lower = 0.0;
+  Vec3 hull_direction = Vec3::Zero();  // world frame
+  if (std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())) <= kMaxMagnitude) {
+    detail::check_distance_options(options, "within_margin: options");
+    DistanceCache local;
+    const MarginResult hull = detail::within_margin_of_rigid_poses(
+        a.hull(), pa, b.hull(), pb, margin, options, cache != nullptr ? cache->hull : local);
+    if (hull.status == MarginStatus::beyond) {
+      r.lower_bound = hull.lower_bound;
+      return r;
+    }
+    hull_lower = hull.lower_bound;
+    if (hull.upper_bound > 0.0) hull_direction = hull.point_b - hull.point_a;
+  }
+  Query q = make_query(a, pa, b, pb, options);
+  if (hull_direction != Vec3::Zero()) q.set_slab(q.pose_a.rotation.transpose() * hull_direction);
+  MarginSearch search(q, margin);
+  const bool same_pair = cache != nullptr;
+  // The last witness (or closest) pair first: a colliding pair often still
+  // collides there.
+  bool found = same_pair && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count() &&
+               cache->triangle_b >= 0 && cache->triangle_b < b.triangle_count() &&
+               search.test(a_triangle(q, cache->triangle_a), b_triangle(q, cache->triangle_b));
+  if (!found) found = search.traverse();
+  r.pairs_tested = search.tested();
+  if (found) {
+    const Triangles ta = a_triangle(q, search.witness_a());
+    const Triangles tb = b_triangle(q, search.witness_b());
+    const ClosestPoints<double> points =
+        closest_triangle_triangle(ta.v[0], ta.v[1], ta.v[2], tb.v[0], tb.v[1], tb.v[2], q.tol);
+    r.status = MarginStatus::within;
+    r.point_a = pa.apply(times_pow2(points.point_a, q.exponent));
+    r.point_b = pa.apply(times_pow2(points.point_b, q.exponent));
+    r.upper_bound = (r.point_b - r.point_a).norm();
+    r.triangle_a = search.witness_a();
+    r.triangle_b = search.witness_b();
+    r.lower_bound = 0.0;
+    if (cache != nullptr) {
+      cache->triangle_a = r.triangle_a;
+      cache->triangle_b = r.triangle_b;
+    }
+    return r;
+  }
+  // No pair within: within any margin still when a surface lies inside the
+  // other, closed mesh (a point of both).
+  Vec3 inside;
+  if (contained_point(q, inside)) {
+    r.status = MarginStatus::within;
+    r.point_a = pa.apply(inside);
+    r.point_b = r.point_a;
+    r.upper_bound = 0.0;
+    r.lower_bound = 0.0;
+    return r;
+  }
+  r.lower_bound = std::max({0.0, std::ldexp(search.lower_scaled(), q.exponent), hull_lower});
+  r.status = r.lower_bound > margin ? MarginStatus::beyond : MarginStatus::undecided;
+  return r;
+}
+
+}  // namespace proxima
