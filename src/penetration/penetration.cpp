@@ -300,19 +300,6 @@ struct Query {
   Vec3 arc_normal_b(int g) const { return -(rotation * arc_normal(b, *shapes_b, g)); }
 };
 
-// The edge vector k times a power of two (exact) that brings its largest
-// coordinate into [1/2, 1): the same direction, whose norms and cross
-// products neither underflow nor overflow. In the query's scaled units a
-// body far smaller than the other has edges as short as 2^-1000 (1e-150
-// against 1e150); their squared norms fall into subnormals, where a cross
-// product's n / n.norm() is no longer unit (0.94: a normal that gave a
-// depth 1% short, points 3.6e57 apart against a band of 1.8e44), or to
-// zero, where an edge pair's candidate was dropped. Pinned by
-// PenetrationRegression.TinyBodyInHugeOneHasUnitNormal.
-Vec3 exponent_free(const Vec3& k) {
-  return detail::times_pow2(k, -detail::magnitude_exponent(k.cwiseAbs().maxCoeff()));
-}
-
 // The face to the left of the directed edge v -> w, or -1.
 int left_face(const ConvexPolytope& poly, int v, int w) {
   const auto offsets = poly.adjacency_offsets();
@@ -336,7 +323,7 @@ int edge_arcs(int dimension, const Vec3& k, const Vec3& nl, const Vec3& nr, bool
     out[0] = {nl, nr, k, tolerance};
     return 1;
   }
-  const Vec3 axis = exponent_free(k).normalized();
+  const Vec3 axis = detail::exponent_free(k).normalized();
   if (dimension == 2) {
     // nl is the left side's normal (for -B: minus it); o the outward normal.
     const Vec3 left = sign * nl;  // the un-negated left normal
@@ -558,8 +545,10 @@ void keep(Query& q, const Candidate& c, Candidates& out) {
 void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
                         int b1, const std::array<Arc, 4>& yb, int nb, Candidates& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
-  const Vec3 ea = exponent_free(xa[0].k);
-  const Vec3 eb = exponent_free(yb[0].k);
+  // Scaled, a small body's edges can be 2^-500 long beside the other's
+  // (PenetrationRegression.TinyBodyInHugeOneHasUnitNormal): exponent_free.
+  const Vec3 ea = detail::exponent_free(xa[0].k);
+  const Vec3 eb = detail::exponent_free(yb[0].k);
   Vec3 n = ea.cross(eb);
   const double length = n.norm();
   if (!(length > 0x1p-200 * ea.norm() * eb.norm()) || !(length > 0.0)) return;
@@ -1451,7 +1440,7 @@ std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& 
     u1 = q.point_a(id.a1);
     w0 = q.point_b(id.b0);
     w1 = q.point_b(id.b1);
-    const Vec3 ea = exponent_free(u1 - u0), eb = exponent_free(w1 - w0);
+    const Vec3 ea = detail::exponent_free(u1 - u0), eb = detail::exponent_free(w1 - w0);
     const double cross = ea.cross(eb).norm();
     if (!(cross > 0.0)) return std::nullopt;
     angle = (8.0 * ea.norm() * eb.norm() / cross + 4.0) * kUnitRoundoff;
@@ -1503,8 +1492,8 @@ PenetrationResult refine(const Query& q, std::span<const Candidate> candidates,
     // magnitude (exact_value's angle, recomputed cheaply here).
     double widen = 0.0;
     if (c.id.kind == MinkowskiFace::edge_edge && c.id.a0 >= 0 && c.id.b0 >= 0) {
-      const Vec3 ea = exponent_free(q.point_a(c.id.a1) - q.point_a(c.id.a0));
-      const Vec3 eb = exponent_free(q.point_b(c.id.b1) - q.point_b(c.id.b0));
+      const Vec3 ea = detail::exponent_free(q.point_a(c.id.a1) - q.point_a(c.id.a0));
+      const Vec3 eb = detail::exponent_free(q.point_b(c.id.b1) - q.point_b(c.id.b0));
       const double cross = ea.cross(eb).norm();
       widen = cross > 0.0 ? 8.0 * ea.norm() * eb.norm() / cross * kUnitRoundoff * reach : kInfinity;
     }

@@ -73,7 +73,9 @@ void convex_episode(Context& c) {
     c.ledger.queries(3);
     const std::string line = reproducer(pair, pose_a, pose_b, algorithm);
     check_answer(c, tag, r, magnitude, world, line);
-    check_answer(c, tag + "/swapped", s, magnitude, world, line);
+    check_answer(c, tag + "/swapped", s, magnitude, world,
+                 "\"algorithm\":\"" + std::string(to_string(algorithm)) + "\"," +
+                     query_line(pair.points_b, pose_b, 0, pair.points_a, pose_a, 0));
     check_answer(c, std::string("convex/") + to_string(other), o, magnitude, world,
                  reproducer(pair, pose_a, pose_b, other));
 
