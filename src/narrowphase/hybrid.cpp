@@ -68,6 +68,17 @@ constexpr double kMaxUnscaled = 0x1p64;
 // 1.00002 (DistanceRegression.TinyBodyTouchingHugeOneHasUnitNormal).
 constexpr double kSquaresLoseDigits = 0x1p-960;
 
+// The distance and the normal of a result whose squared distance lost
+// digits (kSquaresLoseDigits), from its points. Out of line: off the
+// tracked queries' path.
+[[gnu::noinline]] void tiny_distance_from_points(DistanceResult& result) {
+  const detail::LengthAndDirection v = detail::length_and_direction(result.point_b - result.point_a);
+  if (!(v.length > 0.0)) return;
+  result.distance = v.length;
+  result.lower_bound = std::min(result.lower_bound, v.length);
+  result.normal = v.direction;
+}
+
 // A cache whose pose is further than this share of the bodies' size from
 // the query's is taken for stale (see moved_far).
 constexpr double kStaleMotion = 0.5;
@@ -508,20 +519,15 @@ template <bool kScaled, bool kMargin = false>
     if (!improved) break;  // the pair is optimal at machine precision
   }
 
-  double d = std::sqrt(loc.distance_squared);
-  result.normal = d > 0.0 ? Vec3((loc.point_b - loc.point_a) / d) : last_direction;
-  if (loc.distance_squared < kSquaresLoseDigits) [[unlikely]] {
-    const detail::LengthAndDirection v = detail::length_and_direction(loc.point_b - loc.point_a);
-    if (v.length > 0.0) {
-      d = v.length;
-      result.normal = v.direction;
-    }
-  }
+  const double d = std::sqrt(loc.distance_squared);
   result.iterations = iterations;
   result.point_a = loc.point_a;
   result.point_b = loc.point_b;
   result.distance = d;
   result.lower_bound = std::min(std::max(lower, 0.0), d);
+  result.normal = d > 0.0 ? Vec3((loc.point_b - loc.point_a) / d) : last_direction;
+  if (loc.distance_squared < kSquaresLoseDigits) [[unlikely]]
+    tiny_distance_from_points(result);
   if (contact) {
     // In contact at machine precision. Whether the bodies only touch or
     // overlap is decided by the contact unit (hybrid_distance, contact.h).
