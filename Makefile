@@ -15,6 +15,10 @@ release: setup
 	cmake --preset release >/dev/null
 	cmake --build --preset release -j $(JOBS)
 
+# The sanitizer build checks proxima's own code: the tests that link the peers
+# (FCL, Bullet: PROXIMA_PEER_TESTS) and the three longest random sweeps (the
+# asan test preset's exclude filter; 50 s each under ASan) run in the release
+# build only, which keeps `make test` inside its 20 minutes on 2 cores.
 # The sanitizer build compiles at -O1 with line tables only (-g1): enough for
 # ASan's stack traces, and 40% less compile time than -O2 -g (measured on
 # tests/narrowphase/gjk_test.cpp), which keeps `make test` inside its budget on 2 cores.

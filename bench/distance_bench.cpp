@@ -186,6 +186,23 @@ const std::vector<Pose>& random_poses() {
 }
 
 void TrackingTranslation(benchmark::State& s, Algorithm alg) { run(s, alg, true, translations()); }
+// The same queries with poses checked once (RigidPose): what the rigid-pose
+// check of every query costs is the difference with TrackingTranslation.
+void TrackingTranslationRigid(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const ConvexPolytope a(sphere_points(n, 1));
+  const ConvexPolytope b(sphere_points(n, 2));
+  std::vector<RigidPose> poses;
+  for (const Pose& p : translations()) poses.emplace_back(p);
+  const RigidPose identity;
+  DistanceCache cache;
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const DistanceResult r = distance(a, identity, b, poses[i], {}, &cache);
+    benchmark::DoNotOptimize(r.distance);
+    if (++i == poses.size()) i = 0;
+  }
+}
 void NoTrackingTranslation(benchmark::State& s, Algorithm alg) {
   run(s, alg, false, translations());
 }
@@ -202,6 +219,7 @@ void WarmRandom(benchmark::State& s, Algorithm alg) { run(s, alg, true, random_p
   BENCHMARK_CAPTURE(fn, enhanced_gjk, Algorithm::enhanced_gjk)->RangeMultiplier(8)->Range(8, 4096)
 
 PROXIMA_DISTANCE_BENCH(TrackingTranslation);
+BENCHMARK(TrackingTranslationRigid)->Name("TrackingTranslationRigid/hybrid")->RangeMultiplier(8)->Range(8, 4096);
 PROXIMA_DISTANCE_BENCH(NoTrackingTranslation);
 PROXIMA_DISTANCE_BENCH(TrackingRotation);
 PROXIMA_DISTANCE_BENCH(Cold);

@@ -1,8 +1,11 @@
 // Robots from their URDF (proxima/robot/): time per configuration of
 // robot_distances on the Panda (self pairs plus a table and a shelf) along a
 // smooth trajectory and on random configurations, hulls and meshes, tracked
-// and cold, distance only and with gradients; Talos self-collision; and a
-// batch of 10^4 random configurations on 1 and 2 threads. Each figure is
+// and cold, distance only and with gradients, beside FCL on the same pairs
+// at the poses of the same forward kinematics (robot_fcl.h), with both
+// systems' largest difference from an exact referee and their wrong
+// collision verdicts; Talos self-collision; and a batch of 10^4 random
+// configurations on 1 and 2 threads. Each figure is
 // the median of 5 runs, the runs of the variants alternated. Single-thread
 // figures are the thread's CPU time (on a shared machine, wall time counts
 // the other processes' turns too); the batch's are wall time, which is what
@@ -24,6 +27,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "robot_fcl.h"
 
 #ifndef PROXIMA_SOURCE_DIR
 #define PROXIMA_SOURCE_DIR "."
@@ -84,6 +89,12 @@ double cpu_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 double wall_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -94,6 +105,10 @@ struct Variant {
   double per_pass = 1;        // configurations per pass
   std::vector<double> seconds;
   bool wall = false;  // wall time (threads) instead of the thread's CPU time
+  // With wall: the CPU time of all the process's threads, which says
+  // whether the threads share the work without overhead when the machine
+  // has no second core free to run them at once.
+  std::vector<double> process_seconds{};
 };
 
 // Runs every variant 5 times, alternated, and prints each median in us per
@@ -103,12 +118,19 @@ void run_alternated(std::vector<Variant>& variants) {
   for (int repeat = 0; repeat < 5; ++repeat) {
     for (Variant& v : variants) {
       const double start = v.wall ? wall_seconds() : cpu_seconds();
+      const double process_start = process_cpu_seconds();
       v.run();
       v.seconds.push_back((v.wall ? wall_seconds() : cpu_seconds()) - start);
+      v.process_seconds.push_back(process_cpu_seconds() - process_start);
     }
   }
   for (const Variant& v : variants) {
-    std::printf("  %-58s %9.2f us/config\n", v.name.c_str(), 1e6 * median(v.seconds) / v.per_pass);
+    std::printf("  %-58s %9.2f us/config", v.name.c_str(), 1e6 * median(v.seconds) / v.per_pass);
+    if (v.wall) {
+      std::printf("  (CPU of all threads %.2f us/config)",
+                  1e6 * median(v.process_seconds) / v.per_pass);
+    }
+    std::printf("\n");
   }
 }
 
@@ -146,11 +168,60 @@ std::function<void()> pass(const Robot& robot, const Configs& configs,
   };
 }
 
+// A pass of FCL over `configs` (robot_fcl.h: every pair, signed).
+std::function<void()> fcl_pass(proxima::bench::FclRobot& fcl, const Configs& configs,
+                               double* sink) {
+  return [&fcl, &configs, sink] {
+    for (const std::vector<double>& q : configs) *sink += fcl.distance(q).min_signed_distance;
+  };
+}
+
+// Each system's answers on `configs` against the referee's (robot_fcl.h):
+// the largest difference of the smallest signed distance, over the
+// configurations the referee finds collision-free and over the others, and
+// the configurations whose collision verdict differs from the referee's.
+// proxima's is robot_distances tracked along `configs`; its verdict is its
+// closest pair's status, FCL's a signed distance <= 0.
+void compare_with_referee(const char* name, const Robot& robot, const Configs& configs,
+                          const std::vector<proxima::Obstacle>& obstacles,
+                          proxima::bench::FclRobot& fcl) {
+  struct Errors {
+    double free = 0, colliding = 0;
+    int wrong = 0;
+  };
+  Errors ours, theirs;
+  int colliding = 0;
+  proxima::RobotQueryState state;
+  proxima::RobotQueryOptions options;
+  options.margin = 0.05;
+  for (const std::vector<double>& q : configs) {
+    const proxima::bench::RobotMinimum referee = proxima::bench::referee_minimum(robot, q, obstacles);
+    const proxima::RobotDistances r = proxima::robot_distances(robot, q, obstacles, options, &state);
+    const proxima::bench::RobotMinimum f = fcl.distance(q);
+    colliding += referee.colliding ? 1 : 0;
+    const auto add = [&](Errors& e, double value, bool verdict) {
+      double& worst = referee.colliding ? e.colliding : e.free;
+      worst = std::max(worst, std::abs(value - referee.min_signed_distance));
+      e.wrong += verdict != referee.colliding ? 1 : 0;
+    };
+    add(ours, r.min_signed_distance, r.closest.result.status != proxima::Status::separated);
+    add(theirs, f.min_signed_distance, f.colliding);
+  }
+  std::printf("  %s: %zu configurations, %d in collision (referee: cold distance() on every pair)\n",
+              name, configs.size(), colliding);
+  std::printf("    %-34s %14s %14s %8s\n", "largest |min - referee| (m)", "collision-free",
+              "in collision", "wrong");
+  std::printf("    %-34s %14.3g %14.3g %8d\n", "proxima robot_distances, tracked", ours.free,
+              ours.colliding, ours.wrong);
+  std::printf("    %-34s %14.3g %14.3g %8d\n", "FCL distance (signed, libccd)", theirs.free,
+              theirs.colliding, theirs.wrong);
+}
+
 void print_stats(const std::vector<Variant>& variants, const std::vector<PassStats>& stats) {
   std::printf(
       "  (last run of each: pairs queried per configuration; us per collision-free / "
       "colliding configuration)\n");
-  for (std::size_t i = 0; i < variants.size(); ++i) {
+  for (std::size_t i = 0; i < stats.size(); ++i) {  // the variants that keep stats come first
     const PassStats& s = stats[i];
     std::printf("  %-58s %6.1f pairs  free %8.2f us (%4.0f)  colliding %8.2f us (%4.0f)\n",
                 variants[i].name.c_str(), s.queried, 1e6 * s.free_seconds / std::max(1.0, s.free),
@@ -196,7 +267,11 @@ int main(int argc, char** argv) {
   proxima::RobotQueryOptions with_gradients = distance_only;
   with_gradients.gradients = true;
   double sink = 0;
-  std::vector<PassStats> queried(8);
+  proxima::RobotQueryOptions minimum_only;
+  minimum_only.minimum_only = true;
+  proxima::RobotQueryOptions minimum_gradients = minimum_only;
+  minimum_gradients.gradients = true;
+  std::vector<PassStats> queried(10);  // the proxima variants, in the order below
   const Configs mesh_path(path.begin(), path.begin() + 200);
   std::vector<Variant> panda_variants = {
       {"hulls, trajectory, tracked, distance only",
@@ -232,8 +307,35 @@ int main(int argc, char** argv) {
        200.0,
        {}},
   };
+  panda_variants.push_back({"hulls, trajectory, tracked, minimum only",
+                            pass(panda, path, obstacles, minimum_only, true, &sink, &queried[8]),
+                            2000.0, {}});
+  panda_variants.push_back(
+      {"hulls, trajectory, tracked, minimum only, with its gradient",
+       pass(panda, path, obstacles, minimum_gradients, true, &sink, &queried[9]), 2000.0, {}});
+  proxima::bench::FclRobot fcl_hulls(panda, obstacles), fcl_meshes(panda_meshes, obstacles);
+  panda_variants.push_back({"FCL, hulls (fcl::Convex), trajectory, every pair",
+                            fcl_pass(fcl_hulls, path, &sink), 2000.0, {}});
+  panda_variants.push_back({"FCL, hulls (fcl::Convex), random, every pair",
+                            fcl_pass(fcl_hulls, random, &sink), 2000.0, {}});
+  panda_variants.push_back({"FCL, meshes (BVHModel<OBBRSS>), trajectory (first 200)",
+                            fcl_pass(fcl_meshes, mesh_path, &sink), 200.0, {}});
   run_alternated(panda_variants);
   print_stats(panda_variants, queried);
+  const auto ratio = [&](std::size_t fcl, std::size_t ours) {
+    return median(panda_variants[fcl].seconds) / panda_variants[fcl].per_pass /
+           (median(panda_variants[ours].seconds) / panda_variants[ours].per_pass);
+  };
+  std::printf(
+      "  FCL's time over proxima's (tracked, distance only): hulls trajectory %.1fx, hulls random "
+      "%.1fx, meshes trajectory %.1fx\n",
+      ratio(10, 0), ratio(11, 3), ratio(12, 6));
+  std::printf("  FCL's time over proxima's minimum only (hulls trajectory): %.1fx\n", ratio(10, 8));
+  std::printf("Panda against the exact referee:\n");
+  compare_with_referee("hulls, trajectory", panda, path, obstacles, fcl_hulls);
+  compare_with_referee("hulls, random", panda, random, obstacles, fcl_hulls);
+  compare_with_referee("meshes, trajectory (first 200)", panda_meshes, mesh_path, obstacles,
+                       fcl_meshes);
 
   const Robot talos = proxima::load_robot(robots + "/robots/talos_data/robots/talos_full_v2.urdf",
                                           robots + "/robots/talos_data/srdf/talos.srdf", options);
@@ -242,7 +344,9 @@ int main(int argc, char** argv) {
   std::printf("Talos: %d variables, %zu geometries, %zu enabled self pairs\n", talos.dof(),
               talos.geometries().size(), talos.self_pairs().size());
   proxima::RobotQueryOptions talos_options;
-  std::vector<PassStats> talos_queried(3);
+  proxima::RobotQueryOptions talos_minimum;
+  talos_minimum.minimum_only = true;
+  std::vector<PassStats> talos_queried(4);
   std::vector<Variant> talos_variants = {
       {"hulls, self, trajectory, tracked",
        pass(talos, talos_path, {}, talos_options, true, &sink, &talos_queried[0]),
@@ -254,6 +358,10 @@ int main(int argc, char** argv) {
        {}},
       {"hulls, self, random, tracked",
        pass(talos, talos_random, {}, talos_options, true, &sink, &talos_queried[2]),
+       2000.0,
+       {}},
+      {"hulls, self, trajectory, tracked, minimum only",
+       pass(talos, talos_path, {}, talos_minimum, true, &sink, &talos_queried[3]),
        2000.0,
        {}},
   };

@@ -14,7 +14,9 @@
 // poses, warm cache), cold_random (the same poses, cold every query: the
 // figure a warm cache must not exceed by more than 10%, issue 14), cold
 // (the same poses without a cache, as the paper's cold experiment calls
-// distance()). The poses are those of bench/distance_bench.cpp.
+// distance()). The poses are those of bench/distance_bench.cpp. A third
+// argument `rigid` gives the queries poses checked once (RigidPose), so that
+// the rigid-pose check of every query is not counted.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -46,11 +48,11 @@ constexpr int kSteps = 10000;
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
+  if (argc != 3 && !(argc == 4 && std::strcmp(argv[3], "rigid") == 0)) {
     std::fprintf(
         stderr,
         "usage: tracked_instructions translation|rotation|fast_rotation|random|cold_random|cold "
-        "N\n");
+        "N [rigid]\n");
     return 2;
   }
   const char* mode = argv[1];
@@ -82,10 +84,19 @@ int main(int argc, char** argv) {
   double sum = 0.0;
   const bool cold = std::strcmp(mode, "cold_random") == 0;
   const bool no_cache = std::strcmp(mode, "cold") == 0;
-  for (const Pose& pose : poses) {
-    if (cold) cache.reset();
-    sum +=
-        proxima::distance(a, Pose::identity(), b, pose, {}, no_cache ? nullptr : &cache).distance;
+  if (argc == 4) {
+    std::vector<proxima::RigidPose> rigid(poses.begin(), poses.end());
+    const proxima::RigidPose identity;
+    for (const proxima::RigidPose& pose : rigid) {
+      if (cold) cache.reset();
+      sum += proxima::distance(a, identity, b, pose, {}, no_cache ? nullptr : &cache).distance;
+    }
+  } else {
+    for (const Pose& pose : poses) {
+      if (cold) cache.reset();
+      sum += proxima::distance(a, Pose::identity(), b, pose, {}, no_cache ? nullptr : &cache)
+                 .distance;
+    }
   }
   std::printf("queries %d, mode %s, N %d, mean distance %.6f\n", kSteps, mode, n, sum / kSteps);
   return 0;

@@ -31,6 +31,7 @@
 #include "proxima/core/types.h"
 #include "query.h"
 #include "robot.h"
+#include "robot_srdf.h"
 #include "tools.h"
 #include "view.h"
 
@@ -53,13 +54,14 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
 }
 
 int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads,
-                      std::optional<proxima::QuaternionOrder> order) {
+                      std::optional<proxima::QuaternionOrder> order, std::uint64_t max_line_bytes) {
   // Answers go through std::cout only; untying it from C stdio lets it
   // buffer a whole answer line before the explicit flush.
   std::ios::sync_with_stdio(false);
   proxima::cli::QueryRunSummary summary;
   if (file == "-") {
-    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads, order);
+    summary = proxima::cli::run_queries(std::cin, std::cout, options, threads, order,
+                                           max_line_bytes);
   } else {
     // An ifstream opens a directory without complaint and then reads
     // nothing; that would look like an empty, successful run.
@@ -73,7 +75,12 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
       std::cerr << "proxima query: cannot open '" << file << "': " << std::strerror(errno) << "\n";
       return kExitFailure;
     }
-    summary = proxima::cli::run_queries(in, std::cout, options, threads, order);
+    summary = proxima::cli::run_queries(in, std::cout, options, threads, order, max_line_bytes);
+  }
+  if (summary.too_long_line != 0) {
+    std::cerr << "proxima query: "
+              << proxima::cli::too_long_message(summary.too_long_line, max_line_bytes) << "\n";
+    return kExitFailure;
   }
   if (summary.read_failed) {
     std::cerr << "proxima query: reading the input failed after " << summary.answered
@@ -145,6 +152,13 @@ int main(int argc, char** argv) {
                    "(scalar last, as ROS and scipy write them). Without it a rotation must name "
                    "its order: {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, z, w]}")
       ->check(CLI::IsMember(orders));
+  std::uint64_t max_line_bytes = proxima::cli::kDefaultMaxLineBytes;
+  query
+      ->add_option("--max-line-size", max_line_bytes,
+                   "Refuse a query line longer than this many bytes (its error answer is the "
+                   "last: reading stops there)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   query
       ->add_option("--threads", threads,
                    "Threads answering blocks of queries; answers stay in input order")
@@ -292,11 +306,20 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   robot->add_flag("--gradients", robot_command.gradients,
                   "Answer each pair's gradient with respect to the joint vector");
+  robot->add_option("--environment", robot_command.environment,
+                    "JSON Lines of obstacles, one body per line as a query's (\"vertices\", "
+                    "\"triangles\", \"radius\", \"pose\") with an optional \"name\"");
+  robot->add_option("--view", robot_command.view_out,
+                    "Write a viewer page of the last configuration (close pairs drawn, excluded "
+                    "pairs never shown as collisions)");
   robot->footer(
       "Example:\n"
       "  echo '{\"id\":1,\"q\":[0,-0.78,0,-2.36,0,1.57,0.78,0.01]}' |\n"
       "    proxima robot --urdf panda.urdf --srdf panda.srdf --package-dir NAME=DIR --gradients\n"
       "Each line: {\"id\": any, \"q\": [numbers] or {\"joint name\": number, ...}}.");
+
+  proxima::cli::RobotSrdfCommand robot_srdf_command;
+  CLI::App* robot_srdf = proxima::cli::add_robot_srdf(app, robot_srdf_command);
 
   try {
     app.parse(argc, argv);
@@ -310,7 +333,7 @@ int main(int argc, char** argv) {
     if (*demo) return proxima::cli::run_demo();
     if (*query) {
       options.algorithm = parse_algorithm(algorithm);
-      return run_query_command(file, options, threads, parse_order(query_order));
+      return run_query_command(file, options, threads, parse_order(query_order), max_line_bytes);
     }
     if (*distance) {
       distance_command.options.algorithm = parse_algorithm(distance_algorithm);
@@ -332,6 +355,9 @@ int main(int argc, char** argv) {
         return kExitFailure;
       }
       return proxima::cli::run_robot(robot_command, in, std::cout, std::cerr);
+    }
+    if (*robot_srdf) {
+      return proxima::cli::run_robot_srdf(robot_srdf_command, std::cout, std::cerr);
     }
     if (*view) {
       // Exactly one input: two files, a query file or a scene file.

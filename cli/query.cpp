@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "answer_writer.h"
+#include "line_reader.h"
 #include "json_errors.h"
 #include "proxima/motion/time_of_impact.h"
 #include "proxima/query/body_distance.h"
@@ -313,161 +314,82 @@ ConvexPolytope build_hull(const std::vector<Vec3>& vertices, const std::string& 
   }
 }
 
-// Appends the answer to one query line to `out`; returns false for an error
-// answer.
-bool answer_line(const std::string& line, long line_number, const DistanceOptions& options,
-                 std::optional<QuaternionOrder> order, Workspace& work, std::string& out) {
-  if (const std::size_t column = nesting_overflow_column(line); column != 0) {
-    append_error_answer(out, nullptr, line_number,
-                        "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
-                            " levels (at column " + std::to_string(column) + ")");
-    return false;
+// The margin answer of one line (the "margin" field).
+void append_margin_answer(std::string& out, const Json* id, const MarginResult& m,
+                          bool with_triangles) {
+  if (!std::isfinite(m.lower_bound) || !m.point_a.allFinite() || !m.point_b.allFinite())
+    fail("the result is not finite: the coordinates are too large for double arithmetic");
+  out += "{\"id\":";
+  append_id(out, id);
+  out += ",\"within\":";
+  out += m.is_within() ? "true" : "false";
+  out += ",\"status\":\"";
+  out += to_string(m.status);
+  out += "\",\"margin\":";
+  append_number(out, m.margin);
+  out += ",\"lower_bound\":";
+  append_number(out, m.lower_bound);
+  out += ",\"upper_bound\":";
+  if (std::isfinite(m.upper_bound)) {
+    append_number(out, m.upper_bound);
+    out += ",\"point_a\":";
+    append_point(out, m.point_a);
+    out += ",\"point_b\":";
+    append_point(out, m.point_b);
+  } else {
+    out += "null";
   }
-  Json query;
-  try {
-    query = Json::parse(line);
-  } catch (const Json::exception& e) {
-    append_error_answer(out, nullptr, line_number, describe_parse_error(line, e));
-    return false;
+  if (with_triangles) {
+    out += ",\"triangle_a\":" + std::to_string(m.triangle_a);
+    out += ",\"triangle_b\":" + std::to_string(m.triangle_b);
   }
-  if (!query.is_object()) {
-    append_error_answer(out, nullptr, line_number,
-                        "the line is not a JSON object (it is " + kind(query) + ")");
-    return false;
-  }
-  const auto id_it = query.find("id");
-  const Json* id = id_it != query.end() ? &*id_it : nullptr;
+  out += '}';
+}
 
-  DistanceResult r;
-  std::optional<BodyResult> mesh_answer;  // a query with a mesh body
-  bool capped = false;
-  try {
-    Pose pose_a;
-    Pose pose_b;
-    double radius_a = 0.0;
-    double radius_b = 0.0;
-    std::optional<Motion> motion_a;
-    std::optional<Motion> motion_b;
-    read_body(query, "a", order, work.vertices_a, work.triangles_a, pose_a, radius_a, motion_a);
-    read_body(query, "b", order, work.vertices_b, work.triangles_b, pose_b, radius_b, motion_b);
-    const auto margin_it = query.find("margin");
-    if (margin_it != query.end() && !margin_it->is_null()) {
-      // The margin (or, at 0, boolean) query: its own answer line.
-      const double margin = read_nonnegative(query, "margin", 0.0);
-      if (motion_a || motion_b) {
-        fail("margin asks for the margin answer at one pose; a body with a motion asks for a "
-             "time of impact (use target_separation there)");
-      }
-      const MarginResult m =
-          within_margin(query_body(work.vertices_a, work.triangles_a, radius_a, "a"), pose_a,
-                        query_body(work.vertices_b, work.triangles_b, radius_b, "b"), pose_b,
-                        margin, options, nullptr);
-      if (!std::isfinite(m.lower_bound) || !m.point_a.allFinite() || !m.point_b.allFinite())
-        fail("the result is not finite: the coordinates are too large for double arithmetic");
-      out += "{\"id\":";
-      append_id(out, id);
-      out += ",\"within\":";
-      out += m.is_within() ? "true" : "false";
-      out += ",\"status\":\"";
-      out += to_string(m.status);
-      out += "\",\"margin\":";
-      append_number(out, m.margin);
-      out += ",\"lower_bound\":";
-      append_number(out, m.lower_bound);
-      out += ",\"upper_bound\":";
-      if (std::isfinite(m.upper_bound)) {
-        append_number(out, m.upper_bound);
-        out += ",\"point_a\":";
-        append_point(out, m.point_a);
-        out += ",\"point_b\":";
-        append_point(out, m.point_b);
-      } else {
-        out += "null";
-      }
-      if (!work.triangles_a.empty() || !work.triangles_b.empty()) {
-        out += ",\"triangle_a\":" + std::to_string(m.triangle_a);
-        out += ",\"triangle_b\":" + std::to_string(m.triangle_b);
-      }
-      out += '}';
-      return true;
-    }
-    if ((!work.triangles_a.empty() || !work.triangles_b.empty()) && !motion_a && !motion_b) {
-      // A mesh on either side: the one call for any two bodies.
-      const BodyResult m = distance(
-          query_body(work.vertices_a, work.triangles_a, radius_a, "a"), pose_a,
-          query_body(work.vertices_b, work.triangles_b, radius_b, "b"), pose_b, options, nullptr);
-      mesh_answer = m;
-      r = m;
-    } else {
-      if (motion_a || motion_b) {
-        // A time-of-impact query: its own answer line.
-        ImpactOptions impact;
-        impact.distance = options;
-        impact.target_separation = read_nonnegative(query, "target_separation", 0.0);
-        impact.tolerance = read_nonnegative(query, "tolerance", 0.0);
-        const ImpactResult hit =
-            time_of_impact(query_body(work.vertices_a, work.triangles_a, radius_a, "a"),
-                           motion_a.value_or(Motion::fixed(pose_a)),
-                           query_body(work.vertices_b, work.triangles_b, radius_b, "b"),
-                           motion_b.value_or(Motion::fixed(pose_b)), impact);
-        const DistanceResult& at = hit.at_t;
-        if (!std::isfinite(at.distance) || !std::isfinite(at.signed_distance()) ||
-            !at.point_a.allFinite() || !at.point_b.allFinite()) {
-          fail("the result is not finite: the coordinates are too large for double arithmetic");
-        }
-        out += "{\"id\":";
-        append_id(out, id);
-        out += ",\"status\":\"";
-        out += to_string(hit.status);
-        out += "\",\"t\":";
-        append_number(out, hit.t);
-        out += ",\"distance\":";
-        append_number(out, at.distance);
-        out += ",\"signed_distance\":";
-        append_number(out, at.signed_distance());
-        out += ",\"point_a\":";
-        append_point(out, at.point_a);
-        out += ",\"point_b\":";
-        append_point(out, at.point_b);
-        out += ",\"normal\":";
-        append_point(out, at.normal);
-        out += ",\"pose_a\":";
-        append_pose(out, hit.pose_a, order);
-        out += ",\"pose_b\":";
-        append_pose(out, hit.pose_b, order);
-        out += ",\"iterations\":";
-        out += std::to_string(hit.iterations);
-        out += '}';
-        return true;
-      }
-      const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
-      const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
-      if (radius_a > 0.0 || radius_b > 0.0) {
-        // Rounded bodies: the cores' answer offset by the radii, points on
-        // the rounded surfaces.
-        r = distance(Body(a, radius_a), pose_a, Body(b, radius_b), pose_b, options, nullptr);
-      } else {
-        r = distance(*a, pose_a, *b, pose_b, options, nullptr);
-      }
-      capped = r.status == Status::iteration_cap;
-    }
-  } catch (const QueryError& e) {
-    append_error_answer(out, id, line_number, e.what());
-    return false;
-  } catch (const InvalidInput& e) {
-    append_error_answer(out, id, line_number, e.what());
-    return false;
-  } catch (const std::exception& e) {
-    append_error_answer(out, id, line_number, std::string("internal error: ") + e.what());
-    return false;
+// The time-of-impact answer of one line (a body with a motion).
+void append_impact_answer(std::string& out, const Json* id, const ImpactResult& hit,
+                          std::optional<QuaternionOrder> order) {
+  const DistanceResult& at = hit.at_t;
+  if (!std::isfinite(at.distance) || !std::isfinite(at.signed_distance()) ||
+      !at.point_a.allFinite() || !at.point_b.allFinite()) {
+    fail("the result is not finite: the coordinates are too large for double arithmetic");
   }
+  out += "{\"id\":";
+  append_id(out, id);
+  out += ",\"status\":\"";
+  out += to_string(hit.status);
+  out += "\",\"t\":";
+  append_number(out, hit.t);
+  out += ",\"distance\":";
+  append_number(out, at.distance);
+  out += ",\"signed_distance\":";
+  append_number(out, at.signed_distance());
+  out += ",\"point_a\":";
+  append_point(out, at.point_a);
+  out += ",\"point_b\":";
+  append_point(out, at.point_b);
+  out += ",\"normal\":";
+  append_point(out, at.normal);
+  out += ",\"pose_a\":";
+  append_pose(out, hit.pose_a, order);
+  out += ",\"pose_b\":";
+  append_pose(out, hit.pose_b, order);
+  out += ",\"iterations\":";
+  out += std::to_string(hit.iterations);
+  out += '}';
+}
 
+// The distance answer of one line. `mesh_answer`: the answer of a query
+// with a mesh body (its closest triangles are reported), else null.
+// Returns false (and appends an error answer) when a number is not finite.
+bool append_distance_answer(std::string& out, const Json* id, long line_number,
+                            const DistanceResult& r, const BodyResult* mesh_answer) {
   // A JSON line can carry no NaN or infinity. Finite inputs whose products
   // overflow (coordinates near 1e308) are the only way to get one; say so
   // rather than print an invalid line.
   // An overlap with a mesh has no depth: its signed lower bound is
   // -infinity, written as null.
-  const bool no_depth = mesh_answer && mesh_answer->intersecting;
+  const bool no_depth = mesh_answer != nullptr && mesh_answer->intersecting;
   if (!std::isfinite(r.distance) || !std::isfinite(r.signed_distance()) ||
       (!std::isfinite(r.signed_lower_bound()) && !no_depth) ||
       !std::isfinite(r.signed_upper_bound()) || !r.point_a.allFinite() || !r.point_b.allFinite() ||
@@ -481,12 +403,10 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   // A capped answer says so in its status: its distance is an upper bound
   // only, and calling it separated or touching from that bound would claim
   // what the algorithm did not certify.
-  const char* status = to_string(r.status);
-
   out += "{\"id\":";
   append_id(out, id);
   out += ",\"status\":\"";
-  out += status;
+  out += to_string(r.status);
   out += "\",\"distance\":";
   append_number(out, r.distance);
   out += ",\"signed_distance\":";
@@ -507,14 +427,128 @@ bool answer_line(const std::string& line, long line_number, const DistanceOption
   append_point(out, r.normal);
   out += ",\"iterations\":";
   out += std::to_string(r.iterations);
-  if (mesh_answer) {
+  if (mesh_answer != nullptr) {
     // The closest triangles of mesh bodies (-1 for a hull).
     out += ",\"triangle_a\":" + std::to_string(mesh_answer->triangle_a);
     out += ",\"triangle_b\":" + std::to_string(mesh_answer->triangle_b);
   }
-  if (capped) out += ",\"iteration_cap\":true";
+  if (r.status == Status::iteration_cap) out += ",\"iteration_cap\":true";
   out += '}';
   return true;
+}
+
+// The line as a JSON object, or an error answer (id null: it cannot be
+// read) and nullopt.
+std::optional<Json> parse_query_line(const std::string& line, long line_number,
+                                     std::string& out) {
+  if (const std::size_t column = nesting_overflow_column(line); column != 0) {
+    append_error_answer(out, nullptr, line_number,
+                        "the JSON is nested deeper than " + std::to_string(kMaxJsonDepth) +
+                            " levels (at column " + std::to_string(column) + ")");
+    return std::nullopt;
+  }
+  Json query;
+  try {
+    query = Json::parse(line);
+  } catch (const Json::exception& e) {
+    append_error_answer(out, nullptr, line_number, describe_parse_error(line, e));
+    return std::nullopt;
+  }
+  if (!query.is_object()) {
+    append_error_answer(out, nullptr, line_number,
+                        "the line is not a JSON object (it is " + kind(query) + ")");
+    return std::nullopt;
+  }
+  return query;
+}
+
+// Appends the answer to one query line to `out`; returns false for an error
+// answer. The line asks for a margin answer ("margin"), a time of impact (a
+// body with a motion) or the distance.
+bool answer_line(const std::string& line, long line_number, const DistanceOptions& options,
+                 std::optional<QuaternionOrder> order, Workspace& work, std::string& out) {
+  const std::optional<Json> parsed = parse_query_line(line, line_number, out);
+  if (!parsed) return false;
+  const Json& query = *parsed;
+  const auto id_it = query.find("id");
+  const Json* id = id_it != query.end() ? &*id_it : nullptr;
+
+  // Everything the answer may need to write goes to `answer` first, so
+  // that an error part way leaves only the error answer.
+  std::string answer;
+  DistanceResult r;
+  std::optional<BodyResult> mesh_answer;  // a query with a mesh body
+  try {
+    Pose pose_a;
+    Pose pose_b;
+    double radius_a = 0.0;
+    double radius_b = 0.0;
+    std::optional<Motion> motion_a;
+    std::optional<Motion> motion_b;
+    read_body(query, "a", order, work.vertices_a, work.triangles_a, pose_a, radius_a, motion_a);
+    read_body(query, "b", order, work.vertices_b, work.triangles_b, pose_b, radius_b, motion_b);
+    const bool meshes = !work.triangles_a.empty() || !work.triangles_b.empty();
+    const auto body = [&](const char* name) {
+      const bool a = name[0] == 'a';
+      return query_body(a ? work.vertices_a : work.vertices_b,
+                        a ? work.triangles_a : work.triangles_b, a ? radius_a : radius_b, name);
+    };
+    const auto margin_it = query.find("margin");
+    if (margin_it != query.end() && !margin_it->is_null()) {
+      // The margin (or, at 0, boolean) query: its own answer line.
+      const double margin = read_nonnegative(query, "margin", 0.0);
+      if (motion_a || motion_b) {
+        fail("margin asks for the margin answer at one pose; a body with a motion asks for a "
+             "time of impact (use target_separation there)");
+      }
+      append_margin_answer(answer, id,
+                           within_margin(body("a"), pose_a, body("b"), pose_b, margin, options,
+                                         nullptr),
+                           meshes);
+      out += answer;
+      return true;
+    }
+    if (motion_a || motion_b) {
+      // A time-of-impact query: its own answer line.
+      ImpactOptions impact;
+      impact.distance = options;
+      impact.target_separation = read_nonnegative(query, "target_separation", 0.0);
+      impact.tolerance = read_nonnegative(query, "tolerance", 0.0);
+      append_impact_answer(answer, id,
+                           time_of_impact(body("a"), motion_a.value_or(Motion::fixed(pose_a)),
+                                          body("b"), motion_b.value_or(Motion::fixed(pose_b)),
+                                          impact),
+                           order);
+      out += answer;
+      return true;
+    }
+    if (meshes) {
+      // A mesh on either side: the one call for any two bodies.
+      mesh_answer = distance(body("a"), pose_a, body("b"), pose_b, options, nullptr);
+      r = *mesh_answer;
+    } else {
+      const auto a = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_a, "a"));
+      const auto b = std::make_shared<const ConvexPolytope>(build_hull(work.vertices_b, "b"));
+      if (radius_a > 0.0 || radius_b > 0.0) {
+        // Rounded bodies: the cores' answer offset by the radii, points on
+        // the rounded surfaces.
+        r = distance(Body(a, radius_a), pose_a, Body(b, radius_b), pose_b, options, nullptr);
+      } else {
+        r = distance(*a, pose_a, *b, pose_b, options, nullptr);
+      }
+    }
+  } catch (const QueryError& e) {
+    append_error_answer(out, id, line_number, e.what());
+    return false;
+  } catch (const InvalidInput& e) {
+    append_error_answer(out, id, line_number, e.what());
+    return false;
+  } catch (const std::exception& e) {
+    append_error_answer(out, id, line_number, std::string("internal error: ") + e.what());
+    return false;
+  }
+  return append_distance_answer(out, id, line_number, r,
+                                mesh_answer ? &*mesh_answer : nullptr);
 }
 
 }  // namespace
@@ -536,15 +570,36 @@ bool is_blank(std::string_view line) {
 }  // namespace
 
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads, std::optional<QuaternionOrder> order) {
+                            int threads, std::optional<QuaternionOrder> order,
+                            std::uint64_t max_line_bytes) {
   QueryRunSummary summary;
   std::string line;
   long line_number = 0;
+  // A line past the limit gets its error answer, and the run stops there
+  // (read_line: its rest cannot be skipped safely).
+  const auto refuse_long_line = [&] {
+    summary.too_long_line = line_number;
+    std::string answer;
+    append_error_answer(answer, nullptr, line_number,
+                        "longer than the limit of " + std::to_string(max_line_bytes) +
+                            " bytes (--max-line-size)");
+    answer += '\n';
+    out.write(answer.data(), static_cast<std::streamsize>(answer.size()));
+    out.flush();
+    ++summary.answered;
+    ++summary.errors;
+  };
   if (threads <= 1) {
     Workspace work;
     std::string answer;
-    while (std::getline(in, line)) {
+    for (;;) {
+      const LineRead read = read_line(in, line, max_line_bytes);
+      if (read == LineRead::end) break;
       ++line_number;
+      if (read == LineRead::too_long) {
+        refuse_long_line();
+        break;
+      }
       if (is_blank(line)) continue;
       answer.clear();
       if (!answer_line(line, line_number, options, order, work, answer)) ++summary.errors;
@@ -571,14 +626,21 @@ QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceO
   std::vector<Pending> block(block_size);
   std::vector<Workspace> work(static_cast<std::size_t>(threads));
   bool more = true;
+  bool too_long = false;
   while (more) {
     std::size_t count = 0;
     while (count < block_size) {
-      if (!std::getline(in, line)) {
+      const LineRead read = read_line(in, line, max_line_bytes);
+      if (read == LineRead::end) {
         more = false;
         break;
       }
       ++line_number;
+      if (read == LineRead::too_long) {
+        more = false;
+        too_long = true;
+        break;
+      }
       if (!is_blank(line)) {
         Pending& p = block[count++];
         p.line.swap(line);
@@ -626,6 +688,7 @@ QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceO
     }
     out.flush();
   }
+  if (too_long) refuse_long_line();
   summary.read_failed = in.bad();
   return summary;
 }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "json_errors.h"
+#include "line_reader.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/motion/time_of_impact.h"
 #include "proxima/core/types.h"
@@ -26,12 +27,15 @@ struct QueryRunSummary {
   long answered = 0;         // answer lines written, error answers included
   long errors = 0;           // of which status "error"
   bool read_failed = false;  // the input stream broke (not its end): answers may be missing
+  long too_long_line = 0;    // the line past max_line_bytes where reading stopped (0: none)
 };
 
 // Reads every line of `in`, answers each non-blank one on `out` and flushes
 // after each answer, so that a caller feeding queries through a pipe one at a
 // time gets each answer before it sends the next. A bad line yields an error
-// answer and the loop goes on; only the stream ending stops it.
+// answer and the loop goes on; only the stream ending stops it, or a line
+// longer than max_line_bytes (its error answer is the last: the rest of such
+// a line, /dev/zero's for one, cannot be skipped without reading it).
 //
 // With threads > 1 the lines are answered in blocks: up to kQueryBlockLines
 // lines that are already available (a block never waits for input that has
@@ -45,7 +49,8 @@ struct QueryRunSummary {
 // none are an error answer showing both readings.
 inline constexpr int kQueryBlockLines = 256;
 QueryRunSummary run_queries(std::istream& in, std::ostream& out, const DistanceOptions& options,
-                            int threads = 1, std::optional<QuaternionOrder> order = std::nullopt);
+                            int threads = 1, std::optional<QuaternionOrder> order = std::nullopt,
+                            std::uint64_t max_line_bytes = kDefaultMaxLineBytes);
 
 // One line's answer, as run_queries writes it (without the newline); the
 // error answer names line 1. `proxima view` answers the query it draws.

@@ -4,13 +4,20 @@
 // `proxima robot`: see robot.h.
 #include "robot.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <string>
+
+#include "line_reader.h"
 
 #include "json_errors.h"
 #include "proxima/robot/robot_distance.h"
 #include "proxima/robot/urdf.h"
+#include "query.h"
+#include "viewer.h"
 
 namespace proxima::cli {
 namespace {
@@ -68,14 +75,96 @@ std::vector<double> read_q(const Robot& robot, const Json& query) {
   fail("q is neither an array nor an object " + kind(*it));
 }
 
-Json pair_json(const Robot& robot, const RobotPairResult& pair, bool gradients) {
+// The obstacles of an environment file (RobotCommand::environment).
+// Throws QueryError naming the file and line.
+std::vector<Obstacle> read_environment(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail("cannot open the environment '" + path + "'");
+  std::vector<Obstacle> obstacles;
+  std::string line;
+  long number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::string where = path + ", line " + std::to_string(number);
+    try {
+      if (nesting_overflow_column(line) != 0) fail("the JSON is nested too deeply");
+      Json body;
+      try {
+        body = Json::parse(line);
+      } catch (const Json::exception& e) {
+        fail(describe_parse_error(line, e));
+      }
+      if (!body.is_object()) fail("the line is not a JSON object " + kind(body));
+      // A misspelt key ("pose" for "translation") would silently put the
+      // obstacle at the origin: only the body's own keys are read.
+      for (const auto& [key, value] : body.items()) {
+        static const std::array<const char*, 6> kKeys = {"name",     "vertices",    "triangles",
+                                                         "radius",   "translation", "rotation"};
+        if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) {
+          fail("unknown key \"" + key +
+               "\" (an obstacle has name, vertices, triangles, radius, translation, rotation)");
+        }
+      }
+      std::string name = "obstacle " + std::to_string(obstacles.size());
+      if (const auto it = body.find("name"); it != body.end()) {
+        if (!it->is_string()) fail("\"name\" is not a string " + kind(*it));
+        name = it->get<std::string>();
+        body.erase("name");
+      }
+      Json wrapped = Json::object();
+      wrapped["body"] = std::move(body);
+      std::vector<Vec3> vertices;
+      std::vector<std::array<std::int32_t, 3>> triangles;
+      Pose pose;
+      double radius = 0.0;
+      std::optional<Motion> motion;
+      read_body(wrapped, "body", std::nullopt, vertices, triangles, pose, radius, motion);
+      if (motion) fail("an obstacle has no motion");
+      obstacles.emplace_back(query_body(vertices, triangles, radius, "body"), pose, name);
+    } catch (const std::exception& e) {
+      fail(where + ": " + e.what());
+    }
+  }
+  if (in.bad()) fail("reading the environment '" + path + "' failed after line " +
+                     std::to_string(number));
+  return obstacles;
+}
+
+// The viewer page of one configuration: every geometry at its pose, the
+// obstacles after them, and the close pairs (only tested pairs: excluded
+// ones are never queried, so never drawn as collisions).
+std::string robot_page(const Robot& robot, std::span<const Pose> link_poses,
+                       std::span<const Obstacle> obstacles, const RobotDistances& r, double margin,
+                       const std::string& title) {
+  std::vector<viewer::ShownBody> bodies;
+  for (const RobotGeometry& g : robot.geometries()) {
+    bodies.push_back({g.name, g.body, link_poses[static_cast<std::size_t>(g.link)] * g.origin});
+  }
+  for (const Obstacle& o : obstacles) bodies.push_back({o.name, o.body, o.pose});
+  std::vector<viewer::ScenePair> pairs;
+  const int n_geometries = static_cast<int>(robot.geometries().size());
+  for (const RobotPairResult& p : r.close_pairs) {
+    viewer::ScenePair shown;
+    shown.a = p.geometry_a;
+    shown.b = p.environment ? n_geometries + p.geometry_b : p.geometry_b;
+    static_cast<DistanceResult&>(shown.result) = p.result;
+    shown.result.piece_a = p.result.piece_a;
+    shown.result.piece_b = p.result.piece_b;
+    pairs.push_back(shown);
+  }
+  return viewer::scene_page(bodies, pairs, margin, title);
+}
+
+Json pair_json(const Robot& robot, std::span<const Obstacle> obstacles,
+               const RobotPairResult& pair, bool gradients) {
   const auto& geometries = robot.geometries();
   const RobotGeometry& a = geometries[static_cast<std::size_t>(pair.geometry_a)];
   Json out;
   out["a"] = a.name;
   out["link_a"] = robot.links()[static_cast<std::size_t>(a.link)].name;
   if (pair.environment) {
-    out["b"] = "obstacle " + std::to_string(pair.geometry_b);
+    out["b"] = obstacles[static_cast<std::size_t>(pair.geometry_b)].name;
   } else {
     const RobotGeometry& b = geometries[static_cast<std::size_t>(pair.geometry_b)];
     out["b"] = b.name;
@@ -96,9 +185,11 @@ int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, 
   RobotLoadOptions load;
   load.package_dirs = command.package_dirs;
   std::optional<Robot> robot;
+  std::vector<Obstacle> obstacles;
   try {
     load.mesh_as = load_as_from_string(command.mesh_as);
     robot.emplace(load_robot(command.urdf, command.srdf, load));
+    if (!command.environment.empty()) obstacles = read_environment(command.environment);
   } catch (const std::exception& e) {
     err << "proxima robot: " << e.what() << "\n";
     return 1;
@@ -107,10 +198,20 @@ int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, 
   options.margin = command.margin;
   options.gradients = command.gradients;
   RobotQueryState state;
+  std::optional<RobotDistances> last_shown;
+  long shown_line = 0;
   std::string line;
   long line_number = 0;
-  while (std::getline(in, line)) {
+  for (;;) {
+    const LineRead read = read_line(in, line, kDefaultMaxLineBytes);
+    if (read == LineRead::end) break;
     ++line_number;
+    if (read == LineRead::too_long) {
+      // Its rest cannot be skipped safely (read_line): the run stops here.
+      out.flush();
+      err << "proxima robot: " << too_long_message(line_number, kDefaultMaxLineBytes) << "\n";
+      return 1;
+    }
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
     Json answer;
     try {
@@ -127,14 +228,18 @@ int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, 
       if (!query.is_object()) fail("the line is not a JSON object " + kind(query));
       if (const auto id = query.find("id"); id != query.end()) answer["id"] = *id;
       const std::vector<double> q = read_q(*robot, query);
-      const RobotDistances r = robot_distances(*robot, q, {}, options, &state);
+      const RobotDistances r = robot_distances(*robot, q, obstacles, options, &state);
+      if (!command.view_out.empty()) {
+        last_shown = r;
+        shown_line = line_number;
+      }
       answer["min_signed_distance"] = number_json(r.min_signed_distance);
       if (r.closest.geometry_a >= 0) {
-        answer["closest"] = pair_json(*robot, r.closest, command.gradients);
+        answer["closest"] = pair_json(*robot, obstacles, r.closest, command.gradients);
       }
       Json pairs = Json::array();
       for (const RobotPairResult& pair : r.close_pairs) {
-        pairs.push_back(pair_json(*robot, pair, command.gradients));
+        pairs.push_back(pair_json(*robot, obstacles, pair, command.gradients));
       }
       answer["pairs"] = std::move(pairs);
       if (command.gradients && r.closest.geometry_a >= 0) {
@@ -152,6 +257,24 @@ int run_robot(const RobotCommand& command, std::istream& in, std::ostream& out, 
   if (in.bad()) {
     err << "proxima robot: reading the input failed after line " << line_number << "\n";
     return 1;
+  }
+  if (!command.view_out.empty()) {
+    if (!last_shown) {
+      err << "proxima robot: no configuration was answered: no page for --view\n";
+      return 1;
+    }
+    try {
+      const std::string page =
+          robot_page(*robot, state.link_poses(), obstacles, *last_shown, command.margin,
+                     robot->name() + ": configuration of line " + std::to_string(shown_line));
+      std::ofstream file(command.view_out, std::ios::binary);
+      file << page;
+      file.close();
+      if (!file) throw std::runtime_error("cannot write '" + command.view_out + "'");
+    } catch (const std::exception& e) {
+      err << "proxima robot: --view: " << e.what() << "\n";
+      return 1;
+    }
   }
   return out ? 0 : 1;
 }

@@ -12,6 +12,10 @@
 // points, normal and gradient, and the minimum's gradient. The robot's
 // per-pair caches are kept from line to line (a trajectory is tracked). A
 // bad line gets {"id": ..., "error": "line N: ..."} and the run goes on.
+// With --environment the robot's geometries are also measured against the
+// obstacles of that file; with --view the last configuration is drawn as a
+// viewer page (proxima/viewer): only tested pairs are drawn, so adjacent
+// and SRDF-disabled links never show as collisions.
 #pragma once
 
 #include <iosfwd>
@@ -28,6 +32,14 @@ struct RobotCommand {
   double margin = 0.0;
   bool gradients = false;
   std::string file = "-";
+  // JSON Lines of environment bodies, one per line in the format of a
+  // query's body ("vertices", optional "triangles", "radius", "pose"; see
+  // docs/query-format.md) with an optional "name": the obstacles of every
+  // configuration. Empty: none.
+  std::string environment;
+  // A viewer page of the last configuration answered (the robot's
+  // geometries, the obstacles and the close pairs); empty: none.
+  std::string view_out;
 };
 
 // Exit code: 0 when the robot loaded and every line was read (bad lines

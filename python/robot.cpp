@@ -261,17 +261,19 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
       .def(
           "distances",
           [](PyRobot& r, py::handle q, double margin, bool gradients, bool self, bool environment,
-             py::handle base) {
-            return robot_distances(*r.robot, to_q(*r.robot, q), r.obstacles,
-                                   make_robot_options(margin, gradients, self, environment, base),
-                                   &r.state);
+             py::handle base, bool minimum_only) {
+            RobotQueryOptions options =
+                make_robot_options(margin, gradients, self, environment, base);
+            options.minimum_only = minimum_only;
+            return robot_distances(*r.robot, to_q(*r.robot, q), r.obstacles, options, &r.state);
           },
           py::arg("q"), py::arg("margin") = 0.0, py::arg("gradients") = false,
           py::arg("include_self") = true, py::arg("include_environment") = true,
-          py::arg("base") = py::none(),
+          py::arg("base") = py::none(), py::arg("minimum_only") = false,
           "Signed distances at q: the minimum over self and environment pairs, every pair within "
           "`margin`, and with gradients=True each one's gradient with respect to q (tracked "
-          "between calls).")
+          "between calls). minimum_only=True: only the minimum and its pair (close_pairs empty, "
+          "margin not read), fewer pairs queried.")
       .def(
           "distances_batch",
           [](const PyRobot& r, py::handle qs, bool gradients, int threads, bool self,

@@ -261,6 +261,7 @@ Robot::Robot(RobotDescription description)
     BoundingSphere sphere = bounding_sphere(geometry.body);
     sphere.center = geometry.origin.apply(sphere.center);
     geometry_spheres_.push_back(sphere);
+    geometry_boxes_.push_back(bounding_box(geometry.body));
   }
 
   // Enabled link pairs: all but a link with itself, adjacent links, and the

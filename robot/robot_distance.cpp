@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 #include "query/parallel_ranges.h"
@@ -30,26 +31,78 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // Lower bounds on a signed distance. Two spheres: |c_a - c_b| - r_a - r_b
 // (the bodies' overlap is at most the spheres'). A sphere against a box
-// (in the box's frame, the body's radius around it): the distance from the
-// centre to the box, minus both radii.
+// (in the box's frame, the body's radius around it): the signed distance
+// from the centre to the box, minus both radii. Signed: with the centre
+// inside the box, the overlap can be as deep as the centre's distance to
+// the box's boundary plus the radii (moving the sphere out through the
+// nearest face separates them), so that distance is subtracted too.
 double sphere_bound(const Vec3& center_a, double radius_a, const Vec3& center_b, double radius_b) {
   return (center_a - center_b).norm() - radius_a - radius_b;
 }
 
-double box_bound(const Vec3& center, double radius, const Obstacle& obstacle) {
+double obstacle_box_bound(const Vec3& center, double radius, const Obstacle& obstacle) {
   const Vec3 local = obstacle.pose.rotation.transpose() * (center - obstacle.pose.translation);
-  const Vec3 outside =
-      ((local - obstacle.box.center).cwiseAbs() - obstacle.box.half_extents).cwiseMax(0.0);
-  return outside.norm() - radius - obstacle.body.radius();
+  const Vec3 excess = (local - obstacle.box.center).cwiseAbs() - obstacle.box.half_extents;
+  const double to_box = excess.maxCoeff() < 0 ? excess.maxCoeff() : excess.cwiseMax(0.0).norm();
+  return to_box - radius - obstacle.body.radius();
 }
+
+// A body's box in the world: its core's box (centre, the columns of `axes`
+// and the half extents), every point of the body within `radius` of it.
+// Its support along a unit n is n.center + sum_i |n.axes_i| half_i + radius.
+struct WorldBox {
+  Vec3 center;
+  const Mat3* axes;
+  const Vec3* half_extents;
+  double radius;
+  double reach() const { return center.norm() + half_extents->norm() + radius; }
+};
+
+// The rounding of the box bound below, relative to the boxes' reach (the
+// magnitudes it adds): its few dot products err by a few u of it, and a
+// normal read from a result is unit within a few u. The same margin as the
+// bounding spheres' (kBoundingSphereSlack in robot.cpp), far above both.
+constexpr double kBoxBoundSlack = 1e-9;
+
+// A lower bound on the signed distance of two bodies within boxes a and b:
+// for any unit n, A lies in the half-space n.x <= h_A(n) and B in n.x >=
+// -h_B(-n), so their distance is at least the gap n.(c_b - c_a) - (A's
+// extent along n) - (B's), and when they overlap their depth (the least
+// overlap over all directions) is at most minus that gap.
+double box_gap(const WorldBox& a, const WorldBox& b, const Vec3& n) {
+  const double extent_a = (a.axes->transpose() * n).cwiseAbs().dot(*a.half_extents) + a.radius;
+  const double extent_b = (b.axes->transpose() * n).cwiseAbs().dot(*b.half_extents) + b.radius;
+  return n.dot(b.center - a.center) - extent_a - extent_b;
+}
+
+// The box gap along the centres' line and along the pair's last normal
+// (zero before the first query), whichever is larger. The gap is a bound
+// only along a unit axis: both are normalized here, whatever a result held.
+double box_bound(const WorldBox& a, const WorldBox& b, const Vec3& last_normal) {
+  double bound = -kInfinity;
+  const Vec3 line = b.center - a.center;
+  const double length = line.norm();
+  if (length > 0) bound = box_gap(a, b, line / length);
+  const double norm = last_normal.norm();
+  if (norm > 0.5 && norm < 2) bound = std::max(bound, box_gap(a, b, last_normal / norm));
+  return bound - kBoxBoundSlack * (a.reach() + b.reach());
+}
+
+// A margin on |R_after - R_before|_2 for rotations that are orthonormal to
+// a few u (poses are re-orthonormalized by checked_pose, and forward
+// kinematics multiplies a few of them): the identity below holds for exact
+// rotations, and this covers the departure of rounded ones many times over.
+constexpr double kRotationSlack = 1e-9;
 
 // How far any point within `radius` of a body's sphere centre (`local`, in
 // the frame that moved from `before` to `after`) has moved: the centre's
-// displacement plus |R_after - R_before|_2 radius, bounded by the Frobenius
-// norm.
+// displacement plus |R_after - R_before|_2 radius. For two rotations,
+// R_after - R_before = R_before (R - I), R a turn by some angle t, whose
+// singular values are 2 sin(t/2) twice and 0: the spectral norm is the
+// Frobenius norm over sqrt(2).
 double motion(const Pose& before, const Pose& after, const Vec3& local, double radius) {
-  return (after.apply(local) - before.apply(local)).norm() +
-         (after.rotation - before.rotation).norm() * radius;
+  const double turn = (after.rotation - before.rotation).norm() * std::numbers::sqrt2 / 2;
+  return (after.apply(local) - before.apply(local)).norm() + (turn + kRotationSlack) * radius;
 }
 
 const void* core_of(const Body& body) {
@@ -86,7 +139,8 @@ bool by_geometries(const RobotPairResult& x, const RobotPairResult& y) {
 RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
                                std::span<const Obstacle> obstacles,
                                const RobotQueryOptions& options, RobotQueryState* state) {
-  if (!(options.margin >= 0) || std::isinf(options.margin)) {
+  // std::isfinite first: an ordered comparison with NaN raises FE_INVALID.
+  if (!std::isfinite(options.margin) || options.margin < 0) {
     throw InvalidInput("robot query: margin " + std::to_string(options.margin) +
                        " is not a finite value >= 0");
   }
@@ -109,6 +163,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
     s.obstacle_cores_.assign(obstacles.size(), nullptr);
     s.obstacle_radii_.assign(obstacles.size(), 0.0);
     s.obstacle_motion_.assign(obstacles.size(), kInfinity);
+    s.self_normal_.assign(pairs.size(), Vec3::Zero());
+    s.environment_normal_.assign(n_geometries * obstacles.size(), Vec3::Zero());
   }
   std::swap(s.link_poses_, s.previous_link_poses_);
   robot.forward_kinematics(q, options.base, s.link_poses_);
@@ -116,9 +172,12 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
   const auto& spheres = robot.geometry_spheres();
   s.geometry_poses_.resize(n_geometries);
   s.centers_.resize(n_geometries);
+  s.box_centers_.resize(n_geometries);
+  const auto& boxes = robot.geometry_boxes();
   for (std::size_t g = 0; g < n_geometries; ++g) {
     const auto link = static_cast<std::size_t>(geometries[g].link);
     s.geometry_poses_[g] = s.link_poses_[link] * geometries[g].origin;
+    s.box_centers_[g] = s.geometry_poses_[g].apply(boxes[g].center);
     s.centers_[g] = s.link_poses_[link].apply(spheres[g].center);
     s.motion_[g] = moved_before ? motion(s.previous_link_poses_[link], s.link_poses_[link],
                                          spheres[g].center, spheres[g].radius)
@@ -138,6 +197,14 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
     }
     s.obstacle_poses_[o] = obstacles[o].pose;
   }
+  s.obstacle_box_centers_.resize(obstacles.size());
+  for (std::size_t o = 0; o < obstacles.size(); ++o) {
+    s.obstacle_box_centers_[o] = obstacles[o].pose.apply(obstacles[o].box.center);
+  }
+  const auto geometry_box = [&](std::size_t g) {
+    return WorldBox{s.box_centers_[g], &s.geometry_poses_[g].rotation, &boxes[g].half_extents,
+                    geometries[g].body.radius()};
+  };
 
   RobotDistances out;
   const auto report = [&](RobotPairResult&& pair, double& category_min, std::int32_t index,
@@ -148,13 +215,14 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       category_min = sd;
       last = index;
     }
-    if (!closest && sd > options.margin) return;
+    const bool within = !options.minimum_only && sd <= options.margin;
+    if (!closest && !within) return;
     if (options.gradients) fill_gradient(robot, s.link_poses_, pair);
     if (closest) {
       out.min_signed_distance = sd;
       out.closest = pair;
     }
-    if (sd <= options.margin) out.close_pairs.push_back(std::move(pair));
+    if (within) out.close_pairs.push_back(std::move(pair));
   };
   // Each pair's bound decays by the motion first (every pair, queried or
   // not, whatever options.self and options.environment say), so that it
@@ -180,10 +248,14 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       const GeometryPair& pair = pairs[static_cast<std::size_t>(p)];
       const auto a = static_cast<std::size_t>(pair.a), b = static_cast<std::size_t>(pair.b);
       double& bound = s.self_bound_[static_cast<std::size_t>(p)];
-      const double threshold = std::max(options.margin, out.min_self);
+      const double threshold = options.minimum_only ? out.min_self
+                                                    : std::max(options.margin, out.min_self);
       if (bound > threshold) continue;
       bound = std::max(
           bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b], spheres[b].radius));
+      if (bound > threshold) continue;
+      Vec3& normal = s.self_normal_[static_cast<std::size_t>(p)];
+      bound = std::max(bound, box_bound(geometry_box(a), geometry_box(b), normal));
       if (bound > threshold) continue;
       ++out.pairs_queried;
       RobotPairResult result;
@@ -193,6 +265,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
           distance(geometries[a].body, s.geometry_poses_[a], geometries[b].body,
                    s.geometry_poses_[b], options.distance, &s.self_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
+      normal = result.result.normal;
       report(std::move(result), out.min_self, p, last);
     }
     if (last >= 0) s.last_self_ = last;
@@ -211,9 +284,16 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       const auto g = static_cast<std::size_t>(p / n_obstacles);
       const auto o = static_cast<std::size_t>(p % n_obstacles);
       double& bound = s.environment_bound_[static_cast<std::size_t>(p)];
-      const double threshold = std::max(options.margin, out.min_environment);
+      const double threshold = options.minimum_only
+                                   ? out.min_environment
+                                   : std::max(options.margin, out.min_environment);
       if (bound > threshold) continue;
-      bound = std::max(bound, box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
+      bound = std::max(bound, obstacle_box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
+      if (bound > threshold) continue;
+      Vec3& normal = s.environment_normal_[static_cast<std::size_t>(p)];
+      const WorldBox obstacle_box{s.obstacle_box_centers_[o], &obstacles[o].pose.rotation,
+                                  &obstacles[o].box.half_extents, obstacles[o].body.radius()};
+      bound = std::max(bound, box_bound(geometry_box(g), obstacle_box, normal));
       if (bound > threshold) continue;
       ++out.pairs_queried;
       RobotPairResult result;
@@ -224,6 +304,7 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
           distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body, obstacles[o].pose,
                    options.distance, &s.environment_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
+      normal = result.result.normal;
       report(std::move(result), out.min_environment, p, last);
     }
     if (last >= 0) s.last_environment_ = last;
@@ -246,7 +327,7 @@ RobotBatchDistances robot_distances_batch(const Robot& robot, const RowMatrixXd&
   out.min_signed_distance.resize(q.rows());
   if (options.gradients) out.gradient = RowMatrixXd::Zero(q.rows(), robot.dof());
   RobotQueryOptions run_options = options;
-  run_options.margin = 0.0;
+  run_options.minimum_only = true;
   // Runs long enough that tracking pays along a trajectory, short enough
   // that two threads share a batch of a few thousand evenly.
   constexpr std::size_t kRun = 64;

@@ -87,6 +87,12 @@ def test_distances_and_gradients_against_finite_differences_and_the_batch():
         r = robot.distances(q, gradients=True)
         assert abs(minima[k] - r.min_signed_distance) <= 1e-10
         np.testing.assert_allclose(gradients[k], r.gradient, atol=1e-8)
+    # minimum_only: the same minimum, no close pairs.
+    for q in qs[:20]:
+        full = robot.distances(q, margin=0.05)
+        only = robot.distances(q, margin=0.05, minimum_only=True)
+        assert abs(only.min_signed_distance - full.min_signed_distance) <= 1e-10
+        assert len(only.close_pairs) == 0
 
 
 @needs_robots

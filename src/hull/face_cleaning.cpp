@@ -72,92 +72,80 @@ bool face_triangle(const Cycles& faces, Index f, std::span<const Vec3> pts,
   return true;
 }
 
-}  // namespace
 
-// Exact cleaning of a closed triangulated (or polygonal) surface, in the
-// coordinates of the given doubles:
-//  - neighbouring facets that are exactly coplanar (and lie on either side of
-//    their common edge, not folded) become one face: the triangles of a
-//    square;
-//  - a vertex on exactly two faces and exactly collinear with its two
-//    neighbours along them lies inside an edge: it is not an extreme point and
-//    is dropped from both cycles (a cube's edge midpoints).
-// A vertex strictly inside a face disappears with the merge, because it is on
-// no boundary cycle any more.
-//
-// `proven_convex` tells whether the result is exactly a convex polytope's
-// boundary: a closed, consistently oriented surface whose faces are planar
-// and whose every edge is exactly convex (x strictly below the plane of the
-// face across the edge). A closed surface that is locally convex at every
-// edge bounds a convex body, so no global test is needed.
-Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts,
-                   std::span<const Vec3> scaled, bool& proven_convex) {
+// The groups of coplanar neighbour faces that merge (union-find over face
+// ids), and the convexity verdict of the edges between faces (see
+// clean_faces).
+Groups coplanar_groups(const Cycles& raw, const HalfEdges& he, std::span<const Vec3> pts,
+                       std::span<const Vec3> scaled, bool& proven_convex) {
   const Index face_count = raw.count();
-  const HalfEdges he(raw, point_count);
-  proven_convex = he.consistent();
   const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
   Groups groups(face_count);
-  {
-    // A face is planar when all its vertices lie on the plane of a spread
-    // triangle of them (exact; zero is the expected answer, so this is where
-    // the exact fallback runs, once per vertex of a non-triangular face).
-    std::vector<std::array<Index, 3>> tri(static_cast<std::size_t>(face_count));
-    std::vector<bool> planar(static_cast<std::size_t>(face_count), false);
-    for (Index f = 0; f < face_count; ++f) {
-      auto& t = tri[static_cast<std::size_t>(f)];
-      if (!face_triangle(raw, f, pts, scaled, t)) continue;
-      bool flat = true;
-      for (Index i = 0; i < raw.size(f) && flat; ++i) {
-        const Index v = raw.at(f, i);
-        flat =
-            v == t[0] || v == t[1] || v == t[2] || side3d(at(t[0]), at(t[1]), at(t[2]), at(v)) == 0;
-      }
-      planar[static_cast<std::size_t>(f)] = flat;
-      proven_convex = proven_convex && flat;
+  // A face is planar when all its vertices lie on the plane of a spread
+  // triangle of them (exact; zero is the expected answer, so this is where
+  // the exact fallback runs, once per vertex of a non-triangular face).
+  std::vector<std::array<Index, 3>> tri(static_cast<std::size_t>(face_count));
+  std::vector<bool> planar(static_cast<std::size_t>(face_count), false);
+  for (Index f = 0; f < face_count; ++f) {
+    auto& t = tri[static_cast<std::size_t>(f)];
+    if (!face_triangle(raw, f, pts, scaled, t)) continue;
+    bool flat = true;
+    for (Index i = 0; i < raw.size(f) && flat; ++i) {
+      const Index v = raw.at(f, i);
+      flat =
+          v == t[0] || v == t[1] || v == t[2] || side3d(at(t[0]), at(t[1]), at(t[2]), at(v)) == 0;
     }
-    // Planar neighbours f and g share the edge s -> t (in f; t -> s in g).
-    // With y a vertex of f and x one of g off the line s t, side3d(s, t, y, x)
-    // is the edge's convexity: negative convex, zero coplanar, positive
-    // reflex (a defect of the surface). Coplanar faces merge when, in a projection
-    // that keeps the plane's orientation, x and y lie on opposite sides of
-    // the edge.
-    for (Index h = 0; h < static_cast<Index>(raw.vertices.size()); ++h) {
-      const Index twin = he.twin(h);
-      if (twin < 0) continue;
-      const Index f = he.face(h), g = he.face(twin);
-      if (f >= g) continue;
-      if (!planar[static_cast<std::size_t>(f)] || !planar[static_cast<std::size_t>(g)]) continue;
-      const Index s = he.source(h), t = he.target(h);
-      const auto off_line = [&](Index face) {
-        for (const Index v : tri[static_cast<std::size_t>(face)]) {
-          if (v != s && v != t && !collinear3d(at(s), at(t), at(v))) return v;
-        }
-        return Index{-1};
-      };
-      const Index y = off_line(f), x = off_line(g);
-      if (x < 0 || y < 0) {
-        proven_convex = false;
-        continue;
+    planar[static_cast<std::size_t>(f)] = flat;
+    proven_convex = proven_convex && flat;
+  }
+  // Planar neighbours f and g share the edge s -> t (in f; t -> s in g).
+  // With y a vertex of f and x one of g off the line s t, side3d(s, t, y, x)
+  // is the edge's convexity: negative convex, zero coplanar, positive
+  // reflex (a defect of the surface). Coplanar faces merge when, in a projection
+  // that keeps the plane's orientation, x and y lie on opposite sides of
+  // the edge.
+  for (Index h = 0; h < static_cast<Index>(raw.vertices.size()); ++h) {
+    const Index twin = he.twin(h);
+    if (twin < 0) continue;
+    const Index f = he.face(h), g = he.face(twin);
+    if (f >= g) continue;
+    if (!planar[static_cast<std::size_t>(f)] || !planar[static_cast<std::size_t>(g)]) continue;
+    const Index s = he.source(h), t = he.target(h);
+    const auto off_line = [&](Index face) {
+      for (const Index v : tri[static_cast<std::size_t>(face)]) {
+        if (v != s && v != t && !collinear3d(at(s), at(t), at(v))) return v;
       }
-      const int side = side3d(at(s), at(t), at(y), at(x));
-      if (side != 0) {
-        proven_convex = proven_convex && side < 0;
-        continue;
-      }
-      int y_side = 0, x_side = 0;
-      for (int k = 0; k < 3 && y_side == 0; ++k) {
-        const int i = (k + 1) % 3, j = (k + 2) % 3;
-        y_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(y)[i], at(y)[j]);
-        x_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(x)[i], at(x)[j]);
-      }
-      if (x_side == -y_side) {
-        groups.unite(f, g);
-      } else {
-        proven_convex = false;  // folded onto itself
-      }
+      return Index{-1};
+    };
+    const Index y = off_line(f), x = off_line(g);
+    if (x < 0 || y < 0) {
+      proven_convex = false;
+      continue;
+    }
+    const int side = side3d(at(s), at(t), at(y), at(x));
+    if (side != 0) {
+      proven_convex = proven_convex && side < 0;
+      continue;
+    }
+    int y_side = 0, x_side = 0;
+    for (int k = 0; k < 3 && y_side == 0; ++k) {
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      y_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(y)[i], at(y)[j]);
+      x_side = orient2d(at(s)[i], at(s)[j], at(t)[i], at(t)[j], at(x)[i], at(x)[j]);
+    }
+    if (x_side == -y_side) {
+      groups.unite(f, g);
+    } else {
+      proven_convex = false;  // folded onto itself
     }
   }
+  return groups;
+}
 
+// One face per group: the group's boundary chained into one cycle, or its
+// facets unmerged when the boundary is not one simple cycle.
+Cycles merge_groups(const Cycles& raw, const HalfEdges& he, Groups& groups, bool& proven_convex) {
+  const Index face_count = raw.count();
   // Boundary cycle of each group: its half-edges whose twin lies in another
   // group, chained head to tail. A group that does not chain into one simple
   // cycle keeps its facets unmerged.
@@ -215,7 +203,12 @@ Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> p
       for (const Index f : group) add_own(f);
     }
   }
+  return merged;
+}
 
+// `merged` without the vertices that lie inside an edge of two faces.
+Cycles drop_edge_vertices(const Cycles& merged, Index point_count, std::span<const Vec3> pts) {
+  const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
   // Drop vertices inside edges. The cycles become doubly linked lists over
   // nodes (one node per slot of merged.vertices); a vertex on exactly two
   // faces remembers its two nodes.
@@ -289,6 +282,33 @@ Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> p
     out.offsets.push_back(static_cast<Index>(out.vertices.size()));
   }
   return out;
+}
+
+}  // namespace
+
+// Exact cleaning of a closed triangulated (or polygonal) surface, in the
+// coordinates of the given doubles:
+//  - neighbouring facets that are exactly coplanar (and lie on either side of
+//    their common edge, not folded) become one face: the triangles of a
+//    square;
+//  - a vertex on exactly two faces and exactly collinear with its two
+//    neighbours along them lies inside an edge: it is not an extreme point and
+//    is dropped from both cycles (a cube's edge midpoints).
+// A vertex strictly inside a face disappears with the merge, because it is on
+// no boundary cycle any more.
+//
+// `proven_convex` tells whether the result is exactly a convex polytope's
+// boundary: a closed, consistently oriented surface whose faces are planar
+// and whose every edge is exactly convex (x strictly below the plane of the
+// face across the edge). A closed surface that is locally convex at every
+// edge bounds a convex body, so no global test is needed.
+Cycles clean_faces(const Cycles& raw, Index point_count, std::span<const Vec3> pts,
+                   std::span<const Vec3> scaled, bool& proven_convex) {
+  const HalfEdges he(raw, point_count);
+  proven_convex = he.consistent();
+  Groups groups = coplanar_groups(raw, he, pts, scaled, proven_convex);
+  const Cycles merged = merge_groups(raw, he, groups, proven_convex);
+  return drop_edge_vertices(merged, point_count, pts);
 }
 
 }  // namespace proxima::detail

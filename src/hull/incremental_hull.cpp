@@ -53,77 +53,39 @@ namespace {
 // Expected cost O(n log n) predicate calls (random order). Most calls are
 // decided by the double filter of side3d; nearly coplanar rounded points
 // (a rotated cylinder's caps) send many to the exact integer path.
-bool incremental_hull_in_order(std::span<const Vec3> pts, std::span<const Vec3> scaled,
-                               const Frame& frame, Cycles& out) {
+// Shorthand for the index casts of the containers below.
+inline std::size_t at_index(Index i) { return static_cast<std::size_t>(i); }
+
+// The fourth point of the start: the farthest from the base plane (in
+// double, for a well-shaped start) among the points exactly off it; -1 when
+// every point is on it (coplanar: not a solid).
+Index farthest_off_plane(std::span<const Vec3> pts, std::span<const Vec3> scaled, Index a,
+                         Index b, Index c) {
   const auto n = static_cast<Index>(pts.size());
-  const auto at = [&](Index v) -> const Vec3& { return pts[static_cast<std::size_t>(v)]; };
-  const auto sc = [&](Index v) -> const Vec3& { return scaled[static_cast<std::size_t>(v)]; };
-  const Index a = frame.base[0], b = frame.base[1], c = frame.base[2];
-  // Fourth point: the farthest from the base plane (in double, for a
-  // well-shaped start) among the points exactly off it.
-  const Vec3 normal = (sc(b) - sc(a)).cross(sc(c) - sc(a));
+  const Vec3 normal = (scaled[at_index(b)] - scaled[at_index(a)])
+                          .cross(scaled[at_index(c)] - scaled[at_index(a)]);
   Index d = -1;
   double best = -1.0;
   for (Index i = 0; i < n; ++i) {
-    const double h = std::abs(normal.dot(sc(i) - sc(a)));
-    if (h > best && side3d(at(a), at(b), at(c), at(i)) != 0) best = h, d = i;
+    const double h = std::abs(normal.dot(scaled[at_index(i)] - scaled[at_index(a)]));
+    if (h > best && side3d(pts[at_index(a)], pts[at_index(b)], pts[at_index(c)],
+                           pts[at_index(i)]) != 0)
+      best = h, d = i;
   }
-  if (d < 0) return false;  // coplanar: not a solid (the frame says otherwise)
+  return d;
+}
 
-  // Triangles with their neighbours: across[3 t + k] is the triangle across
-  // the edge tri[k] -> tri[k + 1]. Removed triangles' slots are reused.
-  std::vector<std::array<Index, 3>> tris;
-  std::vector<std::array<Index, 3>> across;
-  std::vector<char> mark;            // 0 live, 1 visible from the current point, 2 free
-  std::vector<Index> conflict_head;  // first point of each triangle's conflict list, or -1
-  std::vector<Index> free_slots;
-  std::vector<Index> next_conflict(pts.size(), -1);  // singly linked conflict lists
-  const auto new_triangle = [&](Index u, Index v, Index w) {
-    Index t;
-    if (!free_slots.empty()) {
-      t = free_slots.back();
-      free_slots.pop_back();
-      tris[static_cast<std::size_t>(t)] = {u, v, w};
-      across[static_cast<std::size_t>(t)] = {-1, -1, -1};
-      mark[static_cast<std::size_t>(t)] = 0;
-      conflict_head[static_cast<std::size_t>(t)] = -1;
-    } else {
-      t = static_cast<Index>(tris.size());
-      tris.push_back({u, v, w});
-      across.push_back({-1, -1, -1});
-      mark.push_back(0);
-      conflict_head.push_back(-1);
-    }
-    return t;
-  };
-  const auto sees = [&](Index t, Index x) {
-    const auto& tri = tris[static_cast<std::size_t>(t)];
-    return side3d(at(tri[0]), at(tri[1]), at(tri[2]), at(x)) > 0;
-  };
-  const auto link = [&](Index t, int k, Index s, int j) {
-    across[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)] = s;
-    across[static_cast<std::size_t>(s)][static_cast<std::size_t>(j)] = t;
-  };
-
-  // Outward tetrahedron: with d below triangle (p, q, r), its faces are
-  // (p, q, r), (p, d, q), (q, d, r), (r, d, p).
-  Index p = a, q = b, r = c;
-  if (side3d(at(p), at(q), at(r), at(d)) > 0) std::swap(q, r);
-  const Index t0 = new_triangle(p, q, r), t1 = new_triangle(p, d, q), t2 = new_triangle(q, d, r),
-              t3 = new_triangle(r, d, p);
-  link(t0, 0, t1, 2);  // p -> q | q -> p
-  link(t0, 1, t2, 2);  // q -> r | r -> q
-  link(t0, 2, t3, 2);  // r -> p | p -> r
-  link(t1, 0, t3, 1);  // p -> d | d -> p
-  link(t1, 1, t2, 0);  // d -> q | q -> d
-  link(t2, 1, t3, 0);  // d -> r | r -> d
-
-  // Seeded random order (splitmix64: portable and reproducible), then every
-  // point's first conflict face.
+// Every point but the start's four, in a seeded random order (splitmix64:
+// portable and reproducible), biased (Amenta, Choi and Rote, 2003): rounds
+// of doubling size, each a random sample, each sorted by index. The caller
+// numbers the points along a space-filling curve, so consecutive insertions
+// touch nearby triangles and points (cache), while the rounds keep the
+// expected work of a random order.
+std::vector<Index> insertion_order(Index n, const std::array<Index, 4>& start) {
   std::vector<Index> order;
-  order.reserve(pts.size());
+  order.reserve(at_index(n));
   for (Index i = 0; i < n; ++i) {
-    if (i != a && i != b && i != c && i != d) order.push_back(i);
+    if (std::find(start.begin(), start.end(), i) == start.end()) order.push_back(i);
   }
   std::uint64_t state = 0x9e3779b97f4a7c15ULL ^ static_cast<std::uint64_t>(n);
   const auto random_below = [&](std::size_t bound) {
@@ -135,111 +97,217 @@ bool incremental_hull_in_order(std::span<const Vec3> pts, std::span<const Vec3> 
     return static_cast<std::size_t>(z % bound);
   };
   for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[random_below(i)]);
-  // Biased randomized insertion order (Amenta, Choi and Rote, 2003): rounds
-  // of doubling size, each a random sample, each sorted by index. The caller
-  // numbers the points along a space-filling curve, so consecutive insertions
-  // touch nearby triangles and points (cache), while the rounds keep the
-  // expected work of a random order.
   for (std::size_t first = 0, size = 1; first < order.size(); first += size, size *= 2) {
     const std::size_t last = std::min(order.size(), first + size);
     std::sort(order.begin() + static_cast<std::ptrdiff_t>(first),
               order.begin() + static_cast<std::ptrdiff_t>(last));
   }
-  std::vector<Index> conflict(pts.size(), -1);  // the conflict face of each point, -1 when inside
-  const auto assign = [&](Index x, std::span<const Index> candidates) {
-    for (const Index t : candidates) {
-      if (sees(t, x)) {
-        conflict[static_cast<std::size_t>(x)] = t;
-        next_conflict[static_cast<std::size_t>(x)] = conflict_head[static_cast<std::size_t>(t)];
-        conflict_head[static_cast<std::size_t>(t)] = x;
-        return;
-      }
-    }
-    conflict[static_cast<std::size_t>(x)] = -1;
-  };
-  {
+  return order;
+}
+
+// The growing hull: triangles with their neighbours and the conflict lists
+// of the points not yet added (the construction described above).
+class ConflictHull {
+ public:
+  explicit ConflictHull(std::span<const Vec3> pts)
+      : pts_(pts), next_conflict_(pts.size(), -1), conflict_(pts.size(), -1),
+        cone_from_(pts.size(), -1) {}
+
+  // The outward tetrahedron of a, b, c and d (d off the plane of a, b, c),
+  // and the first conflict face of every point of `order`. With d below
+  // triangle (p, q, r), its faces are (p, q, r), (p, d, q), (q, d, r),
+  // (r, d, p).
+  void start(Index a, Index b, Index c, Index d, std::span<const Index> order) {
+    Index p = a, q = b, r = c;
+    if (side3d(at(p), at(q), at(r), at(d)) > 0) std::swap(q, r);
+    const Index t0 = new_triangle(p, q, r), t1 = new_triangle(p, d, q),
+                t2 = new_triangle(q, d, r), t3 = new_triangle(r, d, p);
+    link(t0, 0, t1, 2);  // p -> q | q -> p
+    link(t0, 1, t2, 2);  // q -> r | r -> q
+    link(t0, 2, t3, 2);  // r -> p | p -> r
+    link(t1, 0, t3, 1);  // p -> d | d -> p
+    link(t1, 1, t2, 0);  // d -> q | q -> d
+    link(t2, 1, t3, 0);  // d -> r | r -> d
     const std::array<Index, 4> first = {t0, t1, t2, t3};
     for (const Index x : order) assign(x, first);
   }
 
-  std::vector<Index> visible;
-  std::vector<Index> stack;
+  // Adds x (a no-op when it is inside the current hull, hence inside the
+  // final one): its visible cap is replaced by the cone from the horizon
+  // to x, and the cap's conflict points are assigned to the cone. False
+  // when the horizon is not a cycle, which exact predicates rule out.
+  bool add(Index x) {
+    const Index start = conflict_[at_index(x)];
+    if (start < 0) return true;
+    find_cap(x, start);
+    find_horizon();
+    // Free the cap (its conflict lists are redistributed below), taking
+    // the lists before the slots are reused.
+    for (const Index t : visible_) {
+      mark_[at_index(t)] = kFree;
+      free_slots_.push_back(t);
+    }
+    stack_.clear();
+    for (const Index t : visible_) {
+      for (Index y = conflict_head_[at_index(t)]; y >= 0; y = next_conflict_[at_index(y)]) {
+        if (y != x) stack_.push_back(y);
+      }
+      conflict_head_[at_index(t)] = -1;
+    }
+    if (!build_cone(x)) return false;
+    conflict_[at_index(x)] = -1;
+    for (const Index y : stack_) assign(y, cone_);
+    return true;
+  }
+
+  // The live triangles.
+  Cycles triangles() const {
+    Cycles out;
+    for (Index t = 0; t < static_cast<Index>(tris_.size()); ++t) {
+      if (mark_[at_index(t)] == kLive) out.add(tris_[at_index(t)]);
+    }
+    return out;
+  }
+
+ private:
+  static constexpr char kLive = 0, kVisible = 1, kFree = 2;
+
   struct HorizonEdge {
     Index u, v, outside;  // u -> v in a visible triangle; `outside` across it, not visible
     int outside_slot;     // which edge of `outside` runs v -> u
   };
-  std::vector<HorizonEdge> horizon;
-  std::vector<Index> cone;
-  std::vector<Index> cone_from(pts.size(), -1);  // horizon vertex u -> the cone triangle (u, v, x)
-  for (const Index x : order) {
-    const Index start = conflict[static_cast<std::size_t>(x)];
-    if (start < 0) continue;  // inside the current hull: inside the final one
-    // The visible cap, by depth-first search from the conflict face.
-    visible.clear();
-    stack.assign(1, start);
-    mark[static_cast<std::size_t>(start)] = 1;
-    while (!stack.empty()) {
-      const Index t = stack.back();
-      stack.pop_back();
-      visible.push_back(t);
-      for (const Index s : across[static_cast<std::size_t>(t)]) {
-        if (mark[static_cast<std::size_t>(s)] == 0 && sees(s, x)) {
-          mark[static_cast<std::size_t>(s)] = 1;
-          stack.push_back(s);
+
+  const Vec3& at(Index v) const { return pts_[at_index(v)]; }
+
+  Index new_triangle(Index u, Index v, Index w) {
+    Index t;
+    if (!free_slots_.empty()) {
+      t = free_slots_.back();
+      free_slots_.pop_back();
+      tris_[at_index(t)] = {u, v, w};
+      across_[at_index(t)] = {-1, -1, -1};
+      mark_[at_index(t)] = kLive;
+      conflict_head_[at_index(t)] = -1;
+    } else {
+      t = static_cast<Index>(tris_.size());
+      tris_.push_back({u, v, w});
+      across_.push_back({-1, -1, -1});
+      mark_.push_back(kLive);
+      conflict_head_.push_back(-1);
+    }
+    return t;
+  }
+
+  bool sees(Index t, Index x) const {
+    const auto& tri = tris_[at_index(t)];
+    return side3d(at(tri[0]), at(tri[1]), at(tri[2]), at(x)) > 0;
+  }
+
+  void link(Index t, int k, Index s, int j) {
+    across_[at_index(t)][static_cast<std::size_t>(k)] = s;
+    across_[at_index(s)][static_cast<std::size_t>(j)] = t;
+  }
+
+  // x's conflict face: the first of `candidates` that sees it, or none
+  // (-1: x is inside for good).
+  void assign(Index x, std::span<const Index> candidates) {
+    for (const Index t : candidates) {
+      if (sees(t, x)) {
+        conflict_[at_index(x)] = t;
+        next_conflict_[at_index(x)] = conflict_head_[at_index(t)];
+        conflict_head_[at_index(t)] = x;
+        return;
+      }
+    }
+    conflict_[at_index(x)] = -1;
+  }
+
+  // The visible cap, by depth-first search from the conflict face.
+  void find_cap(Index x, Index start) {
+    visible_.clear();
+    stack_.assign(1, start);
+    mark_[at_index(start)] = kVisible;
+    while (!stack_.empty()) {
+      const Index t = stack_.back();
+      stack_.pop_back();
+      visible_.push_back(t);
+      for (const Index s : across_[at_index(t)]) {
+        if (mark_[at_index(s)] == kLive && sees(s, x)) {
+          mark_[at_index(s)] = kVisible;
+          stack_.push_back(s);
         }
       }
     }
-    horizon.clear();
-    for (const Index t : visible) {
-      const auto& tri = tris[static_cast<std::size_t>(t)];
+  }
+
+  // The cap's boundary edges, each with the triangle across it.
+  void find_horizon() {
+    horizon_.clear();
+    for (const Index t : visible_) {
+      const auto& tri = tris_[at_index(t)];
       for (int k = 0; k < 3; ++k) {
-        const Index s = across[static_cast<std::size_t>(t)][static_cast<std::size_t>(k)];
-        if (mark[static_cast<std::size_t>(s)] == 1) continue;
+        const Index s = across_[at_index(t)][static_cast<std::size_t>(k)];
+        if (mark_[at_index(s)] == kVisible) continue;
         const Index u = tri[static_cast<std::size_t>(k)],
                     v = tri[static_cast<std::size_t>((k + 1) % 3)];
         int slot = 0;
-        while (tris[static_cast<std::size_t>(s)][static_cast<std::size_t>(slot)] != v) ++slot;
-        horizon.push_back({u, v, s, slot});
+        while (tris_[at_index(s)][static_cast<std::size_t>(slot)] != v) ++slot;
+        horizon_.push_back({u, v, s, slot});
       }
     }
-    // Free the cap (its conflict lists are redistributed below), then build
-    // the cone: triangle (u, v, x) has its edge 0 on the horizon, edge 1
-    // (v -> x) against the cone triangle starting at v, edge 2 (x -> u)
-    // against the one ending at u.
-    for (const Index t : visible) {
-      mark[static_cast<std::size_t>(t)] = 2;
-      free_slots.push_back(t);
-    }
-    // Take the lists before the slots are reused.
-    stack.clear();
-    for (const Index t : visible) {
-      for (Index y = conflict_head[static_cast<std::size_t>(t)]; y >= 0;
-           y = next_conflict[static_cast<std::size_t>(y)]) {
-        if (y != x) stack.push_back(y);
-      }
-      conflict_head[static_cast<std::size_t>(t)] = -1;
-    }
-    cone.clear();
-    for (const HorizonEdge& e : horizon) {
+  }
+
+  // The cone: triangle (u, v, x) has its edge 0 on the horizon, edge 1
+  // (v -> x) against the cone triangle starting at v, edge 2 (x -> u)
+  // against the one ending at u.
+  bool build_cone(Index x) {
+    cone_.clear();
+    for (const HorizonEdge& e : horizon_) {
       const Index t = new_triangle(e.u, e.v, x);
       link(t, 0, e.outside, e.outside_slot);
-      cone_from[static_cast<std::size_t>(e.u)] = t;
-      cone.push_back(t);
+      cone_from_[at_index(e.u)] = t;
+      cone_.push_back(t);
     }
-    for (const Index t : cone) {
-      const Index v = tris[static_cast<std::size_t>(t)][1];
-      const Index s = cone_from[static_cast<std::size_t>(v)];
+    for (const Index t : cone_) {
+      const Index v = tris_[at_index(t)][1];
+      const Index s = cone_from_[at_index(v)];
       if (s < 0) return false;  // the horizon is not a cycle: cannot happen
       link(t, 1, s, 2);
     }
-    for (const HorizonEdge& e : horizon) cone_from[static_cast<std::size_t>(e.u)] = -1;
-    conflict[static_cast<std::size_t>(x)] = -1;
-    for (const Index y : stack) assign(y, cone);
+    for (const HorizonEdge& e : horizon_) cone_from_[at_index(e.u)] = -1;
+    return true;
   }
-  out = Cycles();
-  for (Index t = 0; t < static_cast<Index>(tris.size()); ++t) {
-    if (mark[static_cast<std::size_t>(t)] == 0) out.add(tris[static_cast<std::size_t>(t)]);
+
+  std::span<const Vec3> pts_;
+  // Triangles with their neighbours: across_[t][k] is the triangle across
+  // the edge tri[k] -> tri[k + 1]. Removed triangles' slots are reused.
+  std::vector<std::array<Index, 3>> tris_;
+  std::vector<std::array<Index, 3>> across_;
+  std::vector<char> mark_;            // kLive, kVisible (from the current point), kFree
+  std::vector<Index> conflict_head_;  // first point of each triangle's conflict list, or -1
+  std::vector<Index> free_slots_;
+  std::vector<Index> next_conflict_;  // singly linked conflict lists
+  std::vector<Index> conflict_;       // the conflict face of each point, -1 when inside
+  // Scratch of add(), kept for their capacity.
+  std::vector<Index> visible_;
+  std::vector<Index> stack_;
+  std::vector<HorizonEdge> horizon_;
+  std::vector<Index> cone_;
+  std::vector<Index> cone_from_;  // horizon vertex u -> the cone triangle (u, v, x)
+};
+
+bool incremental_hull_in_order(std::span<const Vec3> pts, std::span<const Vec3> scaled,
+                               const Frame& frame, Cycles& out) {
+  const Index a = frame.base[0], b = frame.base[1], c = frame.base[2];
+  const Index d = farthest_off_plane(pts, scaled, a, b, c);
+  if (d < 0) return false;  // coplanar: not a solid (the frame says otherwise)
+  const std::vector<Index> order = insertion_order(static_cast<Index>(pts.size()), {a, b, c, d});
+  ConflictHull hull(pts);
+  hull.start(a, b, c, d, order);
+  for (const Index x : order) {
+    if (!hull.add(x)) return false;
   }
+  out = hull.triangles();
   return true;
 }
 

@@ -219,6 +219,15 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
   return distance_in_frame(a, pose_a, b, pose_b, options, *cache);
 }
 
+DistanceResult distance(const ConvexPolytope& a, const RigidPose& pose_a, const ConvexPolytope& b,
+                        const RigidPose& pose_b, const DistanceOptions& options,
+                        DistanceCache* cache) {
+  // Under the contract by construction (RigidPose).
+  if (cache == nullptr) [[unlikely]]
+    return distance_of_rigid_poses_cold(a, pose_a.pose(), b, pose_b.pose(), options);
+  return distance_in_frame(a, pose_a.pose(), b, pose_b.pose(), options, *cache);
+}
+
 namespace detail {
 
 DistanceResult distance_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,

@@ -358,6 +358,44 @@ TEST(CliQuery, DeeplyNestedLinesAreErrorsAndTheRunGoesOn) {
   EXPECT_NEAR(check_answer_fields(answers[6]), 5.0, accuracy_bound(5.0, 4.0));
 }
 
+// A line longer than --max-line-size is refused by name and the run stops
+// there, also on an endless line: std::getline read /dev/zero until
+// std::bad_alloc (issue 25). The lines before it are answered, in order,
+// with and without threads.
+TEST(CliQuery, LinesLongerThanTheLimitStopTheRunByName) {
+  REQUIRE_CLI();
+  const std::string good =
+      "{\"id\": 1, \"a\": {\"vertices\": [[0,0,0]]}, \"b\": {\"vertices\": [[3,4,0]]}}\n";
+  const TempFile file(good + "{\"id\": \"" + std::string(5000, 'x') + "\"}\n" + good);
+  for (const char* threads : {"1", "2"}) {
+    SCOPED_TRACE(std::string("threads ") + threads);
+    const CliRun run = run_cli("query --max-line-size 4096 --threads " + std::string(threads) +
+                                   " " + shell_quote(file.path()),
+                               /*with_stderr=*/true);
+    EXPECT_EQ(run.exit_code, 1) << run.out;
+    EXPECT_NE(run.out.find("\"error\":\"line 2: longer than the limit of 4096 bytes "
+                           "(--max-line-size)\"}"),
+              std::string::npos)
+        << run.out;
+    EXPECT_NE(run.out.find("proxima query: line 2 is longer than the limit of 4096 bytes"),
+              std::string::npos)
+        << run.out;
+    EXPECT_EQ(run.out.rfind("{\"id\":1,\"status\":\"separated\"", 0), 0U) << run.out;
+  }
+  // The line at the limit is read.
+  const std::string at_limit = "{\"id\": \"" + std::string(4096 - 10, 'x') + "\"}";
+  ASSERT_EQ(at_limit.size(), 4096U);
+  const TempFile exact(at_limit + "\n");
+  const CliRun run = run_cli("query --max-line-size 4096 " + shell_quote(exact.path()));
+  EXPECT_EQ(run.exit_code, 0) << run.out;
+  EXPECT_NE(run.out.find("missing \\\"a\\\""), std::string::npos) << run.out;
+  // An endless line ends the run at the limit, in bounded memory.
+  const CliRun zero = run_cli("query --max-line-size 100000 /dev/zero", /*with_stderr=*/true);
+  EXPECT_EQ(zero.exit_code, 1);
+  EXPECT_NE(zero.out.find("line 1 is longer than the limit of 100000 bytes"), std::string::npos)
+      << zero.out.substr(0, 500);
+}
+
 TEST(CliQuery, EmptyVertexListIsAnErrorLine) {
   REQUIRE_CLI();
   const Json query = {

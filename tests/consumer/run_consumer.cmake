@@ -39,20 +39,30 @@ endforeach()
 # 1. proxima::proxima alone, with TBB and the readers' parser hidden
 #    from find_package: the package must need Eigen only.
 # 2. proxima::proxima and proxima::io.
+# 3. proxima::robot (find_package with COMPONENTS robot), on the Panda's
+#    URDF given by -DROBOT_DIR (skipped without it).
 set(common_args "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}"
     "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}"
     "-DCMAKE_BUILD_TYPE=${BUILD_TYPE}"
     -DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON)
-foreach(variant core io)
+set(variants core io)
+if(DEFINED ROBOT_DIR AND EXISTS "${prefix}/lib/cmake/proxima/proximaRobotTargets.cmake")
+  list(APPEND variants robot)
+endif()
+foreach(variant IN LISTS variants)
   set(build "${WORK_DIR}/build-${variant}")
+  set(run_args)
   if(variant STREQUAL "core")
     set(variant_args -DCONSUMER_WITH_IO=OFF)
-  else()
+  elseif(variant STREQUAL "io")
     set(variant_args -DCONSUMER_WITH_IO=ON)
+  else()
+    set(variant_args -DCONSUMER_WITH_ROBOT=ON)
+    set(run_args "${ROBOT_DIR}")
   endif()
   run("configure (${variant})" ${CMAKE_COMMAND} -S "${CONSUMER_SOURCE_DIR}" -B "${build}" -G "${GENERATOR}"
       ${common_args} ${variant_args})
   run("build (${variant})" ${CMAKE_COMMAND} --build "${build}")
-  run("run (${variant})" "${build}/consumer")
+  run("run (${variant})" "${build}/consumer" ${run_args})
 endforeach()
-message(STATUS "consumer test: installed proxima found, built and run (alone with Eigen, and with proxima::io)")
+message(STATUS "consumer test: installed proxima found, built and run (${variants})")

@@ -172,6 +172,57 @@ TEST(Pose, EveryEntryPointUsesTheContract) {
   EXPECT_EQ(given.point_b, as_snapped.point_b);
 }
 
+// A pose checked once (RigidPose, issue 28): refused with the contract's
+// words naming where, re-orthonormalized like any query does it, and a
+// query given two of them answers as the Pose overload does, bit for bit,
+// along a tracked walk (the same cache evolution) and cold.
+TEST(Pose, RigidPosesAreCheckedOnceAndAnswerAsPlainPoses) {
+  const Pose skewed(Mat3(Mat3::Identity() * 1.001), Vec3(3, 0, 0));
+  EXPECT_NE(message_of([&] { RigidPose(skewed, "planner: configuration 7"); })
+                .find("planner: configuration 7: rotation is not orthonormal"),
+            std::string::npos);
+  Pose nan_pose;
+  nan_pose.translation.x() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(message_of([&] { RigidPose{nan_pose}; }),
+            "RigidPose is not finite (NaN or infinite rotation or translation)");
+  EXPECT_EQ(RigidPose().pose().rotation, Mat3::Identity());
+
+  const ConvexPolytope a(cube_points());
+  std::mt19937 rng(28);
+  std::vector<Vec3> points;
+  std::normal_distribution<double> g;
+  for (int i = 0; i < 40; ++i) points.emplace_back(g(rng), g(rng), g(rng));
+  const ConvexPolytope b(points);
+  // Float32 rotations (re-orthonormalized by both) and exact ones, B
+  // circling A and spinning: the walk crosses feature changes.
+  DistanceCache plain_cache;
+  DistanceCache rigid_cache;
+  const RigidPose rigid_a(Pose::from_translation(Vec3(0.1, -0.2, 0.3)));
+  for (int i = 0; i < 400; ++i) {
+    const double t = 0.05 * i;
+    const Mat3 turn = Eigen::AngleAxisd(0.07 * i, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    const Mat3 r = i % 3 == 0 ? Mat3(turn.cast<float>().cast<double>()) : turn;
+    const Pose pose_b(r, Vec3(4 * std::cos(t), 4 * std::sin(t), std::sin(3 * t)));
+    const RigidPose rigid_b(pose_b);
+    for (DistanceCache* cache : {&plain_cache, static_cast<DistanceCache*>(nullptr)}) {
+      DistanceCache* other = cache == nullptr ? nullptr : &rigid_cache;
+      const DistanceResult p = distance(a, rigid_a.pose(), b, pose_b, {}, cache);
+      const DistanceResult q = distance(a, rigid_a, b, rigid_b, {}, other);
+      ASSERT_EQ(p.status, q.status) << "step " << i;
+      ASSERT_EQ(p.distance, q.distance) << "step " << i;
+      ASSERT_EQ(p.lower_bound, q.lower_bound) << "step " << i;
+      ASSERT_EQ(p.point_a, q.point_a) << "step " << i;
+      ASSERT_EQ(p.point_b, q.point_b) << "step " << i;
+      ASSERT_EQ(p.normal, q.normal) << "step " << i;
+      ASSERT_EQ(p.feature_a.vertices, q.feature_a.vertices) << "step " << i;
+      ASSERT_EQ(p.feature_b.vertices, q.feature_b.vertices) << "step " << i;
+      ASSERT_EQ(p.iterations, q.iterations) << "step " << i;
+    }
+    ASSERT_EQ(plain_cache.vertices_a, rigid_cache.vertices_a) << "step " << i;
+    ASSERT_EQ(plain_cache.vertices_b, rigid_cache.vertices_b) << "step " << i;
+  }
+}
+
 }  // namespace
 }  // namespace proxima
 

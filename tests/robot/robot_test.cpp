@@ -327,6 +327,50 @@ TEST(RobotDistance, EveryQueryMatchesTheSlowPathAlongATrajectory) {
   EXPECT_GT(pruned, 0);
 }
 
+// minimum_only queries fewer pairs (an overlapping pair that cannot be the
+// deepest is skipped) and must still give the slow path's minima, tracked
+// along a trajectory through collisions, with the closest pair's gradient
+// that of the full query.
+TEST(RobotDistance, MinimumOnlyMatchesTheSlowPathAlongATrajectory) {
+  if (!have_robots()) GTEST_SKIP() << kRobots << " absent";
+  const Robot& robot = panda();
+  const std::vector<proxima::Obstacle> obstacles = table_and_shelf();
+  std::mt19937_64 rng(37);
+  std::vector<double> q = random_q(robot, rng), target = random_q(robot, rng);
+  proxima::RobotQueryState state, full_state;
+  proxima::RobotQueryOptions options, full;
+  options.minimum_only = true;
+  options.gradients = true;
+  options.margin = 0.05;  // not read
+  full.gradients = true;
+  int colliding = 0, fewer = 0;
+  for (int step = 0; step < 120; ++step) {
+    if (step % 10 == 0) target = random_q(robot, rng);
+    for (std::size_t v = 0; v < q.size(); ++v) q[v] += 0.2 * (target[v] - q[v]);
+    const proxima::RobotDistances fast =
+        proxima::robot_distances(robot, q, obstacles, options, &state);
+    const proxima::RobotDistances reference =
+        proxima::robot_distances(robot, q, obstacles, full, &full_state);
+    const SlowAnswer slow = slow_panda(robot, q, obstacles, 0.0);
+    EXPECT_NEAR(fast.min_self, slow.min_self, kAgreement) << "step " << step;
+    EXPECT_NEAR(fast.min_environment, slow.min_environment, kAgreement) << "step " << step;
+    EXPECT_NEAR(fast.min_signed_distance, std::min(slow.min_self, slow.min_environment),
+                kAgreement);
+    EXPECT_TRUE(fast.close_pairs.empty());
+    if (fast.closest.geometry_a == reference.closest.geometry_a &&
+        fast.closest.geometry_b == reference.closest.geometry_b &&
+        fast.closest.environment == reference.closest.environment) {
+      EXPECT_LE((fast.closest.gradient - reference.closest.gradient).cwiseAbs().maxCoeff(),
+                kAgreement)
+          << "step " << step;
+    }
+    colliding += fast.min_signed_distance < 0;
+    fewer += fast.pairs_queried < reference.pairs_queried;
+  }
+  EXPECT_GT(colliding, 5);
+  EXPECT_GT(fewer, 0);
+}
+
 TEST(RobotDistance, PairGradientsMatchCentralDifferences) {
   if (!have_robots()) GTEST_SKIP() << kRobots << " absent";
   const Robot& robot = panda();
@@ -545,6 +589,12 @@ TEST(RobotDistance, BadQueriesAreRefusedNamingTheProblem) {
   q[3] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(error_of(q, 0).find("panda_joint4"), std::string::npos);
   EXPECT_NE(error_of(std::vector<double>(8, 0.0), -1).find("margin"), std::string::npos);
+  // Regression: a NaN margin reached the check !(margin >= 0), whose ordered
+  // comparison raises FE_INVALID, so under the test main's traps the query
+  // died of SIGFPE instead of refusing the margin by name.
+  EXPECT_NE(error_of(std::vector<double>(8, 0.0), std::numeric_limits<double>::quiet_NaN())
+                .find("margin"),
+            std::string::npos);
 }
 
 // A mimic chain composes its maps: c = 2 b + 1 and b = -a + 0.5 make

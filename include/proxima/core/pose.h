@@ -273,6 +273,24 @@ requires std::invocable<What> Pose checked_pose(const Pose& pose, What&& what) {
   return detail::checked_pose_slow(pose, what());
 }
 
+// A pose checked once against the contract above, for a caller that asks
+// many queries of one pose (a body against all its neighbours, a planner's
+// configuration against every obstacle): built by checked_pose (the same
+// refusal, naming `what`; a rotation within kRotationTolerance of
+// orthonormal is re-orthonormalized), then read-only, so that it stays under
+// the contract and a query given two of them does not check them again.
+// A plain Pose is still checked by every query that takes it.
+class RigidPose {
+ public:
+  RigidPose() = default;  // the identity
+  explicit RigidPose(const Pose& pose, std::string_view what = "RigidPose")
+      : pose_(checked_pose(pose, what)) {}
+  const Pose& pose() const { return pose_; }
+
+ private:
+  Pose pose_;
+};
+
 // Throws as checked_pose does; for callers that only validate (the pose is
 // checked again, and re-orthonormalized if needed, by the query that uses it).
 inline void check_pose(const Pose& pose, std::string_view what) { (void)checked_pose(pose, what); }

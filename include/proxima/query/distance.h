@@ -25,6 +25,13 @@ DistanceResult distance(const ConvexPolytope& a, const Pose& pose_a, const Conve
                         const Pose& pose_b, const DistanceOptions& options = {},
                         DistanceCache* cache = nullptr);
 
+// The same for poses checked once (RigidPose, proxima/core/pose.h): the
+// rigid-pose check of the overload above is not paid again; the answer is
+// the one that overload gives for the RigidPoses' poses, bit for bit.
+DistanceResult distance(const ConvexPolytope& a, const RigidPose& pose_a, const ConvexPolytope& b,
+                        const RigidPose& pose_b, const DistanceOptions& options = {},
+                        DistanceCache* cache = nullptr);
+
 namespace detail {
 // distance() for poses already under the contract of proxima/core/pose.h (checked
 // and, where needed, re-orthonormalized by the caller: a Scene's stored

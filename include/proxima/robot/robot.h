@@ -185,6 +185,9 @@ class Robot {
 
   // Each geometry's bounding sphere in its link's frame.
   const std::vector<BoundingSphere>& geometry_spheres() const { return geometry_spheres_; }
+  // Each geometry's core box (bounding_box) in the geometry's own frame
+  // (the link's frame times RobotGeometry::origin).
+  const std::vector<BoundingBox>& geometry_boxes() const { return geometry_boxes_; }
 
   // The geometries of each link (indices into geometries()).
   const std::vector<std::int32_t>& link_geometries(std::int32_t link) const {
@@ -216,6 +219,7 @@ class Robot {
   std::vector<std::uint8_t> pair_enabled_;  // links x links
   std::vector<GeometryPair> self_pairs_;
   std::vector<BoundingSphere> geometry_spheres_;
+  std::vector<BoundingBox> geometry_boxes_;
   std::int32_t root_ = -1;
 };
 

@@ -23,10 +23,12 @@
 // signed distance found so far (in its category: self or environment): it
 // cannot be the closest nor within the margin. The bounds: the bounding
 // spheres' distance (a geometry's sphere against an obstacle's box), and,
-// along a trajectory, the pair's certified lower bound at its last query
-// minus how far any point of either body has moved since (conservative
-// advancement's bound: the centre's displacement plus the rotation's change
-// times the radius). The answer is that of the slow path, a cold distance()
+// the gap between the two bodies' boxes (each geometry's core box,
+// oriented with it, grown by its radius) along two axes, the line of their
+// centres and the pair's normal at its last query; and, along a trajectory,
+// the pair's certified lower bound at its last query minus how far any
+// point of either body has moved since (conservative advancement's bound:
+// the centre's displacement plus the rotation's change times the radius). The answer is that of the slow path, a cold distance()
 // on every pair, within the accuracy standard.
 //
 // The gradient of a pair's signed distance s = n . (p_b - p_a) (n the unit
@@ -71,6 +73,14 @@ struct RobotQueryOptions {
   double margin = 0.0;
   // Whether each reported pair (and the closest) carries its gradient.
   bool gradients = false;
+  // Only the minimum (a collision check, an optimizer's one constraint):
+  // close_pairs stays empty and the margin is not read, so a pair is
+  // queried only while its lower bound is below the smallest signed
+  // distance of its category found so far (an overlapping pair whose
+  // bounds show it cannot be the deepest costs no penetration depth).
+  // min_signed_distance, min_self, min_environment and closest are those
+  // of the full query.
+  bool minimum_only = false;
   // Which pairs are tested.
   bool self = true;
   bool environment = true;
@@ -131,6 +141,12 @@ class RobotQueryState {
   std::vector<Pose> link_poses_;
   std::vector<Pose> geometry_poses_;
   std::vector<Vec3> centers_;
+  std::vector<Vec3> box_centers_;           // per geometry, world
+  std::vector<Vec3> obstacle_box_centers_;  // per obstacle, world
+  // Per pair: the unit normal of its last query (world; zero before the
+  // first), the axis of its box bound.
+  std::vector<Vec3> self_normal_;
+  std::vector<Vec3> environment_normal_;
   // Per pair: a lower bound on its signed distance at the last query (the
   // bookkeeping of conservative advancement, see above), and what it was
   // measured against.
