@@ -93,4 +93,27 @@ inline PowerOfTwoUnit power_of_two_unit(double magnitude) {
   return {pow2(e), pow2(-e)};
 }
 
+// v times a power of two (exact) that brings its largest coordinate into
+// [1/2, 1): the same direction, whose squared norm and cross products
+// neither underflow nor overflow. A vector whose squared norm falls below
+// 2^-1022 keeps only the digits above 2^-1074 there, so v / v.norm() is no
+// longer unit (0.94 for an edge of 1e-159 in the penetration query's scaled
+// units), and below 2^-1074 the norm is zero.
+inline Vec3 exponent_free(const Vec3& v) {
+  return times_pow2(v, -magnitude_exponent(v.cwiseAbs().maxCoeff()));
+}
+
+// |v| and v / |v| through exponent_free (a zero v: length 0, direction 0).
+struct LengthAndDirection {
+  double length = 0.0;
+  Vec3 direction = Vec3::Zero();
+};
+inline LengthAndDirection length_and_direction(const Vec3& v) {
+  const int e = magnitude_exponent(v.cwiseAbs().maxCoeff());
+  const Vec3 w = times_pow2(v, -e);
+  const double n = w.norm();
+  if (!(n > 0.0)) return {};
+  return {std::ldexp(n, e), w / n};
+}
+
 }  // namespace proxima::detail

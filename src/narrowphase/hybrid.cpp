@@ -60,6 +60,25 @@ using detail::kTerminationGapUlps;
 constexpr double kMinUnscaled = 0x1p-64;
 constexpr double kMaxUnscaled = 0x1p64;
 
+// A squared distance below this has lost digits to subnormal squares (the
+// smallest subnormal 2^-1074 is 2^-114 of it): the distance and the normal
+// are then taken from point_b - point_a through a power of two
+// (length_and_direction). A tetrahedron of 1e-101 touching a hull of 1e58
+// is 1e-159 from it in scaled units: the normal v / sqrt(|v|^2) had length
+// 1.00002 (DistanceRegression.TinyBodyTouchingHugeOneHasUnitNormal).
+constexpr double kSquaresLoseDigits = 0x1p-960;
+
+// The distance and the normal of a result whose squared distance lost
+// digits (kSquaresLoseDigits), from its points. Out of line: off the
+// tracked queries' path.
+[[gnu::noinline]] void tiny_distance_from_points(DistanceResult& result) {
+  const detail::LengthAndDirection v = detail::length_and_direction(result.point_b - result.point_a);
+  if (!(v.length > 0.0)) return;
+  result.distance = v.length;
+  result.lower_bound = std::min(result.lower_bound, v.length);
+  result.normal = v.direction;
+}
+
 // A cache whose pose is further than this share of the bodies' size from
 // the query's is taken for stale (see moved_far).
 constexpr double kStaleMotion = 0.5;
@@ -507,6 +526,8 @@ template <bool kScaled, bool kMargin = false>
   result.distance = d;
   result.lower_bound = std::min(std::max(lower, 0.0), d);
   result.normal = d > 0.0 ? Vec3((loc.point_b - loc.point_a) / d) : last_direction;
+  if (loc.distance_squared < kSquaresLoseDigits) [[unlikely]]
+    tiny_distance_from_points(result);
   if (contact) {
     // In contact at machine precision. Whether the bodies only touch or
     // overlap is decided by the contact unit (hybrid_distance, contact.h).

@@ -152,8 +152,10 @@ void keep(Query& q, const Candidate& c, Candidates& out) {
 void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, int na, int b0,
                         int b1, const std::array<Arc, 4>& yb, int nb, Candidates& out) {
   const MinkowskiFaceId id{MinkowskiFace::edge_edge, a0, a1, b0, b1};
-  const Vec3& ea = xa[0].k;
-  const Vec3& eb = yb[0].k;
+  // Scaled, a small body's edges can be 2^-500 long beside the other's
+  // (PenetrationRegression.TinyBodyInHugeOneHasUnitNormal): exponent_free.
+  const Vec3 ea = detail::exponent_free(xa[0].k);
+  const Vec3 eb = detail::exponent_free(yb[0].k);
   Vec3 n = ea.cross(eb);
   const double length = n.norm();
   if (!(length > 0x1p-200 * ea.norm() * eb.norm()) || !(length > 0.0)) return;

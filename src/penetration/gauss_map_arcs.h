@@ -36,7 +36,7 @@ int edge_arcs(int dimension, const Vec3& k, const Vec3& nl, const Vec3& nr, bool
     out[0] = {nl, nr, k, tolerance};
     return 1;
   }
-  const Vec3 axis = k.normalized();
+  const Vec3 axis = detail::exponent_free(k).normalized();
   if (dimension == 2) {
     // nl is the left side's normal (for -B: minus it); o the outward normal.
     const Vec3 left = sign * nl;  // the un-negated left normal

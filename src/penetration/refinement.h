@@ -87,7 +87,7 @@ std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& 
     u1 = q.point_a(id.a1);
     w0 = q.point_b(id.b0);
     w1 = q.point_b(id.b1);
-    const Vec3 ea = u1 - u0, eb = w1 - w0;
+    const Vec3 ea = detail::exponent_free(u1 - u0), eb = detail::exponent_free(w1 - w0);
     const double cross = ea.cross(eb).norm();
     if (!(cross > 0.0)) return std::nullopt;
     angle = (8.0 * ea.norm() * eb.norm() / cross + 4.0) * kUnitRoundoff;
@@ -139,8 +139,8 @@ PenetrationResult refine(const Query& q, std::span<const Candidate> candidates,
     // magnitude (exact_value's angle, recomputed cheaply here).
     double widen = 0.0;
     if (c.id.kind == MinkowskiFace::edge_edge && c.id.a0 >= 0 && c.id.b0 >= 0) {
-      const Vec3 ea = q.point_a(c.id.a1) - q.point_a(c.id.a0);
-      const Vec3 eb = q.point_b(c.id.b1) - q.point_b(c.id.b0);
+      const Vec3 ea = detail::exponent_free(q.point_a(c.id.a1) - q.point_a(c.id.a0));
+      const Vec3 eb = detail::exponent_free(q.point_b(c.id.b1) - q.point_b(c.id.b0));
       const double cross = ea.cross(eb).norm();
       widen = cross > 0.0 ? 8.0 * ea.norm() * eb.norm() / cross * kUnitRoundoff * reach : kInfinity;
     }
