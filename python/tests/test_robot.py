@@ -113,3 +113,21 @@ def test_bad_input_is_refused_naming_the_problem(tmp_path):
         proxima.Robot(str(bad))
     with pytest.raises(ValueError, match="hulls"):
         load_panda(mesh_as="hulls")
+
+
+@needs_robots
+def test_ur5_and_talos_load_from_their_urdf_and_srdf():
+    # Talos writes package:///example-robot-data/... (three slashes).
+    packages = [f"example-robot-data={ROBOTS}"]
+    ur5 = proxima.Robot(str(ROBOTS / "robots" / "ur_description" / "urdf" / "ur5_robot.urdf"),
+                        srdf=str(ROBOTS / "robots" / "ur_description" / "srdf" / "ur5.srdf"),
+                        package_dirs=packages)
+    assert ur5.dof == 6
+    talos = proxima.Robot(str(ROBOTS / "robots" / "talos_data" / "robots" / "talos_full_v2.urdf"),
+                          srdf=str(ROBOTS / "robots" / "talos_data" / "srdf" / "talos.srdf"),
+                          package_dirs=packages)
+    assert talos.dof > 30
+    rng = np.random.default_rng(47)
+    for robot in (ur5, talos):
+        r = robot.distances(random_q(robot, rng))
+        assert np.isfinite(r.min_signed_distance)

@@ -82,6 +82,45 @@ TEST(CliRobot, AnswersConfigurationsAsTheLibraryDoesAndBadLinesWithErrors) {
   EXPECT_NE(lines[4]["error"].get<std::string>().find("q[7]"), std::string::npos);
 }
 
+// The UR5 and Talos (package:/// URIs with three slashes) load from the
+// command line as the Panda does, and answer a configuration.
+TEST(CliRobot, Ur5AndTalosAnswerFromTheirUrdf) {
+  if (!std::filesystem::exists(kUrdf)) GTEST_SKIP() << kRobots << " absent";
+  struct Case {
+    std::string urdf, srdf;
+    std::size_t dof;
+  };
+  const Case cases[] = {
+      {kRobots + "/robots/ur_description/urdf/ur5_robot.urdf",
+       kRobots + "/robots/ur_description/srdf/ur5.srdf", 6},
+      {kRobots + "/robots/talos_data/robots/talos_full_v2.urdf",
+       kRobots + "/robots/talos_data/srdf/talos.srdf", 0},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.urdf);
+    proxima::RobotLoadOptions options;
+    options.package_dirs = {"example-robot-data=" + kRobots};
+    const proxima::Robot robot = proxima::load_robot(c.urdf, c.srdf, options);
+    if (c.dof != 0) EXPECT_EQ(static_cast<std::size_t>(robot.dof()), c.dof);
+    const std::vector<double> q(static_cast<std::size_t>(robot.dof()), 0.0);
+    const TempPath input(".jsonl");
+    {
+      std::ofstream file(input.path());
+      file << Json{{"id", 1}, {"q", q}}.dump() << "\n";
+    }
+    const proxima::test::CliRun run =
+        run_cli("robot " + shell_quote(input.path()) + " --urdf " + shell_quote(c.urdf) +
+                " --srdf " + shell_quote(c.srdf) + " --package-dir " +
+                shell_quote("example-robot-data=" + kRobots));
+    ASSERT_EQ(run.exit_code, 0) << run.out;
+    const std::vector<Json> lines = answers(run.out);
+    ASSERT_EQ(lines.size(), 1u) << run.out;
+    const proxima::RobotDistances expected = proxima::robot_distances(robot, q, {});
+    EXPECT_EQ(lines[0].at("min_signed_distance").get<double>(), expected.min_signed_distance)
+        << run.out;
+  }
+}
+
 TEST(CliRobot, AnUnreadableRobotIsAnErrorNamingTheFile) {
   const proxima::test::CliRun run =
       run_cli("robot --urdf /nonexistent/robot.urdf < /dev/null", true);
