@@ -4,7 +4,7 @@
 #   make test  installs what is missing, builds, runs every test (release + sanitizers)
 JOBS ?= $(shell nproc)
 
-.PHONY: all run test setup release asan dev bench fuzz clean results results-quick compare
+.PHONY: all run test test-release setup release asan dev bench fuzz clean results results-quick compare
 
 all: release
 
@@ -34,7 +34,14 @@ PAPER_ARGS ?=
 run: release
 	./build/release/bench/paper_experiments $(PAPER_ARGS)
 
-test: release asan
+# The tests need no micro-benchmark (bench/*_bench): make test builds the
+# release tree without them (a command-line -D overrides the preset's ON;
+# `make release` and every `cmake --preset release` turn them on again).
+test-release: setup
+	cmake --preset release -DPROXIMA_BUILD_BENCH=OFF >/dev/null
+	cmake --build --preset release -j $(JOBS)
+
+test: test-release asan
 	@echo "== unit tests, release build =="
 	ctest --preset release -j $(JOBS)
 	@echo "== unit tests, ASan + UBSan build =="
