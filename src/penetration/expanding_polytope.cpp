@@ -104,6 +104,52 @@ class Expansion {
     return true;
   }
 
+  // P from a kept surface, its vertices placed at this pose; false when
+  // it is not one (an index out of range: never from keep()).
+  bool start_from(const ExpansionSurface& surface) {
+    const auto nv = static_cast<std::int32_t>(surface.vertices.size());
+    const auto nt = static_cast<std::int32_t>(surface.triangles.size());
+    for (const auto& [i, j] : surface.vertices)
+      vertices_.push_back({m_.point_a(i) - m_.point_b(j), i, j});
+    for (const ExpansionSurface::Triangle& t : surface.triangles) {
+      for (std::size_t k = 0; k < 3; ++k)
+        if (t.v[k] < 0 || t.v[k] >= nv || t.adjacent[k] < 0 || t.adjacent[k] >= nt) return false;
+      const int g = add_triangle({t.v[0], t.v[1], t.v[2]});
+      triangles_[static_cast<std::size_t>(g)].adjacent = {t.adjacent[0], t.adjacent[1],
+                                                          t.adjacent[2]};
+    }
+    return nt >= 4;
+  }
+
+  // Writes the live triangles and the vertices they use to `surface`,
+  // renumbered densely (keys in scaled units).
+  void keep(ExpansionSurface& surface) {
+    surface.clear();
+    std::pmr::vector<int> triangle_at(triangles_.size(), -1, triangles_.get_allocator());
+    std::pmr::vector<int> vertex_at(vertices_.size(), -1, vertices_.get_allocator());
+    for (std::size_t g = 0; g < triangles_.size(); ++g) {
+      if (!triangles_[g].alive) continue;
+      triangle_at[g] = static_cast<int>(surface.triangles.size());
+      surface.triangles.push_back({});
+      for (const int v : triangles_[g].v)
+        if (vertex_at[static_cast<std::size_t>(v)] < 0) {
+          vertex_at[static_cast<std::size_t>(v)] = static_cast<int>(surface.vertices.size());
+          const Vertex& x = vertices_[static_cast<std::size_t>(v)];
+          surface.vertices.push_back({x.a, x.b});
+        }
+    }
+    for (std::size_t g = 0; g < triangles_.size(); ++g) {
+      const Triangle& t = triangles_[g];
+      if (!t.alive) continue;
+      ExpansionSurface::Triangle& out = surface.triangles[static_cast<std::size_t>(triangle_at[g])];
+      for (std::size_t k = 0; k < 3; ++k) {
+        out.v[k] = vertex_at[static_cast<std::size_t>(t.v[k])];
+        out.adjacent[k] = triangle_at[static_cast<std::size_t>(t.adjacent[k])];
+      }
+      out.key = t.offset - t.error;
+    }
+  }
+
   ExpansionResult run(int max_iterations) {
     ExpansionResult r;
     for (; r.iterations < max_iterations; ++r.iterations) {
@@ -160,18 +206,10 @@ class Expansion {
   }
 
   int add_triangle(const std::array<int, 3>& v) {
-    const Vec3& p0 = vertices_[static_cast<std::size_t>(v[0])].p;
-    const Vec3 e1 = vertices_[static_cast<std::size_t>(v[1])].p - p0;
-    const Vec3 e2 = vertices_[static_cast<std::size_t>(v[2])].p - p0;
-    const Vec3 c = e1.cross(e2);
-    const double length = c.norm();
-    Triangle t{v, {-1, -1, -1}, Vec3::Zero(), -kInfinity, 0.0, true};
-    if (length > 0.0 && std::isfinite(length)) {
-      t.normal = c / length;
-      t.offset = t.normal.dot(p0);
-      const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
-      t.error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff * p0.lpNorm<1>();
-    }
+    const TrianglePlane plane = triangle_plane(vertices_[static_cast<std::size_t>(v[0])].p,
+                                               vertices_[static_cast<std::size_t>(v[1])].p,
+                                               vertices_[static_cast<std::size_t>(v[2])].p);
+    Triangle t{v, {-1, -1, -1}, plane.normal, plane.offset, plane.error, true};
     const int index = static_cast<int>(triangles_.size());
     triangles_.push_back(t);
     heap_.push_back({t.offset - t.error, index});
@@ -281,6 +319,43 @@ class Expansion {
 };
 
 }  // namespace
+
+TrianglePlane triangle_plane(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  const Vec3 e1 = p1 - p0;
+  const Vec3 e2 = p2 - p0;
+  const Vec3 c = e1.cross(e2);
+  const double length = c.norm();
+  TrianglePlane t;
+  if (length > 0.0 && std::isfinite(length)) {
+    t.normal = c / length;
+    t.offset = t.normal.dot(p0);
+    const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
+    t.error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff * p0.lpNorm<1>();
+  }
+  return t;
+}
+
+bool on_supporting_plane(const TrianglePlane& t, const Vec3& s) {
+  return t.normal.dot(s) - t.offset <= t.error + kBeyondUlps * kUnitRoundoff * s.lpNorm<1>();
+}
+
+ExpansionResult expand_kept_polytope(const MinkowskiSupport& m, int max_iterations,
+                                     ExpansionSurface& surface) {
+  std::array<std::byte, 24576> buffer;
+  std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
+  Expansion e(m, &memory);
+  const bool started = surface.empty() ? e.start() : e.start_from(surface);
+  if (!started) {
+    surface.clear();
+    return {};
+  }
+  const ExpansionResult r = e.run(max_iterations);
+  if (r.certified && r.converged)
+    e.keep(surface);
+  else
+    surface.clear();
+  return r;
+}
 
 ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations) {
   // The scratch lists on the stack: a cold query's expansion is a few

@@ -38,6 +38,7 @@
 #include <limits>
 
 #include "proxima/core/types.h"
+#include "proxima/detail/penetration/expansion_surface.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima::detail {
@@ -75,5 +76,26 @@ struct ExpansionResult {
 // Expands P from the octahedron of M's supports along the six axes, at
 // most `max_iterations` times.
 ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations);
+
+// The same expansion from a kept surface (its vertices placed at m's pose;
+// the octahedron when it is empty), written back to `surface` (keys in m's
+// scaled units, no anchor or order: tracked_expansion.h sets them) when it
+// certified and converged, cleared otherwise.
+ExpansionResult expand_kept_polytope(const MinkowskiSupport& m, int max_iterations,
+                                     ExpansionSurface& surface);
+
+// A triangle's unit normal (along (p1 - p0) x (p2 - p0)), its plane's
+// offset from the origin and a bound on the offset's rounding, as the
+// expansion keys its triangles; offset -infinity for a degenerate one.
+struct TrianglePlane {
+  Vec3 normal = Vec3::Zero();
+  double offset = -std::numeric_limits<double>::infinity();
+  double error = 0.0;
+};
+TrianglePlane triangle_plane(const Vec3& p0, const Vec3& p1, const Vec3& p2);
+
+// Whether the point s of M is not beyond the triangle's plane (n.s within
+// the rounding of its offset and of n.s): the expansion's convergence test.
+bool on_supporting_plane(const TrianglePlane& t, const Vec3& s);
 
 }  // namespace proxima::detail

@@ -67,6 +67,7 @@
 #include "penetration/gauss_map_arcs.h"
 #include "penetration/query.h"
 #include "penetration/refinement.h"
+#include "penetration/tracked_expansion.h"
 #include "penetration/tracking.h"
 #include "penetration/witnesses.h"
 #include "proxima/detail/geometry/exact_predicates.h"
@@ -256,11 +257,18 @@ constexpr double kRoughCosine = 1e-6;
 constexpr double kAcceptRelative = 5e-13;
 constexpr double kAcceptUlps = 0.5 * kContactBandUlps;
 
+// `keep`: the expansion starts from the cache's kept surface and keeps its
+// own there (a B that turned: tracked_expansion.h).
 std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cache,
-                                                 const Pose& b_in_a) {
+                                                 const Pose& b_in_a, bool keep = false) {
   if (q.a.dimension() != 3 || q.b.dimension() != 3) return std::nullopt;
   const detail::MinkowskiSupport m{q.a, q.b, q.rotation, q.rotation_t, q.translation, q.inverse};
-  const detail::ExpansionResult e = detail::expand_polytope(m, kExpansionIterations);
+  bool warm = false;
+  const detail::ExpansionResult e =
+      keep ? detail::track_expansion(
+                 m, {b_in_a, q.unit, q.magnitude, q.b.centroid().norm() + q.b.bounding_radius()},
+                 cache.surface, kExpansionIterations, warm)
+           : detail::expand_polytope(m, kExpansionIterations);
   if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;
   const Vec3& n = e.normal;
   std::array<Candidate, 48> kept;
@@ -326,6 +334,7 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
   // Every face of A - B has a value of at least the certified bound.
   remember_faces(q, cache, b_in_a, candidates, static_cast<std::size_t>(best - candidates.begin()),
                  e.lower, false);
+  r.tracked = warm;
   return r;
 }
 
@@ -361,6 +370,8 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
   if (!has_start)
     if (std::optional<PenetrationResult> r = solve_expanding(q, cache, b_in_a)) return *r;
   const bool turned = has_start && cache.rotation != b_in_a.rotation;
+  if (turned)
+    if (std::optional<PenetrationResult> r = solve_expanding(q, cache, b_in_a, true)) return *r;
   if (turned) cache.prune_margin *= 0.5;
   const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
   return solve_cold(q, true, &cache, b_in_a, has_start ? &start : nullptr, has_start && !turned);
@@ -384,8 +395,23 @@ PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytop
 
 bool penetration_depth_tracked(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                                PenetrationCache& cache, PenetrationResult& out) {
-  if (cache.facets.empty() || !same_pair(cache, a, b) || cache.rotation != b_in_a.rotation)
-    return false;
+  if (cache.facets.empty() || !same_pair(cache, a, b)) return false;
+  if (cache.rotation != b_in_a.rotation) {
+    // A turned B: the kept expansion, when there is one. When it does not
+    // answer, its surface is dropped, so that penetration_depth (if the
+    // caller asks) does not try it twice.
+    if (cache.surface.empty()) return false;
+    Query q(a, b, b_in_a);
+    const std::optional<PenetrationResult> r = solve_expanding(q, cache, b_in_a, true);
+    cache.previous_translation = b_in_a.translation;
+    if (!r) {
+      cache.surface.clear();
+      return false;
+    }
+    out = *r;
+    cache.last_status = out.status;
+    return true;
+  }
   Query q(a, b, b_in_a);
   double margin = 0.0;
   // Near the band the answer needs an enumeration (kRefineBands): not

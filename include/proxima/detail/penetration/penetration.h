@@ -65,6 +65,7 @@
 #include <vector>
 
 #include "proxima/core/types.h"
+#include "proxima/detail/penetration/expansion_surface.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima {
@@ -286,6 +287,11 @@ struct PenetrationCache {
   } witnesses;
   // The status of the last answer given with this cache.
   PenetrationStatus last_status = PenetrationStatus::separated;
+  // The expanding polytope's surface of the last query whose B had turned
+  // (src/penetration/tracked_expansion.h): the next turned query starts
+  // from it; empty when none (a cold cache, or an expansion that did not
+  // certify).
+  detail::ExpansionSurface surface;
 
   bool is_cold() const { return a == nullptr; }
   void reset() { *this = PenetrationCache{}; }
