@@ -100,7 +100,10 @@ constexpr double kWitnessWindow = 2.0 * kValueSlackUlps;
 // within the contact band of point_a (a separated answer's do not).
 bool witnesses_meet(const Query& q, const PenetrationResult& r) {
   if (r.status == PenetrationStatus::separated) return false;
-  return (r.point_b + r.depth * r.normal - r.point_a).norm() <= contact_band(q.magnitude);
+  // In scaled units: near 1e300 the squared norm of a gap of 1e285
+  // overflows, and no answer's witnesses would meet.
+  return ((r.point_b + r.depth * r.normal - r.point_a) * q.inverse).norm() <=
+         contact_band(q.magnitude) * q.inverse;
 }
 
 // Writes the faces of A - B a cold query evaluated into the cache, with
@@ -266,7 +269,11 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
   bool warm = false;
   const detail::ExpansionResult e =
       keep ? detail::track_expansion(
-                 m, {b_in_a, q.unit, q.magnitude, q.b.centroid().norm() + q.b.bounding_radius()},
+                 m,
+                 // The centroid's norm in scaled units: its square would
+                 // overflow near 1e300.
+                 {b_in_a, q.unit, q.magnitude,
+                  (q.b.centroid() * q.inverse).norm() * q.unit + q.b.bounding_radius()},
                  cache.surface, kExpansionIterations, warm)
            : detail::expand_polytope(m, kExpansionIterations);
   if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;

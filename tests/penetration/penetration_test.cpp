@@ -1044,5 +1044,115 @@ TEST(PenetrationTracking, RotationAndForeignCachesAreNeverWrong) {
   }
 }
 
+// Issue 28: the tracked depth under rotation (src/penetration/tracked_expansion.h)
+// keeps the expanding polytope's surface, bounds how far its vertices moved
+// since the anchor and evaluates only the triangles that bound could put
+// below the answer. Its slow twins: the enumeration of every face and edge
+// pair (penetration_depth_brute_force) at every step, and the exact hull of
+// A - B (CGAL) on every `exact_every`-th. B walks with a turn and a
+// translation per step, each from tiny to large (log-uniform), so that the
+// walk crosses many changes of the answer's facet and re-anchors; pulled
+// back towards A when it wanders off. `warm`: the steps answered from the
+// kept surface (PenetrationResult::tracked for a turned B).
+void turning_walk(const Points& a, const Points& b_local, std::uint64_t seed, int steps,
+                  double max_angle, double max_step, double reach, int exact_every,
+                  int& warm) {
+  Rng rng(seed);
+  const ConvexPolytope pa(a), pb(b_local);
+  const double scale = std::max(max_abs_coordinate(a), max_abs_coordinate(b_local));
+  ExactOracle oracle;
+  PenetrationCache cache;
+  Mat3 rotation = random_rotation(rng);
+  Vec3 t = 0.3 * reach * random_unit_vector(rng);
+  warm = 0;
+  for (int i = 0; i < steps; ++i) {
+    rotation = random_small_rotation(rng, log_uniform(rng, 1e-9, max_angle)) * rotation;
+    t += log_uniform(rng, 1e-9 * reach, max_step) * random_unit_vector(rng);
+    if (t.norm() > reach) t *= 0.5;
+    const Pose pose(rotation, t);
+    const PenetrationResult r = penetration_depth(pa, pb, pose, cache);
+    const PenetrationResult twin = penetration_depth_brute_force(pa, pb, pose);
+    const double tol = kContactBandUlps * kUnitRoundoff * 2.0 * scale;
+    ASSERT_EQ(r.status, twin.status) << i;
+    if (r.status == PenetrationStatus::separated) continue;
+    ASSERT_NEAR(r.depth, twin.depth, kRel * twin.depth + tol) << i;
+    // The certificate holds the twin's depth.
+    ASSERT_LE(r.lower_bound, twin.depth * (1 + kRel) + tol) << i;
+    ASSERT_GE(r.upper_bound, twin.depth * (1 - kRel) - tol) << i;
+    if (exact_every > 0 && i % exact_every == 0)
+      ASSERT_TRUE(meets_standard(a, transformed(b_local, pose), r, oracle)) << i;
+    warm += r.tracked;
+  }
+}
+
+TEST(PenetrationTurning, WalksOfRoundHullsStayCertified) {
+  Rng rng(28);
+  const Points a = points_on_sphere(rng, 100);
+  const Points b = points_on_sphere(rng, 60, 0.7);
+  int warm = 0;
+  EXPECT_NO_FATAL_FAILURE(turning_walk(a, b, 1, 300, 0.05, 0.02, 0.5, 60, warm));
+  // Most steps answer from the kept surface (the path this test is for).
+  EXPECT_GE(warm, 150);
+  // Small turns and steps, as a robot's trajectory or a resting contact.
+  EXPECT_NO_FATAL_FAILURE(turning_walk(a, b, 2, 300, 2e-3, 2e-3, 0.5, 100, warm));
+  EXPECT_GE(warm, 250);
+}
+
+TEST(PenetrationTurning, WalksOfBoxesCubesAndThinBodiesStayCertified) {
+  int warm = 0;
+  // Boxes (coplanar faces, parallel edges: ties of facets of A - B), cube
+  // clouds, a sliver and a needle through a box, a flat polygon through a
+  // cube (M flat or thin: the expansion cannot certify and the enumeration
+  // answers), large turns included.
+  Rng rng(280);
+  const Points box_a = box(Vec3(1.0, 0.6, 0.4));
+  const Points box_b = box(Vec3(0.5, 0.5, 0.2));
+  EXPECT_NO_FATAL_FAILURE(turning_walk(box_a, box_b, 3, 200, 0.3, 0.05, 0.6, 10, warm));
+  const Points cloud_a = points_in_cube(rng, 60), cloud_b = points_in_cube(rng, 40, 0.5);
+  EXPECT_NO_FATAL_FAILURE(turning_walk(cloud_a, cloud_b, 4, 200, 0.01, 0.01, 0.6, 20, warm));
+  EXPECT_NO_FATAL_FAILURE(turning_walk(box_a, sliver(rng, 1e-9), 5, 100, 0.05, 0.02, 0.5, 20, warm));
+  EXPECT_NO_FATAL_FAILURE(turning_walk(box_a, needle(rng, 1.0, 1e-7), 6, 100, 0.05, 0.02, 0.5, 20, warm));
+  EXPECT_NO_FATAL_FAILURE(turning_walk(cloud_a, flat_polygon(rng, 12), 7, 100, 0.05, 0.02, 0.5, 20, warm));
+}
+
+TEST(PenetrationTurning, WalksNearTouchingStayCertified) {
+  int warm = 0;
+  // B's centre near A's boundary: depths from a few bands to a few percent,
+  // separated steps between them.
+  Rng rng(2800);
+  const Points a = points_on_sphere(rng, 80);
+  const Points b = points_on_sphere(rng, 50, 0.3);
+  EXPECT_NO_FATAL_FAILURE(turning_walk(a, b, 8, 300, 0.01, 1e-3, 1.3, 30, warm));
+}
+
+TEST(PenetrationTurning, WalksFrom1em300To1e300StayCertified) {
+  Rng rng(28000);
+  const Points a = points_on_sphere(rng, 64);
+  const Points b = points_in_cube(rng, 40, 0.4);
+  for (const double s : {1e-300, 1e-150, 1.0, 1e150, 1e300}) {
+    int warm = 0;
+    EXPECT_NO_FATAL_FAILURE(turning_walk(scaled(a, s), scaled(b, s), 9, 100, 0.01, 0.01 * s,
+                                                0.5 * s, 0, warm))
+        << s;
+    // The same share of warm answers at every scale: the bounds scale with R.
+    EXPECT_GE(warm, 50) << s;
+  }
+}
+
+// The cold query's expansion was never accepted near 1e300: its check that
+// the witnesses meet (point_b + depth n = point_a within the band) squared
+// a gap of about 1e285, which overflowed, so every cold query there fell
+// back to the enumeration (and a turned B never kept its surface). Spheres
+// of radius 1e300 overlapping: answered by the expansion, no enumeration.
+TEST(PenetrationRegression, ExpansionAnswersNear1e300) {
+  Rng rng(1300);
+  const ConvexPolytope a(scaled(points_on_sphere(rng, 64), 1e300));
+  const ConvexPolytope b(scaled(points_on_sphere(rng, 40), 4e299));
+  PenetrationCache cache;
+  const PenetrationResult r = penetration_depth(a, b, Pose(Mat3::Identity(), Vec3(1e299, 5e298, 0.0)), cache);
+  EXPECT_EQ(r.status, PenetrationStatus::intersecting);
+  EXPECT_EQ(cache.enumerations, 0);
+}
+
 }  // namespace
 }  // namespace proxima::test
