@@ -47,6 +47,7 @@ struct Triangle {
   Vec3 normal;
   double offset;
   double error;  // bound on the offset's rounding
+  double normal_error;  // bound on the normal's (TrianglePlane)
   bool alive;
 };
 
@@ -146,6 +147,8 @@ class Expansion {
         out.v[k] = vertex_at[static_cast<std::size_t>(t.v[k])];
         out.adjacent[k] = triangle_at[static_cast<std::size_t>(t.adjacent[k])];
       }
+      out.normal = t.normal;
+      out.normal_error = t.normal_error;
       out.key = t.offset - t.error;
     }
   }
@@ -209,7 +212,7 @@ class Expansion {
     const TrianglePlane plane = triangle_plane(vertices_[static_cast<std::size_t>(v[0])].p,
                                                vertices_[static_cast<std::size_t>(v[1])].p,
                                                vertices_[static_cast<std::size_t>(v[2])].p);
-    Triangle t{v, {-1, -1, -1}, plane.normal, plane.offset, plane.error, true};
+    Triangle t{v, {-1, -1, -1}, plane.normal, plane.offset, plane.error, plane.normal_error, true};
     const int index = static_cast<int>(triangles_.size());
     triangles_.push_back(t);
     heap_.push_back({t.offset - t.error, index});
@@ -330,7 +333,8 @@ TrianglePlane triangle_plane(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
     t.normal = c / length;
     t.offset = t.normal.dot(p0);
     const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
-    t.error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff * p0.lpNorm<1>();
+    t.normal_error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff;
+    t.error = t.normal_error * p0.lpNorm<1>();
   }
   return t;
 }

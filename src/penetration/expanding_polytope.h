@@ -79,7 +79,7 @@ ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations);
 
 // The same expansion from a kept surface (its vertices placed at m's pose;
 // the octahedron when it is empty), written back to `surface` (keys in m's
-// scaled units, no anchor or order: tracked_expansion.h sets them) when it
+// scaled units, no anchor: tracked_expansion.h sets it) when it
 // certified and converged, cleared otherwise.
 ExpansionResult expand_kept_polytope(const MinkowskiSupport& m, int max_iterations,
                                      ExpansionSurface& surface);
@@ -90,7 +90,8 @@ ExpansionResult expand_kept_polytope(const MinkowskiSupport& m, int max_iteratio
 struct TrianglePlane {
   Vec3 normal = Vec3::Zero();
   double offset = -std::numeric_limits<double>::infinity();
-  double error = 0.0;
+  double error = 0.0;         // normal_error |p0|_1
+  double normal_error = 0.0;  // bound on |normal - exact unit normal|
 };
 TrianglePlane triangle_plane(const Vec3& p0, const Vec3& p1, const Vec3& p2);
 

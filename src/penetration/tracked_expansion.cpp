@@ -15,10 +15,11 @@ namespace proxima::detail {
 namespace {
 
 // The rounding of a vertex's placement a_i s - (R (b_j s) + t s) at the
-// anchor and now (a few u of the scaled magnitude each), and of `moved`
-// itself (the Frobenius norm of the rounded R - R_G, a few u relative,
-// times a reach of at most the magnitude), in u of the scaled magnitude:
-// generously above their sum, as the contact band is.
+// anchor and now (a few u of the larger scaled magnitude each), and of the
+// bound itself (the Frobenius norm of the rounded R - R_G, a few u
+// relative, times a reach of at most the magnitude; the dot product with
+// the shift), in u of the scaled magnitude: generously above their sum,
+// as the contact band is.
 constexpr double kMovedUlps = 64.0;
 
 // A kept surface past this many triangles is dropped (the next query
@@ -34,33 +35,51 @@ bool lazy(const MinkowskiSupport& m, const TrackedPose& pose, const ExpansionSur
   // In the query's scaled units (m.inverse, exact): keys and poses are
   // kept in A's units.
   const double inverse = m.inverse;
-  const double moved = (pose.b_in_a.rotation - s.rotation).norm() * (pose.b_reach * inverse) +
-                       ((pose.b_in_a.translation - s.translation) * inverse).norm() +
-                       kMovedUlps * kUnitRoundoff * pose.magnitude * inverse;
-  if (!(s.least * inverse > moved)) return false;
+  const double turn = (pose.b_in_a.rotation - s.rotation).norm() * (pose.b_reach * inverse) +
+                      kMovedUlps * kUnitRoundoff * std::max(pose.magnitude, s.magnitude) * inverse;
+  const Vec3 shift = (pose.b_in_a.translation - s.translation) * inverse;
+  const double shift_1 = shift.lpNorm<1>();
+  // The bound on a triangle's distance from the origin now, from the
+  // anchor (see the header): key - turn - n.shift less the normal's error
+  // on the shift.
+  const auto bound = [&](const ExpansionSurface::Triangle& t) {
+    return t.key * inverse - turn - t.normal.dot(shift) - t.normal_error * shift_1;
+  };
   const auto place = [&](std::int32_t v) {
     const auto& [i, j] = s.vertices[static_cast<std::size_t>(v)];
     return Vec3(m.point_a(i) - m.point_b(j));
   };
-  double best = std::numeric_limits<double>::infinity();
-  TrianglePlane plane;
-  std::int32_t winner = -1;
-  for (const std::int32_t g : s.order) {
-    const ExpansionSurface::Triangle& t = s.triangles[static_cast<std::size_t>(g)];
-    // Sorted by key at the anchor: every triangle after this one has a
-    // bound of at least the best key found.
-    if (!(t.key * inverse - moved < best)) break;
-    const TrianglePlane p = triangle_plane(place(t.v[0]), place(t.v[1]), place(t.v[2]));
-    const double key = p.offset - p.error;
-    if (key < best) {
-      best = key;
+  const auto evaluate = [&](const ExpansionSurface::Triangle& t) {
+    return triangle_plane(place(t.v[0]), place(t.v[1]), place(t.v[2]));
+  };
+  // Every bound positive: the winding number held all the way (the
+  // header's Winding); the least bound's triangle is evaluated first.
+  double least = std::numeric_limits<double>::infinity();
+  std::size_t first = 0;
+  for (std::size_t g = 0; g < s.triangles.size(); ++g) {
+    const double b = bound(s.triangles[g]);
+    if (!(b > 0.0)) return false;
+    if (b < least) {
+      least = b;
+      first = g;
+    }
+  }
+  TrianglePlane plane = evaluate(s.triangles[first]);
+  double best = plane.offset - plane.error;
+  std::size_t winner = first;
+  // Then every triangle whose bound is below the least key evaluated: the
+  // others' bounds are at least it.
+  for (std::size_t g = 0; g < s.triangles.size(); ++g) {
+    if (g == first || !(bound(s.triangles[g]) < best)) continue;
+    const TrianglePlane p = evaluate(s.triangles[g]);
+    if (p.offset - p.error < best) {
+      best = p.offset - p.error;
       plane = p;
       winner = g;
     }
   }
-  if (winner < 0 || !(best > 0.0)) return false;
-  const auto& [hint_a, hint_b] =
-      s.vertices[static_cast<std::size_t>(s.triangles[static_cast<std::size_t>(winner)].v[0])];
+  if (!(best > 0.0)) return false;
+  const auto& [hint_a, hint_b] = s.vertices[static_cast<std::size_t>(s.triangles[winner].v[0])];
   const int i = support_hill_climb(m.a, plane.normal, hint_a);
   const int j = support_hill_climb(m.b, m.rotation_t * (-plane.normal), hint_b);
   const Vec3 support = m.point_a(i) - m.point_b(j);
@@ -76,21 +95,12 @@ bool lazy(const MinkowskiSupport& m, const TrackedPose& pose, const ExpansionSur
   return true;
 }
 
-// Makes the pose of this query the surface's anchor: keys in A's units,
-// sorted.
+// Makes the pose of this query the surface's anchor: keys in A's units.
 void anchor(const TrackedPose& pose, ExpansionSurface& s) {
-  s.order.resize(s.triangles.size());
-  for (std::size_t g = 0; g < s.triangles.size(); ++g) {
-    s.triangles[g].key *= pose.unit;
-    s.order[g] = static_cast<std::int32_t>(g);
-  }
-  std::sort(s.order.begin(), s.order.end(), [&](std::int32_t x, std::int32_t y) {
-    return s.triangles[static_cast<std::size_t>(x)].key <
-           s.triangles[static_cast<std::size_t>(y)].key;
-  });
-  s.least = s.triangles[static_cast<std::size_t>(s.order.front())].key;
+  for (ExpansionSurface::Triangle& t : s.triangles) t.key *= pose.unit;
   s.rotation = pose.b_in_a.rotation;
   s.translation = pose.b_in_a.translation;
+  s.magnitude = pose.magnitude;
 }
 
 }  // namespace

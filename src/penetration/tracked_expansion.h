@@ -10,38 +10,41 @@
 // whose triangles all have positive keys (plane offset less its rounding
 // bound): the origin has winding number at least 1 about P, and the ball of
 // radius min key is in M. The cache keeps P (ExpansionSurface) with each
-// triangle's key at the pose where it was last evaluated in full (the
-// anchor G). At a new pose of B the vertices are the same points of the new
-// M, each moved from its place at G by at most
-//   moved = |R - R_G|_F max_j |b_j| + |t - t_G|
-// (plus their placement's rounding): (R - R_G) b_j + (t - t_G).
+// triangle's key and rounded unit normal n at the pose where they were
+// last evaluated (the anchor G). At a new pose of B its vertices are the
+// same points of the new M, each moved by
+//   -((R - R_G) b_j + (t - t_G)),
+// so along a triangle's exact unit normal n* (within e of n) every point X
+// of it has now
+//   n*.X >= key - turn - n.shift - e |shift|_1 =: bound,
+// turn = |R - R_G|_F max_j |b_j| (plus the placements' rounding), shift =
+// t - t_G: the plane offset at G (at least key) less how far the point
+// can have moved towards the origin along n*.
 //
 // Winding. Move every vertex along the segment from its place at G to its
 // place now: each point of a triangle (the same barycentric combination)
-// moves along a segment of length at most `moved`, so it stays at distance
-// at least key_G - moved > 0 from the origin when the least key at G
-// exceeds `moved`. The origin never meets the moving surface, and its
-// winding number, an integer that changes only there, is still at least 1.
+// moves along a segment, and n*.X along it stays at least min(key, bound)
+// (linear in the segment's parameter). When every triangle's bound is
+// positive, the origin never meets the moving surface, and its winding
+// number about it, an integer that changes only there, is still at least 1.
 //
-// The ball. Every point of a triangle is now within `moved` of a point of
-// the same triangle at G, so its distance from the origin is at least
-// key_G - moved; or, evaluated at this pose, at least its plane's offset
-// less rounding (its key now). Every point of the ball whose radius is the
-// least of these bounds has winding number at least 1 too (the ball does
-// not meet P), so it lies in conv(P), inside M: that radius is a certified
-// lower bound on the depth, as the cold one.
+// The ball. A triangle's distance from the origin is at least its bound
+// (|X| >= n*.X), or, evaluated at this pose, its key now. Every point of
+// the ball whose radius is the least of these has winding number at least
+// 1 too (the ball does not meet P), so it lies in conv(P), inside M: that
+// radius is a certified lower bound on the depth, as the cold one.
 //
-// Laziness. The triangles are sorted by key at G, so the least bound is
-// found by evaluating only the triangles whose key_G - moved is below the
-// least key evaluated so far: those near the answer's facet, a handful when
-// B turned a little. The least triangle's normal n then gives the upper
-// bound h_M(n) from the supports (hill climbing from the triangle's own
-// vertex ids); when n.s is on the triangle's plane (the expansion's
-// convergence test) the answer is certified as a cold expansion's is
-// (penetration.cpp, solve_expanding). Otherwise, and when `moved` reached
-// the least key at G, the expansion goes on from P placed at this pose
-// (every key evaluated again: a new anchor), and falls back to the cold
-// query only when that does not certify.
+// Laziness. A pass over the triangles computes their bounds (a dot
+// product each); only the triangle of least bound, and then those whose
+// bound is below the least key evaluated, are evaluated: those near the
+// answer's facet, a handful when B moved a little. The least triangle's
+// normal n then gives the upper bound h_M(n) from the supports (hill
+// climbing from the triangle's own vertex ids); when n.s is on the
+// triangle's plane (the expansion's convergence test) the answer is
+// certified as a cold expansion's is (penetration.cpp, solve_expanding).
+// Otherwise, and when a bound is not positive, the expansion goes on from
+// P placed at this pose (every key evaluated again: a new anchor), and
+// falls back to the cold query only when that does not certify.
 #pragma once
 
 #include "penetration/expanding_polytope.h"

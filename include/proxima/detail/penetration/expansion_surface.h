@@ -26,23 +26,25 @@ struct ExpansionSurface {
   struct Triangle {
     std::array<std::int32_t, 3> v;         // counter-clockwise seen from outside
     std::array<std::int32_t, 3> adjacent;  // across the edge v[k] -> v[k + 1]
-    double key = 0.0;  // plane offset less its rounding bound at the anchor (A's units)
+    // At the anchor: the rounded unit normal, within normal_error of the
+    // exact one, and the plane's offset less its rounding bound (A's
+    // units), a lower bound on the exact plane's offset.
+    Vec3 normal = Vec3::Zero();
+    double normal_error = 0.0;
+    double key = 0.0;
   };
   std::vector<std::array<std::int32_t, 2>> vertices;  // (vertex of A, vertex of B)
   std::vector<Triangle> triangles;
-  // Triangle indices by key at the anchor, least first.
-  std::vector<std::int32_t> order;
-  // B's pose in A's frame at the anchor (A's units), and the least key
-  // there.
+  // B's pose in A's frame at the anchor (A's units), and the standard's R
+  // there (the vertices' placement rounded relative to it).
   Mat3 rotation = Mat3::Zero();
   Vec3 translation = Vec3::Zero();
-  double least = 0.0;
+  double magnitude = 0.0;
 
   bool empty() const { return triangles.empty(); }
   void clear() {
     vertices.clear();
     triangles.clear();
-    order.clear();
   }
 };
 
