@@ -105,23 +105,6 @@ class Expansion {
     return true;
   }
 
-  // P from a kept surface, its vertices placed at this pose; false when
-  // it is not one (an index out of range: never from keep()).
-  bool start_from(const ExpansionSurface& surface) {
-    const auto nv = static_cast<std::int32_t>(surface.vertices.size());
-    const auto nt = static_cast<std::int32_t>(surface.triangles.size());
-    for (const auto& [i, j] : surface.vertices)
-      vertices_.push_back({m_.point_a(i) - m_.point_b(j), i, j});
-    for (const ExpansionSurface::Triangle& t : surface.triangles) {
-      for (std::size_t k = 0; k < 3; ++k)
-        if (t.v[k] < 0 || t.v[k] >= nv || t.adjacent[k] < 0 || t.adjacent[k] >= nt) return false;
-      const int g = add_triangle({t.v[0], t.v[1], t.v[2]});
-      triangles_[static_cast<std::size_t>(g)].adjacent = {t.adjacent[0], t.adjacent[1],
-                                                          t.adjacent[2]};
-    }
-    return nt >= 4;
-  }
-
   // Writes the live triangles and the vertices they use to `surface`,
   // renumbered densely (keys in scaled units).
   void keep(ExpansionSurface& surface) {
@@ -348,16 +331,10 @@ ExpansionResult expand_kept_polytope(const MinkowskiSupport& m, int max_iteratio
   std::array<std::byte, 24576> buffer;
   std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
   Expansion e(m, &memory);
-  const bool started = surface.empty() ? e.start() : e.start_from(surface);
-  if (!started) {
-    surface.clear();
-    return {};
-  }
+  surface.clear();
+  if (!e.start()) return {};
   const ExpansionResult r = e.run(max_iterations);
-  if (r.certified && r.converged)
-    e.keep(surface);
-  else
-    surface.clear();
+  if (r.certified && r.converged) e.keep(surface);
   return r;
 }
 

@@ -77,10 +77,9 @@ struct ExpansionResult {
 // most `max_iterations` times.
 ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations);
 
-// The same expansion from a kept surface (its vertices placed at m's pose;
-// the octahedron when it is empty), written back to `surface` (keys in m's
-// scaled units, no anchor: tracked_expansion.h sets it) when it
-// certified and converged, cleared otherwise.
+// The same expansion, its surface P written to `surface` (keys in m's
+// scaled units, no anchor: tracked_expansion.h sets it) when it certified
+// and converged, cleared otherwise.
 ExpansionResult expand_kept_polytope(const MinkowskiSupport& m, int max_iterations,
                                      ExpansionSurface& surface);
 

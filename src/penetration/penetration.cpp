@@ -269,11 +269,7 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
   bool warm = false;
   const detail::ExpansionResult e =
       keep ? detail::track_expansion(
-                 m,
-                 // The centroid's norm in scaled units: its square would
-                 // overflow near 1e300.
-                 {b_in_a, q.unit, q.magnitude,
-                  (q.b.centroid() * q.inverse).norm() * q.unit + q.b.bounding_radius()},
+                 m, {b_in_a, q.unit, q.magnitude, q.b.centroid(), q.b.bounding_radius()},
                  cache.surface, kExpansionIterations, warm)
            : detail::expand_polytope(m, kExpansionIterations);
   if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;

@@ -22,12 +22,6 @@ namespace {
 // as the contact band is.
 constexpr double kMovedUlps = 64.0;
 
-// A kept surface past this many triangles is dropped (the next query
-// starts from the octahedron): a long walk keeps refining P where the
-// answer's facet goes, and re-placing all of it at every new anchor would
-// cost more than a cold expansion.
-constexpr std::size_t kMaxSurfaceTriangles = 1024;
-
 // The lazy path (tracked_expansion.h): true with `r` certified and
 // converged when the kept surface answers at this pose without expanding.
 bool lazy(const MinkowskiSupport& m, const TrackedPose& pose, const ExpansionSurface& s,
@@ -35,9 +29,11 @@ bool lazy(const MinkowskiSupport& m, const TrackedPose& pose, const ExpansionSur
   // In the query's scaled units (m.inverse, exact): keys and poses are
   // kept in A's units.
   const double inverse = m.inverse;
-  const double turn = (pose.b_in_a.rotation - s.rotation).norm() * (pose.b_reach * inverse) +
+  const Mat3 turned = pose.b_in_a.rotation - s.rotation;
+  const double turn = turned.norm() * (pose.b_radius * inverse) +
                       kMovedUlps * kUnitRoundoff * std::max(pose.magnitude, s.magnitude) * inverse;
-  const Vec3 shift = (pose.b_in_a.translation - s.translation) * inverse;
+  const Vec3 shift =
+      turned * (pose.b_centroid * inverse) + (pose.b_in_a.translation - s.translation) * inverse;
   const double shift_1 = shift.lpNorm<1>();
   // The bound on a triangle's distance from the origin now, from the
   // anchor (see the header): key - turn - n.shift less the normal's error
@@ -110,8 +106,13 @@ ExpansionResult track_expansion(const MinkowskiSupport& m, const TrackedPose& po
   ExpansionResult r;
   warm = !surface.empty() && lazy(m, pose, surface, r);
   if (warm) return r;
+  // Not answered from the kept surface: a fresh expansion from the
+  // octahedron, rather than one going on from P placed here. P has grown
+  // where the answer's facet was (a hundred triangles on a robot's links),
+  // and placing all of it again cost more than a fresh start on the
+  // robots' hulls and on spheres up to N = 512 (instruction counts in the
+  // commit that chose this).
   r = expand_kept_polytope(m, max_iterations, surface);
-  if (surface.triangles.size() > kMaxSurfaceTriangles) surface.clear();
   if (!surface.empty()) anchor(pose, surface);
   return r;
 }

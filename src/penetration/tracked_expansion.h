@@ -13,13 +13,15 @@
 // triangle's key and rounded unit normal n at the pose where they were
 // last evaluated (the anchor G). At a new pose of B its vertices are the
 // same points of the new M, each moved by
-//   -((R - R_G) b_j + (t - t_G)),
-// so along a triangle's exact unit normal n* (within e of n) every point X
-// of it has now
+//   -((R - R_G) b_j + (t - t_G)) = -((R - R_G) (b_j - c) + shift),
+// c B's centroid, shift = (R - R_G) c + (t - t_G) the same for all, so
+// along a triangle's exact unit normal n* (within e of n) every point X of
+// it has now
 //   n*.X >= key - turn - n.shift - e |shift|_1 =: bound,
-// turn = |R - R_G|_F max_j |b_j| (plus the placements' rounding), shift =
-// t - t_G: the plane offset at G (at least key) less how far the point
-// can have moved towards the origin along n*.
+// turn = |R - R_G|_F max_j |b_j - c| (plus the placements' rounding): the
+// plane offset at G (at least key) less how far the point can have moved
+// towards the origin along n*. A turn about B's centroid costs only B's
+// radius about it, wherever B's frame is.
 //
 // Winding. Move every vertex along the segment from its place at G to its
 // place now: each point of a triangle (the same barycentric combination)
@@ -42,9 +44,9 @@
 // climbing from the triangle's own vertex ids); when n.s is on the
 // triangle's plane (the expansion's convergence test) the answer is
 // certified as a cold expansion's is (penetration.cpp, solve_expanding).
-// Otherwise, and when a bound is not positive, the expansion goes on from
-// P placed at this pose (every key evaluated again: a new anchor), and
-// falls back to the cold query only when that does not certify.
+// Otherwise, and when a bound is not positive, a fresh expansion from the
+// octahedron answers and its P is kept (a new anchor); the enumeration
+// answers only when that does not certify.
 #pragma once
 
 #include "penetration/expanding_polytope.h"
@@ -53,20 +55,19 @@ namespace proxima::detail {
 
 // B's pose in A's frame (A's units), the query's unit (a power of two: m's
 // inverse is its reciprocal), R (the standard's magnitude, A's units), and
-// the largest distance of a vertex of B from B's origin (A's units) or a
-// bound above it.
+// B's centroid (B's frame) and the largest distance of a vertex of B from
+// it.
 struct TrackedPose {
   const Pose& b_in_a;
   double unit;
   double magnitude;
-  double b_reach;
+  Vec3 b_centroid;
+  double b_radius;
 };
 
-// The expanding polytope's result at this pose, from the kept surface when
-// there is one (from the octahedron when not), keeping P in `surface` for
-// the next query (cleared when the expansion did not certify, or when P
-// grew past kMaxSurfaceTriangles). `warm` tells whether the kept surface
-// answered without an expansion (the lazy path).
+// The expanding polytope's result at this pose: from the kept surface when
+// it answers (`warm`), else from a fresh expansion, whose P is kept in
+// `surface` for the next query (cleared when it did not certify).
 ExpansionResult track_expansion(const MinkowskiSupport& m, const TrackedPose& pose,
                                 ExpansionSurface& surface, int max_iterations, bool& warm);
 
