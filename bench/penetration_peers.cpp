@@ -4,6 +4,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 //   ./build/release/bench/penetration_peers [--passes 5] [--sample 40] [--quick]
+//       [--turn RAD]   (B also turns RAD radians per step: the tracked
+//                       depth under rotation, issue 28)
 //
 // Bodies: A = hull of N points on the unit sphere, B = hull of N points on
 // the sphere of radius 0.8 (seeded; N = 8, 64, 512, 4096). A sits at the
@@ -124,24 +126,31 @@ struct Options {
   // referee (each costs 0.5 to 1 s); the rest are counted as not refereed.
   int max_refereed_disagreements = 16;
   std::vector<int> sizes = {8, 64, 512, 4096};
+  double turn = 0.0;  // radians per step (--turn)
 };
 
 // The sweep: B's pose in A's frame (A at the identity).
 constexpr double kSweepStep = 1.6e-3;
 constexpr double kSweepHalfLength = 2.4;
 
-std::vector<Pose> sweep() {
+// `turn`: B also turns by this many radians per step about a fixed axis
+// (--turn; 0: the paper's translation sweep).
+std::vector<Pose> sweep(double turn) {
   const int steps = static_cast<int>(std::lround(4 * kSweepHalfLength / kSweepStep));
   std::vector<Pose> poses;
   poses.reserve(static_cast<std::size_t>(steps));
   const Vec3 dir = Vec3(1.0, 0.3, -0.2).normalized();
+  const Vec3 axis = Vec3(1.0, 2.0, 3.0).normalized();
   const Mat3 rotation =
       Quat(Eigen::AngleAxisd(0.7, Vec3(0.2, -1.0, 0.4).normalized())).toRotationMatrix();
   for (int i = 0; i < steps; ++i) {
     const double phase = static_cast<double>(i) / steps;
     const double h = kSweepHalfLength;
     const double s = phase < 0.5 ? -h + 4 * h * phase : 3 * h - 4 * h * phase;
-    poses.emplace_back(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
+    const Mat3 r = turn == 0.0
+                       ? rotation
+                       : Mat3(Quat(Eigen::AngleAxisd(turn * i, axis)).toRotationMatrix() * rotation);
+    poses.emplace_back(r, s * dir + Vec3(0.01, 0.02, -0.03));
   }
   return poses;
 }
@@ -445,7 +454,7 @@ SizeResult run_size(int n, const Options& opt) {
   const std::vector<Vec3> va = points_on_sphere(rng, n, 1.0);
   const std::vector<Vec3> vb = points_on_sphere(rng, n, 0.8);
   const ConvexPolytope a(va), b(vb);
-  const std::vector<Pose> poses = sweep();
+  const std::vector<Pose> poses = sweep(opt.turn);
 
   ProximaSystem tracked(a, b, poses, true), cold(a, b, poses, false);
   FclSystem fcl(a, b, poses);
@@ -589,12 +598,12 @@ void print_results(const std::vector<SizeResult>& results, const Options& opt) {
       "(bench/penetration_peers)\n\n");
   std::printf(
       "B (N points on a sphere of radius 0.8) sweeps through A (N points on the unit "
-      "sphere) and back, %d poses in steps of %.1e, B's rotation fixed. Median over %d "
+      "sphere) and back, %d poses in steps of %.1e, B turning %g rad per step. Median over %d "
       "passes of the thread's CPU time per query, in ns. proxima tracked runs every pose "
       "in order with one DistanceCache; proxima cold and the peers (no tracking) every "
       "k-th pose of the same sweep ('untracked poses'). ratio = proxima tracked / peer "
       "(proxima cold / peer in brackets): below 1, proxima is faster.\n\n",
-      results.front().poses, kSweepStep, opt.passes);
+      results.front().poses, kSweepStep, opt.turn, opt.passes);
   std::printf("| N | overlapping | untracked poses | proxima tracked | proxima cold |");
   for (std::size_t k = 2; k < results[0].rows.size(); ++k)
     std::printf(" %s | ratio |", results[0].rows[k].name.c_str());
@@ -724,8 +733,18 @@ int main(int argc, char** argv) {
       opt.untracked_budget = 40000;
       opt.untracked_min = 20;
       opt.max_refereed_disagreements = 2;
+    } else if (arg == "--turn") {
+      char* end = nullptr;
+      opt.turn = next != nullptr ? std::strtod(next, &end) : NAN;
+      if (next == nullptr || *end != '\0' || !(std::abs(opt.turn) <= 1.0)) {
+        std::fprintf(stderr, "penetration_peers: --turn needs radians per step in [-1, 1], got '%s'\n",
+                     next != nullptr ? next : "");
+        return 2;
+      }
+      ++i;
     } else {
-      std::fprintf(stderr, "usage: penetration_peers [--passes P] [--sample K] [--quick]\n");
+      std::fprintf(stderr,
+                   "usage: penetration_peers [--passes P] [--sample K] [--quick] [--turn RAD]\n");
       return 2;
     }
   }

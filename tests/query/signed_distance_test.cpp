@@ -196,6 +196,7 @@ TEST(SignedDistanceOption, SeparatedAnswersAreBitForBitThoseWithoutTheDepth) {
     skip.penetration = false;
     DistanceCache cache_with, cache_skip;
     int separated = 0, overlapping = 0;
+    bool after_overlap = false;
     for (int i = 0; i < 400; ++i) {
       const double t = 2.0 * std::numbers::pi * i / 400;
       const Pose pb(Quat(Eigen::AngleAxisd(0.01 * i, Vec3(1, 2, 3).normalized())),
@@ -203,9 +204,23 @@ TEST(SignedDistanceOption, SeparatedAnswersAreBitForBitThoseWithoutTheDepth) {
       const DistanceResult x = distance(a, Pose::identity(), b, pb, with, &cache_with);
       const DistanceResult y = distance(a, Pose::identity(), b, pb, skip, &cache_skip);
       if (x.status != Status::intersecting) {
-        ASSERT_TRUE(same_answer(x, y)) << to_string(algorithm) << " step " << i;
+        // The first separated step after an overlap: the tracked depth
+        // answered the overlapping steps without running the algorithm
+        // (issue 28: a turning B too), so the algorithm starts from an
+        // older warm state than without the depth and may take other
+        // iterations to the same answer; every other field is the same.
+        if (after_overlap) {
+          DistanceResult z = x;
+          z.iterations = y.iterations;
+          z.second_algorithm = y.second_algorithm;
+          ASSERT_TRUE(same_answer(z, y)) << to_string(algorithm) << " step " << i;
+        } else {
+          ASSERT_TRUE(same_answer(x, y)) << to_string(algorithm) << " step " << i;
+        }
+        after_overlap = false;
         ++separated;
       } else {
+        after_overlap = true;
         ASSERT_EQ(y.status, Status::intersecting);
         ASSERT_TRUE(same_bits(x.distance, y.distance) && same_bits(x.lower_bound, y.lower_bound));
         ++overlapping;

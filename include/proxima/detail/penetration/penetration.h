@@ -167,9 +167,13 @@ struct PenetrationResult {
 // groups expands them: each is enumerated alone at the new pose (pruned
 // against the best value, its own pruned parts kept as new groups), its
 // faces join the cache, and the search certifies again. A rotated B
-// enumerates again; so does the first translation after a cold
-// enumeration (which records no groups: a caller querying cold every time
-// would pay for them).
+// first tries the expanding polytope's surface kept from the last turned
+// query (`surface`, src/penetration/tracked_expansion.h: its keys bounded
+// by how far B moved, a few triangles evaluated again), then a fresh
+// expansion (whose surface it keeps), and enumerates only when neither
+// certifies; the first translation after a cold enumeration enumerates
+// again (it records no groups: a caller querying cold every time would
+// pay for them).
 struct PenetrationCache {
   struct Facet {
     MinkowskiFaceId id;
@@ -309,17 +313,21 @@ struct PenetrationCache {
 // face of A - B (and every edge of A with all its edge pairs) whose lower
 // bound exceeds the best value found so far, so that only the faces near
 // the answer are evaluated; a tracked query (same pair, same rotation, see
-// PenetrationCache) searches the cached faces' tree. A rotated B enumerates
-// again (with the cached face normals and the last answer as the first
-// bound). Not thread-safe on one cache; the polytopes may be shared.
+// PenetrationCache) searches the cached faces' tree. A rotated B answers
+// from the kept expansion when it certifies, else from a fresh one, else
+// enumerates again (with the cached face normals and the last answer as
+// the first bound). Not thread-safe on one cache; the polytopes may be
+// shared.
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
                                     const Pose& b_in_a, PenetrationCache& cache);
 
 // The tracked query alone: when `cache` holds this pair's faces of A - B
 // at B's rotation and certifies their least value without enumerating
 // again (the translation-only path of penetration_depth, expansions of
-// pruned groups included), fills `out` with the answer penetration_depth
-// would give and returns true; else returns false, `out` and the answer's
+// pruned groups included), or B turned and the kept expansion's surface
+// certifies the depth (dropped when it does not), fills `out` with the
+// answer penetration_depth would give and returns true; else returns
+// false, `out` and the answer's
 // cache state unchanged (the tree's bounds may have been tightened, faces
 // added), and the caller decides whether the depth is wanted (distance() asks it first for a pair
 // that was penetrating, and skips its own algorithm when the depth certifies the overlap).
