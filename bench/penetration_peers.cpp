@@ -97,6 +97,7 @@
 #include "proxima/detail/penetration/penetration.h"
 #include "support/exact_oracle.h"
 #include "support/penetration_oracle.h"
+#include "support/penetration_sweep.h"
 #include "support/random.h"
 
 static_assert(sizeof(btScalar) == 8,
@@ -125,26 +126,6 @@ struct Options {
   int max_refereed_disagreements = 16;
   std::vector<int> sizes = {8, 64, 512, 4096};
 };
-
-// The sweep: B's pose in A's frame (A at the identity).
-constexpr double kSweepStep = 1.6e-3;
-constexpr double kSweepHalfLength = 2.4;
-
-std::vector<Pose> sweep() {
-  const int steps = static_cast<int>(std::lround(4 * kSweepHalfLength / kSweepStep));
-  std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(steps));
-  const Vec3 dir = Vec3(1.0, 0.3, -0.2).normalized();
-  const Mat3 rotation =
-      Quat(Eigen::AngleAxisd(0.7, Vec3(0.2, -1.0, 0.4).normalized())).toRotationMatrix();
-  for (int i = 0; i < steps; ++i) {
-    const double phase = static_cast<double>(i) / steps;
-    const double h = kSweepHalfLength;
-    const double s = phase < 0.5 ? -h + 4 * h * phase : 3 * h - 4 * h * phase;
-    poses.emplace_back(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
-  }
-  return poses;
-}
 
 // ---------------------------------------------------------------------------
 // The systems: each answers the signed distance of pose i.
@@ -441,11 +422,10 @@ std::string format_pose(const Pose& p) {
 SizeResult run_size(int n, const Options& opt) {
   SizeResult out;
   out.n = n;
-  Rng rng(static_cast<std::uint64_t>(n) * 7919 + 1);
-  const std::vector<Vec3> va = points_on_sphere(rng, n, 1.0);
-  const std::vector<Vec3> vb = points_on_sphere(rng, n, 0.8);
-  const ConvexPolytope a(va), b(vb);
-  const std::vector<Pose> poses = sweep();
+  const SweepBodies bodies = penetration_sweep_bodies(n);
+  const ConvexPolytope& a = bodies.a;
+  const ConvexPolytope& b = bodies.b;
+  const std::vector<Pose> poses = penetration_sweep();
 
   ProximaSystem tracked(a, b, poses, true), cold(a, b, poses, false);
   FclSystem fcl(a, b, poses);
@@ -516,8 +496,8 @@ SizeResult run_size(int n, const Options& opt) {
   }
   auto band_at = [&](std::size_t i) {
     double radius = 0.0;
-    for (const Vec3& v : va) radius = std::max(radius, v.cwiseAbs().maxCoeff());
-    for (const Vec3& v : vb) radius = std::max(radius, poses[i].apply(v).cwiseAbs().maxCoeff());
+    for (const Vec3& v : a.vertices()) radius = std::max(radius, v.cwiseAbs().maxCoeff());
+    for (const Vec3& v : b.vertices()) radius = std::max(radius, poses[i].apply(v).cwiseAbs().maxCoeff());
     return kContactBandUlps * 0x1p-53 * radius;
   };
   // The screen: every untracked pose, every other system against proxima
