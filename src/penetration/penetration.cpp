@@ -239,8 +239,15 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
 // answer to the enumeration.
 //
 // The expansion's iteration cap: past it, the enumeration is cheaper (a B
-// near A's centre, where many facets of A - B are near the depth).
+// near A's centre, where many facets of A - B are near the depth). The
+// enumeration's cost grows like the vertex count (every face's normal and
+// pruning bound), an iteration's does not: the cap is at least
+// kExpansionIterations and grows with the hulls, one iteration per
+// kVerticesPerIteration vertices of the two hulls (an iteration costs
+// about as much as the enumeration's work on a few vertices; past the cap
+// the expansion's work is lost).
 constexpr int kExpansionIterations = 256;
+constexpr int kVerticesPerIteration = 8;
 // A face or edge pair is a candidate when its normal's cosine with the
 // expansion's is at least 1 - this: the facet's normal is within rounding
 // of the expansion's (a few hundred u for a well-shaped triangle), and
@@ -260,7 +267,9 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
                                                  const Pose& b_in_a) {
   if (q.a.dimension() != 3 || q.b.dimension() != 3) return std::nullopt;
   const detail::MinkowskiSupport m{q.a, q.b, q.rotation, q.rotation_t, q.translation, q.inverse};
-  const detail::ExpansionResult e = detail::expand_polytope(m, kExpansionIterations);
+  const int cap = std::max(kExpansionIterations,
+                           (q.a.vertex_count() + q.b.vertex_count()) / kVerticesPerIteration);
+  const detail::ExpansionResult e = detail::expand_polytope(m, cap);
   if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;
   const Vec3& n = e.normal;
   std::array<Candidate, 48> kept;
