@@ -14,9 +14,11 @@
 // default 7) and prints the queries, how many overlap, and the sum of the
 // signed distances (printed to the last bit, so that two builds can be
 // compared); instructions per query = the collected total / the queries.
-// A third argument `overlapping` keeps only the overlapping poses. With
-// `--passes P` first, it also times P passes (thread CPU time) and prints
-// the median ns per query.
+// A third argument `overlapping` keeps only the overlapping poses;
+// `tracked` runs the same poses in sweep order with one DistanceCache (the
+// tracked depth, for comparison; stride 1 is penetration_peers' tracked
+// sweep). With `--passes P` first, it also times P passes (thread CPU
+// time) and prints the median ns per query.
 #include <time.h>
 
 #include <algorithm>
@@ -47,8 +49,10 @@ int main(int argc, char** argv) {
     arg = 3;
   }
   if (argc - arg < 1 || argc - arg > 3 ||
-      (argc - arg == 3 && std::strcmp(argv[arg + 2], "overlapping") != 0)) {
-    std::fprintf(stderr, "usage: cold_instructions [--passes P] N [stride] [overlapping]\n");
+      (argc - arg == 3 && std::strcmp(argv[arg + 2], "overlapping") != 0 &&
+       std::strcmp(argv[arg + 2], "tracked") != 0)) {
+    std::fprintf(stderr,
+                 "usage: cold_instructions [--passes P] N [stride] [overlapping|tracked]\n");
     return 2;
   }
   const int n = std::atoi(argv[arg]);
@@ -57,7 +61,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "cold_instructions: N >= 4, stride >= 1 and passes >= 0 needed\n");
     return 2;
   }
-  const bool overlapping_only = argc - arg == 3;
+  const bool overlapping_only = argc - arg == 3 && argv[arg + 2][0] == 'o';
+  const bool tracked = argc - arg == 3 && argv[arg + 2][0] == 't';
   const bench::SweepBodies bodies = bench::penetration_sweep_bodies(n);
   const std::vector<Pose> sweep = bench::penetration_sweep();
   std::vector<Pose> poses;
@@ -68,21 +73,26 @@ int main(int argc, char** argv) {
       continue;
     poses.push_back(sweep[i]);
   }
+  // A cold query is distance() without a cache.
+  DistanceCache cache;
+  DistanceCache* const cache_or_null = tracked ? &cache : nullptr;
   double sum = 0.0;
   int overlapping = 0;
   for (const Pose& p : poses) {
-    const DistanceResult r = distance(bodies.a, Pose::identity(), bodies.b, p);
+    const DistanceResult r = distance(bodies.a, Pose::identity(), bodies.b, p, {}, cache_or_null);
     sum += r.signed_distance();
     overlapping += r.status == Status::intersecting ? 1 : 0;
   }
-  std::printf("N = %d: %zu cold queries, %d overlapping, sum of signed distances %a\n", n,
-              poses.size(), overlapping, sum);
+  std::printf("N = %d: %zu %s queries, %d overlapping, sum of signed distances %a\n", n,
+              poses.size(), tracked ? "tracked" : "cold", overlapping, sum);
   if (passes > 0) {
     std::vector<double> ns;
     for (int k = 0; k < passes; ++k) {
       const double t0 = thread_cpu_ns();
       double s = 0.0;
-      for (const Pose& p : poses) s += distance(bodies.a, Pose::identity(), bodies.b, p).signed_distance();
+      cache.reset();
+      for (const Pose& p : poses)
+        s += distance(bodies.a, Pose::identity(), bodies.b, p, {}, cache_or_null).signed_distance();
       ns.push_back((thread_cpu_ns() - t0) / static_cast<double>(poses.size()));
       if (s != sum) std::printf("pass %d: the sum differs (%a)\n", k, s);
     }
