@@ -292,9 +292,8 @@ double pass_ns(System& system, const std::vector<std::size_t>& indices) {
 // touching, +1 separated) and the exact square of its magnitude.
 struct Referee {
   int sign = 0;
-  // |sd*|^2: exact from the depth oracle (CGAL's number type) or from the
-  // distance oracle and the slow twin (GMP rationals).
-  std::optional<test::ExactFT> depth_squared;
+  // |sd*|^2 in GMP rationals: exact from the depth and distance oracles,
+  // the slow twin's double squared otherwise.
   mpq_class magnitude_squared = 0;
   double value = 0.0;  // sd*, rounded
   bool exact = true;   // false: proxima's slow twin (double)
@@ -321,7 +320,7 @@ std::optional<Referee> referee(const ConvexPolytope& a, const ConvexPolytope& b,
     const test::ExactDepth e = test::exact_depth(pa, pb);
     if (e.flat || e.origin != test::OriginInM::inside) return separated_or_touching();
     r.sign = -1;
-    r.depth_squared = e.depth_squared;
+    r.magnitude_squared = e.depth_squared;
     r.value = -e.depth();
     return r;
   }
@@ -354,10 +353,6 @@ struct Accuracy {
 bool within(double sd, const Referee& ref, double rel, double band) {
   const int s = sd > 0 ? 1 : sd < 0 ? -1 : 0;
   if (s == 0 || ref.sign == 0 || s == ref.sign) {
-    if (ref.depth_squared) {
-      const test::ScopedFpTrapsOff traps_off;
-      return test::within_bound(std::abs(sd), *ref.depth_squared, rel, band);
-    }
     return test::within_bound(std::abs(sd), ref.magnitude_squared, rel, band);
   }
   // Opposite signs: |sd - sd*| = |sd| + |sd*|.
