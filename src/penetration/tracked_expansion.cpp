@@ -102,7 +102,8 @@ void anchor(const TrackedPose& pose, ExpansionSurface& s) {
 }  // namespace
 
 ExpansionResult track_expansion(const MinkowskiSupport& m, const TrackedPose& pose,
-                                ExpansionSurface& surface, int max_iterations, bool& warm) {
+                                ExpansionSurface& surface, int max_iterations,
+                                const DepthSeed& seed, bool& warm) {
   ExpansionResult r;
   warm = !surface.empty() && lazy(m, pose, surface, r);
   if (warm) return r;
@@ -112,7 +113,7 @@ ExpansionResult track_expansion(const MinkowskiSupport& m, const TrackedPose& po
   // and placing all of it again cost more than a fresh start on the
   // robots' hulls and on spheres up to N = 512 (instruction counts in the
   // commit that chose this).
-  r = expand_kept_polytope(m, max_iterations, surface);
+  r = expand_kept_polytope(m, max_iterations, surface, seed);
   if (!surface.empty()) anchor(pose, surface);
   return r;
 }

@@ -67,8 +67,10 @@ struct TrackedPose {
 
 // The expanding polytope's result at this pose: from the kept surface when
 // it answers (`warm`), else from a fresh expansion, whose P is kept in
-// `surface` for the next query (cleared when it did not certify).
+// `surface` for the next query (cleared when it did not certify); `seed`
+// as expand_polytope's.
 ExpansionResult track_expansion(const MinkowskiSupport& m, const TrackedPose& pose,
-                                ExpansionSurface& surface, int max_iterations, bool& warm);
+                                ExpansionSurface& surface, int max_iterations,
+                                const DepthSeed& seed, bool& warm);
 
 }  // namespace proxima::detail
