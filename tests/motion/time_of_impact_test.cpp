@@ -452,51 +452,6 @@ TEST(TimeOfImpact, MotionAtIsTheAngleAxisTurnAndStaysRigid) {
   }
 }
 
-// The exact first time of contact of the hull of `a` (fixed) and the hull of
-// `b` translated by t u, t in [0, 1]: the ray t u entering M = A - B (CGAL's
-// exact hull of the differences of the given doubles), or nothing when it
-// misses M or enters after t = 1. Exact rationals throughout; rounded once
-// at the end.
-std::optional<double> exact_translation_toi(const std::vector<Vec3>& a, const std::vector<Vec3>& b,
-                                            const Vec3& u) {
-  using test::ExactFT;
-  using test::ExactKernel;
-  using test::ExactPoint;
-  test::ScopedFpTrapsOff traps_off;
-  std::vector<ExactPoint> m;
-  for (const Vec3& x : a)
-    for (const Vec3& y : b)
-      m.emplace_back(ExactFT(x.x()) - ExactFT(y.x()), ExactFT(x.y()) - ExactFT(y.y()),
-                     ExactFT(x.z()) - ExactFT(y.z()));
-  CGAL::Polyhedron_3<ExactKernel> hull;
-  CGAL::convex_hull_3(m.begin(), m.end(), hull);
-  const ExactKernel::Vector_3 ue(ExactFT(u.x()), ExactFT(u.y()), ExactFT(u.z()));
-  ExactFT enter = 0;  // the ray t u is inside M for t in [enter, leave]
-  std::optional<ExactFT> leave;
-  const ExactPoint origin(0, 0, 0);
-  for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
-    auto h = f->facet_begin();
-    const ExactPoint& p0 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p1 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p2 = h->vertex()->point();
-    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);  // outward
-    const ExactFT offset = n * (p0 - origin);              // inside: n . x <= offset
-    const ExactFT along = n * ue;
-    if (along == 0) {
-      if (offset < 0) return std::nullopt;  // parallel and outside
-    } else if (along < 0) {
-      enter = CGAL::max(enter, offset / along);
-    } else {
-      const ExactFT t = offset / along;
-      leave = leave ? CGAL::min(*leave, t) : t;
-    }
-  }
-  if ((leave && enter > *leave) || enter > 1) return std::nullopt;
-  return CGAL::to_double(enter);
-}
-
 // Pure translation against the exact oracle: 80 seeded pairs, B moving
 // towards A (most hit, some miss by a margin, some graze). Every contact
 // found is never after t* and within the tolerance of it; every t* in
@@ -514,7 +469,7 @@ TEST(TimeOfImpact, PureTranslationAgreesWithTheExactRayAgainstTheMinkowskiHull) 
     for (Vec3& y : pb) y += (3.0 + u01(rng)) * dir;  // B starts about 3 to 4 away
     const Vec3 aim = 0.6 * Vec3(g(rng), g(rng), g(rng));
     const Vec3 move = (aim - (pb[0] - 0.0 * dir)).normalized() * (4.0 + 4.0 * u01(rng));
-    const std::optional<double> t_star = exact_translation_toi(pa, pb, move);
+    const std::optional<double> t_star = test::exact_translation_toi(pa, pb, move);
     for (const int e : {0, -996, 996}) {
       SCOPED_TRACE("trial " + std::to_string(trial) + ", scale 2^" + std::to_string(e));
       const double s = std::ldexp(1.0, e);

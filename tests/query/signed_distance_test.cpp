@@ -333,7 +333,7 @@ TEST(SignedDistanceOracle, OverlapsAtTheBandHaveTheExactStatus) {
     if (exact.flat || exact.origin != OriginInM::inside) continue;
     const double band = band_of(a, b);
     const double d = exact.depth();
-    const bool deep = exact.depth_squared > ExactFT(band) * ExactFT(band);
+    const bool deep = exact.depth_squared > mpq_class(band) * mpq_class(band);
     above += deep && d < 2 * band;
     below += !deep && d > 0.5 * band;
     const ConvexPolytope pa(a), pb(b);
