@@ -2,7 +2,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // scene layer (internal): the state of a Scene (Scene::Impl) and the helpers
-// its three files share: scene.cpp (bodies, filters, step), scene_sweep.cpp
+// its four files share: scene.cpp (bodies, filters, step), scene_margin.cpp
+// (step_within, first_within: the collision checks), scene_sweep.cpp
 // (continuous collision) and scene_queries.cpp (nearest_pair,
 // pairs_within, the twins).
 //
@@ -45,7 +46,7 @@
 #include "scene/broad_phase.h"
 
 // The helpers live in a namespace of their own, brought into proxima's by
-// the using-directive below: this header is private to the scene's three
+// the using-directive below: this header is private to the scene's four
 // files, which read them unqualified as they did in one file.
 namespace proxima::scene_impl {
 
