@@ -97,6 +97,7 @@
 #include "proxima/detail/penetration/penetration.h"
 #include "support/exact_oracle.h"
 #include "support/penetration_oracle.h"
+#include "support/penetration_sweep.h"
 #include "support/random.h"
 
 static_assert(sizeof(btScalar) == 8,
@@ -125,26 +126,6 @@ struct Options {
   int max_refereed_disagreements = 16;
   std::vector<int> sizes = {8, 64, 512, 4096};
 };
-
-// The sweep: B's pose in A's frame (A at the identity).
-constexpr double kSweepStep = 1.6e-3;
-constexpr double kSweepHalfLength = 2.4;
-
-std::vector<Pose> sweep() {
-  const int steps = static_cast<int>(std::lround(4 * kSweepHalfLength / kSweepStep));
-  std::vector<Pose> poses;
-  poses.reserve(static_cast<std::size_t>(steps));
-  const Vec3 dir = Vec3(1.0, 0.3, -0.2).normalized();
-  const Mat3 rotation =
-      Quat(Eigen::AngleAxisd(0.7, Vec3(0.2, -1.0, 0.4).normalized())).toRotationMatrix();
-  for (int i = 0; i < steps; ++i) {
-    const double phase = static_cast<double>(i) / steps;
-    const double h = kSweepHalfLength;
-    const double s = phase < 0.5 ? -h + 4 * h * phase : 3 * h - 4 * h * phase;
-    poses.emplace_back(rotation, s * dir + Vec3(0.01, 0.02, -0.03));
-  }
-  return poses;
-}
 
 // ---------------------------------------------------------------------------
 // The systems: each answers the signed distance of pose i.
@@ -311,9 +292,8 @@ double pass_ns(System& system, const std::vector<std::size_t>& indices) {
 // touching, +1 separated) and the exact square of its magnitude.
 struct Referee {
   int sign = 0;
-  // |sd*|^2: exact from the depth oracle (CGAL's number type) or from the
-  // distance oracle and the slow twin (GMP rationals).
-  std::optional<test::ExactFT> depth_squared;
+  // |sd*|^2 in GMP rationals: exact from the depth and distance oracles,
+  // the slow twin's double squared otherwise.
   mpq_class magnitude_squared = 0;
   double value = 0.0;  // sd*, rounded
   bool exact = true;   // false: proxima's slow twin (double)
@@ -340,7 +320,7 @@ std::optional<Referee> referee(const ConvexPolytope& a, const ConvexPolytope& b,
     const test::ExactDepth e = test::exact_depth(pa, pb);
     if (e.flat || e.origin != test::OriginInM::inside) return separated_or_touching();
     r.sign = -1;
-    r.depth_squared = e.depth_squared;
+    r.magnitude_squared = e.depth_squared;
     r.value = -e.depth();
     return r;
   }
@@ -373,10 +353,6 @@ struct Accuracy {
 bool within(double sd, const Referee& ref, double rel, double band) {
   const int s = sd > 0 ? 1 : sd < 0 ? -1 : 0;
   if (s == 0 || ref.sign == 0 || s == ref.sign) {
-    if (ref.depth_squared) {
-      const test::ScopedFpTrapsOff traps_off;
-      return test::within_bound(std::abs(sd), *ref.depth_squared, rel, band);
-    }
     return test::within_bound(std::abs(sd), ref.magnitude_squared, rel, band);
   }
   // Opposite signs: |sd - sd*| = |sd| + |sd*|.
@@ -441,11 +417,10 @@ std::string format_pose(const Pose& p) {
 SizeResult run_size(int n, const Options& opt) {
   SizeResult out;
   out.n = n;
-  Rng rng(static_cast<std::uint64_t>(n) * 7919 + 1);
-  const std::vector<Vec3> va = points_on_sphere(rng, n, 1.0);
-  const std::vector<Vec3> vb = points_on_sphere(rng, n, 0.8);
-  const ConvexPolytope a(va), b(vb);
-  const std::vector<Pose> poses = sweep();
+  const SweepBodies bodies = penetration_sweep_bodies(n);
+  const ConvexPolytope& a = bodies.a;
+  const ConvexPolytope& b = bodies.b;
+  const std::vector<Pose> poses = penetration_sweep();
 
   ProximaSystem tracked(a, b, poses, true), cold(a, b, poses, false);
   FclSystem fcl(a, b, poses);
@@ -516,8 +491,8 @@ SizeResult run_size(int n, const Options& opt) {
   }
   auto band_at = [&](std::size_t i) {
     double radius = 0.0;
-    for (const Vec3& v : va) radius = std::max(radius, v.cwiseAbs().maxCoeff());
-    for (const Vec3& v : vb) radius = std::max(radius, poses[i].apply(v).cwiseAbs().maxCoeff());
+    for (const Vec3& v : a.vertices()) radius = std::max(radius, v.cwiseAbs().maxCoeff());
+    for (const Vec3& v : b.vertices()) radius = std::max(radius, poses[i].apply(v).cwiseAbs().maxCoeff());
     return kContactBandUlps * 0x1p-53 * radius;
   };
   // The screen: every untracked pose, every other system against proxima

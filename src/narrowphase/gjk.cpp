@@ -111,22 +111,81 @@ struct Polished {
   int nb = 0;
 };
 
+// Up to four hull vertices of one body, the features of a polishing round:
+// the stalled simplex's (at most three a side) and the new support point's.
+using FourPoints = std::array<Vec3, 4>;
+
+// The closest points of conv(pa[0..na)) and conv(pb[0..nb)), na and nb in
+// 1..4, with the kernel's coefficients and active bits over those indices.
+// A side of four vertices is the union of its four triangles' hulls' boundary
+// (a tetrahedron's surface, or a flat quadrilateral, which two of them
+// cover): the minimum over them is the features' distance unless the other
+// feature lies inside the tetrahedron, and even then it is the distance of
+// points of the two hulls, an upper bound that only the gap test certifies.
+// Polishing a simplex of three vertex pairs whose support point brought a
+// fourth vertex of a polygon or a cloud gave up before, and GJK answered
+// `touching` 31 bands away (GjkRegression.StalledSimplexWithAFourthVertex).
+struct FeatureClosest {
+  ClosestPoints<double> c;              // points and squared distance
+  std::array<double, 4> coef_a{}, coef_b{};
+  std::uint8_t active_a = 0, active_b = 0;
+};
+FeatureClosest closest_of_features(const FourPoints& pa, int na, const FourPoints& pb, int nb,
+                                   const KernelTolerance<double>& tol) {
+  static constexpr std::array<std::array<int, 3>, 4> kTriangles = {
+      {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}}};
+  static constexpr std::array<int, 3> kFirst = {0, 1, 2};
+  FeatureClosest best;
+  bool have = false;
+  for (int i = 0; i < (na == 4 ? 4 : 1); ++i) {
+    for (int j = 0; j < (nb == 4 ? 4 : 1); ++j) {
+      const std::array<int, 3>& ta = na == 4 ? kTriangles[idx(i)] : kFirst;
+      const std::array<int, 3>& tb = nb == 4 ? kTriangles[idx(j)] : kFirst;
+      const int ma = std::min(na, 3);
+      const int mb = std::min(nb, 3);
+      std::array<Vec3, 3> sa;
+      std::array<Vec3, 3> sb;
+      for (int k = 0; k < ma; ++k) sa[idx(k)] = pa[idx(ta[idx(k)])];
+      for (int k = 0; k < mb; ++k) sb[idx(k)] = pb[idx(tb[idx(k)])];
+      const ClosestPoints<double> c = closest_points<double>(sa.data(), ma, sb.data(), mb, tol);
+      if (have && !(c.distance_squared < best.c.distance_squared)) continue;
+      have = true;
+      best.c = c;
+      best.coef_a = {};
+      best.coef_b = {};
+      best.active_a = 0;
+      best.active_b = 0;
+      for (int k = 0; k < ma; ++k) {
+        if (!(c.active_a & (1u << k))) continue;
+        best.active_a = static_cast<std::uint8_t>(best.active_a | (1u << ta[idx(k)]));
+        best.coef_a[idx(ta[idx(k)])] = c.coef_a[idx(k)];
+      }
+      for (int k = 0; k < mb; ++k) {
+        if (!(c.active_b & (1u << k))) continue;
+        best.active_b = static_cast<std::uint8_t>(best.active_b | (1u << tb[idx(k)]));
+        best.coef_b[idx(tb[idx(k)])] = c.coef_b[idx(k)];
+      }
+    }
+  }
+  return best;
+}
+
 template <class Support>
 Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, double tol,
                         Simplex& simplex, SupportPoint w, Support& support, int& iterations,
                         double& lower, double& w_max2) {
   const KernelTolerance<double> kernel_tol = kernel_tolerance(frame.magnitude * frame.inv_unit);
-  const auto add = [](std::array<std::int32_t, 3>& ids, int& n, std::int32_t id) {
+  const auto add = [](std::array<std::int32_t, 4>& ids, int& n, std::int32_t id) {
     for (int k = 0; k < n; ++k)
       if (ids[idx(k)] == id) return true;
-    if (n == 3) return false;  // the kernels take at most three vertices a side
+    if (n == 4) return false;  // closest_of_features takes at most four a side
     ids[idx(n++)] = id;
     return true;
   };
   Polished out;
   // The first features: the stalled simplex's vertices of each body.
-  std::array<std::int32_t, 3> ids_a{};
-  std::array<std::int32_t, 3> ids_b{};
+  std::array<std::int32_t, 4> ids_a{};
+  std::array<std::int32_t, 4> ids_b{};
   int na = 0;
   int nb = 0;
   for (int k = 0; k < simplex.size; ++k) {
@@ -135,28 +194,30 @@ Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, d
   }
   for (;;) {
     if (!add(ids_a, na, w.ia) || !add(ids_b, nb, w.ib)) return out;
-    std::array<Vec3, 3> pa;
-    std::array<Vec3, 3> pb;
+    FourPoints pa;
+    FourPoints pb;
     for (int k = 0; k < na; ++k) pa[idx(k)] = frame.a.vertex(ids_a[idx(k)]) * frame.inv_unit;
     for (int k = 0; k < nb; ++k) pb[idx(k)] = frame.b_point(ids_b[idx(k)]) * frame.inv_unit;
-    const ClosestPoints<double> c = closest_points<double>(pa.data(), na, pb.data(), nb, kernel_tol);
+    const FeatureClosest f = closest_of_features(pa, na, pb, nb, kernel_tol);
+    const ClosestPoints<double>& c = f.c;
     if (!(c.distance_squared < simplex.vv)) return out;
-    // The features reduced to the kernel's active vertices.
+    // The features reduced to the kernel's active vertices (at most three
+    // a side: the kernels take triangles).
     out.have = true;
     out.na = 0;
     out.nb = 0;
     for (int i = 0; i < na; ++i) {
-      if (!(c.active_a & (1u << i))) continue;
+      if (!(f.active_a & (1u << i))) continue;
       out.ids_a[idx(out.na)] = ids_a[idx(i)];
-      out.coef_a[idx(out.na++)] = c.coef_a[idx(i)];
+      out.coef_a[idx(out.na++)] = f.coef_a[idx(i)];
     }
     for (int j = 0; j < nb; ++j) {
-      if (!(c.active_b & (1u << j))) continue;
+      if (!(f.active_b & (1u << j))) continue;
       out.ids_b[idx(out.nb)] = ids_b[idx(j)];
-      out.coef_b[idx(out.nb++)] = c.coef_b[idx(j)];
+      out.coef_b[idx(out.nb++)] = f.coef_b[idx(j)];
     }
-    ids_a = out.ids_a;
-    ids_b = out.ids_b;
+    std::copy(out.ids_a.begin(), out.ids_a.end(), ids_a.begin());
+    std::copy(out.ids_b.begin(), out.ids_b.end(), ids_b.begin());
     na = out.na;
     nb = out.nb;
     // The simplex: the pairs of active vertices, at most four of them

@@ -104,7 +104,56 @@ class Expansion {
     return true;
   }
 
-  ExpansionResult run(int max_iterations) {
+  // The tetrahedron of the seed's points, oriented outwards by the sign of
+  // its volume; false (P left empty) when an id is out of range, two
+  // points are the same pair, or a key is not positive (the origin not
+  // strictly inside beyond rounding, or a volume too flat for its sign).
+  bool start(const DepthSeed& seed) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (seed.a[k] < 0 || seed.a[k] >= m_.a.vertex_count() || seed.b[k] < 0 ||
+          seed.b[k] >= m_.b.vertex_count())
+        return false;
+      for (std::size_t l = 0; l < k; ++l)
+        if (seed.a[k] == seed.a[l] && seed.b[k] == seed.b[l]) return false;
+    }
+    for (std::size_t k = 0; k < 4; ++k)
+      vertices_.push_back({m_.point_a(seed.a[k]) - m_.point_b(seed.b[k]), seed.a[k], seed.b[k]});
+    const Vec3& p0 = vertices_[0].p;
+    const double volume =
+        (vertices_[1].p - p0).dot((vertices_[2].p - p0).cross(vertices_[3].p - p0));
+    // Positive volume: (0 2 1), (0 1 3), (0 3 2), (1 2 3) are
+    // counter-clockwise seen from outside (the unit tetrahedron checks it);
+    // a negative one swaps vertices 1 and 2.
+    const int i1 = volume > 0.0 ? 1 : 2, i2 = volume > 0.0 ? 2 : 1;
+    const std::array<std::array<int, 3>, 4> faces = {
+        {{0, i2, i1}, {0, i1, 3}, {0, 3, i2}, {i1, i2, 3}}};
+    for (const auto& f : faces) {
+      const int g = add_triangle(f);
+      const Triangle& t = triangles_[static_cast<std::size_t>(g)];
+      if (!(t.offset - t.error > 0.0)) {
+        vertices_.clear();
+        triangles_.clear();
+        heap_.clear();
+        return false;
+      }
+    }
+    // Adjacency as for the octahedron: the triangle holding the edge
+    // reversed.
+    std::array<std::array<int, 4>, 4> owner{};
+    for (int g = 0; g < 4; ++g)
+      for (std::size_t i = 0; i < 3; ++i) {
+        const Triangle& t = triangles_[static_cast<std::size_t>(g)];
+        owner[static_cast<std::size_t>(t.v[i])][static_cast<std::size_t>(t.v[(i + 1) % 3])] = g;
+      }
+    for (Triangle& t : triangles_)
+      for (std::size_t i = 0; i < 3; ++i)
+        t.adjacent[i] = owner[static_cast<std::size_t>(t.v[(i + 1) % 3])][static_cast<std::size_t>(t.v[i])];
+    return true;
+  }
+
+  // Out of line: inlined into expand_polytope beside the two starts, its
+  // loop was compiled into more instructions per iteration (callgrind).
+  [[gnu::noinline]] ExpansionResult run(int max_iterations) {
     ExpansionResult r;
     for (; r.iterations < max_iterations; ++r.iterations) {
       const int f = pop();
@@ -112,8 +161,7 @@ class Expansion {
       const Triangle& t = triangles_[static_cast<std::size_t>(f)];
       const double key = t.offset - t.error;
       if (!std::isfinite(key)) return r;
-      const Vertex s = support(t.normal, vertices_[static_cast<std::size_t>(t.v[0])].a,
-                               vertices_[static_cast<std::size_t>(t.v[0])].b);
+      const Vertex s = support(t.normal, t.v);
       const double h = t.normal.dot(s.p);
       if (h < r.upper) r.upper = h;
       r.normal = t.normal;
@@ -148,6 +196,25 @@ class Expansion {
     const int i = hint_a < 0 ? support_without_hint(m_.a, n) : support_hill_climb(m_.a, n, hint_a);
     const int j =
         hint_b < 0 ? support_without_hint(m_.b, n_b) : support_hill_climb(m_.b, n_b, hint_b);
+    return {m_.point_a(i) - m_.point_b(j), i, j};
+  }
+
+  // Along a triangle's normal: each hull's climb starts at the best of the
+  // triangle's three vertices along it (they are supports along nearby
+  // directions; the best is the nearest to the support, three dot products
+  // against the climb's steps of a whole ring each).
+  Vertex support(const Vec3& n, const std::array<int, 3>& v) const {
+    const Vec3 n_b = m_.rotation_t * (-n);
+    int hint_a = -1, hint_b = -1;
+    double best_a = -kInfinity, best_b = -kInfinity;
+    for (const int k : v) {
+      const Vertex& x = vertices_[static_cast<std::size_t>(k)];
+      const double da = n.dot(m_.a.vertex(x.a)), db = n_b.dot(m_.b.vertex(x.b));
+      if (da > best_a) best_a = da, hint_a = x.a;
+      if (db > best_b) best_b = db, hint_b = x.b;
+    }
+    const int i = support_hill_climb(m_.a, n, hint_a);
+    const int j = support_hill_climb(m_.b, n_b, hint_b);
     return {m_.point_a(i) - m_.point_b(j), i, j};
   }
 
@@ -282,13 +349,14 @@ class Expansion {
 
 }  // namespace
 
-ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations) {
+ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations,
+                                const DepthSeed& seed) {
   // The scratch lists on the stack: a cold query's expansion is a few
   // dozen iterations, and heap allocations would cost as much as they.
   std::array<std::byte, 24576> buffer;
   std::pmr::monotonic_buffer_resource memory(buffer.data(), buffer.size());
   Expansion e(m, &memory);
-  if (!e.start()) return {};
+  if (!e.start(seed) && !e.start()) return {};
   return e.run(max_iterations);
 }
 

@@ -22,6 +22,10 @@
 // construction, integer bookkeeping only) and positive keys, not P's
 // convexity, which rounding can break.
 //
+// Start. The seed's tetrahedron (the contact classification's, which the
+// distance query built when it found the overlap) or the octahedron; a
+// seed whose four keys are not all positive is dropped for the octahedron.
+//
 // Expansion. The triangle of least key is expanded: the support s of M
 // along its normal n (h_M(n) = n.s, an upper bound on the depth) replaces
 // the triangles whose planes s is beyond (a connected set around it) by
@@ -38,6 +42,7 @@
 #include <limits>
 
 #include "proxima/core/types.h"
+#include "proxima/detail/penetration/penetration.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima::detail {
@@ -72,8 +77,12 @@ struct ExpansionResult {
   int iterations = 0;
 };
 
-// Expands P from the octahedron of M's supports along the six axes, at
-// most `max_iterations` times.
-ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations);
+// Expands P, at most `max_iterations` times, from the tetrahedron of the
+// seed's points of M when every one of its four triangles (oriented by the
+// sign of its volume) has a positive key (the certificate's condition, so
+// that P stays certified), else from the octahedron of M's supports along
+// the six axes.
+ExpansionResult expand_polytope(const MinkowskiSupport& m, int max_iterations,
+                                const DepthSeed& seed = {});
 
 }  // namespace proxima::detail

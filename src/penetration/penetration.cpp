@@ -239,8 +239,23 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
 // answer to the enumeration.
 //
 // The expansion's iteration cap: past it, the enumeration is cheaper (a B
-// near A's centre, where many facets of A - B are near the depth).
+// near A's centre, where many facets of A - B are near the depth). The
+// enumeration's cost grows like the vertex count (every face's normal and
+// pruning bound), an iteration's does not: the cap is at least
+// kExpansionIterations and grows with the hulls, one iteration per
+// kVerticesPerIteration vertices of the two hulls (an iteration costs
+// about as much as the enumeration's work on a few vertices; past the cap
+// the expansion's work is lost).
 constexpr int kExpansionIterations = 256;
+constexpr int kVerticesPerIteration = 8;
+// The contact classification's tetrahedron (the seed) starts the expansion
+// when both hulls have at most this many vertices; larger ones start from
+// the octahedron of supports along the axes. The tetrahedron saves the
+// octahedron's six cold supports but, flatter and from the distance
+// query's directions, costs a few more iterations, whose climbs grow with
+// the hulls: on the sphere hulls of bench/cold_instructions the seed saves
+// instructions at 8 and 64 vertices and costs them at 512 and 4096.
+constexpr int kSeedVertices = 64;
 // A face or edge pair is a candidate when its normal's cosine with the
 // expansion's is at least 1 - this: the facet's normal is within rounding
 // of the expansion's (a few hundred u for a well-shaped triangle), and
@@ -257,10 +272,13 @@ constexpr double kAcceptRelative = 5e-13;
 constexpr double kAcceptUlps = 0.5 * kContactBandUlps;
 
 std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cache,
-                                                 const Pose& b_in_a) {
+                                                 const Pose& b_in_a, const DepthSeed& seed) {
   if (q.a.dimension() != 3 || q.b.dimension() != 3) return std::nullopt;
   const detail::MinkowskiSupport m{q.a, q.b, q.rotation, q.rotation_t, q.translation, q.inverse};
-  const detail::ExpansionResult e = detail::expand_polytope(m, kExpansionIterations);
+  const int cap = std::max(kExpansionIterations,
+                           (q.a.vertex_count() + q.b.vertex_count()) / kVerticesPerIteration);
+  const bool small = q.a.vertex_count() <= kSeedVertices && q.b.vertex_count() <= kSeedVertices;
+  const detail::ExpansionResult e = detail::expand_polytope(m, cap, small ? seed : DepthSeed{});
   if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;
   const Vec3& n = e.normal;
   std::array<Candidate, 48> kept;
@@ -334,7 +352,7 @@ bool same_pair(const PenetrationCache& cache, const ConvexPolytope& a, const Con
 }
 
 PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
-                        PenetrationCache& cache) {
+                        PenetrationCache& cache, const DepthSeed& seed) {
   Query q(a, b, b_in_a);
   const bool same_polytopes = same_pair(cache, a, b);
   if (!same_polytopes) {
@@ -359,7 +377,7 @@ PenetrationResult depth(const ConvexPolytope& a, const ConvexPolytope& b, const 
   // query certifies with their least bound, as an unrecorded cache does.
   const bool has_start = same_polytopes && !cache.facets.empty();
   if (!has_start)
-    if (std::optional<PenetrationResult> r = solve_expanding(q, cache, b_in_a)) return *r;
+    if (std::optional<PenetrationResult> r = solve_expanding(q, cache, b_in_a, seed)) return *r;
   const bool turned = has_start && cache.rotation != b_in_a.rotation;
   if (turned) cache.prune_margin *= 0.5;
   const PenetrationCache::Facet start = has_start ? cache.last : PenetrationCache::Facet{};
@@ -375,8 +393,9 @@ PenetrationResult penetration_depth_brute_force(const ConvexPolytope& a, const C
 }
 
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
-                                    const Pose& b_in_a, PenetrationCache& cache) {
-  PenetrationResult r = depth(a, b, b_in_a, cache);
+                                    const Pose& b_in_a, PenetrationCache& cache,
+                                    const DepthSeed& seed) {
+  PenetrationResult r = depth(a, b, b_in_a, cache, seed);
   cache.last_status = r.status;
   cache.previous_translation = b_in_a.translation;
   return r;

@@ -70,6 +70,8 @@ std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& 
   Vec3 u0, u1, w0, w1;
   // The normal's angle error (of the rounded normal from the exact one).
   double angle = 0.0;
+  // Whether N and the supports are taken in B's frame (a face of B).
+  bool in_b = false;
   if (id.kind == MinkowskiFace::face_vertex && id.a0 >= 0) {
     const auto cycle = q.a.face(id.a0);
     u0 = w0 = q.point_a(cycle[0]);
@@ -77,11 +79,16 @@ std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& 
     w1 = q.point_a(cycle[2]);
     angle = 16.0 * (static_cast<double>(cycle.size()) + 1.0) * kUnitRoundoff;
   } else if (id.kind == MinkowskiFace::vertex_face && id.b0 >= 0) {
+    // A face of B: its normal from B's own coordinates, in B's frame
+    // (exact_value_in_b); the placed ones are rounded by u R each, which
+    // tilts the normal of a thin fan triangle by u R / (its height), and
+    // the value by that times the points' distance from it.
     const auto cycle = q.b.face(id.b0);
-    u0 = w0 = q.point_b(cycle[0]);
-    u1 = q.point_b(cycle[1]);
-    w1 = q.point_b(cycle[2]);
+    u0 = w0 = q.b.vertex(cycle[0]) * q.inverse;
+    u1 = q.b.vertex(cycle[1]) * q.inverse;
+    w1 = q.b.vertex(cycle[2]) * q.inverse;
     angle = (16.0 * (static_cast<double>(cycle.size()) + 1.0) + 8.0) * kUnitRoundoff;
+    in_b = true;
   } else if (id.kind == MinkowskiFace::edge_edge && id.a0 >= 0 && id.b0 >= 0) {
     u0 = q.point_a(id.a0);
     u1 = q.point_a(id.a1);
@@ -96,7 +103,8 @@ std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& 
   }
   // N along the rounded normal: (u1 - u0) x (w1 - w0), or with the edges
   // swapped its negative.
-  if ((u1 - u0).cross(w1 - w0).dot(c.normal) < 0.0) {
+  const Vec3 normal = in_b ? Vec3(q.rotation_t * c.normal) : c.normal;
+  if ((u1 - u0).cross(w1 - w0).dot(normal) < 0.0) {
     std::swap(u0, w0);
     std::swap(u1, w1);
   }
@@ -110,6 +118,13 @@ std::optional<detail::ExactOffset> exact_value(const Query& q, const Candidate& 
       q.a, [&](int i) { return q.point_a(i); }, c.normal, c.support_a, tie, ids, xs);
   tie_region(
       q.b, [&](int j) { return q.point_b(j); }, Vec3(-c.normal), c.support_b, tie, ids, ys);
+  if (in_b) {
+    // The value in B's frame: the translation cancels from h_A(n) + h_B(-n),
+    // A's supports are mapped there (rounded by a few u R, which the value
+    // takes once, not times a lever) and B's are its own coordinates.
+    for (Vec3& x : xs) x = q.rotation_t * (x - q.translation);
+    for (std::size_t k = 0; k < ys.size(); ++k) ys[k] = q.b.vertex(ids[k]) * q.inverse;
+  }
   const detail::ExactOffset e = detail::exact_offset(u0, u1, w0, w1, xs, ys, c_band);
   if (e.degenerate) return std::nullopt;
   return e;

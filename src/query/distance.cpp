@@ -21,6 +21,7 @@
 #include "proxima/detail/narrowphase/hybrid.h"
 #include "core/accuracy.h"
 #include "core/paired_pose.h"
+#include "query/extended_distance.h"
 #include "query/signed_distance.h"
 
 namespace proxima {
@@ -64,6 +65,44 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   return hybrid_distance(a, b, b_in_a, options, contact_tolerance, cache);
 }
 
+// The contact band of a lower bound on R_w taken from the cached features
+// and support hints. Most contacts (overlapping bodies) end with a
+// distance of a few roundings, inside this band, where the exact R_w could
+// not change the answer, and it is not computed. O(1).
+double band_floor(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                  const Pose& pose_b, const DistanceOptions& options, const DistanceCache& c) {
+  const std::array ids_a = {c.vertices_a[0], c.vertices_a[1], c.vertices_a[2], c.hint_a};
+  const std::array ids_b = {c.vertices_b[0], c.vertices_b[1], c.vertices_b[2], c.hint_b};
+  const double r_floor =
+      std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
+  return contact_band(r_floor, options.absolute_tolerance);
+}
+
+// An answer within a few bands of touching (detail::kExtendedBands): its
+// witness pair's distance recomputed in double-double
+// (query/extended_distance.h), and the status decided from it against the
+// band of R_w: the cheap bounds on that band first (`band_floor`, a lower
+// one from a few vertices, and `band_bound`), the exact R_w (O(N)) only
+// between them. `result` in A's frame. Out of line: off the tracked path.
+[[gnu::noinline]] void refine_near_band(const ConvexPolytope& a, const Pose& pose_a,
+                                        const ConvexPolytope& b, const Pose& pose_b,
+                                        const DistanceOptions& options, double band_bound,
+                                        const DistanceCache& c, DistanceResult& result) {
+  Vec3 normal;
+  if (!detail::refine_distance_extended(a, pose_a, b, pose_b, result, normal)) return;
+  const double d = result.distance;
+  bool separated = d > band_bound;
+  if (!separated && d > band_floor(a, pose_a, b, pose_b, options, c)) {
+    const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
+    separated = d > contact_band(r_exact, options.absolute_tolerance);
+  }
+  result.status = separated ? Status::separated : Status::touching;
+  // The lower bound is the gap along the pair's normal: the answer's
+  // normal must be that one (a rounded body trusts the normal of a core
+  // answer whose lower bound is positive, BodyOracle.TouchingCores...).
+  result.normal = pose_a.rotation.transpose() * normal;
+}
+
 // The result's points and normal from A's frame to the world frame, in
 // place (core/paired_pose.h).
 [[gnu::always_inline]] inline void to_world(const Pose& pose_a, DistanceResult& result) {
@@ -79,17 +118,6 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
                                                 const Pose& b_in_a, const DistanceOptions& options,
                                                 double band_bound, DistanceCache& c,
                                                 DistanceResult& result) {
-  // Most contacts (overlapping bodies) end with a distance of a few
-  // roundings: inside the band of a lower bound on R taken from the cached
-  // features and support hints, where the exact R could not change the
-  // answer, and it is not computed.
-  const auto band_floor = [&] {
-    const std::array ids_a = {c.vertices_a[0], c.vertices_a[1], c.vertices_a[2], c.hint_a};
-    const std::array ids_b = {c.vertices_b[0], c.vertices_b[1], c.vertices_b[2], c.hint_b};
-    const double r_floor =
-        std::max(world_magnitude_floor(a, pose_a, ids_a), world_magnitude_floor(b, pose_b, ids_b));
-    return contact_band(r_floor, options.absolute_tolerance);
-  };
   // A touching answer above the band of the exact R is re-solved with that
   // band, the algorithm's cross-check and contact classification included,
   // so that whichever stage answers decides with it
@@ -97,12 +125,16 @@ DistanceResult run(const ConvexPolytope& a, const ConvexPolytope& b, const Pose&
   // cross-check used the cheap band and turned the refined separated answer
   // back into touching).
   if (result.status == Status::touching && result.distance > 0.0 &&
-      result.distance > band_floor()) {
+      result.distance > band_floor(a, pose_a, b, pose_b, options, c)) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
     const double exact_band = contact_band(r_exact, options.absolute_tolerance);
     if (exact_band < band_bound && result.distance > exact_band) {
       result = run(a, b, b_in_a, options, exact_band, c);
     }
+  }
+  if (result.distance <= detail::kExtendedBands * band_bound &&
+      (result.status == Status::separated || result.status == Status::touching)) [[unlikely]] {
+    refine_near_band(a, pose_a, b, pose_b, options, band_bound, c, result);
   }
   // The signed distance: nothing to add when separated (the depth fields
   // stay 0); a contact gets its penetration depth, computed only now, and

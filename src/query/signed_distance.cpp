@@ -40,6 +40,10 @@ double ball_depth_bound(const ConvexPolytope& a, const ConvexPolytope& b, const 
   return std::max(ra + rb - d, 0.0) + slack;
 }
 
+// The contact classification's tetrahedron (around the origin when it
+// certified the overlap), where a cold depth's expansion starts.
+DepthSeed contact_seed(const DistanceCache& cache) { return {cache.contact_a, cache.contact_b}; }
+
 // The depth's answer in place of the algorithm's. A separated or touching
 // verdict of the depth for an intersecting answer (the two disagree within
 // rounding near contact) has depth 0 and bounds 0: the status stays
@@ -154,7 +158,7 @@ void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const C
     double exact_band = -1.0;  // not computed yet
     if (touching_certified(a, pose_a, b, pose_b, b_in_a, options, cache, result, exact_band))
       return;
-    const PenetrationResult p = penetration_depth(a, b, b_in_a, cache.penetration.get_or_create());
+    const PenetrationResult p = penetration_depth(a, b, b_in_a, cache.penetration.get_or_create(), contact_seed(cache));
     if (p.status == PenetrationStatus::separated) return;
     // Intersecting exactly when the depth is above the band of R_w (near
     // the band the depth is exact up to 8 u of itself: penetration.cpp,
@@ -169,7 +173,7 @@ void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const C
     take_depth(p, result);
     return;
   }
-  take_depth(penetration_depth(a, b, b_in_a, cache.penetration.get_or_create()), result);
+  take_depth(penetration_depth(a, b, b_in_a, cache.penetration.get_or_create(), contact_seed(cache)), result);
 }
 
 bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,

@@ -7,11 +7,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <vector>
 
 #include "core/power_of_two.h"
 #include "proxima/detail/penetration/penetration.h"
+#include "proxima/query/distance.h"
 #include "support/generators.h"
 
 namespace proxima::test {
@@ -28,12 +31,13 @@ struct Scaled {
   detail::ExpansionResult e;
   double unit = 1.0;
 };
-Scaled expand(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& pose, int cap) {
+Scaled expand(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& pose, int cap,
+              const DepthSeed& seed = {}) {
   const detail::PowerOfTwoUnit u =
       detail::power_of_two_unit(std::max(a.scale(), magnitude_bound(pose, b.scale())));
   const detail::MinkowskiSupport m{a, b, pose.rotation, pose.rotation.transpose(),
                                    pose.translation * u.inverse, u.inverse};
-  return {detail::expand_polytope(m, cap), u.unit};
+  return {detail::expand_polytope(m, cap, seed), u.unit};
 }
 
 TEST(ExpandingPolytope, CertifiedLowerBoundHoldsAtEveryIterationCap) {
@@ -65,6 +69,77 @@ TEST(ExpandingPolytope, CertifiedLowerBoundHoldsAtEveryIterationCap) {
   // The set holds certified stops both midway and converged.
   EXPECT_GT(certified, converged);
   EXPECT_GT(converged, 30);
+}
+
+TEST(ExpandingPolytope, SeededFromTheContactTetrahedronCertifiesTheSameDepth) {
+  // The distance query's contact tetrahedron (DistanceCache::contact_a,
+  // contact_b) as the start: at every cap the bound is certified as from
+  // the octahedron, and converged it is the depth. Seeds that cannot start
+  // a certified surface (ids out of range, a repeated point, a tetrahedron
+  // beside the origin: its vertices shifted to one side) fall back to the
+  // octahedron and give the same converged depth.
+  Rng rng(2905);
+  int seeded = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const int n = uniform_int(rng, 8, 120);
+    const ConvexPolytope a(trial % 3 == 0 ? points_in_cube(rng, n) : points_on_sphere(rng, n));
+    const ConvexPolytope b(points_on_sphere(rng, n, uniform(rng, 0.2, 0.9)));
+    const Pose pose(random_quaternion(rng), uniform(rng, 0.0, 1.0) * random_unit_vector(rng));
+    DistanceCache cache;
+    if (distance(a, Pose::identity(), b, pose, {}, &cache).status != Status::intersecting) continue;
+    const DepthSeed seed{cache.contact_a, cache.contact_b};
+    if (seed.a[3] < 0) continue;
+    ++seeded;
+    const PenetrationResult slow = penetration_depth_brute_force(a, b, pose);
+    const double band = band_of(a, b, pose);
+    for (const int cap : {1, 2, 4, 16, 4096}) {
+      const Scaled s = expand(a, b, pose, cap, seed);
+      if (!s.e.certified) continue;
+      EXPECT_LE(s.e.lower * s.unit, slow.depth + band) << trial << " cap " << cap;
+      if (s.e.converged) {
+        EXPECT_NEAR(s.e.lower * s.unit, slow.depth, kRel * slow.depth + 2 * band) << trial;
+      }
+    }
+    const Scaled from_octahedron = expand(a, b, pose, 4096);
+    ASSERT_TRUE(from_octahedron.e.converged) << trial;
+    DepthSeed out_of_range = seed, repeated = seed;
+    out_of_range.b[2] = b.vertex_count();
+    repeated.a[1] = repeated.a[0];
+    repeated.b[1] = repeated.b[0];
+    for (const DepthSeed& bad : {out_of_range, repeated}) {
+      const Scaled s = expand(a, b, pose, 4096, bad);
+      EXPECT_TRUE(s.e.converged) << trial;
+      EXPECT_EQ(s.e.lower, from_octahedron.e.lower) << trial;
+    }
+  }
+  EXPECT_GE(seeded, 20);
+}
+
+TEST(ExpandingPolytope, SeedBesideTheOriginIsNotUsed) {
+  // A tetrahedron of points of A - B all on one side of the origin (A's
+  // four vertices furthest along +x less B's four furthest along -x, as
+  // placed): its keys are not all positive, and the expansion must start
+  // from the octahedron instead, the same answer to the last bit.
+  Rng rng(2906);
+  const ConvexPolytope a(points_on_sphere(rng, 60));
+  const ConvexPolytope b(points_on_sphere(rng, 60, 0.7));
+  const Pose pose(random_quaternion(rng), Vec3(0.1, -0.05, 0.02));
+  const auto furthest = [](const ConvexPolytope& p, const Pose& place, double sign) {
+    std::vector<int> ids(static_cast<std::size_t>(p.vertex_count()));
+    for (int i = 0; i < p.vertex_count(); ++i) ids[static_cast<std::size_t>(i)] = i;
+    std::sort(ids.begin(), ids.end(), [&](int i, int j) {
+      return sign * place.apply(p.vertex(i)).x() > sign * place.apply(p.vertex(j)).x();
+    });
+    return std::array<std::int32_t, 4>{ids[0], ids[1], ids[2], ids[3]};
+  };
+  const DepthSeed beside{furthest(a, Pose::identity(), 1.0), furthest(b, pose, -1.0)};
+  for (std::size_t k = 0; k < 4; ++k)
+    ASSERT_GT((a.vertex(beside.a[k]) - pose.apply(b.vertex(beside.b[k]))).x(), 0.5);
+  const Scaled seeded = expand(a, b, pose, 4096, beside);
+  const Scaled plain = expand(a, b, pose, 4096);
+  ASSERT_TRUE(plain.e.certified && plain.e.converged);
+  EXPECT_EQ(seeded.e.lower, plain.e.lower);
+  EXPECT_EQ(seeded.e.iterations, plain.e.iterations);
 }
 
 TEST(ExpandingPolytope, SeparatedAndFlatPairsAreNeverCertified) {

@@ -10,6 +10,8 @@
 #include <numbers>
 #include <string>
 
+#include "core/paired_pose.h"
+#include "proxima/query/distance.h"
 #include "proxima/shape/support.h"
 #include "support/exact_oracle.h"
 #include "support/generators.h"
@@ -516,6 +518,94 @@ TEST(PenetrationRegression, DepthJustAboveTheBandIsPenetrating) {
     EXPECT_NEAR(r.depth, 7.662212386177775e-15, 1e-28);
     EXPECT_LE(r.lower_bound, 7.662212386177775e-15);
     EXPECT_GE(r.upper_bound, 7.662212386177775e-15);
+  }
+}
+
+TEST(PenetrationRegression, PointOnALargePolygonFarFromTheOrigin) {
+  // Story (issue 25, the soak: seed 8, episode 7576): a point 9.2e-14 from
+  // the plane of a 46-gon of radius 500 placed 500 from the origin (band
+  // 64 u R 6.3e-12): A - B is flat, so the depth is 0 and the pair
+  // touching. The refinement near the band evaluated the polygon's face
+  // (a vertex-face of A - B) "exactly" from B's placed vertices, which
+  // are rounded by u R each: the normal of the fan triangle of three
+  // consecutive vertices (a turn of 7.8 degrees) was tilted by about 1e-14
+  // and the value off by that times 500, a depth of 1.28e-11 (2 bands)
+  // with the certificate [1.28e-11, 1.28e-11] that excluded the truth;
+  // distance() then answered `intersecting` with points 9.5e-14 apart. A
+  // face of B is now evaluated in B's own frame (refinement.h).
+  const ConvexPolytope a(std::vector<Vec3>{
+        Vec3(-0.03436092086531007, -0.01848281701598599, -0.18232891597242576)});
+  Mat3 rotation_a;
+  rotation_a << 0.05188385760615, 0.1543812241142617, -0.9866481150647819, -0.8541100179308936, -0.5051067747903644, -0.12394847046641982, -0.5174979638510604, 0.8491369640416428, 0.10565166211730037;
+  const Pose pose_a(rotation_a, Vec3(0.0, 0.0, 0.0));
+  const ConvexPolytope b(std::vector<Vec3>{
+        Vec3(502.7199660499584, -1.234422277351084e-14, 0.0),
+        Vec3(498.0376051575551, 68.45369321080167, 0.0),
+        Vec3(484.07774600440365, 135.63222363644763, 0.0),
+        Vec3(461.1004343534595, 200.28418236176893, 0.0),
+        Vec3(429.5336940460364, 261.2052257219164, 0.0),
+        Vec3(389.9655537274953, 317.26050994613126, 0.0),
+        Vec3(343.1330929861742, 367.4058311499871, 0.0),
+        Vec3(289.9087119552651, 410.70707687804753, 0.0),
+        Vec3(231.28388014897766, 446.35762685150195, 0.0),
+        Vec3(168.35066726142145, 473.6933787777759, 0.0),
+        Vec3(102.28139997447992, 492.20511931971186, 0.0),
+        Vec3(34.30682372985475, 501.5480097765716, 0.0),
+        Vec3(-34.306823729854564, 501.5480097765716, 0.0),
+        Vec3(-102.28139997447998, 492.20511931971186, 0.0),
+        Vec3(-168.3506672614214, 473.69337877777593, 0.0),
+        Vec3(-231.2838801489776, 446.35762685150195, 0.0),
+        Vec3(-289.90871195526506, 410.7070768780476, 0.0),
+        Vec3(-343.13309298617423, 367.405831149987, 0.0),
+        Vec3(-389.96555372749526, 317.2605099461314, 0.0),
+        Vec3(-429.53369404603626, 261.2052257219166, 0.0),
+        Vec3(-461.1004343534595, 200.2841823617689, 0.0),
+        Vec3(-484.07774600440365, 135.63222363644763, 0.0),
+        Vec3(-498.03760515755505, 68.45369321080192, 0.0),
+        Vec3(-502.7199660499584, 4.922121695554392e-14, 0.0),
+        Vec3(-498.0376051575551, -68.4536932108016, 0.0),
+        Vec3(-484.07774600440365, -135.63222363644772, 0.0),
+        Vec3(-461.10043435345943, -200.28418236176898, 0.0),
+        Vec3(-429.5336940460365, -261.20522572191624, 0.0),
+        Vec3(-389.9655537274953, -317.26050994613126, 0.0),
+        Vec3(-343.1330929861742, -367.4058311499871, 0.0),
+        Vec3(-289.9087119552651, -410.70707687804753, 0.0),
+        Vec3(-231.28388014897791, -446.35762685150183, 0.0),
+        Vec3(-168.3506672614215, -473.6933787777759, 0.0),
+        Vec3(-102.28139997447988, -492.20511931971186, 0.0),
+        Vec3(-34.30682372985435, -501.54800977657163, 0.0),
+        Vec3(34.30682372985463, -501.5480097765716, 0.0),
+        Vec3(102.2813999744797, -492.2051193197119, 0.0),
+        Vec3(168.35066726142134, -473.69337877777593, 0.0),
+        Vec3(231.28388014897735, -446.3576268515021, 0.0),
+        Vec3(289.908711955265, -410.70707687804764, 0.0),
+        Vec3(343.13309298617423, -367.4058311499871, 0.0),
+        Vec3(389.9655537274952, -317.26050994613144, 0.0),
+        Vec3(429.5336940460364, -261.2052257219164, 0.0),
+        Vec3(461.1004343534594, -200.28418236176915, 0.0),
+        Vec3(484.07774600440354, -135.63222363644812, 0.0),
+        Vec3(498.0376051575551, -68.45369321080156, 0.0)});
+  Mat3 rotation_b;
+  rotation_b << -0.12573786008215726, -0.9295327841106754, -0.34663928485591067, -0.9320580049261593, 0.23036350411977935, -0.27964357926246824, 0.3397909151154986, 0.2879261350296526, -0.8953438863207023;
+  const Pose pose_b(rotation_b, Vec3(-298.19568598766614, 404.51812396367177, -10.824942811379202));
+  const Pose b_in_a = detail::relative_pose(pose_a, pose_b);
+  PenetrationCache cache;
+  for (const PenetrationResult& r :
+       {penetration_depth(a, b, b_in_a, cache), penetration_depth_brute_force(a, b, b_in_a)}) {
+    EXPECT_NE(r.status, PenetrationStatus::intersecting);
+    EXPECT_EQ(r.lower_bound, 0.0);
+  }
+  double r = 0.0;  // R of the standard: the placed vertices' largest coordinate
+  for (const Vec3& x : a.vertices()) r = std::max(r, pose_a.apply(x).cwiseAbs().maxCoeff());
+  for (const Vec3& y : b.vertices()) r = std::max(r, pose_b.apply(y).cwiseAbs().maxCoeff());
+  const double band = kContactBandUlps * kUnitRoundoff * r;
+  for (const bool swapped : {false, true}) {
+    SCOPED_TRACE(swapped ? "swapped" : "polygon second");
+    const DistanceResult d = swapped ? distance(b, pose_b, a, pose_a) : distance(a, pose_a, b, pose_b);
+    EXPECT_EQ(d.status, Status::touching);
+    EXPECT_LE(d.signed_upper_bound(), band);
+    EXPECT_GE(d.signed_lower_bound(), -band);
+    EXPECT_NEAR((d.point_a - d.point_b).norm(), d.distance, band);
   }
 }
 

@@ -220,9 +220,16 @@ std::string body_json(const std::vector<Vec3>& points, const Pose& pose, double 
     if (i > 0) out += ",";
     out += vec(points[i]);
   }
+  // The quaternion for the CLI, and the rotation matrix itself, which the
+  // CLI ignores: the quaternion's matrix may differ from the queried one by
+  // an ulp, which near the band's edge changes the answer (seed 8, episode
+  // 7576 replayed through the quaternion was touching, not intersecting).
   const Quat q(pose.rotation);
+  const Mat3& m = pose.rotation;
   out += "],\"rotation\":{\"wxyz\":[" + number(q.w()) + "," + number(q.x()) + "," + number(q.y()) +
-         "," + number(q.z()) + "]},\"translation\":" + vec(pose.translation);
+         "," + number(q.z()) + "]},\"matrix\":[" + vec(m.row(0).transpose()) + "," +
+         vec(m.row(1).transpose()) + "," + vec(m.row(2).transpose()) +
+         "],\"translation\":" + vec(pose.translation);
   if (radius > 0) out += ",\"radius\":" + number(radius);
   return out + "}";
 }

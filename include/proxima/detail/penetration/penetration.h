@@ -306,8 +306,20 @@ struct PenetrationCache {
 // PenetrationCache) searches the cached faces' tree. A rotated B enumerates
 // again (with the cached face normals and the last answer as the first
 // bound). Not thread-safe on one cache; the polytopes may be shared.
+//
+// `seed`: vertex pairs (a_k of A, b_k of B) of four points a_k - b_k of
+// A - B whose tetrahedron may hold the origin, the contact classification's
+// (DistanceCache::contact_a, contact_b); a cold expansion starts from it
+// when it does (certified as the expansion certifies a triangle), from
+// supports along the six axes otherwise. Any ids are safe: a seed out of
+// range, flat or beside the origin is not used.
+struct DepthSeed {
+  std::array<std::int32_t, 4> a = {-1, -1, -1, -1};
+  std::array<std::int32_t, 4> b = {-1, -1, -1, -1};
+};
 PenetrationResult penetration_depth(const ConvexPolytope& a, const ConvexPolytope& b,
-                                    const Pose& b_in_a, PenetrationCache& cache);
+                                    const Pose& b_in_a, PenetrationCache& cache,
+                                    const DepthSeed& seed = {});
 
 // The tracked query alone: when `cache` holds this pair's faces of A - B
 // at B's rotation and certifies their least value without enumerating
