@@ -15,6 +15,12 @@
 //                                 for meshes) carried along;
 //   proxima intersects, cold      the same without a cache;
 //   proxima within 5 cm, tracked  within_margin(..., 0.05, ...), tracked;
+//   intersects_batch, tracked     the same as one batch call per configuration
+//                                 (within_margin_batch, margin 0; the
+//                                 poses gathered into its arrays inside the
+//                                 timing), a cache per row (DistanceCache
+//                                 for hulls, BodyCache for meshes);
+//   within_margin_batch 5 cm      the batch with the 5 cm margin;
 //   FCL collide                   fcl::collide (default CollisionRequest:
 //                                 one contact), fcl::Convexd of the same
 //                                 hull / BVHModel<OBBRSS> of the same mesh;
@@ -30,6 +36,7 @@
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
 #include <proxima/io.h>
+#include <proxima/query/batch.h>
 #include <proxima/query/distance.h>
 #include <proxima/query/margin.h>
 #include <proxima/query/mesh_distance.h>
@@ -95,10 +102,20 @@ struct Links {
   std::vector<std::shared_ptr<fcl::CollisionGeometryd>> fcl_meshes;
 };
 
-enum System { tracked, cold, margin_tracked, fcl_collide, fcl_distance, kSystems };
+enum System {
+  tracked,
+  cold,
+  margin_tracked,
+  batch_tracked,
+  batch_margin,
+  fcl_collide,
+  fcl_distance,
+  kSystems
+};
 const std::array<const char*, kSystems> kNames = {
     "proxima intersects, tracked", "proxima intersects, cold", "proxima within 5 cm, tracked",
-    "FCL collide", "FCL distance <= 5 cm"};
+    "intersects_batch, tracked",   "within_margin_batch 5 cm",  "FCL collide",
+    "FCL distance <= 5 cm"};
 
 void run_case(const Links& links, bool meshes, const char* motion,
               const std::vector<std::array<proxima::Pose, kBodies>>& poses, int repeat) {
@@ -109,6 +126,22 @@ void run_case(const Links& links, bool meshes, const char* motion,
   std::array<Verdicts, kSystems> verdicts;
   std::vector<proxima::DistanceCache> hull_caches(pairs.size()), hull_margin(pairs.size());
   std::vector<proxima::MeshCache> mesh_caches(pairs.size()), mesh_margin(pairs.size());
+  // The batches: one call per configuration over every pair (hulls as
+  // BatchPairs with DistanceCaches, meshes as BodyPairs with BodyCaches),
+  // in the calling thread (28 pairs are under two of the batch's grains).
+  std::vector<proxima::Body> mesh_bodies;
+  for (const auto& m : links.meshes) mesh_bodies.emplace_back(m);
+  std::vector<proxima::BatchPair> batch_pairs;
+  std::vector<proxima::BodyPair> body_pairs;
+  for (const auto& [a, b] : pairs) {
+    batch_pairs.push_back({links.hulls[a].get(), links.hulls[b].get()});
+    body_pairs.push_back({&mesh_bodies[a], &mesh_bodies[b]});
+  }
+  std::vector<proxima::DistanceCache> batch_hull_caches(pairs.size()),
+      batch_hull_margin(pairs.size());
+  std::vector<proxima::BodyCache> batch_body_caches(pairs.size()), batch_body_margin(pairs.size());
+  std::vector<proxima::Pose> batch_poses_a(pairs.size()), batch_poses_b(pairs.size());
+  std::vector<proxima::MarginResult> batch_results(pairs.size());
   long sink = 0;
   long pairs_tested = 0, answers = 0;
   std::vector<double> referee_distance(pairs.size()), band(pairs.size());
@@ -134,6 +167,31 @@ void run_case(const Links& links, bool meshes, const char* motion,
         verdicts[s].add(m.is_within(), referee_distance[k], referee_contact[k], margin, band[k]);
     }
     times[s].push_back(seconds_since(start));
+  };
+  const auto run_batch = [&](int s, const std::array<proxima::Pose, kBodies>& pose, bool check) {
+    const double margin = s == batch_margin ? kMargin : 0.0;
+    const auto start = Clock::now();
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      batch_poses_a[k] = pose[pairs[k].first];
+      batch_poses_b[k] = pose[pairs[k].second];
+    }
+    if (meshes) {
+      proxima::within_margin_batch(
+          body_pairs, batch_poses_a, batch_poses_b, margin, batch_results,
+          s == batch_margin ? batch_body_margin : batch_body_caches, {}, 1);
+    } else {
+      proxima::within_margin_batch(
+          batch_pairs, batch_poses_a, batch_poses_b, margin, batch_results,
+          s == batch_margin ? batch_hull_margin : batch_hull_caches, {}, 1);
+    }
+    times[s].push_back(seconds_since(start));
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      sink += batch_results[k].is_within() ? 1 : 0;
+      if (check) {
+        verdicts[s].add(batch_results[k].is_within(), referee_distance[k], referee_contact[k],
+                        margin, band[k]);
+      }
+    }
   };
   const auto run_fcl = [&](int s, const std::array<proxima::Pose, kBodies>& pose, bool check) {
     const auto start = Clock::now();
@@ -186,7 +244,8 @@ void run_case(const Links& links, bool meshes, const char* motion,
   // its own between two configurations); the passes alternate in a
   // shuffled order in every repetition, so that load changes of the
   // machine fall on all of them.
-  std::array<int, kSystems> order = {tracked, cold, margin_tracked, fcl_collide, fcl_distance};
+  std::array<int, kSystems> order = {tracked,      cold,        margin_tracked, batch_tracked,
+                                     batch_margin, fcl_collide, fcl_distance};
   std::mt19937 rng(26);
   for (int r = 0; r < repeat; ++r) {
     std::shuffle(order.begin(), order.end(), rng);
@@ -197,6 +256,8 @@ void run_case(const Links& links, bool meshes, const char* motion,
         band = bands[c];
         if (s == fcl_collide || s == fcl_distance) {
           run_fcl(s, poses[c], r == 0);
+        } else if (s == batch_tracked || s == batch_margin) {
+          run_batch(s, poses[c], r == 0);
         } else {
           run_proxima(s, poses[c], r == 0);
         }

@@ -46,7 +46,6 @@ Body to_body(py::handle obj, const char* name) {
 
 namespace {
 
-using PyBodyCache = Guarded<BodyCache>;
 
 const char* kind_name(const Body& b) {
   switch (b.kind()) {

@@ -332,6 +332,19 @@ void bind_compound_and_scene(py::module_& m) {
                ", distance=" + py::repr(py::float_(p.result.distance)).cast<std::string>() + ")";
       });
 
+  py::class_<MarginPair>(m, "MarginPair",
+                         "A pair of bodies within the scene's margin as the margin query "
+                         "proves it (a < b): Scene.step_within, Scene.first_within.")
+      .def_readonly("a", &MarginPair::a, "Body id.")
+      .def_readonly("b", &MarginPair::b, "Body id.")
+      .def_readonly("result", &MarginPair::result,
+                    "The MarginResult of the pair: status 'within' (or 'undecided' at the "
+                    "iteration cap), the witness points, pieces and triangles; no distance.")
+      .def("__repr__", [](const MarginPair& p) {
+        return "proxima.MarginPair(" + std::to_string(p.a) + ", " + std::to_string(p.b) +
+               ", status='" + to_string(p.result.status) + "')";
+      });
+
   py::class_<ImpactPair>(m, "ImpactPair",
                          "A pair of bodies that meet during a sweep (a < b), and when.")
       .def_readonly("a", &ImpactPair::a, "Body id.")
@@ -567,6 +580,38 @@ void bind_compound_and_scene(py::module_& m) {
           },
           "Broad phase and tracked narrow phase on the current poses: the list of ClosePair, "
           "sorted by (a, b).")
+      .def(
+          "step_within",
+          [](PyScene& s) {
+            const InUse in_use(s, "Scene");
+            std::span<const MarginPair> pairs;
+            {
+              py::gil_scoped_release release;
+              pairs = s.step_within();
+            }
+            py::list out;
+            for (const MarginPair& p : pairs) out.append(py::cast(p));
+            return out;
+          },
+          "step()'s pairs without their distances: the same broad phase and pair caches, then "
+          "the margin query on each candidate, stopped at its first proof. The list of "
+          "MarginPair (status 'within', or 'undecided' at the iteration cap), sorted by (a, b); "
+          "the same pairs as step() up to the contact band of the margin.")
+      .def(
+          "first_within",
+          [](PyScene& s) -> py::object {
+            const InUse in_use(s, "Scene");
+            std::optional<MarginPair> hit;
+            {
+              py::gil_scoped_release release;
+              hit = s.first_within();
+            }
+            if (!hit) return py::none();
+            return py::cast(*hit);
+          },
+          "The collision check of the whole scene: the first pair found within the margin (a "
+          "MarginPair; the last call's pair is asked first), or None when every pair is proved "
+          "beyond it.")
       .def_property_readonly(
           "stats",
           [](const PyScene& s) {

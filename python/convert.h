@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "proxima/query/body_distance.h"
+#include "proxima/query/margin.h"
 #include "proxima/io.h"
 #include "proxima/shape/polytope.h"
 #include "proxima/core/types.h"
@@ -755,6 +756,7 @@ class InUse {
 };
 
 using PyDistanceCache = Guarded<DistanceCache>;
+using PyBodyCache = Guarded<BodyCache>;
 
 // Registers CompoundBody, Scene and their companions (compound_scene.cpp),
 // and PairBatch (pair_batch.cpp).
@@ -769,6 +771,13 @@ void bind_robot(py::module_& m);
 Body to_body(py::handle obj, const char* name);
 // Motion, ImpactResult and time_of_impact (time_of_impact.cpp).
 void bind_time_of_impact(py::module_& m);
+// MarginResult (before the scene and PairBatch, which answer with it), and
+// within_margin and intersects (after the bodies and their caches):
+// margin.cpp.
+void bind_margin_result(py::module_& m);
+void bind_margin_queries(py::module_& m);
+// A margin batch's answers as a dict of arrays with K rows (margin.cpp).
+py::dict margin_dict(std::span<const MarginResult> results);
 // view and view_scene, the viewer's page (view.cpp).
 void bind_view(py::module_& m);
 

@@ -588,9 +588,11 @@ feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k],
   // Before the scene: Scene.sweep's ImpactPair holds an ImpactResult, whose
   // type must be known when its property is bound (for its signature).
   bind_time_of_impact(m);
+  bind_margin_result(m);
   bind_compound_and_scene(m);
   bind_pair_batch(m);
   bind_bodies(m);
+  bind_margin_queries(m);
   bind_mesh(m);
   bind_view(m);
   bind_robot(m);

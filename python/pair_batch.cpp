@@ -39,6 +39,7 @@ struct PairBatchState {
   // nothing for them.
   std::vector<Pose> poses_a;
   std::vector<Pose> poses_b;
+  std::vector<MarginResult> margin_results;  // of the last margin call
   double last_call_seconds = 0.0;
 
   std::size_t size() const { return pairs.size() + body_pairs.size(); }
@@ -48,10 +49,41 @@ using PyPairBatch = Guarded<PairBatchState>;
 // distance_batch's refusal as PairBatch.distance's: the poses are checked
 // there (the pose contract, once, by the batch itself), so its message
 // names the pose (poses_a[k]) or the pair; only the caller's name differs.
-std::string in_python_words(std::string_view message) {
-  constexpr std::string_view kBatch = "distance_batch: ";
-  if (message.starts_with(kBatch)) message.remove_prefix(kBatch.size());
-  return "PairBatch.distance: " + std::string(message);
+std::string in_python_words(std::string_view message, std::string_view batch = "distance_batch",
+                            std::string_view method = "distance") {
+  const std::string prefix = std::string(batch) + ": ";
+  if (message.starts_with(prefix)) message.remove_prefix(prefix.size());
+  return "PairBatch." + std::string(method) + ": " + std::string(message);
+}
+
+// PairBatch.within_margin and PairBatch.intersects: the margin batch on the
+// pairs' own caches (the distance query's: the three methods keep each
+// other warm), poses checked by the batch itself.
+py::dict margin_call(PyPairBatch& s, py::object poses_a, py::object poses_b, double margin,
+                     int threads, const DistanceOptions& options, const char* method) {
+  const InUse in_use(s, "PairBatch");
+  const auto k = static_cast<py::ssize_t>(s.size());
+  to_poses(poses_a, k, "poses_a", PoseCheck::by_the_batch, s.poses_a);
+  to_poses(poses_b, k, "poses_b", PoseCheck::by_the_batch, s.poses_b);
+  s.margin_results.resize(s.size());
+  {
+    py::gil_scoped_release release;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      if (!s.body_pairs.empty()) {
+        within_margin_batch(s.body_pairs, s.poses_a, s.poses_b, margin, s.margin_results,
+                            s.body_caches, options, threads);
+      } else {
+        within_margin_batch(s.pairs, s.poses_a, s.poses_b, margin, s.margin_results, s.caches,
+                            options, threads);
+      }
+    } catch (const InvalidInput& e) {
+      throw InvalidInput(in_python_words(e.what(), "within_margin_batch", method));
+    }
+    s.last_call_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  return margin_dict(s.margin_results);
 }
 
 py::sequence body_list(py::handle list, const std::string& name) {
@@ -178,6 +210,47 @@ distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).
 out: None (new arrays), or the dict of an earlier answer of this batch: its arrays are
 filled again in place and the same dict is returned, so that a loop allocates nothing
 (a bad out raises ValueError before any cache or array changes).)doc")
+      .def(
+          "within_margin",
+          [](PyPairBatch& s, py::object poses_a, py::object poses_b, double margin, int threads,
+             const std::string& algorithm, double relative_tolerance, double absolute_tolerance,
+             int max_iterations) {
+            const DistanceOptions options = make_options(algorithm, relative_tolerance,
+                                                         absolute_tolerance, max_iterations, false);
+            return margin_call(s, std::move(poses_a), std::move(poses_b), margin, threads,
+                               options, "within_margin");
+          },
+          py::arg("poses_a"), py::arg("poses_b"), py::arg("margin"), py::arg("threads") = 0,
+          py::arg("algorithm") = to_string(defaults.algorithm),
+          py::arg("relative_tolerance") = defaults.relative_tolerance,
+          py::arg("absolute_tolerance") = defaults.absolute_tolerance,
+          py::arg("max_iterations") = defaults.max_iterations,
+          R"doc(Whether each pair k is within `margin` at poses_a[k], poses_b[k], each query stopped at its first proof.
+
+Tracked on the pairs' caches, the same ones distance() uses (either keeps them warm for the
+other). poses and threads as in distance(). Returns a dict of arrays with K rows: status
+('within', 'beyond', 'undecided'), within (bool), lower_bound (certified; > margin when
+beyond), upper_bound (|point_a - point_b|), point_a and point_b (K, 3; the witness when
+within), piece_a, piece_b, triangle_a, triangle_b (-1 where not a compound / mesh),
+pairs_tested, iterations. Row k equals within_margin(a[k], poses_a[k], b[k], poses_b[k],
+margin, cache=<pair k's cache>).)doc")
+      .def(
+          "intersects",
+          [](PyPairBatch& s, py::object poses_a, py::object poses_b, int threads,
+             const std::string& algorithm, double relative_tolerance, double absolute_tolerance,
+             int max_iterations) {
+            const DistanceOptions options = make_options(algorithm, relative_tolerance,
+                                                         absolute_tolerance, max_iterations, false);
+            return margin_call(s, std::move(poses_a), std::move(poses_b), 0.0, threads, options,
+                               "intersects");
+          },
+          py::arg("poses_a"), py::arg("poses_b"), py::arg("threads") = 0,
+          py::arg("algorithm") = to_string(defaults.algorithm),
+          py::arg("relative_tolerance") = defaults.relative_tolerance,
+          py::arg("absolute_tolerance") = defaults.absolute_tolerance,
+          py::arg("max_iterations") = defaults.max_iterations,
+          "Whether each pair k touches or intersects: within_margin with margin 0 (same "
+          "arguments otherwise, same dict).")
       .def(
           "reset",
           [](PyPairBatch& s) {

@@ -12,8 +12,10 @@
 #include <cstddef>
 #include <string>
 
+#include "core/accuracy.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
+#include "proxima/query/margin.h"
 #include "query/parallel_ranges.h"
 
 namespace proxima {
@@ -28,9 +30,9 @@ constexpr std::size_t kGrainSize = 32;
 
 std::string at(std::size_t k) { return std::to_string(k); }
 
-void check_size(std::size_t size, std::size_t expected, const char* name) {
+void check_size(const char* who, std::size_t size, std::size_t expected, const char* name) {
   if (size != expected) {
-    throw InvalidInput("distance_batch: " + std::string(name) + " has " + at(size) +
+    throw InvalidInput(std::string(who) + ": " + name + " has " + at(size) +
                        " elements, expected " + at(expected) + " (one per pair)");
   }
 }
@@ -38,38 +40,39 @@ void check_size(std::size_t size, std::size_t expected, const char* name) {
 // Every pose under the contract, before any query runs: both poses of pair
 // k in one paired test (detail::are_rigid, as distance() itself does), the
 // full check, which names the pose, only for a pair that fails it.
-void check_poses(std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
+void check_poses(const char* who, std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
   for (std::size_t k = 0; k < poses_a.size(); ++k) {
     if (detail::are_rigid(poses_a[k], poses_b[k])) [[likely]]
       continue;
-    check_pose(poses_a[k], [&] { return "distance_batch: poses_a[" + at(k) + "]"; });
-    check_pose(poses_b[k], [&] { return "distance_batch: poses_b[" + at(k) + "]"; });
+    check_pose(poses_a[k], [&] { return std::string(who) + ": poses_a[" + at(k) + "]"; });
+    check_pose(poses_b[k], [&] { return std::string(who) + ": poses_b[" + at(k) + "]"; });
   }
 }
 
 // The shared part of every overload. `pair(k)` returns the pair of index k
-// (a span lookup or the one fixed pair): a BatchPair or a BodyPair, whose
-// distance() overload answers into Result with a Cache.
-template <class PairOf, class Result, class Cache>
-void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
-               std::span<const Pose> poses_b, std::span<Result> results, std::span<Cache> caches,
-               const DistanceOptions& options, int threads) {
-  check_size(poses_a.size(), n, "poses_a");
-  check_size(poses_b.size(), n, "poses_b");
-  check_size(results.size(), n, "results");
-  if (!caches.empty()) check_size(caches.size(), n, "caches (when not empty)");
+// (a span lookup or the one fixed pair): a BatchPair or a BodyPair;
+// `query(pair, pose_a, pose_b, cache)` answers it into Result with a Cache
+// (null: cold). `who` names the batch in every message.
+template <class PairOf, class Query, class Result, class Cache>
+void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
+               std::span<const Pose> poses_a, std::span<const Pose> poses_b,
+               std::span<Result> results, std::span<Cache> caches, int threads) {
+  check_size(who, poses_a.size(), n, "poses_a");
+  check_size(who, poses_b.size(), n, "poses_b");
+  check_size(who, results.size(), n, "results");
+  if (!caches.empty()) check_size(who, caches.size(), n, "caches (when not empty)");
   if (threads < 0) {
-    throw InvalidInput("distance_batch: threads must be >= 0 (0: all cores), got " +
+    throw InvalidInput(std::string(who) + ": threads must be >= 0 (0: all cores), got " +
                        std::to_string(threads));
   }
   for (std::size_t k = 0; k < n; ++k) {
     const auto p = pair(k);
     if (p.a == nullptr || p.b == nullptr) {
-      throw InvalidInput("distance_batch: pairs[" + at(k) + "]." + (p.a == nullptr ? "a" : "b") +
-                         " is null");
+      throw InvalidInput(std::string(who) + ": pairs[" + at(k) + "]." +
+                         (p.a == nullptr ? "a" : "b") + " is null");
     }
   }
-  check_poses(poses_a, poses_b);
+  check_poses(who, poses_a, poses_b);
 
   // Runs the queries of [begin, end). An InvalidInput from a query (the
   // options are checked by distance() itself) is re-thrown with its index;
@@ -79,10 +82,9 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
     for (std::size_t k = begin; k < end; ++k) {
       const auto p = pair(k);
       try {
-        results[k] = distance(*p.a, poses_a[k], *p.b, poses_b[k], options,
-                              caches.empty() ? nullptr : &caches[k]);
+        results[k] = query(p, poses_a[k], poses_b[k], caches.empty() ? nullptr : &caches[k]);
       } catch (const InvalidInput& e) {
-        throw InvalidInput("distance_batch: pair " + at(k) + ": " + e.what());
+        throw InvalidInput(std::string(who) + ": pair " + at(k) + ": " + e.what());
       }
     }
   };
@@ -94,14 +96,35 @@ void run_batch(std::size_t n, PairOf pair, std::span<const Pose> poses_a,
   detail::parallel_ranges(n, kGrainSize, threads, run_range);
 }
 
+// The distance query of one pair, for run_batch.
+auto distance_with(const DistanceOptions& options) {
+  return [&options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache) {
+    return distance(*p.a, pose_a, *p.b, pose_b, options, cache);
+  };
+}
+
+// The margin query of one pair, for run_batch; the margin and the options
+// are checked once, in the calling thread, before anything is written.
+auto within_margin_with(double margin, const DistanceOptions& options, const char* who) {
+  detail::check_margin(margin, who);
+  detail::check_distance_options(options, (std::string(who) + ": options").c_str());
+  return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache) {
+    return within_margin(*p.a, pose_a, *p.b, pose_b, margin, options, cache);
+  };
+}
+
+constexpr const char* kDistance = "distance_batch";
+constexpr const char* kWithin = "within_margin_batch";
+constexpr const char* kIntersects = "intersects_batch";
+
 }  // namespace
 
 void distance_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a,
                     std::span<const Pose> poses_b, std::span<DistanceResult> results,
                     std::span<DistanceCache> caches, const DistanceOptions& options, int threads) {
   run_batch(
-      pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b, results, caches,
-      options, threads);
+      kDistance, pairs.size(), [pairs](std::size_t k) { return pairs[k]; },
+      distance_with(options), poses_a, poses_b, results, caches, threads);
 }
 
 void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, const ConvexPolytope& b,
@@ -109,16 +132,85 @@ void distance_batch(const ConvexPolytope& a, std::span<const Pose> poses_a, cons
                     std::span<DistanceCache> caches, const DistanceOptions& options, int threads) {
   const BatchPair fixed{&a, &b};
   run_batch(
-      poses_a.size(), [fixed](std::size_t) { return fixed; }, poses_a, poses_b, results, caches,
-      options, threads);
+      kDistance, poses_a.size(), [fixed](std::size_t) { return fixed; }, distance_with(options),
+      poses_a, poses_b, results, caches, threads);
 }
 
 void distance_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
                     std::span<const Pose> poses_b, std::span<BodyResult> results,
                     std::span<BodyCache> caches, const DistanceOptions& options, int threads) {
   run_batch(
-      pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b, results, caches,
-      options, threads);
+      kDistance, pairs.size(), [pairs](std::size_t k) { return pairs[k]; },
+      distance_with(options), poses_a, poses_b, results, caches, threads);
+}
+
+namespace {
+
+// Every margin batch: `who` names it (within_margin_batch, or
+// intersects_batch with the margin 0).
+template <class PairOf, class Cache>
+void margin_batch(const char* who, std::size_t n, PairOf pair, std::span<const Pose> poses_a,
+                  std::span<const Pose> poses_b, double margin, std::span<MarginResult> results,
+                  std::span<Cache> caches, const DistanceOptions& options, int threads) {
+  run_batch(who, n, pair, within_margin_with(margin, options, who), poses_a, poses_b, results,
+            caches, threads);
+}
+
+}  // namespace
+
+void within_margin_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a,
+                         std::span<const Pose> poses_b, double margin,
+                         std::span<MarginResult> results, std::span<DistanceCache> caches,
+                         const DistanceOptions& options, int threads) {
+  margin_batch(
+      kWithin, pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b,
+      margin, results, caches, options, threads);
+}
+
+void within_margin_batch(const ConvexPolytope& a, std::span<const Pose> poses_a,
+                         const ConvexPolytope& b, std::span<const Pose> poses_b, double margin,
+                         std::span<MarginResult> results, std::span<DistanceCache> caches,
+                         const DistanceOptions& options, int threads) {
+  const BatchPair fixed{&a, &b};
+  margin_batch(
+      kWithin, poses_a.size(), [fixed](std::size_t) { return fixed; }, poses_a, poses_b, margin,
+      results, caches, options, threads);
+}
+
+void within_margin_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
+                         std::span<const Pose> poses_b, double margin,
+                         std::span<MarginResult> results, std::span<BodyCache> caches,
+                         const DistanceOptions& options, int threads) {
+  margin_batch(
+      kWithin, pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b,
+      margin, results, caches, options, threads);
+}
+
+void intersects_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a,
+                      std::span<const Pose> poses_b, std::span<MarginResult> results,
+                      std::span<DistanceCache> caches, const DistanceOptions& options,
+                      int threads) {
+  margin_batch(
+      kIntersects, pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b,
+      0.0, results, caches, options, threads);
+}
+
+void intersects_batch(const ConvexPolytope& a, std::span<const Pose> poses_a,
+                      const ConvexPolytope& b, std::span<const Pose> poses_b,
+                      std::span<MarginResult> results, std::span<DistanceCache> caches,
+                      const DistanceOptions& options, int threads) {
+  const BatchPair fixed{&a, &b};
+  margin_batch(
+      kIntersects, poses_a.size(), [fixed](std::size_t) { return fixed; }, poses_a, poses_b, 0.0,
+      results, caches, options, threads);
+}
+
+void intersects_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
+                      std::span<const Pose> poses_b, std::span<MarginResult> results,
+                      std::span<BodyCache> caches, const DistanceOptions& options, int threads) {
+  margin_batch(
+      kIntersects, pairs.size(), [pairs](std::size_t k) { return pairs[k]; }, poses_a, poses_b,
+      0.0, results, caches, options, threads);
 }
 
 }  // namespace proxima

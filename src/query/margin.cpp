@@ -110,8 +110,11 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
     const std::size_t k = n == 0 ? first : n <= first ? n - 1 : n;
     const std::size_t i = k / mb.size();
     const std::size_t j = k % mb.size();
-    const Pose place_a = pose_a * ma[i].pose;
-    const Pose place_b = pose_b * mb[j].pose;
+    // A mesh body is its one mesh at the identity: its pose as it is (the
+    // product with the identity would give the same bits, at the cost of
+    // two pose products on every query of a tracked mesh pair).
+    const Pose place_a = a.kind() == Body::Kind::mesh ? pose_a : pose_a * ma[i].pose;
+    const Pose place_b = b.kind() == Body::Kind::mesh ? pose_b : pose_b * mb[j].pose;
     if (pairs > 1) {
       const double gap = detail::sphere_gap_lower_bound(
           place_a.apply(ma[i].mesh->center()), ma[i].mesh->bounding_radius(),
@@ -250,6 +253,13 @@ MarginResult within_margin(const ConvexPolytope& a, const Pose& pose_a, const Co
 
 MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                            double margin, const DistanceOptions& options, BodyCache* cache) {
+  // A cold cache of its own only where the caller gave none: a BodyCache
+  // (with its penetration and mesh caches) costs about as much to build and
+  // destroy as a tracked query of a mesh pair whose hulls are apart.
+  if (cache == nullptr) {
+    BodyCache cold;
+    return within_margin(a, pose_a, b, pose_b, margin, options, &cold);
+  }
   detail::check_margin(margin, "within_margin");
   detail::check_distance_options(options, "within_margin: options");
   const Pose pa = checked_pose(pose_a, "within_margin: pose_a");
@@ -265,8 +275,7 @@ MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, con
       throw InvalidInput(message);
     }
   }
-  BodyCache cold;
-  BodyCache& c = cache != nullptr ? *cache : cold;
+  BodyCache& c = *cache;
   const double core_margin = margin + a.radius() + b.radius();
   MarginResult r;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {

@@ -4,6 +4,13 @@
 // query layer: the distance between a triangle mesh and a convex polytope
 // (mesh.h): the mesh's hierarchy against the polytope's box, the convex
 // query at the leaves on each near triangle as a polytope of its vertices.
+//
+// The mesh's hull (TriangleMesh::hull()) holds every triangle, so the
+// hull-polytope distance L is a certified lower bound on the answer: the
+// search stops at the first triangle within the accuracy standard of L (the
+// mesh-mesh query's rule, mesh_pair.h), and the last closest triangle is
+// tested first, so that a tracked query of a pair whose hull is apart from
+// the polytope is one hull query and one triangle.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,6 +18,7 @@
 #include "core/accuracy.h"
 #include "proxima/query/distance.h"
 #include "proxima/query/mesh_distance.h"
+#include "query/mesh_pair.h"
 
 namespace proxima {
 namespace {
@@ -27,6 +35,7 @@ struct ConvexQuery {
   Mat3 rotation;  // B in A's frame
   Vec3 translation;
   Vec3 lo, hi;  // B's box in A's frame
+  double magnitude = 0.0;
   double slack = 0.0;
   DistanceOptions options;
 };
@@ -42,6 +51,7 @@ ConvexQuery make_query(const TriangleMesh& a, const Pose& pose_a, const ConvexPo
                 {},
                 {},
                 0.0,
+                0.0,
                 options};
   const Pose rel = q.pose_a.inverse() * q.pose_b;
   q.rotation = rel.rotation;
@@ -53,10 +63,10 @@ ConvexQuery make_query(const TriangleMesh& a, const Pose& pose_a, const ConvexPo
     q.lo = q.lo.cwiseMin(p);
     q.hi = q.hi.cwiseMax(p);
   }
-  const double magnitude =
+  q.magnitude =
       std::max({magnitude_bound(q.pose_a, a.scale()), magnitude_bound(q.pose_b, b.scale()),
                 a.scale(), magnitude_bound(rel, b.scale())});
-  q.slack = detail::prune_slack(magnitude);
+  q.slack = detail::prune_slack(q.magnitude);
   q.options.penetration = false;  // the status is all a leaf needs
   return q;
 }
@@ -71,6 +81,32 @@ double gap(const ConvexQuery& q, const Vec3& lo, const Vec3& hi) {
     if (g > 0.0) s += g * g;
   }
   return 2.0 * std::sqrt(s);
+}
+
+// The hull's bound: whether A's hull is apart from B, the certified lower
+// bound L on the distance it gives, and the distance at which a triangle is
+// the answer (L (1 + kHullStopRelative) + kHullStopUlps u R: no triangle is
+// closer than L, and that one is within the accuracy standard of it).
+struct HullStop {
+  bool apart = false;
+  double lower = 0.0;
+  double stop = -1.0;  // -1: no stop (hull not apart, or not asked)
+};
+
+HullStop hull_stop(const ConvexQuery& q, MeshCache* cache) {
+  // The convex query's range of placed magnitudes: beyond, the search
+  // alone answers.
+  if (!(q.magnitude <= kMaxMagnitude)) return {};
+  DistanceCache local;
+  const DistanceResult r = detail::distance_of_rigid_poses(
+      q.a.hull(), q.pose_a, q.b, q.pose_b, q.options, cache != nullptr ? &cache->hull : &local);
+  if (r.status != Status::separated || !(r.lower_bound > 0.0)) return {};
+  HullStop h;
+  h.apart = true;
+  h.lower = r.lower_bound;
+  h.stop = r.lower_bound * (1.0 + detail::mesh_pair::kHullStopRelative) +
+           detail::mesh_pair::kHullStopUlps * kUnitRoundoff * q.magnitude;
+  return h;
 }
 
 struct Best {
@@ -109,15 +145,24 @@ void test_triangle(const ConvexQuery& q, std::int32_t t, Best& best, int& tested
   }
 }
 
-MeshResult finish(const ConvexQuery& q, const Best& best, int tested, int nodes) {
+// The answer from the best triangle; `hull` says whether A's hull is apart
+// from B (then B holds no point inside A's closed mesh: the inside test is
+// skipped) and, when the search stopped at its bound, the certified lower
+// bound it gives.
+MeshResult finish(const ConvexQuery& q, const Best& best, int tested, int nodes,
+                  const HullStop& hull, bool stopped_at_hull) {
   MeshResult r;
   static_cast<DistanceResult&>(r) = best.result;
   r.triangle_a = best.triangle;
   r.triangle_b = -1;
   r.pairs_tested = tested;
   r.nodes_tested = nodes;
+  // Stopped at the hull's bound, the best triangle's own lower bound does
+  // not cover the triangles not tested; L does (every triangle lies in the
+  // hull).
+  if (stopped_at_hull) r.lower_bound = std::min(r.lower_bound, hull.lower);
   bool inside = false;
-  if (r.status != Status::intersecting && q.a.is_closed())
+  if (r.status != Status::intersecting && q.a.is_closed() && !hull.apart)
     inside = q.a.contains(q.rotation * q.b.vertex(0) + q.translation);
   if (inside) {
     // The closest points of the surfaces are apart; B's vertex inside the
@@ -147,7 +192,7 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const C
     test_triangle(q, t, best, tested);
     if (best.result.status == Status::intersecting) break;
   }
-  return finish(q, best, tested, 0);
+  return finish(q, best, tested, 0, HullStop{}, false);
 }
 
 MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
@@ -155,8 +200,24 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolyt
   const ConvexQuery q = make_query(a, pose_a, b, pose_b, options);
   Best best;
   int tested = 0, nodes = 0;
-  if (cache != nullptr && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count())
+  // Every query asks the hull, tracked or not: unlike the mesh-mesh query
+  // (whose triangle pairs cost tens of nanoseconds), a triangle here is a
+  // convex query on a polytope built for it, many times a tracked hull
+  // query, so skipping the hull (MeshCache::hull_wait) saves less than one
+  // triangle and loses the bound whenever the hull has come apart since.
+  const HullStop hull = hull_stop(q, cache);
+  const auto reached_hull = [&] { return best.have && best.result.distance <= hull.stop; };
+  const auto answer = [&](bool stopped_at_hull) {
+    if (cache != nullptr) {
+      cache->triangle_a = best.triangle;
+      cache->triangle_b = -1;
+    }
+    return finish(q, best, tested, nodes, hull, stopped_at_hull);
+  };
+  if (cache != nullptr && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count()) {
     test_triangle(q, cache->triangle_a, best, tested);
+    if (reached_hull()) return answer(true);
+  }
   const auto bound = [&] {
     return best.have ? best.result.distance + q.slack : std::numeric_limits<double>::infinity();
   };
@@ -165,7 +226,8 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolyt
   stack.emplace_back(0, 0.0);
   const auto nodes_a = a.nodes();
   const auto order = a.triangle_order();
-  while (!stack.empty() && best.result.status != Status::intersecting) {
+  bool stopped = false;
+  while (!stack.empty() && best.result.status != Status::intersecting && !stopped) {
     const auto [id, lb] = stack.back();
     stack.pop_back();
     if (lb > bound()) continue;
@@ -181,6 +243,10 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolyt
         if (gap(q, p0.cwiseMin(p1).cwiseMin(p2), p0.cwiseMax(p1).cwiseMax(p2)) > bound()) continue;
         test_triangle(q, t, best, tested);
         if (best.result.status == Status::intersecting) break;
+        if (reached_hull()) {
+          stopped = true;
+          break;
+        }
       }
       continue;
     }
@@ -196,12 +262,7 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolyt
     if (lbs[1 - near] <= bound()) stack.emplace_back(children[1 - near], lbs[1 - near]);
     if (lbs[near] <= bound()) stack.emplace_back(children[near], lbs[near]);
   }
-  MeshResult r = finish(q, best, tested, nodes);
-  if (cache != nullptr) {
-    cache->triangle_a = best.triangle;
-    cache->triangle_b = -1;
-  }
-  return r;
+  return answer(stopped);
 }
 
 }  // namespace proxima

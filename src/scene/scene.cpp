@@ -217,74 +217,12 @@ const SceneOptions& Scene::options() const { return impl_->options; }
 
 std::span<const ClosePair> Scene::step() {
   Impl& s = *impl_;
-  const int threads = s.options.threads;
-  s.boxes.resize(s.bodies.size());
-  detail::parallel_chunks(s.bodies.size(), kBoxChunk, threads,
-                          [&s](std::size_t, std::size_t begin, std::size_t end) {
-                            for (std::size_t k = begin; k < end; ++k) {
-                              if (s.bodies[k].live) s.boxes[k] = s.world_box(s.bodies[k]);
-                            }
-                          });
-  s.finder->find_pairs(s.boxes, s.candidates, threads);
-  const int filtered = s.filter_candidates(s.candidates);
-  s.drop_removed(s.pairs, s.removed_since_step);
-  const int warm = s.carry_caches(s.candidates, s.pairs, nullptr, threads);
-
-  // The narrow phase and the close pairs in pair order. On one thread, the
-  // close answers go straight to the output. On threads, in fixed chunks of
-  // pairs: each chunk answers its pairs into their result slots and counts
-  // its close ones, the offsets follow, and each chunk copies its close
-  // answers to its place (the count rides on the answering pass, which has
-  // the answers at hand, instead of a pass of its own over every slot).
-  const std::size_t n = s.pairs.size();
+  s.find_candidates();
   const double margin = s.options.margin;
-  const std::size_t chunk = narrow_chunk(n);
-  const std::size_t chunks = detail::chunk_count(n, chunk);
-  int convex_queries = 0;
-  if (threads == 1 || chunks < 2) {
-    s.close.clear();
-    for (std::size_t k = 0; k < n; ++k) {
-      ClosePair& p = s.close.emplace_back();
-      s.query_into(s.pairs[k], p);
-      convex_queries += p.result.pairs_tested;
-      if (!is_close(p.result, margin)) s.close.pop_back();
-    }
-  } else {
-    s.results.resize(n);
-    s.chunk_close.assign(chunks, 0);
-    s.chunk_queries.assign(chunks, 0);
-    detail::parallel_chunks(n, chunk, threads,
-                            [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
-                              std::size_t count = 0;
-                              int queries = 0;
-                              for (std::size_t k = begin; k < end; ++k) {
-                                ClosePair& p = s.results[k];
-                                s.query_into(s.pairs[k], p);
-                                count += is_close(p.result, margin) ? 1 : 0;
-                                queries += p.result.pairs_tested;
-                              }
-                              s.chunk_close[c] = count;
-                              s.chunk_queries[c] = queries;
-                            });
-    std::size_t total = 0;
-    for (std::size_t& c : s.chunk_close) total += std::exchange(c, total);
-    s.close.resize(total);
-    detail::parallel_chunks(n, chunk, threads,
-                            [&s, margin](std::size_t c, std::size_t begin, std::size_t end) {
-                              std::size_t at = s.chunk_close[c];
-                              for (std::size_t k = begin; k < end; ++k) {
-                                if (is_close(s.results[k].result, margin))
-                                  s.close[at++] = s.results[k];
-                              }
-                            });
-    for (const int q : s.chunk_queries) convex_queries += q;
-  }
-  s.stats.bodies = s.live_count;
-  s.stats.candidate_pairs = static_cast<int>(n);
+  s.stats.convex_queries = s.narrow_phase(
+      s.results, s.close, [&s](Impl::PairState& state, ClosePair& p) { s.query_into(state, p); },
+      [margin](const ClosePair& p) { return is_close(p.result, margin); });
   s.stats.close_pairs = static_cast<int>(s.close.size());
-  s.stats.convex_queries = convex_queries;
-  s.stats.warm_pairs = warm;
-  s.stats.filtered_pairs = filtered;
   return s.close;
 }
 

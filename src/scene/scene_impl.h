@@ -2,7 +2,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // scene layer (internal): the state of a Scene (Scene::Impl) and the helpers
-// its three files share: scene.cpp (bodies, filters, step), scene_sweep.cpp
+// its four files share: scene.cpp (bodies, filters, step), scene_margin.cpp
+// (step_within, first_within: the collision checks), scene_sweep.cpp
 // (continuous collision) and scene_queries.cpp (nearest_pair,
 // pairs_within, the twins).
 //
@@ -45,7 +46,7 @@
 #include "scene/broad_phase.h"
 
 // The helpers live in a namespace of their own, brought into proxima's by
-// the using-directive below: this header is private to the scene's three
+// the using-directive below: this header is private to the scene's four
 // files, which read them unqualified as they did in one file.
 namespace proxima::scene_impl {
 
@@ -212,6 +213,11 @@ struct Scene::Impl {
   std::vector<int> chunk_queries;          // convex queries per chunk of pairs
   std::vector<int> chunk_warm;             // warm pairs per chunk of carry_caches
   std::vector<ClosePair> close;
+  std::vector<MarginPair> margin_results;  // parallel to pairs (step_within on threads)
+  std::vector<MarginPair> margin_close;
+  // The pair first_within found last (0: none; no pair has key 0, whose
+  // bodies would both be body 0).
+  std::uint64_t last_within = 0;
   SceneStats stats;
 
   // The sweep's own broad phase and coherence, made by the first sweep.
@@ -363,6 +369,113 @@ struct Scene::Impl {
     p = ClosePair{
         ia, ib,
         distance(*a.compound, a.pose, *b.compound, b.pose, options.distance, &state.compound)};
+  }
+
+  // The margin answer of pair `state` (the scene's margin) written into
+  // `p`: the margin query of the pair's kind, from and into the same cache
+  // as query_into's (so step() and step_within() keep each other warm).
+  void margin_into(PairState& state, MarginPair& p) const {
+    p.a = detail::pair_first(state.key);
+    p.b = detail::pair_second(state.key);
+    const Body& a = bodies[slot(p.a)];
+    const Body& b = bodies[slot(p.b)];
+    const double margin = options.margin;
+    if (a.general || b.general) {
+      p.result = within_margin(a.shape->padded, a.pose, b.shape->padded, b.pose, margin,
+                               options.distance, &state.body.get());
+      return;
+    }
+    if (a.convex && b.convex) {
+      // The stored poses were checked by add and set_pose, the margin and
+      // options by the constructor.
+      p.result = detail::within_margin_of_rigid_poses(*a.convex, a.pose, *b.convex, b.pose, margin,
+                                                      options.distance, state.convex);
+      return;
+    }
+    p.result =
+        within_margin(*a.compound, a.pose, *b.compound, b.pose, margin, options.distance,
+                      &state.compound);
+    // A convex body met a compound as its one-piece wrapper: no pieces.
+    if (a.convex) p.result.piece_a = -1;
+    if (b.convex) p.result.piece_b = -1;
+  }
+
+  // The broad phase of a step on the current poses: the world boxes, the
+  // candidate pairs, the filters, and each surviving pair's cache carried
+  // over (stats' bodies, candidate, warm and filtered counts).
+  void find_candidates() {
+    const int threads = options.threads;
+    boxes.resize(bodies.size());
+    detail::parallel_chunks(bodies.size(), kBoxChunk, threads,
+                            [this](std::size_t, std::size_t begin, std::size_t end) {
+                              for (std::size_t k = begin; k < end; ++k) {
+                                if (bodies[k].live) boxes[k] = world_box(bodies[k]);
+                              }
+                            });
+    finder->find_pairs(boxes, candidates, threads);
+    stats.filtered_pairs = filter_candidates(candidates);
+    drop_removed(pairs, removed_since_step);
+    stats.warm_pairs = carry_caches(candidates, pairs, nullptr, threads);
+    stats.bodies = live_count;
+    stats.candidate_pairs = static_cast<int>(pairs.size());
+  }
+
+  // The narrow phase of a step: `answer(state, slot)` answers one
+  // candidate pair into its slot and `reported(slot)` says whether the
+  // step reports it; the reported answers land in `out` in pair order.
+  // Returns the leaf queries run (the answers' pairs_tested). On one
+  // thread, the reported answers go straight to `out`. On threads, in fixed
+  // chunks of pairs: each chunk answers its pairs into their slots of
+  // `slots` and counts its reported ones, the offsets follow, and each
+  // chunk copies its reported answers to its place (the count rides on
+  // the answering pass, which has the answers at hand, instead of a pass
+  // of its own over every slot).
+  template <class Answer, class AnswerInto, class Reported>
+  int narrow_phase(std::vector<Answer>& slots, std::vector<Answer>& out, AnswerInto answer,
+                   Reported reported) {
+    const int threads = options.threads;
+    const std::size_t n = pairs.size();
+    const std::size_t chunk = narrow_chunk(n);
+    const std::size_t chunks = detail::chunk_count(n, chunk);
+    int queries = 0;
+    if (threads == 1 || chunks < 2) {
+      out.clear();
+      for (std::size_t k = 0; k < n; ++k) {
+        Answer& p = out.emplace_back();
+        answer(pairs[k], p);
+        queries += p.result.pairs_tested;
+        if (!reported(p)) out.pop_back();
+      }
+      return queries;
+    }
+    slots.resize(n);
+    chunk_close.assign(chunks, 0);
+    chunk_queries.assign(chunks, 0);
+    detail::parallel_chunks(n, chunk, threads, [&](std::size_t c, std::size_t begin,
+                                                   std::size_t end) {
+      std::size_t count = 0;
+      int work = 0;
+      for (std::size_t k = begin; k < end; ++k) {
+        Answer& p = slots[k];
+        answer(pairs[k], p);
+        count += reported(p) ? 1 : 0;
+        work += p.result.pairs_tested;
+      }
+      chunk_close[c] = count;
+      chunk_queries[c] = work;
+    });
+    std::size_t total = 0;
+    for (std::size_t& c : chunk_close) total += std::exchange(c, total);
+    out.resize(total);
+    detail::parallel_chunks(n, chunk, threads,
+                            [&](std::size_t c, std::size_t begin, std::size_t end) {
+                              std::size_t at = chunk_close[c];
+                              for (std::size_t k = begin; k < end; ++k) {
+                                if (reported(slots[k])) out[at++] = slots[k];
+                              }
+                            });
+    for (const int q : chunk_queries) queries += q;
+    return queries;
   }
 
   ClosePair query(PairState& state) const {

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cfenv>
 #include <chrono>
@@ -27,6 +28,7 @@
 
 #include "query/parallel_ranges.h"
 #include "proxima/query/distance.h"
+#include "proxima/query/margin.h"
 #include "proxima/shape/primitives.h"
 #include "support/generators.h"
 #include "support/same_bits.h"
@@ -550,6 +552,184 @@ TEST(ParallelRanges, EachLoopRunsUnderTheCallersFloatingPointSettings) {
         100, 7, threads, [&](std::size_t b, std::size_t e) { covered += static_cast<int>(e - b); });
     EXPECT_EQ(covered.load(), 100) << threads << " threads";
   }
+}
+
+
+// ---------------------------------------------------------------------------
+// The margin batches (issue 26): within_margin_batch and intersects_batch.
+
+bool same_margin(const MarginResult& x, const MarginResult& y) {
+  return x.status == y.status && same_bits(x.lower_bound, y.lower_bound) &&
+         same_bits(x.upper_bound, y.upper_bound) && same_bits(x.point_a, y.point_a) &&
+         same_bits(x.point_b, y.point_b) && x.piece_a == y.piece_a && x.piece_b == y.piece_b &&
+         x.triangle_a == y.triangle_a && x.triangle_b == y.triangle_b &&
+         x.pairs_tested == y.pairs_tested && x.iterations == y.iterations;
+}
+
+// A closed box mesh of half extents h.
+TriangleMesh box_triangles(const Vec3& h) {
+  std::vector<Vec3> v;
+  for (int k = 0; k < 8; ++k)
+    v.emplace_back((k & 1) ? h.x() : -h.x(), (k & 2) ? h.y() : -h.y(), (k & 4) ? h.z() : -h.z());
+  const std::vector<TriangleMesh::Triangle> t = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6},
+                                                 {0, 1, 4}, {1, 5, 4}, {2, 6, 3}, {3, 6, 7},
+                                                 {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return TriangleMesh(v, t);
+}
+
+TEST(MarginBatch, EqualsTheSingleQueriesBitForBitTrackedOnEveryKindAndThreads) {
+  Rng rng(2603);
+  const Scene s = make_scene(rng, 200);
+  std::vector<Body> pool;
+  pool.emplace_back(ConvexPolytope(test::points_on_sphere(rng, 40)), 0.1);
+  pool.emplace_back(ConvexPolytope(test::points_in_cube(rng, 30)));
+  const std::vector<std::vector<Vec3>> piece_points = {
+      test::points_on_sphere(rng, 20),
+      test::translated(test::points_in_cube(rng, 20), Vec3(1.5, 0, 0))};
+  pool.emplace_back(CompoundBody::from_point_sets(piece_points));
+  pool.emplace_back(box_triangles(Vec3(0.6, 0.4, 0.3)));
+  pool.push_back(make_capsule(0.6, 0.2));
+  std::vector<BodyPair> body_pairs;
+  for (std::size_t k = 0; k < s.pairs.size(); ++k) {
+    const auto pick = [&] {
+      return &pool[static_cast<std::size_t>(test::uniform_int(rng, 0, int(pool.size()) - 1))];
+    };
+    body_pairs.push_back({pick(), pick()});
+  }
+  const std::size_t n = s.pairs.size();
+  constexpr double kMarginOfTest = 0.3;
+  for (int threads : kThreadCounts) {
+    SCOPED_TRACE("threads " + std::to_string(threads));
+    std::vector<DistanceCache> loop_caches(n), batch_caches(n), fixed_loop(n), fixed_batch(n);
+    std::vector<BodyCache> body_loop(n), body_batch(n);
+    std::vector<Pose> pa = s.poses_a;
+    std::vector<Pose> pb = s.poses_b;
+    Rng motion(11);
+    int within = 0;
+    int beyond = 0;
+    for (int frame = 0; frame < 3; ++frame) {
+      // Frame 1 asks intersects; the others the margin; frame 2 follows a
+      // distance batch on the same caches (they serve both queries).
+      const double margin = frame == 1 ? 0.0 : kMarginOfTest;
+      if (frame == 2) {
+        std::vector<DistanceResult> d(n);
+        distance_batch(s.pairs, pa, pb, d, batch_caches, {}, threads);
+        for (std::size_t k = 0; k < n; ++k)
+          distance(*s.pairs[k].a, pa[k], *s.pairs[k].b, pb[k], {}, &loop_caches[k]);
+        std::vector<BodyResult> bd(n);
+        distance_batch(body_pairs, pa, pb, bd, body_batch, {}, threads);
+        for (std::size_t k = 0; k < n; ++k)
+          distance(*body_pairs[k].a, pa[k], *body_pairs[k].b, pb[k], {}, &body_loop[k]);
+      }
+      std::vector<MarginResult> batch(n), fixed(n), bodies(n), cold(n);
+      if (margin == 0.0) {
+        intersects_batch(s.pairs, pa, pb, batch, batch_caches, {}, threads);
+        intersects_batch(*s.pairs[0].a, pa, *s.pairs[0].b, pb, fixed, fixed_batch, {}, threads);
+        intersects_batch(body_pairs, pa, pb, bodies, body_batch, {}, threads);
+      } else {
+        within_margin_batch(s.pairs, pa, pb, margin, batch, batch_caches, {}, threads);
+        within_margin_batch(*s.pairs[0].a, pa, *s.pairs[0].b, pb, margin, fixed, fixed_batch, {},
+                            threads);
+        within_margin_batch(body_pairs, pa, pb, margin, bodies, body_batch, {}, threads);
+      }
+      within_margin_batch(s.pairs, pa, pb, margin, cold, {}, {}, threads);
+      for (std::size_t k = 0; k < n; ++k) {
+        const MarginResult loop = within_margin(*s.pairs[k].a, pa[k], *s.pairs[k].b, pb[k],
+                                                margin, {}, &loop_caches[k]);
+        EXPECT_TRUE(same_margin(batch[k], loop)) << "pair " << k << ", frame " << frame;
+        expect_same_cache(batch_caches[k], loop_caches[k], k);
+        const MarginResult one = within_margin(*s.pairs[0].a, pa[k], *s.pairs[0].b, pb[k], margin,
+                                               {}, &fixed_loop[k]);
+        EXPECT_TRUE(same_margin(fixed[k], one)) << "fixed pair, row " << k;
+        const MarginResult body = within_margin(*body_pairs[k].a, pa[k], *body_pairs[k].b, pb[k],
+                                                margin, {}, &body_loop[k]);
+        EXPECT_TRUE(same_margin(bodies[k], body)) << "body pair " << k << ", frame " << frame;
+        const MarginResult once =
+            within_margin(*s.pairs[k].a, pa[k], *s.pairs[k].b, pb[k], margin);
+        EXPECT_TRUE(same_margin(cold[k], once)) << "cold pair " << k;
+        within += loop.is_within() ? 1 : 0;
+        beyond += loop.status == MarginStatus::beyond ? 1 : 0;
+      }
+      step(motion, pa);
+      step(motion, pb);
+    }
+    EXPECT_GE(within, 50) << "the batch should mix verdicts";
+    EXPECT_GE(beyond, 50) << "the batch should mix verdicts";
+  }
+}
+
+// The slow twin: the full distance query compared with the margin gives
+// the same verdicts, up to the contact band.
+TEST(MarginBatch, VerdictsAreTheFullDistanceComparedWithTheMargin) {
+  Rng rng(2604);
+  const Scene s = make_scene(rng, 400);
+  const std::size_t n = s.pairs.size();
+  // R is about 4 here: the band 64 u R is about 6e-14; a thousand times it.
+  constexpr double kBand = 1e-10;
+  int within = 0;
+  for (const double margin : {0.0, 0.05, 0.5}) {
+    std::vector<MarginResult> hits(n);
+    std::vector<DistanceCache> caches(n);
+    within_margin_batch(s.pairs, s.poses_a, s.poses_b, margin, hits, caches, {}, 2);
+    for (std::size_t k = 0; k < n; ++k) {
+      const DistanceResult d = distance(*s.pairs[k].a, s.poses_a[k], *s.pairs[k].b, s.poses_b[k]);
+      const bool contact = d.status == Status::touching || d.status == Status::intersecting;
+      if (contact || d.distance < margin - kBand) {
+        EXPECT_TRUE(hits[k].is_within()) << "pair " << k << " at " << d.distance;
+        EXPECT_LE(hits[k].upper_bound, margin + kBand) << "pair " << k;
+        if (!contact) {
+          EXPECT_GE(hits[k].upper_bound, d.distance - kBand) << "pair " << k;
+        }
+        ++within;
+      } else if (d.distance > margin + kBand) {
+        EXPECT_EQ(hits[k].status, MarginStatus::beyond) << "pair " << k << " at " << d.distance;
+        EXPECT_GT(hits[k].lower_bound, margin) << "pair " << k;
+        EXPECT_LE(hits[k].lower_bound, d.distance + kBand) << "pair " << k;
+      }
+    }
+  }
+  EXPECT_GE(within, 100);
+}
+
+TEST(MarginBatch, BadInputIsRefusedByNameBeforeAnythingIsWritten) {
+  Rng rng(2605);
+  const Scene s = make_scene(rng, 80);
+  const std::size_t n = s.pairs.size();
+  std::vector<MarginResult> results(n);
+  for (MarginResult& r : results) r.margin = -7.0;  // a mark: untouched
+  std::vector<DistanceCache> caches(n);
+  const auto untouched = [&] {
+    return std::all_of(results.begin(), results.end(), [](const MarginResult& r) {
+      return r.margin == -7.0;
+    }) && std::all_of(caches.begin(), caches.end(), [](const DistanceCache& c) {
+      return c.is_cold();
+    });
+  };
+  EXPECT_EQ(invalid_input_message([&] {
+              within_margin_batch(s.pairs, s.poses_a, s.poses_b, -0.1, results, caches, {}, 2);
+            }),
+            "within_margin_batch: margin must be finite and >= 0, got -0.1");
+  EXPECT_EQ(invalid_input_message([&] {
+              within_margin_batch(s.pairs, s.poses_a, s.poses_b,
+                                  std::numeric_limits<double>::quiet_NaN(), results, caches, {}, 2);
+            }),
+            "within_margin_batch: margin must be finite and >= 0, got nan");
+  std::vector<Pose> bad = s.poses_b;
+  bad[41].translation.y() = std::numeric_limits<double>::infinity();
+  const std::string pose_message = invalid_input_message(
+      [&] { intersects_batch(s.pairs, s.poses_a, bad, results, caches, {}, 2); });
+  EXPECT_TRUE(pose_message.starts_with("intersects_batch: poses_b[41]")) << pose_message;
+  EXPECT_EQ(invalid_input_message([&] {
+              within_margin_batch(s.pairs, s.poses_a, s.poses_b, 0.1,
+                                  std::span<MarginResult>(results).first(n - 1), caches, {}, 2);
+            }),
+            "within_margin_batch: results has 79 elements, expected 80 (one per pair)");
+  DistanceOptions options;
+  options.max_iterations = 0;
+  const std::string options_message = invalid_input_message(
+      [&] { within_margin_batch(s.pairs, s.poses_a, s.poses_b, 0.1, results, caches, options, 2); });
+  EXPECT_TRUE(options_message.starts_with("within_margin_batch: options")) << options_message;
+  EXPECT_TRUE(untouched());
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // proxima: minimum distance between convex polyhedra.
 // SPDX-License-Identifier: BSD-3-Clause
 //
-// query layer: batch queries. Many independent distance() calls at once, spread
+// query layer: batch queries. Many independent distance() (or
+// within_margin(), intersects(): below) calls at once, spread
 // over a TBB thread pool. Result k is exactly (bit for bit) what
 //   distance(*pairs[k].a, poses_a[k], *pairs[k].b, poses_b[k], options, &caches[k])
 // returns: the batch only decides which thread computes it.
@@ -37,6 +38,7 @@
 
 #include "proxima/core/types.h"
 #include "proxima/query/body_distance.h"
+#include "proxima/query/margin.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima {
@@ -90,5 +92,44 @@ void distance_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses
                     std::span<const Pose> poses_b, std::span<BodyResult> results,
                     std::span<BodyCache> caches, const DistanceOptions& options = {},
                     int threads = 0);
+
+// The boolean and margin queries (proxima/query/margin.h) in batches: results[k] is
+// exactly (bit for bit) within_margin(*pairs[k].a, poses_a[k], *pairs[k].b,
+// poses_b[k], margin, options, caches.empty() ? nullptr : &caches[k]), each
+// stopped at its first proof and certified as the single query is (within:
+// a witness pair at most margin + band apart; beyond: a lower bound above
+// the margin). The caches are the distance batch's: a row's cache kept
+// from a distance_batch serves its margin query and the other way round.
+// Same sizes, threads and errors as distance_batch (messages begin with
+// the function's name); a bad margin is refused before anything is
+// written. intersects_batch is the margin 0.
+//
+//   std::vector<proxima::MarginResult> hits(pairs.size());
+//   proxima::within_margin_batch(pairs, poses_a, poses_b, 0.05, hits, caches);
+//   for (const auto& h : hits) if (h.is_within()) ...  // h.point_a, h.point_b: the witness
+void within_margin_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a,
+                         std::span<const Pose> poses_b, double margin,
+                         std::span<MarginResult> results, std::span<DistanceCache> caches,
+                         const DistanceOptions& options = {}, int threads = 0);
+void within_margin_batch(const ConvexPolytope& a, std::span<const Pose> poses_a,
+                         const ConvexPolytope& b, std::span<const Pose> poses_b, double margin,
+                         std::span<MarginResult> results, std::span<DistanceCache> caches,
+                         const DistanceOptions& options = {}, int threads = 0);
+void within_margin_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
+                         std::span<const Pose> poses_b, double margin,
+                         std::span<MarginResult> results, std::span<BodyCache> caches,
+                         const DistanceOptions& options = {}, int threads = 0);
+void intersects_batch(std::span<const BatchPair> pairs, std::span<const Pose> poses_a,
+                      std::span<const Pose> poses_b, std::span<MarginResult> results,
+                      std::span<DistanceCache> caches, const DistanceOptions& options = {},
+                      int threads = 0);
+void intersects_batch(const ConvexPolytope& a, std::span<const Pose> poses_a,
+                      const ConvexPolytope& b, std::span<const Pose> poses_b,
+                      std::span<MarginResult> results, std::span<DistanceCache> caches,
+                      const DistanceOptions& options = {}, int threads = 0);
+void intersects_batch(std::span<const BodyPair> pairs, std::span<const Pose> poses_a,
+                      std::span<const Pose> poses_b, std::span<MarginResult> results,
+                      std::span<BodyCache> caches, const DistanceOptions& options = {},
+                      int threads = 0);
 
 }  // namespace proxima

@@ -36,6 +36,7 @@
 #include "proxima/motion/time_of_impact.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/compound_distance.h"
+#include "proxima/query/margin.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima {
@@ -120,6 +121,21 @@ struct ClosePair {
   CompoundResult result;
   std::int32_t triangle_a = -1;
   std::int32_t triangle_b = -1;
+};
+
+// One pair within the scene's margin as the margin query answers it
+// (Scene::step_within, Scene::first_within): a < b and the MarginResult of
+// within_margin (proxima/query/margin.h) on the two bodies (padded bodies as
+// for step()) with the scene's margin: a witness pair at most margin + band
+// apart, the pieces of compounds and triangles of meshes where it lies (-1
+// for other kinds), no distance. Its status is within, or undecided for a
+// pair that neither proof settled at the iteration cap (both bounds
+// reported: a caller who needs a proof of "no collision" must treat it as
+// within).
+struct MarginPair {
+  BodyId a = -1;
+  BodyId b = -1;
+  MarginResult result;
 };
 
 // One pair of a sweep (Scene::sweep): a < b, and the time of impact of
@@ -216,6 +232,31 @@ class Scene {
   std::span<const ClosePair> step();
   const SceneStats& stats() const;
 
+  // step()'s question without its answers, for a planner that asks only
+  // "which pairs are within the margin?": the same broad phase, filters
+  // and pair caches as step(), then the margin query (within_margin) on
+  // each candidate pair, which stops at the first proof (a witness pair
+  // within the margin, or a certified lower bound above it) instead of
+  // converging to the distance. The pairs within the margin (and the
+  // undecided ones, see MarginPair), sorted by (a, b); valid until the
+  // next call of a non-const method. step(), step_within() and
+  // first_within() share the pair caches: each keeps them warm for the
+  // others. The same pairs as step() except those within the contact band
+  // (64 u R) of the margin, which either may report; bit-identical
+  // answers whatever options.threads. stats() describes it as a step
+  // (close_pairs: the pairs reported).
+  std::span<const MarginPair> step_within();
+  // The collision check of the whole scene: stops at the first pair found
+  // within the margin (or undecided) and returns it; nullopt when every
+  // pair the filters let through is proved beyond the margin. The pair
+  // found by the last call is asked first when it is still a candidate (a
+  // planner's colliding pair tends to stay colliding), then the candidates
+  // in (a, b) order, in the calling thread (options.threads is not used:
+  // the search ends at its first proof). Candidates after the one found
+  // are not queried and keep their caches as they were. stats():
+  // close_pairs is 1 or 0, convex_queries the work done.
+  std::optional<MarginPair> first_within();
+
   // Continuous collision (issue 13): each body moves over t in [0, 1] from
   // its pose to its end pose with the motion of proxima/motion/time_of_impact.h
   // (constant linear velocity of its frame's origin, constant angular
@@ -289,7 +330,9 @@ class Scene {
   std::optional<ClosePair> nearest_pair();
   std::vector<ClosePair> pairs_within(BodyId id, double margin);
 
-  // The slow, obvious twin of step(): the cold distance query on every pair
+  // The slow, obvious twin of step() (and of step_within() and
+  // first_within(), whose pairs are those of its answers within the
+  // margin, up to the contact band): the cold distance query on every pair
   // of bodies that tests_pair (distance(Body, Body) on the padded bodies
   // for a pair with a general body, as step()), no broad phase, no caches;
   // same output order. For tests.
