@@ -149,8 +149,9 @@ void run(const char* title, const TriangleMesh& env, const TriangleMesh& rob,
     }
   }
   // The referee on evenly spaced poses.
+  // --referee 0 skips it (the header line says so; the rows' errors then read 0).
   const std::size_t stride =
-      std::max<std::size_t>(1, poses.size() / static_cast<std::size_t>(referee_count));
+      referee_count > 0 ? std::max<std::size_t>(1, poses.size() / static_cast<std::size_t>(referee_count)) : 1;
   int refereed = 0;
   double referee_time = 0.0;
   for (std::size_t i = 0; i < poses.size() && refereed < referee_count; i += stride, ++refereed) {
@@ -163,8 +164,12 @@ void run(const char* title, const TriangleMesh& env, const TriangleMesh& rob,
     rss.worst = std::max(rss.worst, std::abs(d_rss[i] - d));
   }
   const double fcl_time = median(obbrss.times);
-  std::printf("%s: %zu poses (%d intersecting), refereed on %d (brute force %.0f ms each)\n", title,
-              poses.size(), intersecting, refereed, referee_time / 1000.0 / refereed);
+  if (refereed > 0)
+    std::printf("%s: %zu poses (%d intersecting), refereed on %d (brute force %.0f ms each)\n", title,
+                poses.size(), intersecting, refereed, referee_time / 1000.0 / refereed);
+  else
+    std::printf("%s: %zu poses (%d intersecting), not refereed (--referee 0)\n", title, poses.size(),
+                intersecting);
   for (const Row* r : {&cold, &tracked, &obbrss, &rss}) print_row(*r, fcl_time);
   std::printf(
       "  cold, median triangle pairs / node pairs tested: intersecting %.0f / %.0f, apart %.0f / "
@@ -185,6 +190,10 @@ int main(int argc, char** argv) {
       steps = std::atoi(argv[++i]);
     } else if (arg == "--referee" && i + 1 < argc) {
       referee = std::atoi(argv[++i]);
+      if (referee < 0) {
+        std::fprintf(stderr, "mesh_bench: --referee takes a count >= 0, got %s\n", argv[i]);
+        return 2;
+      }
     } else {
       dir = arg;
     }

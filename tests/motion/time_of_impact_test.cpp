@@ -867,7 +867,10 @@ TEST(TimeOfImpact, AVelocityMotionTurnsAtItsRateThroughAnyAngle) {
   // {w, the end of the sampled span (past the true contact, or 1)}.
   const std::pair<double, double> cases[] = {
       {3.0, 1.0}, {3.2, 1.0}, {4.0, 1.0}, {2 * M_PI, 1.0}, {1000.0, 0.01}};
-  for (const auto& [w, span] : cases) {
+  for (const auto& [rate, span] : cases) {
+    // A named copy: lambdas may not capture a structured binding before
+    // C++20's P1091, which clang 14 (the sanitizer build) lacks.
+    const double w = rate;
     SCOPED_TRACE("w = " + std::to_string(w));
     const Motion spin = Motion::from_velocity(pivot, Vec3::Zero(), Vec3(0, 0, w));
     ASSERT_TRUE(spin.angular.has_value());
