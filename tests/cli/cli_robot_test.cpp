@@ -101,7 +101,9 @@ TEST(CliRobot, Ur5AndTalosAnswerFromTheirUrdf) {
     proxima::RobotLoadOptions options;
     options.package_dirs = {"example-robot-data=" + kRobots};
     const proxima::Robot robot = proxima::load_robot(c.urdf, c.srdf, options);
-    if (c.dof != 0) EXPECT_EQ(static_cast<std::size_t>(robot.dof()), c.dof);
+    if (c.dof != 0) {
+      EXPECT_EQ(static_cast<std::size_t>(robot.dof()), c.dof);
+    }
     const std::vector<double> q(static_cast<std::size_t>(robot.dof()), 0.0);
     const TempPath input(".jsonl");
     {

@@ -1169,8 +1169,9 @@ void turning_walk(const Points& a, const Points& b_local, std::uint64_t seed, in
     // The certificate holds the twin's depth.
     ASSERT_LE(r.lower_bound, twin.depth * (1 + kRel) + tol) << i;
     ASSERT_GE(r.upper_bound, twin.depth * (1 - kRel) - tol) << i;
-    if (exact_every > 0 && i % exact_every == 0)
+    if (exact_every > 0 && i % exact_every == 0) {
       ASSERT_TRUE(meets_standard(a, transformed(b_local, pose), r, oracle)) << i;
+    }
     warm += r.tracked;
   }
 }
