@@ -39,6 +39,44 @@ mpq_class rational_of(const Exact& e) {
 
 mpq_class to_mpq(const ExactFT& x) { return rational_of(CGAL::exact(x)); }
 
+// The differences a_i - b_j, exact (Epeck's numbers are exact for sums of
+// doubles): the points whose hull is M = A - B.
+std::vector<ExactPoint> differences(const Points& a, const Points& b) {
+  std::vector<ExactPoint> m;
+  m.reserve(a.size() * b.size());
+  for (const Vec3& x : a)
+    for (const Vec3& y : b)
+      m.emplace_back(ExactFT(x.x()) - ExactFT(y.x()), ExactFT(x.y()) - ExactFT(y.y()),
+                     ExactFT(x.z()) - ExactFT(y.z()));
+  return m;
+}
+
+// A facet of M's exact hull: its outward normal N = (p1 - p0) x (p2 - p0)
+// and offset N . p0 (a point x is inside the facet's plane when N . x <= offset).
+struct FacetPlane {
+  ExactKernel::Vector_3 normal;
+  ExactFT offset;
+};
+
+// The facets of the exact hull of m, as CGAL's convex_hull_3 builds it.
+std::vector<FacetPlane> facet_planes(const std::vector<ExactPoint>& m) {
+  CGAL::Polyhedron_3<ExactKernel> hull;
+  CGAL::convex_hull_3(m.begin(), m.end(), hull);
+  const ExactPoint origin(0, 0, 0);
+  std::vector<FacetPlane> planes;
+  for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
+    auto h = f->facet_begin();
+    const ExactPoint& p0 = h->vertex()->point();
+    ++h;
+    const ExactPoint& p1 = h->vertex()->point();
+    ++h;
+    const ExactPoint& p2 = h->vertex()->point();
+    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);
+    planes.push_back({n, n * (p0 - origin)});
+  }
+  return planes;
+}
+
 }  // namespace
 
 double ExactDepth::depth() const {
@@ -52,12 +90,7 @@ double ExactDepth::depth() const {
 
 ExactDepth exact_depth(const Points& a, const Points& b) {
   ScopedFpTrapsOff traps_off;
-  std::vector<ExactPoint> m;
-  m.reserve(a.size() * b.size());
-  for (const Vec3& x : a)
-    for (const Vec3& y : b)
-      m.emplace_back(ExactFT(x.x()) - ExactFT(y.x()), ExactFT(x.y()) - ExactFT(y.y()),
-                     ExactFT(x.z()) - ExactFT(y.z()));
+  const std::vector<ExactPoint> m = differences(a, b);
   ExactDepth r;
   std::frexp(std::max(max_abs_coordinate(a), max_abs_coordinate(b)), &r.exponent);
   // Solid? Four affinely independent points.
@@ -75,20 +108,9 @@ ExactDepth exact_depth(const Points& a, const Points& b) {
     r.origin = OriginInM::boundary;  // callers give flat M only when it holds the origin
     return r;
   }
-  CGAL::Polyhedron_3<ExactKernel> hull;
-  CGAL::convex_hull_3(m.begin(), m.end(), hull);
   ExactFT depth_squared = 0;
   bool first = true, boundary = false, outside = false;
-  const ExactPoint origin(0, 0, 0);
-  for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
-    auto h = f->facet_begin();
-    const ExactPoint& p0 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p1 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p2 = h->vertex()->point();
-    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);
-    const ExactFT offset = n * (p0 - origin);
+  for (const auto& [n, offset] : facet_planes(m)) {
     if (offset < 0) outside = true;
     if (offset == 0) boundary = true;
     const ExactFT d2 = offset * offset / n.squared_length();
@@ -106,26 +128,11 @@ ExactDepth exact_depth(const Points& a, const Points& b) {
 
 std::optional<double> exact_translation_toi(const Points& a, const Points& b, const Vec3& u) {
   ScopedFpTrapsOff traps_off;
-  std::vector<ExactPoint> m;
-  for (const Vec3& x : a)
-    for (const Vec3& y : b)
-      m.emplace_back(ExactFT(x.x()) - ExactFT(y.x()), ExactFT(x.y()) - ExactFT(y.y()),
-                     ExactFT(x.z()) - ExactFT(y.z()));
-  CGAL::Polyhedron_3<ExactKernel> hull;
-  CGAL::convex_hull_3(m.begin(), m.end(), hull);
+  const std::vector<ExactPoint> m = differences(a, b);
   const ExactKernel::Vector_3 ue(ExactFT(u.x()), ExactFT(u.y()), ExactFT(u.z()));
   ExactFT enter = 0;  // the ray t u is inside M for t in [enter, leave]
   std::optional<ExactFT> leave;
-  const ExactPoint origin(0, 0, 0);
-  for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
-    auto h = f->facet_begin();
-    const ExactPoint& p0 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p1 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p2 = h->vertex()->point();
-    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);  // outward
-    const ExactFT offset = n * (p0 - origin);              // inside: n . x <= offset
+  for (const auto& [n, offset] : facet_planes(m)) {
     const ExactFT along = n * ue;
     if (along == 0) {
       if (offset < 0) return std::nullopt;  // parallel and outside
