@@ -34,6 +34,7 @@
 #include "proxima/motion/time_of_impact.h"
 #include "support/generators.h"
 #include "support/same_bits.h"
+#include "support/scene_bodies.h"
 
 namespace proxima {
 namespace {
@@ -42,17 +43,9 @@ using test::Rng;
 using test::same_bits;
 using test::same_feature;
 using Tri = TriangleMesh::Triangle;
-
-// Axis-aligned box [lo, hi] as a closed mesh, counter-clockwise seen from
-// outside.
-TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi) {
-  std::vector<Vec3> v;
-  for (int k = 0; k < 8; ++k)
-    v.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
-  const std::vector<Tri> t = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return TriangleMesh(v, t);
-}
+using Entry = test::SceneEntry;
+using test::box_mesh;
+using test::lockstep_scenes;
 
 // An open soup of n triangles within `extent` of the origin.
 TriangleMesh random_soup(Rng& rng, int n, double extent, double size) {
@@ -83,13 +76,6 @@ std::shared_ptr<const CompoundBody> random_compound(Rng& rng) {
   return std::make_shared<const CompoundBody>(CompoundBody::from_point_sets(sets));
 }
 
-// One body of a scene: the Body as added, its padding, its pose.
-struct Entry {
-  Body body;
-  double padding = 0.0;
-  Pose pose;
-  Body padded() const { return body.with_radius(body.radius() + padding); }
-};
 
 // Every kind, rounded or not, padded or not, in a cube of side `side`.
 std::vector<Entry> random_entries(Rng& rng, int n, double side) {
@@ -167,20 +153,6 @@ std::vector<ClosePair> steps(Scene& scene) {
 
 bool general(const Entry& e) {
   return e.body.kind() == Body::Kind::mesh || e.body.radius() + e.padding > 0.0;
-}
-
-std::vector<Scene> lockstep_scenes(double margin) {
-  std::vector<Scene> scenes;
-  for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
-    for (const int threads : {1, 2}) {
-      SceneOptions o;
-      o.margin = margin;
-      o.broad_phase = bp;
-      o.threads = threads;
-      scenes.emplace_back(o);
-    }
-  }
-  return scenes;
 }
 
 TEST(SceneBodies, EveryKindMatchesTheTwinAndDistanceOfBodiesOnAnyThreadsAndBroadPhase) {

@@ -29,28 +29,22 @@
 #include "proxima/shape/primitives.h"
 #include "support/generators.h"
 #include "support/same_bits.h"
+#include "support/scene_bodies.h"
 
 namespace proxima {
 namespace {
 
 using test::Rng;
 using test::same_bits;
-using Tri = TriangleMesh::Triangle;
+using Entry = test::SceneEntry;
+using test::box_mesh;
+using test::lockstep_scenes;
 
 // Verdicts of pairs closer to the margin than this may differ between the
 // margin query and the twin: the contact band 64 u R of the accuracy
 // standard is about 1.4e-13 for these scenes (R about 10); the test allows
 // a thousand times that, far below any other distance in the scenes.
 constexpr double kBandSlack = 1e-10;
-
-TriangleMesh box_mesh(const Vec3& lo, const Vec3& hi) {
-  std::vector<Vec3> v;
-  for (int k = 0; k < 8; ++k)
-    v.emplace_back((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
-  const std::vector<Tri> t = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                              {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return TriangleMesh(v, t);
-}
 
 std::shared_ptr<const ConvexPolytope> random_convex(Rng& rng) {
   return std::make_shared<const ConvexPolytope>(test::scaled(
@@ -67,11 +61,6 @@ std::shared_ptr<const CompoundBody> random_compound(Rng& rng) {
   return std::make_shared<const CompoundBody>(CompoundBody::from_point_sets(sets));
 }
 
-struct Entry {
-  Body body;
-  double padding = 0.0;
-  Pose pose;
-};
 
 // Every kind in a cube of side `side`; `plain_only` keeps to plain convex
 // and compound bodies (the scene's fast paths).
@@ -167,20 +156,6 @@ int expect_twin_pairs(std::span<const MarginPair> within, const std::vector<Clos
     }
   }
   return static_cast<int>(within.size());
-}
-
-std::vector<Scene> lockstep_scenes(double margin) {
-  std::vector<Scene> scenes;
-  for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
-    for (const int threads : {1, 2}) {
-      SceneOptions o;
-      o.margin = margin;
-      o.broad_phase = bp;
-      o.threads = threads;
-      scenes.emplace_back(o);
-    }
-  }
-  return scenes;
 }
 
 void move(Rng& rng, std::vector<Entry>& entries, std::vector<Scene>& scenes) {
