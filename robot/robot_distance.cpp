@@ -176,14 +176,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
   const auto& boxes = robot.geometry_boxes();
   for (std::size_t g = 0; g < n_geometries; ++g) {
     const auto link = static_cast<std::size_t>(geometries[g].link);
-    // Checked once here, for every pair the geometry takes part in (the
-    // queries below do not check it again); the bound boxes from the
-    // product itself, as before the check moved here.
-    const Pose placed = s.link_poses_[link] * geometries[g].origin;
-    s.box_centers_[g] = placed.apply(boxes[g].center);
-    s.geometry_poses_[g] = checked_pose(placed, [&] {
-      return "robot distances: the pose of geometry " + std::to_string(g);
-    });
+    s.geometry_poses_[g] = s.link_poses_[link] * geometries[g].origin;
+    s.box_centers_[g] = s.geometry_poses_[g].apply(boxes[g].center);
     s.centers_[g] = s.link_poses_[link].apply(spheres[g].center);
     s.motion_[g] = moved_before ? motion(s.previous_link_poses_[link], s.link_poses_[link],
                                          spheres[g].center, spheres[g].radius)
@@ -268,9 +262,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       result.geometry_a = pair.a;
       result.geometry_b = pair.b;
       result.result =
-          detail::distance_of_rigid_poses(geometries[a].body, s.geometry_poses_[a],
-                                          geometries[b].body, s.geometry_poses_[b],
-                                          options.distance, &s.self_[static_cast<std::size_t>(p)]);
+          distance(geometries[a].body, s.geometry_poses_[a], geometries[b].body,
+                   s.geometry_poses_[b], options.distance, &s.self_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
       normal = result.result.normal;
       report(std::move(result), out.min_self, p, last);
@@ -286,11 +279,6 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
     const auto n = static_cast<std::int32_t>(n_geometries) * n_obstacles;
     const std::int32_t first = s.last_environment_ >= 0 ? s.last_environment_ : 0;
     std::int32_t last = -1;
-    // Obstacle poses are checked at construction, but a caller may assign
-    // one since: each is tested once per call, not once per pair, and a
-    // pose that fails goes through the checking query (its named refusal).
-    bool obstacles_rigid = true;
-    for (const Obstacle& obstacle : obstacles) obstacles_rigid &= detail::is_rigid(obstacle.pose);
     for (std::int32_t k = 0; k < n; ++k) {
       const std::int32_t p = k == 0 ? first : (k <= first ? k - 1 : k);
       const auto g = static_cast<std::size_t>(p / n_obstacles);
@@ -313,14 +301,8 @@ RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
       result.geometry_b = static_cast<std::int32_t>(o);
       result.environment = true;
       result.result =
-          obstacles_rigid
-              ? detail::distance_of_rigid_poses(geometries[g].body, s.geometry_poses_[g],
-                                                obstacles[o].body, obstacles[o].pose,
-                                                options.distance,
-                                                &s.environment_[static_cast<std::size_t>(p)])
-              : distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body,
-                         obstacles[o].pose, options.distance,
-                         &s.environment_[static_cast<std::size_t>(p)]);
+          distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body, obstacles[o].pose,
+                   options.distance, &s.environment_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
       normal = result.result.normal;
       report(std::move(result), out.min_environment, p, last);
