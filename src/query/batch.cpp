@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <string>
+#include <type_traits>
 
 #include "core/accuracy.h"
 #include "proxima/query/body_distance.h"
@@ -40,19 +41,25 @@ void check_size(const char* who, std::size_t size, std::size_t expected, const c
 // Every pose under the contract, before any query runs: both poses of pair
 // k in one paired test (detail::are_rigid, as distance() itself does), the
 // full check, which names the pose, only for a pair that fails it.
-void check_poses(const char* who, std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
+// Returns whether every pair passed the paired test (then a query may skip
+// its own check of the poses).
+bool check_poses(const char* who, std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
+  bool all_rigid = true;
   for (std::size_t k = 0; k < poses_a.size(); ++k) {
     if (detail::are_rigid(poses_a[k], poses_b[k])) [[likely]]
       continue;
+    all_rigid = false;
     check_pose(poses_a[k], [&] { return std::string(who) + ": poses_a[" + at(k) + "]"; });
     check_pose(poses_b[k], [&] { return std::string(who) + ": poses_b[" + at(k) + "]"; });
   }
+  return all_rigid;
 }
 
 // The shared part of every overload. `pair(k)` returns the pair of index k
 // (a span lookup or the one fixed pair): a BatchPair or a BodyPair;
-// `query(pair, pose_a, pose_b, cache)` answers it into Result with a Cache
-// (null: cold). `who` names the batch in every message.
+// `query(pair, pose_a, pose_b, cache, rigid)` answers it into Result with a
+// Cache (null: cold); `rigid` says that both poses passed the paired
+// rigidity test. `who` names the batch in every message.
 template <class PairOf, class Query, class Result, class Cache>
 void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
                std::span<const Pose> poses_a, std::span<const Pose> poses_b,
@@ -72,7 +79,7 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
                          (p.a == nullptr ? "a" : "b") + " is null");
     }
   }
-  check_poses(who, poses_a, poses_b);
+  const bool all_rigid = check_poses(who, poses_a, poses_b);
 
   // Runs the queries of [begin, end). An InvalidInput from a query (the
   // options are checked by distance() itself) is re-thrown with its index;
@@ -82,7 +89,8 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
     for (std::size_t k = begin; k < end; ++k) {
       const auto p = pair(k);
       try {
-        results[k] = query(p, poses_a[k], poses_b[k], caches.empty() ? nullptr : &caches[k]);
+        results[k] =
+            query(p, poses_a[k], poses_b[k], caches.empty() ? nullptr : &caches[k], all_rigid);
       } catch (const InvalidInput& e) {
         throw InvalidInput(std::string(who) + ": pair " + at(k) + ": " + e.what());
       }
@@ -98,7 +106,7 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
 
 // The distance query of one pair, for run_batch.
 auto distance_with(const DistanceOptions& options) {
-  return [&options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache) {
+  return [&options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache, bool) {
     return distance(*p.a, pose_a, *p.b, pose_b, options, cache);
   };
 }
@@ -108,7 +116,16 @@ auto distance_with(const DistanceOptions& options) {
 auto within_margin_with(double margin, const DistanceOptions& options, const char* who) {
   detail::check_margin(margin, who);
   detail::check_distance_options(options, (std::string(who) + ": options").c_str());
-  return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache) {
+  return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache,
+                            bool rigid) {
+    // A Body row of a batch whose poses are all rigid (run_batch's
+    // check_poses, the query's own paired test) skips the query's checks
+    // of the margin, the options and the poses, done once for the batch.
+    if constexpr (std::is_same_v<std::remove_cvref_t<decltype(p)>, BodyPair>) {
+      if (cache != nullptr && rigid)
+        return detail::within_margin_of_rigid_poses(*p.a, pose_a, *p.b, pose_b, margin, options,
+                                                    *cache);
+    }
     return within_margin(*p.a, pose_a, *p.b, pose_b, margin, options, cache);
   };
 }
