@@ -919,7 +919,9 @@ TEST(TrianglePolytope, ConvexQueryMatchesTheBuiltTriangleAndTheExactDistance) {
       {Vec3(-0.4, -0.4, 0), Vec3(0.4, -0.4, 0), Vec3(0.4, 0.4, 0), Vec3(-0.4, 0.4, 0)},
       {Vec3(-0.5, 0.1, 0.0), Vec3(0.5, -0.1, 0.1)}};
   int separated = 0, contact = 0;
-  for (int trial = 0; trial < 240; ++trial) {
+  // 160 cases: well under a second in release, a few seconds under ASan
+  // (the oracle's exact quadratic program dominates).
+  for (int trial = 0; trial < 160; ++trial) {
     const std::vector<Vec3>& body = bodies[static_cast<std::size_t>(trial % 4)];
     const ConvexPolytope b(body);
     const int kind = (trial / 4) % 5;
@@ -985,8 +987,8 @@ TEST(TrianglePolytope, ConvexQueryMatchesTheBuiltTriangleAndTheExactDistance) {
     }
   }
   // The set holds both kinds of answers.
-  EXPECT_GT(separated, 40);
-  EXPECT_GT(contact, 40);
+  EXPECT_GT(separated, 25);
+  EXPECT_GT(contact, 25);
 }
 
 // Degenerate triangles (segments and points) in a mesh take the built
