@@ -126,9 +126,11 @@ auto within_margin_with(double margin, const DistanceOptions& options, const cha
   detail::check_distance_options(options, (std::string(who) + ": options").c_str());
   return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache,
                             bool rigid) {
-    // A convex pair with a cache: the query that does not check the poses
-    // (nor the margin and options, checked above) again.
-    if constexpr (std::is_same_v<std::remove_pointer_t<decltype(cache)>, DistanceCache>) {
+    // A convex pair or a Body row with a cache, in a batch whose poses all
+    // passed check_poses' paired test: the query that does not check the
+    // poses (nor the margin and options, checked above) again.
+    if constexpr (std::is_same_v<std::remove_pointer_t<decltype(cache)>, DistanceCache> ||
+                  std::is_same_v<std::remove_cvref_t<decltype(p)>, BodyPair>) {
       if (rigid && cache != nullptr) [[likely]]
         return detail::within_margin_of_rigid_poses(*p.a, pose_a, *p.b, pose_b, margin, options,
                                                     *cache);

@@ -62,12 +62,13 @@ MarginResult from_distance(const DistanceResult& r, double margin, double band) 
 // both radii (exact: a rounded body's distance is its core's minus the
 // radii): the witness points moved onto the rounded surfaces along their
 // difference, or to one common point when the rounded bodies overlap.
-MarginResult rounded(MarginResult r, double margin, double radius_a, double radius_b) {
+// In place: the answer of a pair without radii is the cores' as it is.
+void add_radii(MarginResult& r, double margin, double radius_a, double radius_b) {
   r.margin = margin;
   const double radii = radius_a + radius_b;
-  if (radii == 0.0) return r;
+  if (radii == 0.0) return;
   r.lower_bound = std::max(0.0, r.lower_bound - radii);
-  if (!std::isfinite(r.upper_bound)) return r;
+  if (!std::isfinite(r.upper_bound)) return;
   const Vec3 diff = r.point_b - r.point_a;
   const double d = diff.norm();
   if (d > radii) {
@@ -82,7 +83,6 @@ MarginResult rounded(MarginResult r, double margin, double radius_a, double radi
     r.point_b = p;
     r.upper_bound = 0.0;
   }
-  return r;
 }
 
 // Pairs with a mesh on at least one side: every pair of meshes of
@@ -113,8 +113,16 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
     // A mesh body is its one mesh at the identity: its pose as it is (the
     // product with the identity would give the same bits, at the cost of
     // two pose products on every query of a tracked mesh pair).
-    const Pose place_a = a.kind() == Body::Kind::mesh ? pose_a : pose_a * ma[i].pose;
-    const Pose place_b = b.kind() == Body::Kind::mesh ? pose_b : pose_b * mb[j].pose;
+    // A piece's placement (a product of rigid poses, rigid up to rounding)
+    // is put under the contract as the mesh query would have put it.
+    // Referenced, not copied, for a mesh body (the common tracked pair).
+    Pose placed_a, placed_b;
+    const Pose& place_a = a.kind() == Body::Kind::mesh
+                              ? pose_a
+                              : (placed_a = checked_pose(pose_a * ma[i].pose, "within_margin: pose_a"));
+    const Pose& place_b = b.kind() == Body::Kind::mesh
+                              ? pose_b
+                              : (placed_b = checked_pose(pose_b * mb[j].pose, "within_margin: pose_b"));
     if (pairs > 1) {
       const double gap = detail::sphere_gap_lower_bound(
           place_a.apply(ma[i].mesh->center()), ma[i].mesh->bounding_radius(),
@@ -124,8 +132,9 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
         continue;
       }
     }
-    MarginResult r =
-        within_margin(*ma[i].mesh, place_a, *mb[j].mesh, place_b, margin, options, &cache.mesh[k]);
+    // Poses, margin and options were checked by within_margin(Body, ...).
+    MarginResult r = detail::within_margin_of_rigid_poses(*ma[i].mesh, place_a, *mb[j].mesh,
+                                                          place_b, margin, options, &cache.mesh[k]);
     tested += r.pairs_tested;
     if (r.status == MarginStatus::within) {
       cache.mesh_closest = static_cast<std::int32_t>(k);
@@ -262,11 +271,23 @@ MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, con
   }
   detail::check_margin(margin, "within_margin");
   detail::check_distance_options(options, "within_margin: options");
-  const Pose pa = checked_pose(pose_a, "within_margin: pose_a");
-  const Pose pb = checked_pose(pose_b, "within_margin: pose_b");
+  // Both poses in one paired test (as the convex query), no copies when
+  // they are rigid.
+  if (detail::are_rigid(pose_a, pose_b)) [[likely]]
+    return detail::within_margin_of_rigid_poses(a, pose_a, b, pose_b, margin, options, *cache);
+  return detail::within_margin_of_rigid_poses(a, checked_pose(pose_a, "within_margin: pose_a"), b,
+                                              checked_pose(pose_b, "within_margin: pose_b"),
+                                              margin, options, *cache);
+}
+
+namespace detail {
+
+MarginResult within_margin_of_rigid_poses(const Body& a, const Pose& pa, const Body& b,
+                                          const Pose& pb, double margin,
+                                          const DistanceOptions& options, BodyCache& cache) {
   for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
     const double reach = magnitude_bound(*pose, body->scale());
-    if (!(reach <= kMaxMagnitude)) {
+    if (!(reach <= kMaxMagnitude)) [[unlikely]] {
       char message[200];
       std::snprintf(message, sizeof message,
                     "within_margin: body %s with radius %g reaches coordinates of magnitude %g, "
@@ -275,7 +296,7 @@ MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, con
       throw InvalidInput(message);
     }
   }
-  BodyCache& c = *cache;
+  BodyCache& c = cache;
   const double core_margin = margin + a.radius() + b.radius();
   MarginResult r;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
@@ -289,7 +310,10 @@ MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, con
     if (a.kind() == Body::Kind::convex) r.piece_a = -1;
     if (b.kind() == Body::Kind::convex) r.piece_b = -1;
   }
-  return rounded(r, margin, a.radius(), b.radius());
+  add_radii(r, margin, a.radius(), b.radius());
+  return r;
 }
+
+}  // namespace detail
 
 }  // namespace proxima

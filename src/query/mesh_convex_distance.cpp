@@ -3,7 +3,8 @@
 //
 // query layer: the distance between a triangle mesh and a convex polytope
 // (mesh.h): the mesh's hierarchy against the polytope's box, the convex
-// query at the leaves on each near triangle as a polytope of its vertices.
+// query at the leaves on each near triangle, placed in one scratch triangle
+// polytope (shape/triangle_polytope.h: no hull built per triangle).
 //
 // The mesh's hull (TriangleMesh::hull()) holds every triangle, so the
 // hull-polytope distance L is a certified lower bound on the answer: the
@@ -14,11 +15,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "core/accuracy.h"
 #include "proxima/query/distance.h"
 #include "proxima/query/mesh_distance.h"
 #include "query/mesh_pair.h"
+#include "shape/triangle_polytope.h"
 
 namespace proxima {
 namespace {
@@ -38,6 +41,11 @@ struct ConvexQuery {
   double magnitude = 0.0;
   double slack = 0.0;
   DistanceOptions options;
+  // The triangle under test; rewritten by each test_triangle.
+  detail::TrianglePolytope triangle;
+  // Build every triangle's ConvexPolytope from its points instead (the
+  // slow twin, distance_all_pairs).
+  bool general_polytopes = false;
 };
 
 ConvexQuery make_query(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
@@ -52,7 +60,9 @@ ConvexQuery make_query(const TriangleMesh& a, const Pose& pose_a, const ConvexPo
                 {},
                 0.0,
                 0.0,
-                options};
+                options,
+                {},
+                false};
   const Pose rel = q.pose_a.inverse() * q.pose_b;
   q.rotation = rel.rotation;
   q.translation = rel.translation;
@@ -115,14 +125,19 @@ struct Best {
   bool have = false;
 };
 
-// The convex query between triangle t and the polytope; lowers `best`.
-void test_triangle(const ConvexQuery& q, std::int32_t t, Best& best, int& tested) {
+// The convex query between triangle t and the polytope; lowers `best`. A
+// proper triangle is the scratch polytope with its vertices rewritten; a
+// degenerate one (a segment or a point), or every triangle of the slow
+// twin, a ConvexPolytope built from its points.
+void test_triangle(ConvexQuery& q, std::int32_t t, Best& best, int& tested) {
   const auto& tri = q.a.triangle(t);
   const std::array<Vec3, 3> v = {q.a.vertex(static_cast<int>(tri[0])),
                                  q.a.vertex(static_cast<int>(tri[1])),
                                  q.a.vertex(static_cast<int>(tri[2]))};
   ++tested;
-  const ConvexPolytope piece(v);
+  std::optional<ConvexPolytope> built;
+  if (q.general_polytopes || !q.triangle.assign(v[0], v[1], v[2])) built.emplace(v);
+  const ConvexPolytope& piece = built ? *built : q.triangle.polytope();
   DistanceResult r =
       detail::distance_of_rigid_poses(piece, q.pose_a, q.b, q.pose_b, q.options, nullptr);
   // Hull ids of the piece -> mesh vertex ids; the face is the triangle.
@@ -185,7 +200,8 @@ MeshResult finish(const ConvexQuery& q, const Best& best, int tested, int nodes,
 
 MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
                               const Pose& pose_b, const DistanceOptions& options) {
-  const ConvexQuery q = make_query(a, pose_a, b, pose_b, options);
+  ConvexQuery q = make_query(a, pose_a, b, pose_b, options);
+  q.general_polytopes = true;
   Best best;
   int tested = 0;
   for (std::int32_t t = 0; t < a.triangle_count(); ++t) {
@@ -197,7 +213,7 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const C
 
 MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
                     const Pose& pose_b, const DistanceOptions& options, MeshCache* cache) {
-  const ConvexQuery q = make_query(a, pose_a, b, pose_b, options);
+  ConvexQuery q = make_query(a, pose_a, b, pose_b, options);
   Best best;
   int tested = 0, nodes = 0;
   // Every query asks the hull, tracked or not: unlike the mesh-mesh query

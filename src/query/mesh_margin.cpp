@@ -25,17 +25,22 @@ using namespace detail::mesh_pair;
 class MarginSearch {
  public:
   MarginSearch(const Query& q, double margin) : q_(q), margin_(margin) {
-    margin_s_ = std::ldexp(margin, -q.exponent);
+    margin_s_ = margin * q.factor;  // exact scaling (make_query_of_rigid_poses)
     yes_s_ = margin_s_ + q.band_s;
-    slack_s_ = detail::prune_slack(std::ldexp(q.magnitude, -q.exponent));
+    slack_s_ = detail::prune_slack(q.magnitude * q.factor);
     prune_s_ = margin_s_ + slack_s_;
     lower_s_ = std::numeric_limits<double>::infinity();
   }
 
   // Whether triangle pair (ta, tb) is within; tested pairs lower the bound.
   bool test(const Triangles& ta, const Triangles& tb) {
-    Best unused;
-    const double d2 = test_pair(q_, ta, tb, unused, tested_, yes_s_);
+    // Marked crossing: test_pair then skips its crossing test (exact
+    // predicates on every pair within the band) and its ranking, which only
+    // the distance query needs; here any pair within margin + band is a
+    // witness, crossing or not.
+    Best witness_only;
+    witness_only.crossing = true;
+    const double d2 = test_pair(q_, ta, tb, witness_only, tested_, yes_s_);
     if (d2 <= yes_s_ * yes_s_) {
       witness_a_ = ta.id;
       witness_b_ = tb.id;
@@ -47,6 +52,21 @@ class MarginSearch {
     lower_s_ = std::min(lower_s_, std::isfinite(d2) ? std::sqrt(d2) - kLowerBoundUlps * kUnitRoundoff
                                                     : yes_s_ - 0.5 * q_.band_s);
     return false;
+  }
+
+  // Whether the root boxes' bound (A's and B's axes) proves every pair
+  // beyond the margin; it lowers the bound as a pruned node pair does. The
+  // first test of the hierarchies, before the hulls' query, which costs
+  // many times more on the poses of a planner's random samples.
+  bool roots_apart() {
+    const double prune2 = prune_s_ * prune_s_;
+    const Box ba = node_box(q_.a.nodes()[0], q_.box_unit_a);
+    const Box bb = node_box(q_.b.nodes()[0], q_.box_unit_b);
+    const double lb2 = lower_bound_on_a_axes(q_, ba, bb, q_.rotation * bb.center + q_.translation_s,
+                                             q_.abs_rotation * bb.half, prune2);
+    if (!(lb2 > prune2)) return false;
+    lower_s_ = std::min(lower_s_, std::sqrt(lb2) - slack_s_);
+    return true;
   }
 
   bool traverse() {
@@ -136,14 +156,20 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
                            const Pose& pose_b, double margin, const DistanceOptions& options,
                            MeshCache* cache) {
   detail::check_margin(margin, "within_margin");
-  const Pose pa = checked_pose(pose_a, "within_margin: pose_a");
-  const Pose pb = checked_pose(pose_b, "within_margin: pose_b");
+  detail::check_distance_options(options, "within_margin: options");
+  return detail::within_margin_of_rigid_poses(a, checked_pose(pose_a, "within_margin: pose_a"), b,
+                                              checked_pose(pose_b, "within_margin: pose_b"),
+                                              margin, options, cache);
+}
+
+namespace detail {
+
+MarginResult within_margin_of_rigid_poses(const TriangleMesh& a, const Pose& pa,
+                                          const TriangleMesh& b, const Pose& pb, double margin,
+                                          const DistanceOptions& options, MeshCache* cache) {
   MarginResult r;
   r.margin = margin;
-  // Far apart: the root boxes' balls prove it without the hierarchies (the
-  // options are checked first, as every query checks them).
-  if (!is_finite_bits(options.absolute_tolerance) || !(options.absolute_tolerance >= 0.0))
-    throw InvalidInput("within_margin: absolute_tolerance must be finite and >= 0");
+  // Far apart: the root boxes' balls prove it without the hierarchies.
   const double gap = detail::sphere_gap_lower_bound(pa.apply(a.center()), a.bounding_radius(),
                                                     pb.apply(b.center()), b.bounding_radius());
   if (gap > margin) {
@@ -155,14 +181,20 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     cache->mesh_a = a.id();
     cache->mesh_b = b.id();
   }
+  Query q = make_query_of_rigid_poses(a, pa, b, pb, options);
+  MarginSearch search(q, margin);
+  const double unit = detail::pow2(q.exponent);  // scaled -> unscaled, exact
+  if (search.roots_apart()) {
+    r.lower_bound = std::max(0.0, search.lower_scaled() * unit);
+    if (r.lower_bound > margin) return r;
+  }
   // The hulls hold the surfaces: hulls beyond the margin prove the meshes
-  // beyond it, before the hierarchies' query is set up; otherwise the
+  // beyond it; otherwise the
   // hulls' closest points aim the slab bound of the traversal. Only within
   // the convex query's range of placed magnitudes (as hull_bound).
   double hull_lower = 0.0;
   Vec3 hull_direction = Vec3::Zero();  // world frame
   if (std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())) <= kMaxMagnitude) {
-    detail::check_distance_options(options, "within_margin: options");
     DistanceCache local;
     const MarginResult hull = detail::within_margin_of_rigid_poses(
         a.hull(), pa, b.hull(), pb, margin, options, cache != nullptr ? cache->hull : local);
@@ -173,9 +205,7 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     hull_lower = hull.lower_bound;
     if (hull.upper_bound > 0.0) hull_direction = hull.point_b - hull.point_a;
   }
-  Query q = make_query(a, pa, b, pb, options);
   if (hull_direction != Vec3::Zero()) q.set_slab(q.pose_a.rotation.transpose() * hull_direction);
-  MarginSearch search(q, margin);
   const bool same_pair = cache != nullptr;
   // The last witness (or closest) pair first: a colliding pair often still
   // collides there.
@@ -213,9 +243,11 @@ MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const Tria
     r.lower_bound = 0.0;
     return r;
   }
-  r.lower_bound = std::max({0.0, std::ldexp(search.lower_scaled(), q.exponent), hull_lower});
+  r.lower_bound = std::max({0.0, search.lower_scaled() * unit, hull_lower});
   r.status = r.lower_bound > margin ? MarginStatus::beyond : MarginStatus::undecided;
   return r;
 }
+
+}  // namespace detail
 
 }  // namespace proxima

@@ -93,27 +93,36 @@ struct Query {
   }
 };
 
-inline Query make_query(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
-                 const Pose& pose_b, const DistanceOptions& options) {
-  const Pose pa = checked_pose(pose_a, "mesh distance: pose_a");
-  const Pose pb = checked_pose(pose_b, "mesh distance: pose_b");
-  detail::check_distance_options(options, "mesh distance: options");
+// The query of poses already under the contract (checked_pose) and options
+// already checked. Every scaling is a product with a power of two between
+// 2^-1000 and 2^1000 (a normal double: the exponent is clamped), so each
+// is the correctly rounded value, the same bits as ldexp's, at a
+// multiplication's cost instead of a libm call.
+inline Query make_query_of_rigid_poses(const TriangleMesh& a, const Pose& pa, const TriangleMesh& b,
+                                       const Pose& pb, const DistanceOptions& options) {
   const Pose rel = pa.inverse() * pb;
   Query q{a, b, rel.rotation, rel.translation, {}, 1.0, 0, 0.0, 0.0, 1.0, 1.0, {}, {}, {}, {}};
   q.magnitude = std::max({magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale()), a.scale(),
                           magnitude_bound(rel, b.scale())});
   q.exponent = detail::clamped_magnitude_exponent(q.magnitude);
-  q.factor = std::ldexp(1.0, -q.exponent);
-  q.translation_s = times_pow2(rel.translation, -q.exponent);
-  q.band_s = contact_band(std::ldexp(q.magnitude, -q.exponent),
-                          std::ldexp(options.absolute_tolerance, -q.exponent));
-  q.box_unit_a = std::ldexp(1.0, magnitude_exponent(a.unit()) - 1 - q.exponent);
-  q.box_unit_b = std::ldexp(1.0, magnitude_exponent(b.unit()) - 1 - q.exponent);
+  q.factor = detail::pow2(-q.exponent);
+  q.translation_s = rel.translation * q.factor;
+  q.band_s = contact_band(q.magnitude * q.factor, options.absolute_tolerance * q.factor);
+  q.box_unit_a = detail::pow2(magnitude_exponent(a.unit()) - 1 - q.exponent);
+  q.box_unit_b = detail::pow2(magnitude_exponent(b.unit()) - 1 - q.exponent);
   q.abs_rotation = rel.rotation.cwiseAbs();
-  q.tol = kernel_tolerance(std::ldexp(q.magnitude, -q.exponent));
+  q.tol = kernel_tolerance(q.magnitude * q.factor);
   q.pose_a = pa;
   q.pose_b = pb;
   return q;
+}
+
+inline Query make_query(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
+                 const Pose& pose_b, const DistanceOptions& options) {
+  const Pose pa = checked_pose(pose_a, "mesh distance: pose_a");
+  const Pose pb = checked_pose(pose_b, "mesh distance: pose_b");
+  detail::check_distance_options(options, "mesh distance: options");
+  return make_query_of_rigid_poses(a, pa, b, pb, options);
 }
 
 // A node's box as center and half extents, scaled units of the query.

@@ -240,6 +240,12 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   put(face_vertices);
   if (!identity_input_) put(input_index);
 
+  measure();
+  interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
+}
+
+void ConvexPolytope::measure() {
+  const std::span<const Vec3> vertices = this->vertices();
   // Centroid and radius on power-of-two scaled copies: exact scaling, and no
   // sum or square can overflow near the largest doubles.
   const int exponent = magnitude_exponent(max_abs_coordinate(vertices));
@@ -254,7 +260,6 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   centroid_ = times_pow2(mean, exponent);
   bounding_radius_ = std::ldexp(radius, exponent);
   scale_ = max_abs_coordinate(vertices);
-  interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
 }
 
 std::size_t ConvexPolytope::int_count() const {

@@ -25,6 +25,9 @@
 
 #include "geometry/triangle_distance.h"
 #include "proxima/geometry/closest_point.h"
+#include "proxima/query/distance.h"
+#include "shape/triangle_polytope.h"
+#include "support/exact_oracle.h"
 #include "support/generators.h"
 
 namespace proxima {
@@ -851,6 +854,165 @@ TEST(MeshConvex, InsideEitherIsIntersecting) {
   EXPECT_GE(apart.triangle_a, 0);
   EXPECT_EQ(apart.triangle_b, -1);
   EXPECT_NEAR(apart.point_a.x(), 2.0, 1e-12);  // on the box's face x = 2
+}
+
+// --- 7. the scratch triangle of the mesh-convex query ----------------------------
+
+// The scratch polytope (shape/triangle_polytope.h) is the hull of its
+// triangle: the same vertex set, dimension, counts and measures as the
+// ConvexPolytope built from the three points, at any scale; degenerate
+// triangles are refused and leave it unchanged.
+TEST(TrianglePolytope, IsTheHullOfItsTriangle) {
+  Rng rng(2626);
+  detail::TrianglePolytope scratch;
+  for (int trial = 0; trial < 300; ++trial) {
+    const double scale = std::ldexp(1.0, test::uniform_int(rng, -990, 990));
+    std::array<Vec3, 3> v;
+    for (Vec3& p : v)
+      p = scale * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
+                       test::uniform(rng, -1, 1));
+    if (trial % 5 == 0) v[2] = v[0] + 1e-9 * (v[1] - v[0]).cross(Vec3(0.3, 0.2, 1.0));  // sliver
+    ASSERT_TRUE(scratch.assign(v[0], v[1], v[2])) << trial;
+    const ConvexPolytope& p = scratch.polytope();
+    const ConvexPolytope built(v);
+    ASSERT_EQ(built.dimension(), 2) << trial;
+    EXPECT_EQ(p.dimension(), 2);
+    EXPECT_EQ(p.vertex_count(), 3);
+    EXPECT_EQ(p.face_count(), 2);
+    EXPECT_EQ(p.edge_count(), 3);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(p.vertex(k), v[static_cast<std::size_t>(k)]) << trial;
+      EXPECT_EQ(p.input_index()[static_cast<std::size_t>(k)], k);
+      EXPECT_EQ(p.neighbors(k).size(), 2u);
+      EXPECT_TRUE(std::find(built.vertices().begin(), built.vertices().end(), p.vertex(k)) !=
+                  built.vertices().end());
+    }
+    EXPECT_EQ(p.scale(), built.scale()) << trial;
+    // Compared in units of the scale (a difference near 1e300 overflows).
+    const double unit = built.scale();
+    EXPECT_LE((p.centroid() / unit - built.centroid() / unit).norm(), 4 * kU) << trial;
+    EXPECT_NEAR(p.bounding_radius() / unit, built.bounding_radius() / unit, 8 * kU) << trial;
+    // The two faces are the triangle's two sides.
+    EXPECT_NEAR(p.face_plane(0).normal.dot(p.face_plane(1).normal), -1.0, 1e-9) << trial;
+  }
+  const Vec3 a(1, 2, 3), b(2, 4, 6), c(3, 6, 9);
+  ASSERT_TRUE(scratch.assign(a, b, Vec3(0, 0, 1)));
+  EXPECT_FALSE(scratch.assign(a, b, c));  // collinear, exactly
+  EXPECT_FALSE(scratch.assign(a, a, c));  // repeated
+  EXPECT_EQ(scratch.polytope().vertex(2), Vec3(0, 0, 1));  // unchanged
+}
+
+// The slow twin of the mesh-convex leaf test: the convex query on the
+// scratch triangle against the same query on the triangle's built
+// ConvexPolytope (today's path before the scratch), field by field within
+// the accuracy standard, and the distance against the exact oracle
+// (CGAL's quadratic program in exact arithmetic). Triangles at random,
+// resting on a face of the box (touching), lying in a face's plane across
+// its edge (coplanar overlap), crossing the box, slivers; against a box,
+// a random cloud, a flat square and a segment.
+TEST(TrianglePolytope, ConvexQueryMatchesTheBuiltTriangleAndTheExactDistance) {
+  Rng rng(2627);
+  test::ExactOracle oracle;
+  detail::TrianglePolytope scratch;
+  const std::vector<std::vector<Vec3>> bodies = {
+      test::box(Vec3(0.5, 0.3, 0.2)), random_cloud(rng, 10, 0.5),
+      {Vec3(-0.4, -0.4, 0), Vec3(0.4, -0.4, 0), Vec3(0.4, 0.4, 0), Vec3(-0.4, 0.4, 0)},
+      {Vec3(-0.5, 0.1, 0.0), Vec3(0.5, -0.1, 0.1)}};
+  int separated = 0, contact = 0;
+  // 160 cases: well under a second in release, a few seconds under ASan
+  // (the oracle's exact quadratic program dominates).
+  for (int trial = 0; trial < 160; ++trial) {
+    const std::vector<Vec3>& body = bodies[static_cast<std::size_t>(trial % 4)];
+    const ConvexPolytope b(body);
+    const int kind = (trial / 4) % 5;
+    std::array<Vec3, 3> v;
+    const auto random_point = [&](double extent) {
+      return Vec3(test::uniform(rng, -extent, extent), test::uniform(rng, -extent, extent),
+                  test::uniform(rng, -extent, extent));
+    };
+    Pose pose_b = random_pose(rng, 0.3);
+    if (kind == 0) {  // at random near the body
+      const Vec3 c = random_point(1.0);
+      for (Vec3& p : v) p = c + random_point(0.4);
+    } else if (kind == 1 || kind == 2) {
+      // In the plane z = 0.2 of the box's top face at B's pose: on it
+      // (touching the box) or across its edge (coplanar with the face).
+      pose_b = Pose::from_translation(random_point(0.05));
+      const double top = 0.2 + pose_b.translation.z();
+      const double reach = kind == 1 ? 0.2 : 0.9;
+      for (Vec3& p : v)
+        p = Vec3(test::uniform(rng, -reach, reach), test::uniform(rng, -reach, reach), top);
+    } else if (kind == 3) {  // crossing the body
+      const Vec3 c = pose_b.translation;
+      const Vec3 n = random_point(1.0).normalized();
+      const Vec3 e = n.unitOrthogonal();
+      v = {c + 0.8 * e, c - 0.4 * e + 0.7 * n.cross(e), c - 0.4 * e - 0.7 * n.cross(e)};
+    } else {  // a sliver near the body
+      const Vec3 c = random_point(0.8);
+      const Vec3 d = random_point(0.5);
+      v = {c, c + d, c + 0.5 * d + 1e-10 * random_point(1.0)};
+    }
+    if (!scratch.assign(v[0], v[1], v[2])) continue;
+    const ConvexPolytope built(v);
+    DistanceOptions options;
+    options.penetration = false;
+    const DistanceResult fast =
+        detail::distance_of_rigid_poses(scratch.polytope(), Pose(), b, pose_b, options, nullptr);
+    const DistanceResult slow =
+        detail::distance_of_rigid_poses(built, Pose(), b, pose_b, options, nullptr);
+    double magnitude = 0.0;
+    for (const Vec3& p : v) magnitude = std::max(magnitude, p.cwiseAbs().maxCoeff());
+    for (const Vec3& p : body)
+      magnitude = std::max(magnitude, pose_b.apply(p).cwiseAbs().maxCoeff());
+    const double standard = 1e-12 * slow.distance + 64 * kU * magnitude;
+    const std::string where = "trial " + std::to_string(trial) + " kind " + std::to_string(kind);
+    EXPECT_EQ(fast.status, slow.status) << where;
+    EXPECT_NEAR(fast.distance, slow.distance, standard) << where;
+    EXPECT_NEAR((fast.point_b - fast.point_a).norm(), fast.distance, standard) << where;
+    EXPECT_LE(fast.lower_bound, fast.distance) << where;
+    EXPECT_LE(std::abs(fast.normal.norm() - 1.0), 1e-12) << where;
+    test::Points placed;
+    for (const Vec3& p : body) placed.push_back(pose_b.apply(p));
+    const auto exact = oracle.distance(test::Points(v.begin(), v.end()), placed);
+    ASSERT_TRUE(exact.has_value()) << where << ": " << oracle.last_error();
+    EXPECT_TRUE(test::within_bound(fast.distance, exact->distance_squared, 1e-12,
+                                   64 * kU * magnitude))
+        << where << ": " << fast.distance;
+    EXPECT_LE(fast.lower_bound, std::sqrt(exact->distance_squared.get_d()) + standard) << where;
+    if (fast.status == Status::separated) {
+      ++separated;
+    } else {
+      ++contact;
+      EXPECT_TRUE(test::sqrt_at_most(exact->distance_squared, 128 * kU * magnitude)) << where;
+    }
+  }
+  // The set holds both kinds of answers.
+  EXPECT_GT(separated, 25);
+  EXPECT_GT(contact, 25);
+}
+
+// Degenerate triangles (segments and points) in a mesh take the built
+// polytope, proper ones the scratch: the mesh-convex query against the
+// twin that builds every triangle, on soups where a third of the
+// triangles are degenerate.
+TEST(MeshConvex, DegenerateTrianglesAmongProperOnes) {
+  Rng rng(2628);
+  for (int trial = 0; trial < 20; ++trial) {
+    MeshData soup = random_soup(rng, 30, 1.5, 0.5);
+    for (std::size_t t = 0; t < soup.triangles.size(); t += 3) {
+      const Tri& tri = soup.triangles[t];
+      soup.vertices[tri[2]] = t % 2 == 0 ? Vec3(soup.vertices[tri[0]])
+                                         : Vec3(0.5 * (soup.vertices[tri[0]] + soup.vertices[tri[1]]));
+      soup.vertices[tri[1]] = t % 6 == 0 ? Vec3(soup.vertices[tri[0]]) : Vec3(soup.vertices[tri[1]]);
+    }
+    const TriangleMesh mesh = soup.build();
+    const ConvexPolytope box(test::box(Vec3(0.4, 0.3, 0.2)));
+    const Pose pb = random_pose(rng, 1.0);
+    const MeshResult r = distance(mesh, Pose(), box, pb);
+    const MeshResult twin = distance_all_pairs(mesh, Pose(), box, pb);
+    EXPECT_EQ(r.status, twin.status) << trial;
+    EXPECT_NEAR(r.distance, twin.distance, 1e-12 * twin.distance + 64 * kU * 4) << trial;
+  }
 }
 
 }  // namespace

@@ -157,6 +157,17 @@ MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& p
                                           const ConvexPolytope& b, const Pose& pose_b,
                                           double margin, const DistanceOptions& options,
                                           DistanceCache& cache);
+// The mesh margin query for poses already under the contract, margin and
+// options already checked (a Body's meshes, a batch's rows).
+MarginResult within_margin_of_rigid_poses(const TriangleMesh& a, const Pose& pose_a,
+                                          const TriangleMesh& b, const Pose& pose_b,
+                                          double margin, const DistanceOptions& options,
+                                          MeshCache* cache);
+// The Body margin query for poses already under the contract, margin and
+// options already checked (a batch's rows of rigid poses).
+MarginResult within_margin_of_rigid_poses(const Body& a, const Pose& pose_a, const Body& b,
+                                          const Pose& pose_b, double margin,
+                                          const DistanceOptions& options, BodyCache& cache);
 // A certified lower bound on the distance between two balls (world
 // centers and radii, each holding its body up to the rounding of the
 // radius): the gap |c_a - c_b| - r_a - r_b less a slack for the rounding of

@@ -25,6 +25,10 @@
 
 namespace proxima {
 
+namespace detail {
+class TrianglePolytope;
+}  // namespace detail
+
 struct Plane {
   Vec3 normal;    // unit, outward
   double offset;  // normal.dot(x) == offset on the plane
@@ -170,6 +174,9 @@ class ConvexPolytope {
   std::size_t memory_bytes() const;
 
  private:
+  // A scratch triangle rewrites the vertices of a polytope built once
+  // (src/shape/triangle_polytope.h).
+  friend class detail::TrianglePolytope;
   // Every array lives in one allocation (bench/polytope_bench.cpp measures
   // the bytes against the vertices plus the adjacency): the vertices, then
   // the 32-bit arrays in this order: adjacency offsets (vertex_count + 1),
@@ -199,6 +206,8 @@ class ConvexPolytope {
   static std::size_t doubles_for(std::int32_t vertex_count, std::size_t int_count);
   void allocate(std::size_t doubles);
   void take(ConvexPolytope& other) noexcept;  // moves other's state here, leaves it empty
+  // centroid_, bounding_radius_ and scale_ from the stored vertices.
+  void measure();
 
   std::unique_ptr<double[]> data_;
   std::int32_t vertex_count_ = 0;
