@@ -231,14 +231,17 @@ class Expansion {
     return {m_.point_a(i) - m_.point_b(j), i, j};
   }
 
-  // Along a triangle's normal: each hull's climb starts at the best of the
-  // triangle's three vertices along it (they are supports along nearby
-  // directions; the best is the nearest to the support, three dot products
-  // against the climb's steps of a whole ring each).
+  // Along a triangle's normal: each hull's climb starts at the best along
+  // it of the triangle's three vertices (supports along nearby directions
+  // once P is fine) and the hull's table start (support_start: a step or
+  // two away on a round hull, whatever the triangle; the better start on
+  // P's first, large triangles). Four dot products against the climb's
+  // steps of a whole ring each.
   Vertex support(const Vec3& n, const std::array<int, 3>& v) const {
     const Vec3 n_b = m_.rotation_t * (-n);
-    int hint_a = -1, hint_b = -1;
-    double best_a = -kInfinity, best_b = -kInfinity;
+    int hint_a = m_.a.support_start(n), hint_b = m_.b.support_start(n_b);
+    double best_a = hint_a < 0 ? -kInfinity : n.dot(m_.a.vertex(hint_a));
+    double best_b = hint_b < 0 ? -kInfinity : n_b.dot(m_.b.vertex(hint_b));
     for (const int k : v) {
       const Vertex& x = vertices_[static_cast<std::size_t>(k)];
       const double da = n.dot(m_.a.vertex(x.a)), db = n_b.dot(m_.b.vertex(x.b));
