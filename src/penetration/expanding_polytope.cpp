@@ -220,9 +220,10 @@ class Expansion {
   }
 
  private:
-  // Without hints (-1): support_without_hint's seeded climb, which on a
-  // large round hull starts near the support where a climb from vertex 0
-  // crosses half of it.
+  // Without hints (-1): support_without_hint's climb from the hull's table
+  // (ConvexPolytope::support_start), which on a large round hull starts a
+  // step or two from the support where a climb from vertex 0 crosses half
+  // of it.
   Vertex support(const Vec3& n, int hint_a, int hint_b) const {
     const Vec3 n_b = m_.rotation_t * (-n);
     const int i = hint_a < 0 ? support_without_hint(m_.a, n) : support_hill_climb(m_.a, n, hint_a);
