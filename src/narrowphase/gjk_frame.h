@@ -59,9 +59,18 @@ struct HillClimbSupport {
   std::int32_t hint_a = 0;
   std::int32_t hint_b = 0;
   SupportPoint operator()(const Vec3& d) {
-    hint_a = support_hill_climb(frame.a, d, hint_a);
-    hint_b = support_hill_climb(frame.b, frame.dir_in_b(-d), hint_b);
+    const Vec3 d_b = frame.dir_in_b(-d);
+    hint_a = support_hill_climb(frame.a, d, nearer_start(frame.a, d, hint_a));
+    hint_b = support_hill_climb(frame.b, d_b, nearer_start(frame.b, d_b, hint_b));
     return frame.point(hint_a, hint_b);
+  }
+  // The hint or the hull's table start (ConvexPolytope::support_start),
+  // whichever is higher along d: GJK's directions jump between iterations,
+  // and a climb from the last support can cross much of a large hull.
+  static int nearer_start(const ConvexPolytope& p, const Vec3& d, int hint) {
+    const int start = p.support_start(d);
+    if (start < 0 || hint < 0 || hint >= p.vertex_count()) return start < 0 ? hint : start;
+    return d.dot(p.vertex(start)) > d.dot(p.vertex(hint)) ? start : hint;
   }
 };
 

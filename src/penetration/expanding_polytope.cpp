@@ -220,9 +220,10 @@ class Expansion {
   }
 
  private:
-  // Without hints (-1): support_without_hint's seeded climb, which on a
-  // large round hull starts near the support where a climb from vertex 0
-  // crosses half of it.
+  // Without hints (-1): support_without_hint's climb from the hull's table
+  // (ConvexPolytope::support_start), which on a large round hull starts a
+  // step or two from the support where a climb from vertex 0 crosses half
+  // of it.
   Vertex support(const Vec3& n, int hint_a, int hint_b) const {
     const Vec3 n_b = m_.rotation_t * (-n);
     const int i = hint_a < 0 ? support_without_hint(m_.a, n) : support_hill_climb(m_.a, n, hint_a);
@@ -231,14 +232,17 @@ class Expansion {
     return {m_.point_a(i) - m_.point_b(j), i, j};
   }
 
-  // Along a triangle's normal: each hull's climb starts at the best of the
-  // triangle's three vertices along it (they are supports along nearby
-  // directions; the best is the nearest to the support, three dot products
-  // against the climb's steps of a whole ring each).
+  // Along a triangle's normal: each hull's climb starts at the best along
+  // it of the triangle's three vertices (supports along nearby directions
+  // once P is fine) and the hull's table start (support_start: a step or
+  // two away on a round hull, whatever the triangle; the better start on
+  // P's first, large triangles). Four dot products against the climb's
+  // steps of a whole ring each.
   Vertex support(const Vec3& n, const std::array<int, 3>& v) const {
     const Vec3 n_b = m_.rotation_t * (-n);
-    int hint_a = -1, hint_b = -1;
-    double best_a = -kInfinity, best_b = -kInfinity;
+    int hint_a = m_.a.support_start(n), hint_b = m_.b.support_start(n_b);
+    double best_a = hint_a < 0 ? -kInfinity : n.dot(m_.a.vertex(hint_a));
+    double best_b = hint_b < 0 ? -kInfinity : n_b.dot(m_.b.vertex(hint_b));
     for (const int k : v) {
       const Vertex& x = vertices_[static_cast<std::size_t>(k)];
       const double da = n.dot(m_.a.vertex(x.a)), db = n_b.dot(m_.b.vertex(x.b));

@@ -38,6 +38,7 @@
 #include "hull/incremental_hull.h"
 #include "hull/polygon_hull.h"
 #include "hull/sorted_distinct.h"
+#include "proxima/shape/support.h"
 #include "proxima/detail/geometry/exact_predicates.h"
 
 namespace proxima {
@@ -224,10 +225,12 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   identity_input_ = true;
   for (Index v = 0; v < vertex_count; ++v)
     identity_input_ = identity_input_ && input_index[static_cast<std::size_t>(v)] == v;
+  table_side_ = static_cast<std::int16_t>(table_side_for(vertex_count));
   allocate(doubles_for(vertex_count_, adjacency.offsets.size() + 2 * adjacency.neighbors.size() +
                                           (triangles_only_ ? 0 : face_offsets.size()) +
                                           face_vertices.size() +
-                                          (identity_input_ ? 0 : input_index.size())));
+                                          (identity_input_ ? 0 : input_index.size()) +
+                                          6 * static_cast<std::size_t>(table_side_) * table_side_));
   std::uninitialized_copy(vertices.begin(), vertices.end(), reinterpret_cast<Vec3*>(data_.get()));
   auto* out = const_cast<std::int32_t*>(ints());
   const auto put = [&out](const std::vector<std::int32_t>& values) {
@@ -239,6 +242,7 @@ ConvexPolytope::ConvexPolytope(std::span<const Vec3> points) {
   if (!triangles_only_) put(face_offsets);
   put(face_vertices);
   if (!identity_input_) put(input_index);
+  build_table();
 
   measure();
   interior_point_count_ = static_cast<int>(points.size()) - vertex_count;
@@ -263,7 +267,38 @@ void ConvexPolytope::measure() {
 }
 
 std::size_t ConvexPolytope::int_count() const {
-  return input_index_at() + (identity_input_ ? 0 : static_cast<std::size_t>(vertex_count_));
+  return table_at() + 6 * static_cast<std::size_t>(table_side_) * static_cast<std::size_t>(table_side_);
+}
+
+int ConvexPolytope::table_side_for(std::int32_t vertex_count) {
+  if (vertex_count <= kTableMinVertices) return 0;
+  // 6 side^2 cells, about vertex_count / kTableVerticesPerCell of them.
+  const double cells = static_cast<double>(vertex_count) / kTableVerticesPerCell;
+  return std::max(1, static_cast<int>(std::ceil(std::sqrt(cells / 6.0))));
+}
+
+// Each cell's support along its centre direction, by hill climbing from
+// the previous cell's (rows run back and forth, so that consecutive cells
+// are neighbours and each climb is short). Exact: a climb reaches a
+// maximizer from any start (support.h).
+void ConvexPolytope::build_table() {
+  if (table_side_ == 0) return;
+  const int side = table_side_;
+  auto* table = const_cast<std::int32_t*>(ints()) + table_at();
+  int last = 0;
+  for (int face = 0; face < 6; ++face) {
+    const int axis = face / 2;
+    for (int row = 0; row < side; ++row)
+      for (int k = 0; k < side; ++k) {
+        const int column = row % 2 == 0 ? k : side - 1 - k;
+        Vec3 d;
+        d[axis] = face % 2 == 0 ? 1.0 : -1.0;
+        d[(axis + 1) % 3] = -1.0 + (2.0 * row + 1.0) / side;
+        d[(axis + 2) % 3] = -1.0 + (2.0 * column + 1.0) / side;
+        last = support_hill_climb(*this, d, last);
+        table[(face * side + row) * side + column] = last;
+      }
+  }
 }
 
 std::size_t ConvexPolytope::doubles_for(std::int32_t vertex_count, std::size_t int_count) {
@@ -285,6 +320,7 @@ ConvexPolytope::ConvexPolytope(const ConvexPolytope& other)
       dimension_(other.dimension_),
       triangles_only_(other.triangles_only_),
       identity_input_(other.identity_input_),
+      table_side_(other.table_side_),
       centroid_(other.centroid_),
       bounding_radius_(other.bounding_radius_),
       scale_(other.scale_) {
@@ -313,6 +349,7 @@ void ConvexPolytope::take(ConvexPolytope& other) noexcept {
   dimension_ = std::exchange(other.dimension_, 0);
   triangles_only_ = std::exchange(other.triangles_only_, true);
   identity_input_ = std::exchange(other.identity_input_, true);
+  table_side_ = std::exchange(other.table_side_, 0);
   centroid_ = other.centroid_;
   bounding_radius_ = other.bounding_radius_;
   scale_ = other.scale_;

@@ -32,6 +32,10 @@ int support_brute_force(std::span<const Vec3> vertices, const Vec3& dir) {
 int support_without_hint(const ConvexPolytope& polytope, const Vec3& dir) {
   const int n = polytope.vertex_count();
   if (n <= kScanVertices) return support_brute_force(polytope.vertices(), dir);
+  // The table's start (a climb of a step or two on a round hull); the
+  // seeds below only for a direction the table refuses (zero, not finite).
+  if (const int start = polytope.support_start(dir); start >= 0)
+    return support_hill_climb(polytope, dir, start);
   const Vec3* vertices = polytope.vertices().data();
   const int stride = n / kSupportSeeds;  // >= 1
   int seed = 0;

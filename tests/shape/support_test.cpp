@@ -27,8 +27,10 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "proxima/shape/polytope.h"
@@ -254,6 +256,63 @@ TEST(Support, WithoutHintIsTheScanOnSmallBodiesAndAMaximizerOnLarge) {
   }
   EXPECT_GT(scanned, 1000);  // premise: both regimes ran
   EXPECT_GT(climbed, 1000);
+}
+
+// ConvexPolytope::support_start's table: at the centre of every cell the
+// start is the support itself (the table holds the cell centre's support),
+// so a wrong cell index, a face or axis mixed up, or a table lost or
+// misplaced by a copy or a move gives a start below the maximum there; on
+// random directions the start is a vertex id in range and the climb from
+// it a maximizer. Small hulls (scanned) and refused directions (zero, NaN,
+// infinite) have no start.
+TEST(Support, TableStartIsTheSupportAtCellCentres) {
+  Rng rng(211);
+  std::vector<ConvexPolytope> bodies;
+  for (const int n : {ConvexPolytope::kTableMinVertices + 1, 100, 2000})
+    bodies.emplace_back(sphere_points(rng, n));
+  Points thin = sphere_points(rng, 300);  // a flat ellipsoid: far from round
+  for (Vec3& x : thin) x = x.cwiseProduct(Vec3(3.0, 1.0, 1e-3));
+  bodies.emplace_back(thin);
+  long centres = 0;
+  for (const ConvexPolytope& built : bodies) {
+    const ConvexPolytope copy(built);
+    ConvexPolytope moved_from(built);
+    const ConvexPolytope moved(std::move(moved_from));
+    for (const ConvexPolytope* p : {&built, &copy, &moved}) {
+      SCOPED_TRACE("vertices " + std::to_string(p->vertex_count()));
+      const int cells = std::max(1, p->vertex_count() / ConvexPolytope::kTableVerticesPerCell);
+      const int side = static_cast<int>(std::ceil(std::sqrt(cells / 6.0)));
+      for (int axis = 0; axis < 3; ++axis)
+        for (const double sign : {1.0, -1.0})
+          for (int row = 0; row < side; ++row)
+            for (int column = 0; column < side; ++column) {
+              Vec3 d;
+              d[axis] = sign;
+              d[(axis + 1) % 3] = -1.0 + (2.0 * row + 1.0) / side;
+              d[(axis + 2) % 3] = -1.0 + (2.0 * column + 1.0) / side;
+              const int start = p->support_start(d);
+              ASSERT_GE(start, 0);
+              ASSERT_EQ(d.dot(p->vertex(start)),
+                        d.dot(p->vertex(support_brute_force(p->vertices(), d))))
+                  << d.transpose();
+              ++centres;
+            }
+      for (int i = 0; i < 200; ++i) {
+        const Vec3 d = random_direction(rng) * std::pow(10.0, uniform(rng, -300, 300));
+        const int start = p->support_start(d);
+        ASSERT_GE(start, 0);
+        ASSERT_LT(start, p->vertex_count());
+        const int got = support_hill_climb(*p, d, start);
+        ASSERT_EQ(d.dot(p->vertex(got)), d.dot(p->vertex(support_brute_force(p->vertices(), d))));
+      }
+      const double inf = std::numeric_limits<double>::infinity();
+      for (const Vec3& refused : {Vec3(0, 0, 0), Vec3(std::nan(""), 1, 0), Vec3(inf, 0, 0)})
+        EXPECT_EQ(p->support_start(refused), -1);
+    }
+  }
+  EXPECT_GT(centres, 2000);  // premise: the tables were walked
+  const ConvexPolytope small(sphere_points(rng, ConvexPolytope::kTableMinVertices));
+  EXPECT_EQ(small.support_start(Vec3(1, 0, 0)), -1);
 }
 
 TEST(Support, RandomSpherePolytopes) {

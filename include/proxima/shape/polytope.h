@@ -14,6 +14,8 @@
 // shared between threads without synchronization.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
@@ -173,6 +175,24 @@ class ConvexPolytope {
   // Bytes held by this object (its own size plus its arrays).
   std::size_t memory_bytes() const;
 
+  // A vertex near the support along `dir`, the start of a climb
+  // (support_without_hint, the expanding polytope of the cold depth): the
+  // support along the centre of dir's cell in a cube map of directions,
+  // tabulated when the hull is built (see kTableVerticesPerCell). -1 when
+  // the hull has no table (at most kTableMinVertices vertices) or dir is
+  // zero, not finite or so large that the sum of its magnitudes overflows.
+  // O(1).
+  int support_start(const Vec3& dir) const;
+
+  // Hulls of more than this many vertices get the table of support_start;
+  // smaller ones are scanned (support_without_hint, kScanVertices).
+  static constexpr int kTableMinVertices = 32;
+  // About this many hull vertices per cell of the table: each cell then
+  // spans about two vertex spacings on a round hull, so that a climb from
+  // its support reaches the support along any direction of the cell in one
+  // or two steps, at 4 bytes per cell (about 1% of the hull's memory).
+  static constexpr int kTableVerticesPerCell = 4;
+
  private:
   // A scratch triangle rewrites the vertices of a polytope built once
   // (src/shape/triangle_polytope.h).
@@ -202,6 +222,13 @@ class ConvexPolytope {
     return triangles_only_ ? 3 * size(f) : size(ints()[face_offsets_at() + size(f)]);
   }
   std::size_t input_index_at() const { return face_vertices_at() + face_begin(face_count_); }
+  // The table of support_start: 6 table_side_^2 vertex ids, cube face
+  // 2 axis + (negative), then row, then column, after the input index.
+  std::size_t table_at() const {
+    return input_index_at() + (identity_input_ ? 0 : static_cast<std::size_t>(vertex_count_));
+  }
+  static int table_side_for(std::int32_t vertex_count);
+  void build_table();
   std::size_t int_count() const;  // of the 32-bit part, once it is filled
   static std::size_t doubles_for(std::int32_t vertex_count, std::size_t int_count);
   void allocate(std::size_t doubles);
@@ -218,9 +245,32 @@ class ConvexPolytope {
   std::int8_t dimension_ = 0;
   bool triangles_only_ = true;
   bool identity_input_ = true;
+  std::int16_t table_side_ = 0;  // 0: no table
   Vec3 centroid_ = Vec3::Zero();
   double bounding_radius_ = 0.0;
   double scale_ = 0.0;
 };
+
+inline int ConvexPolytope::support_start(const Vec3& dir) const {
+  if (table_side_ == 0) return -1;
+  // The cube face of dir's largest component, then its cell: the other two
+  // components divided by it lie in [-1, 1] (no overflow, whatever dir's
+  // size), so each index is in [0, side] before the clamp.
+  // Refused first without comparing a NaN (an ordered comparison of a NaN
+  // raises the invalid-operation flag, which the tests trap); a sum that
+  // overflows is refused too (the caller's seeds then start the climb).
+  const Vec3 m = dir.cwiseAbs();
+  const double total = m.x() + m.y() + m.z();
+  if (!std::isfinite(total) || total == 0.0) return -1;
+  const int axis = m.x() >= m.y() ? (m.x() >= m.z() ? 0 : 2) : (m.y() >= m.z() ? 1 : 2);
+  const double largest = m[axis];
+  const int side = table_side_;
+  const double half = 0.5 * side;
+  const int row = std::min(side - 1, static_cast<int>((dir[(axis + 1) % 3] / largest + 1.0) * half));
+  const int column =
+      std::min(side - 1, static_cast<int>((dir[(axis + 2) % 3] / largest + 1.0) * half));
+  const int face = 2 * axis + (dir[axis] < 0.0 ? 1 : 0);
+  return ints()[table_at() + static_cast<std::size_t>((face * side + row) * side + column)];
+}
 
 }  // namespace proxima

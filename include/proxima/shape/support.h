@@ -25,6 +25,8 @@ int support_brute_force(std::span<const Vec3> vertices, const Vec3& dir);
 // body. Cold queries on random poses (bench/distance_bench) are faster
 // scanned up to 32 vertices, no faster at 64.
 inline constexpr int kScanVertices = 32;
+// Larger bodies have the table of ConvexPolytope::support_start.
+static_assert(kScanVertices == ConvexPolytope::kTableMinVertices);
 
 // Vertices at evenly spaced ids that seed support_without_hint's climb on
 // larger bodies: more seeds start the climb nearer the support point, at
@@ -34,10 +36,12 @@ inline constexpr int kSupportSeeds = 16;
 
 // Index of a vertex maximizing dir.dot(vertex) when no hint is known (a
 // cold start): support_brute_force on bodies of up to kScanVertices
-// vertices; on larger ones, support_hill_climb from the best of
-// kSupportSeeds vertices at evenly spaced ids (vertex 0 first), which on a
-// round body is already near the support point, where a climb from vertex
-// 0 crosses half of it. Exact like the climb (any start reaches a maximizer).
+// vertices; on larger ones, support_hill_climb from the polytope's table
+// (support_start: the support along the centre of dir's cell, a step or
+// two from dir's on a round body, where a climb from vertex 0 crosses half
+// of it), or, for a direction the table refuses, from the best of
+// kSupportSeeds vertices at evenly spaced ids (vertex 0 first). Exact like
+// the climb (any start reaches a maximizer).
 int support_without_hint(const ConvexPolytope& polytope, const Vec3& dir);
 
 // Index of a vertex maximizing dir.dot(vertex), found by walking from `hint`
