@@ -1007,6 +1007,62 @@ TEST(GjkRegression, StalledSimplexWithAFourthVertex) {
   }
 }
 
+// Regression (issue 25, the soak: seed 10, episode 6125): a point at 3e93
+// in its own frame, placed by a translation that cancels it to within
+// 3.7e77 of a box of size 100 at the origin. GJK worked in a unit near R
+// (1e94), where the box, which is A - B, was 1e-92 in size; the solver's
+// squared face normals (fourth powers, 1e-368) underflowed to zero, no
+// triangle around the origin's projection was ever found, and GJK and
+// Enhanced GJK stopped at the iteration cap with distance 0 (their
+// certificate [-2e79, 0] excluded the exact 3.7e77; the hybrid answered
+// it). The unit now follows the spread of A - B (gjk_frame.h).
+TEST(GjkRegression, CancelledTranslationConverges) {
+  const Vec3 half(25.830336028769672, 34.169303400112128, 51.946510876643764);
+  const ConvexPolytope box_body(box(-half, half));
+  const Vec3 local(1.865208878257629e+93, -2.4178279444583283e+93, 2.8539780796806809e+93);
+  const ConvexPolytope point(std::vector<Vec3>{local});
+  Mat3 rotation_box;
+  rotation_box << -0.30748909473401476, -0.76927650256259694, 0.56005724638175591,
+      -0.078777707468663749, 0.60713240863883933, 0.79068597507884442, -0.94828504650534162,
+      0.19900728877470825, -0.24728843399743172;
+  Mat3 rotation_point;
+  rotation_point << 0.10138475302065772, -0.35623199399934591, 0.92888099254220402,
+      0.16043002374613988, -0.91561734389905791, -0.36865578393949966, 0.9818265322019738,
+      0.18639647529522699, -0.035679331016186699;
+  const Pose pose_box(rotation_box, Vec3::Zero());
+  const Pose pose_point(rotation_point, Vec3(-3.7014174026033021e+93, -1.4609051788294062e+93,
+                                             -1.2788089294368173e+93));
+  // The placed point exactly (rationals): the box is within its
+  // circumradius of the origin, so d* is within it of the point's norm.
+  mpq_class norm2 = 0;
+  for (int i = 0; i < 3; ++i) {
+    mpq_class c = pose_point.translation[i];
+    for (int j = 0; j < 3; ++j) c += mpq_class(pose_point.rotation(i, j)) * mpq_class(local[j]);
+    norm2 += c * c;
+  }
+  const double centre_distance = std::sqrt(norm2.get_d());
+  const double circumradius = half.norm();
+  // R of the standard counts the translation (docs/accuracy.md).
+  const double band = 64 * kUnitRoundoff * pose_point.translation.cwiseAbs().maxCoeff();
+  for (const Algorithm alg : {Algorithm::gjk, Algorithm::enhanced_gjk, Algorithm::hybrid}) {
+    DistanceOptions options;
+    options.algorithm = alg;
+    for (const bool swapped : {false, true}) {
+      SCOPED_TRACE(std::string(to_string(alg)) + (swapped ? ", swapped" : ""));
+      const DistanceResult r = swapped ? distance(point, pose_point, box_body, pose_box, options)
+                                       : distance(box_body, pose_box, point, pose_point, options);
+      expect_finite(r);
+      EXPECT_NE(r.status, Status::iteration_cap);
+      EXPECT_LT(r.iterations, 16);
+      // Within the standard (64 u R, R the translation), and the
+      // certificate holds the exact distance within that band.
+      EXPECT_LE(std::abs(r.signed_distance()), centre_distance + circumradius + band);
+      EXPECT_LE(r.signed_lower_bound(), centre_distance + circumradius + band);
+      EXPECT_GE(r.signed_upper_bound(), centre_distance - circumradius - band);
+    }
+  }
+}
+
 TEST(Gjk, IterationCapIsReportedWithValidBounds) {
   Rng rng(8);
   const ConvexPolytope a(sphere_points(rng, 500, 1.0));
