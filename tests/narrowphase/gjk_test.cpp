@@ -1063,6 +1063,51 @@ TEST(GjkRegression, CancelledTranslationConverges) {
   }
 }
 
+// Regression (issue 25, found with ForeignCache.FlatContactTetrahedron...
+// of status_band_test): a pyramid with its apex at the origin and B that
+// point (d* = 0), its base a few bands above and nearly flat (one corner
+// lifted by a few u), Enhanced GJK warm-started from the base. The
+// origin's foot on the base is on its diagonal, so the kernels reduce the
+// base to that edge; the direction across it, left by the closest points'
+// difference, is rounding (u R / |v|, 1e-3 here), and the support along it
+// came back from the base instead of the apex. Enhanced GJK stopped at
+// 16-19 bands with a lower bound of 0 and answered `touching` there. The
+// polish now searches once along the normal of the features it searched
+// (the base's) and reaches the apex.
+TEST(GjkRegression, FlatFaceAboveATouchingApexReachesIt) {
+  test::Rng rng(5);
+  int queries = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const double size = test::log_uniform(rng, 1e-9, 1e3);
+    const double band = 64.0 * kUnitRoundoff * size;
+    const double h = test::uniform(rng, 2.0, 20.0) * band;
+    const double lift = test::uniform_int(rng, 0, 8) * kUnitRoundoff * size;
+    const Mat3 rot = test::random_rotation(rng);
+    const test::Points base = {rot * Vec3(size, size, h), rot * Vec3(-size, size, h),
+                               rot * Vec3(-size, -size, h), rot * Vec3(size, -size, h + lift)};
+    test::Points a = base;
+    a.push_back(Vec3::Zero());
+    const ConvexPolytope pa(a);
+    const ConvexPolytope pb(test::Points{Vec3::Zero()});
+    DistanceCache cache;
+    for (std::size_t k = 0; k < 4; ++k) {
+      for (int v = 0; v < pa.vertex_count(); ++v) {
+        if (pa.vertex(v) == base[k]) cache.vertices_a[k] = v;
+      }
+      cache.vertices_b[k] = 0;
+    }
+    if (std::find(cache.vertices_a.begin(), cache.vertices_a.end(), -1) != cache.vertices_a.end())
+      continue;
+    DistanceOptions options;
+    options.algorithm = Algorithm::enhanced_gjk;
+    const DistanceResult r = distance(pa, Pose{}, pb, Pose{}, options, &cache);
+    ++queries;
+    EXPECT_EQ(r.status, Status::touching) << "trial " << trial;
+    EXPECT_LE(r.distance, band) << "trial " << trial << ": " << r.distance / band << " bands";
+  }
+  EXPECT_GT(queries, 100);
+}
+
 TEST(Gjk, IterationCapIsReportedWithValidBounds) {
   Rng rng(8);
   const ConvexPolytope a(sphere_points(rng, 500, 1.0));
@@ -1333,6 +1378,55 @@ TEST(GjkTouching, NeedlesSideBySideTouch) {
                         Vec3(3.4982695674100519, -2.614128529220503, 2.8188579502450088),
                         Vec3(3.0268385150591319, -2.9226703833767185, 1.9323402709478863),
                         Vec3(3.0222748708772791, -2.9256571928742439, 1.9237584160379899)});
+}
+
+// Regression (issue 25): the needles above, d* = 6e-5 bands. GJK's
+// stalled simplex was polished to the pair of edges {1, 6} of A and {0, 4}
+// of B, 6,840 bands apart, and the support along their closest points'
+// difference came back from those edges with the gap open: that
+// difference, of points each rounded by u R, was 3e-10 long and tilted by
+// 2e-6, which along needles 0.6 long moved the support value 30 times the
+// distance. The polish stopped with a lower bound of 0, and distance()
+// answered `touching` at 11,850 bands with a certificate [0, 11850] bands
+// (the status right by luck, the distance 10^4 times outside the
+// standard). The polish now searches along the features' own normal
+// (certifying_direction in gjk.cpp) and reaches the distance.
+TEST(GjkRegression, StalledNeedlesReachTheDistance) {
+  const test::Points a = {Vec3(3.2373982772939152, -2.7835848549293236, 2.3290728952413882),
+                          Vec3(3.2399032411110107, -2.7845024680382378, 2.3322259280010171),
+                          Vec3(3.239593947308288, -2.7843891681654576, 2.3318366155855381),
+                          Vec3(3.2391957277667367, -2.7842432932035019, 2.3313353711315332),
+                          Vec3(3.2389604055651491, -2.7841570904746518, 2.3310391678323041),
+                          Vec3(3.2388533589588375, -2.7841178774010062, 2.3309044267423693),
+                          Vec3(3.2374844630430593, -2.7836164263495884, 2.3291813784599089),
+                          Vec3(3.2387330561807706, -2.7840738083568808, 2.3307529999883325)};
+  const test::Points b = {Vec3(2.9540599052029797, -2.9703024772589894, 1.7954813894160513),
+                          Vec3(3.5232416109977769, -2.5977848466145512, 2.8658174353138595),
+                          Vec3(3.0852813111793065, -2.8844207893768075, 2.0422409004258082),
+                          Vec3(3.2285982623984584, -2.7906228112394884, 2.3117458748038637),
+                          Vec3(3.2890742545942211, -2.7510425251745012, 2.4254699045178034),
+                          Vec3(3.4982695674100519, -2.614128529220503, 2.8188579502450088),
+                          Vec3(3.0268385150591319, -2.9226703833767185, 1.9323402709478863),
+                          Vec3(3.0222748708772791, -2.9256571928742439, 1.9237584160379899)};
+  const std::optional<test::ExactDistance> exact = exact_distance(a, b);
+  ASSERT_TRUE(exact);
+  const double band =
+      64 * kUnitRoundoff * std::max(test::max_abs_coordinate(a), test::max_abs_coordinate(b));
+  const ConvexPolytope pa(a);
+  const ConvexPolytope pb(b);
+  for (const Algorithm alg : {Algorithm::gjk, Algorithm::enhanced_gjk}) {
+    DistanceOptions options;
+    options.algorithm = alg;
+    for (const bool swapped : {false, true}) {
+      SCOPED_TRACE(std::string(to_string(alg)) + (swapped ? ", swapped" : ""));
+      const DistanceResult r = swapped ? distance(pb, Pose::identity(), pa, Pose::identity(), options)
+                                       : distance(pa, Pose::identity(), pb, Pose::identity(), options);
+      EXPECT_EQ(r.status, Status::touching);
+      EXPECT_LE(std::abs(r.distance - exact->distance()), band);
+      EXPECT_LE(r.lower_bound, exact->distance() + band);
+      EXPECT_LE((r.point_a - r.point_b).norm(), 2 * band);
+    }
+  }
 }
 
 // Story (issue 9, "found at 21.5 x 64 u R where the exact distance is below
