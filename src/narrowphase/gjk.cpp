@@ -342,6 +342,30 @@ Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, d
   }
 }
 
+// The status of an answer that did not reach the contact band, from what
+// it certifies (docs/accuracy.md): separated when its lower bound or its
+// closed gap certifies the distance and that is above the band; touching
+// when the distance is within the band. An answer left uncertified (a
+// stall that neither the polish nor the stall plane's normal could close)
+// within kExtendedBands bands is touching too: distance() recomputes its
+// witness pair in double-double there and decides the status from it
+// (query/extended_distance.h). Farther out nothing decides it, and its
+// bounds [lower_bound, distance] are all it knows: iteration_cap, the
+// status of an undecided answer whose bounds hold, never a touching
+// answer thousands of bands from contact
+// (GjkStatus.FollowsTheCertifiedBoundsOnEveryExit). The band there is at
+// least that of GJK's own frame, so that an answer re-solved with the
+// exact R's smaller band (distance.cpp, finish_query) keeps the
+// refinement's range.
+Status bounded_status(double distance, double contact_tolerance, const GjkFrame& frame,
+                      bool separation_certified) {
+  if (distance > contact_tolerance && separation_certified) return Status::separated;
+  if (distance <= contact_tolerance) return Status::touching;
+  const double refined = detail::kExtendedBands *
+                         std::max(contact_tolerance, contact_band(frame.magnitude));
+  return distance <= refined ? Status::touching : Status::iteration_cap;
+}
+
 // ---------------------------------------------------------------------------
 // The loop shared by both variants.
 // ---------------------------------------------------------------------------
@@ -395,8 +419,13 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
       certified = true;
       break;
     }
-    if (simplex.contains(w.ia, w.ib)) {  // nothing new: v is exact for this simplex
-      certified = true;
+    if (simplex.contains(w.ia, w.ib)) {
+      // Nothing new, with the gap open: v is the simplex's closest point,
+      // but its direction, a difference of rounded points, failed the
+      // support test, which certifies nothing. Polished like a stall
+      // (certifying_direction), it is certified or left undecided there.
+      stall_point = w;
+      rounding_stall = true;
       break;
     }
     Simplex next = simplex;
@@ -519,10 +548,7 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     result.point_b = point_b;
     result.distance = ((point_b - point_a) * frame.inv_unit).norm() * frame.unit;
     result.lower_bound = std::clamp(lower * frame.unit, 0.0, result.distance);
-    if (!contact) {
-      status = result.distance > contact_tolerance && separation_certified ? Status::separated
-                                                                           : Status::touching;
-    }
+    if (!contact) status = bounded_status(result.distance, contact_tolerance, frame, separation_certified);
     if (capped) status = Status::iteration_cap;
     // Within the band the points' difference is rounding noise: keep the
     // last search direction there.
