@@ -1,7 +1,8 @@
 # proxima: the two commands of the README.
 #   make run   builds in release and runs the main job, the paper's experiments
 #              (bench/paper_experiments; PAPER_ARGS=--quick for the reduced run)
-#   make test  installs what is missing, builds, runs every test (release + sanitizers)
+#   make test  installs what is missing, builds, runs every test (unit tests under the
+#              sanitizers; long sweeps, peers, Python and packaging in release)
 JOBS ?= $(shell nproc)
 
 .PHONY: all run test test-release setup release asan dev bench fuzz clean results results-quick compare
@@ -15,13 +16,13 @@ release: setup
 	cmake --preset release >/dev/null
 	cmake --build --preset release -j $(JOBS)
 
-# The sanitizer build checks proxima's own code: the tests that link the peers
-# (FCL, Bullet: PROXIMA_PEER_TESTS) and the three longest random sweeps (the
-# asan test preset's exclude filter; 50 s each under ASan) run in the release
-# build only, which keeps `make test` inside its 20 minutes on 2 cores.
-# The sanitizer build compiles at -O1 with line tables only (-g1): enough for
-# ASan's stack traces, and 40% less compile time than -O2 -g (measured on
-# tests/narrowphase/gjk_test.cpp), which keeps `make test` inside its budget on 2 cores.
+# The sanitizer build (ASan + UBSan, every check) compiles with clang at -O1
+# with line tables only: enough for the sanitizers' stack traces, and gcc's
+# UBSan instrumentation (its alignment and null checks) made each test file
+# 2 to 3 times slower to compile. It builds and runs every unit test; the
+# tests that link the peers (FCL, Bullet: PROXIMA_PEER_TESTS) and the three
+# longest random sweeps (the asan test preset's exclude filter; 50 s each
+# under ASan) run in the release build only.
 asan: setup
 	cmake --preset asan >/dev/null
 	cmake --build --preset asan -j $(JOBS)
@@ -34,17 +35,19 @@ PAPER_ARGS ?=
 run: release
 	./build/release/bench/paper_experiments $(PAPER_ARGS)
 
-# The tests need no micro-benchmark (bench/*_bench): make test builds the
-# release tree without them (a command-line -D overrides the preset's ON;
-# `make release` and every `cmake --preset release` turn them on again).
+# The tests need no micro-benchmark (bench/*_bench), and the unit tests run
+# in the sanitizer build: make test builds the release tree without either
+# (PROXIMA_UNIT_TESTS=OFF keeps the peers' tests and the long sweeps' files;
+# a command-line -D overrides the preset's ON; `make release` and every
+# `cmake --preset release` turn them on again).
 test-release: setup
-	cmake --preset release -DPROXIMA_BUILD_BENCH=OFF >/dev/null
+	cmake --preset release -DPROXIMA_BUILD_BENCH=OFF -DPROXIMA_UNIT_TESTS=OFF >/dev/null
 	cmake --build --preset release -j $(JOBS)
 
 test: test-release asan
-	@echo "== unit tests, release build =="
+	@echo "== release build: long sweeps, peer tests, examples, Python, packaging, docs =="
 	ctest --preset release -j $(JOBS)
-	@echo "== unit tests, ASan + UBSan build =="
+	@echo "== unit tests, ASan + UBSan build (clang) =="
 	ctest --preset asan -j $(JOBS)
 	@echo "== fuzz smoke run of the mesh readers (20 s) =="
 	bash scripts/fuzz 20
@@ -85,5 +88,5 @@ clean:
 	rm -rf build out
 
 # Fuzzes the mesh readers for 30 s (clang, libFuzzer + ASan + UBSan).
-fuzz:
+fuzz: setup
 	bash scripts/fuzz 30

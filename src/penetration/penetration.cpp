@@ -275,6 +275,63 @@ constexpr double kRoughCosine = 1e-6;
 constexpr double kAcceptRelative = 5e-13;
 constexpr double kAcceptUlps = 0.5 * kContactBandUlps;
 
+// The candidate of the facet of A - B with id `last` (the previous answer's)
+// as solve_expanding's ring enumeration would build and evaluate it at the
+// supports sa of A and sb of B along the expansion's normal n: a face of A
+// holding sa (with sb), a face of B holding sb (with sa), or an edge of A
+// out of sa with an edge of B out of sb, its normal kept only when within
+// kFacetCosine of n. Nothing when the facet is not among the ring's (the
+// supports moved to other vertices) or not near n. While B turns slowly
+// the depth's facet rarely changes: this one evaluation then replaces the
+// ring's (tens of cross products and a climb per candidate); any facet's
+// value is an upper bound, so accepting it against the certified lower
+// bound is as sound as accepting the ring's least.
+std::optional<Candidate> cached_facet(const Query& q, const MinkowskiFaceId& last, const Vec3& n,
+                                      int sa, int sb) {
+  const auto holds = [](const ConvexPolytope& p, int f, int v) {
+    if (f < 0 || f >= p.face_count()) return false;
+    for (const std::int32_t u : p.face(f)) {
+      if (u == v) return true;
+    }
+    return false;
+  };
+  const auto near = [&](const Vec3& normal) { return normal.dot(n) >= 1.0 - kFacetCosine; };
+  switch (last.kind) {
+    case MinkowskiFace::face_vertex: {
+      if (!holds(q.a, last.a0, sa)) return std::nullopt;
+      const Vec3 normal = q.a.face_plane(last.a0).normal;
+      if (!near(normal)) return std::nullopt;
+      return evaluate(q, {MinkowskiFace::face_vertex, last.a0, -1, sb, -1}, normal, sa, sb);
+    }
+    case MinkowskiFace::vertex_face: {
+      if (!holds(q.b, last.b0, sb)) return std::nullopt;
+      const Vec3 normal = -(q.rotation * q.b.face_plane(last.b0).normal);
+      if (!near(normal)) return std::nullopt;
+      return evaluate(q, {MinkowskiFace::vertex_face, sa, -1, last.b0, -1}, normal, sa, sb);
+    }
+    case MinkowskiFace::edge_edge: {
+      // The ring's edges run out of sa and sb: the other ends w and x.
+      const int w = last.a0 == sa ? last.a1 : last.a1 == sa ? last.a0 : -1;
+      const int x = last.b0 == sb ? last.b1 : last.b1 == sb ? last.b0 : -1;
+      if (w < 0 || x < 0 || w >= q.a.vertex_count() || x >= q.b.vertex_count())
+        return std::nullopt;
+      // As the ring computes it (the same bits: only the edges' order in
+      // the ids differs, an exact negation undone by the orientation).
+      Vec3 normal = (q.point_a(w) - q.point_a(sa)).cross(q.point_b(x) - q.point_b(sb));
+      const double length = normal.norm();
+      if (!(length > 0.0)) return std::nullopt;
+      normal /= length;
+      if (normal.dot(n) < 0.0) normal = -normal;
+      if (!near(normal)) return std::nullopt;
+      return evaluate(q,
+                      {MinkowskiFace::edge_edge, std::min(sa, w), std::max(sa, w), std::min(sb, x),
+                       std::max(sb, x)},
+                      normal, sa, sb);
+    }
+  }
+  return std::nullopt;
+}
+
 // `keep`: the expansion starts from the cache's kept surface and keeps its
 // own there (a B that turned: tracked_expansion.h).
 std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cache,
@@ -293,6 +350,35 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
            : detail::expand_polytope(m, cap, small ? seed : DepthSeed{});
   if (!e.certified || !e.converged || near_band(q, e.lower)) return std::nullopt;
   const Vec3& n = e.normal;
+  const int sa = e.support_a, sb = e.support_b;
+  // The answer from candidates[best]: accepted when its value (an upper
+  // bound: h_A + h_B along any unit normal is at least the depth) is
+  // within half the standard of the certified lower bound.
+  const double slack = kAcceptUlps * kUnitRoundoff * q.magnitude * q.inverse;
+  const auto accepted = [&](const Candidate& best) {
+    return best.value - e.lower <= kAcceptRelative * best.value + slack;
+  };
+  const auto answer = [&](std::span<const Candidate> candidates,
+                          std::size_t best) -> std::optional<PenetrationResult> {
+    PenetrationResult r =
+        finish(q, candidates[best], e.lower, static_cast<int>(candidates.size()), false);
+    if (!witnesses_meet(q, r) || needs_refinement(q, r)) return std::nullopt;
+    // Every face of A - B has a value of at least the certified bound.
+    remember_faces(q, cache, b_in_a, candidates, best, e.lower, false);
+    r.tracked = warm;
+    return r;
+  };
+  // A turned B: the last answer's facet of A - B first, alone (cached_facet),
+  // then the rings of the supports when it is not accepted.
+  if (keep) {
+    if (const std::optional<Candidate> c = cached_facet(q, cache.last.id, n, sa, sb);
+        c && accepted(*c)) {
+      if (std::optional<PenetrationResult> r = answer(std::span(&*c, 1), 0)) {
+        ++cache.cached_facets;
+        return r;
+      }
+    }
+  }
   std::array<Candidate, 48> kept;
   std::size_t count = 0;
   const auto consider = [&](const MinkowskiFaceId& id, const Vec3& normal, int hint_a, int hint_b) {
@@ -304,7 +390,6 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
     return std::pair<std::int32_t, std::int32_t>{offsets[static_cast<std::size_t>(v)],
                                                  offsets[static_cast<std::size_t>(v) + 1]};
   };
-  const int sa = e.support_a, sb = e.support_b;
   const auto [a_begin, a_end] = ring(q.a, sa);
   const auto [b_begin, b_end] = ring(q.b, sb);
   // A face's rough normal (its first three vertices) first: face_plane's
@@ -349,15 +434,8 @@ std::optional<PenetrationResult> solve_expanding(Query& q, PenetrationCache& cac
   const auto best =
       std::min_element(candidates.begin(), candidates.end(),
                        [](const Candidate& x, const Candidate& y) { return x.value < y.value; });
-  const double slack = kAcceptUlps * kUnitRoundoff * q.magnitude * q.inverse;
-  if (!(best->value - e.lower <= kAcceptRelative * best->value + slack)) return std::nullopt;
-  PenetrationResult r = finish(q, *best, e.lower, static_cast<int>(count), false);
-  if (!witnesses_meet(q, r) || needs_refinement(q, r)) return std::nullopt;
-  // Every face of A - B has a value of at least the certified bound.
-  remember_faces(q, cache, b_in_a, candidates, static_cast<std::size_t>(best - candidates.begin()),
-                 e.lower, false);
-  r.tracked = warm;
-  return r;
+  if (!accepted(*best)) return std::nullopt;
+  return answer(candidates, static_cast<std::size_t>(best - candidates.begin()));
 }
 
 bool same_pair(const PenetrationCache& cache, const ConvexPolytope& a, const ConvexPolytope& b) {

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <string>
+#include <type_traits>
 
 #include "core/accuracy.h"
 #include "proxima/query/body_distance.h"
@@ -39,20 +40,29 @@ void check_size(const char* who, std::size_t size, std::size_t expected, const c
 
 // Every pose under the contract, before any query runs: both poses of pair
 // k in one paired test (detail::are_rigid, as distance() itself does), the
-// full check, which names the pose, only for a pair that fails it.
-void check_poses(const char* who, std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
+// full check, which names the pose, only for a pair that fails it. True
+// when every pose passed the paired test: the queries may then take them
+// as they are, without checking them again (a pose accepted but within
+// kRotationTolerance only is re-orthonormalized by the query that checks
+// it, so a batch holding one asks the checking queries).
+bool check_poses(const char* who, std::span<const Pose> poses_a, std::span<const Pose> poses_b) {
+  bool rigid = true;
   for (std::size_t k = 0; k < poses_a.size(); ++k) {
     if (detail::are_rigid(poses_a[k], poses_b[k])) [[likely]]
       continue;
     check_pose(poses_a[k], [&] { return std::string(who) + ": poses_a[" + at(k) + "]"; });
     check_pose(poses_b[k], [&] { return std::string(who) + ": poses_b[" + at(k) + "]"; });
+    rigid = false;
   }
+  return rigid;
 }
 
 // The shared part of every overload. `pair(k)` returns the pair of index k
 // (a span lookup or the one fixed pair): a BatchPair or a BodyPair;
-// `query(pair, pose_a, pose_b, cache)` answers it into Result with a Cache
-// (null: cold). `who` names the batch in every message.
+// `query(pair, pose_a, pose_b, cache, rigid)` answers it into Result with a
+// Cache (null: cold); `rigid`: the poses passed check_poses' paired test, so
+// the query need not check them again. `who` names the batch in every
+// message.
 template <class PairOf, class Query, class Result, class Cache>
 void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
                std::span<const Pose> poses_a, std::span<const Pose> poses_b,
@@ -72,7 +82,7 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
                          (p.a == nullptr ? "a" : "b") + " is null");
     }
   }
-  check_poses(who, poses_a, poses_b);
+  const bool rigid = check_poses(who, poses_a, poses_b);
 
   // Runs the queries of [begin, end). An InvalidInput from a query (the
   // options are checked by distance() itself) is re-thrown with its index;
@@ -82,7 +92,8 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
     for (std::size_t k = begin; k < end; ++k) {
       const auto p = pair(k);
       try {
-        results[k] = query(p, poses_a[k], poses_b[k], caches.empty() ? nullptr : &caches[k]);
+        results[k] =
+            query(p, poses_a[k], poses_b[k], caches.empty() ? nullptr : &caches[k], rigid);
       } catch (const InvalidInput& e) {
         throw InvalidInput(std::string(who) + ": pair " + at(k) + ": " + e.what());
       }
@@ -96,9 +107,14 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
   detail::parallel_ranges(n, kGrainSize, threads, run_range);
 }
 
-// The distance query of one pair, for run_batch.
+// The distance query of one pair, for run_batch: poses that passed
+// check_poses' test go to the query that does not check them again (the
+// same answer, bit for bit).
 auto distance_with(const DistanceOptions& options) {
-  return [&options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache) {
+  return [&options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache,
+                    bool rigid) {
+    if (rigid) [[likely]]
+      return detail::distance_of_rigid_poses(*p.a, pose_a, *p.b, pose_b, options, cache);
     return distance(*p.a, pose_a, *p.b, pose_b, options, cache);
   };
 }
@@ -108,7 +124,15 @@ auto distance_with(const DistanceOptions& options) {
 auto within_margin_with(double margin, const DistanceOptions& options, const char* who) {
   detail::check_margin(margin, who);
   detail::check_distance_options(options, (std::string(who) + ": options").c_str());
-  return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache) {
+  return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache,
+                            bool rigid) {
+    // A convex pair with a cache: the query that does not check the poses
+    // (nor the margin and options, checked above) again.
+    if constexpr (std::is_same_v<std::remove_pointer_t<decltype(cache)>, DistanceCache>) {
+      if (rigid && cache != nullptr) [[likely]]
+        return detail::within_margin_of_rigid_poses(*p.a, pose_a, *p.b, pose_b, margin, options,
+                                                    *cache);
+    }
     return within_margin(*p.a, pose_a, *p.b, pose_b, margin, options, cache);
   };
 }

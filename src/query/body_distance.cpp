@@ -448,10 +448,28 @@ BodyResult mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pos
 
 BodyResult distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options, BodyCache* cache) {
+  // One paired test in the common case; the named refusal (or the
+  // re-orthonormalized poses) only for a pose that fails it.
+  if (!detail::are_rigid(pose_a, pose_b)) [[unlikely]] {
+    return detail::distance_of_rigid_poses(a, checked_pose(pose_a, "distance: pose_a"), b,
+                                           checked_pose(pose_b, "distance: pose_b"), options,
+                                           cache);
+  }
+  return detail::distance_of_rigid_poses(a, pose_a, b, pose_b, options, cache);
+}
+
+BodyResult distance(const Body& a, const RigidPose& pose_a, const Body& b, const RigidPose& pose_b,
+                    const DistanceOptions& options, BodyCache* cache) {
+  // Under the contract by construction (RigidPose).
+  return detail::distance_of_rigid_poses(a, pose_a.pose(), b, pose_b.pose(), options, cache);
+}
+
+namespace detail {
+
+BodyResult distance_of_rigid_poses(const Body& a, const Pose& pa, const Body& b, const Pose& pb,
+                                   const DistanceOptions& options, BodyCache* cache) {
   BodyCache cold;
   BodyCache& c = cache != nullptr ? *cache : cold;
-  const Pose pa = checked_pose(pose_a, "distance: pose_a");
-  const Pose pb = checked_pose(pose_b, "distance: pose_b");
   // The cores' query refuses coordinates beyond kMaxMagnitude; radii that
   // take the rounded bodies there are refused too (their sum, the signed
   // distance or the offset points could overflow to infinity).
@@ -477,4 +495,5 @@ BodyResult distance(const Body& a, const Pose& pose_a, const Body& b, const Pose
   return compound_pair(a, pa, b, pb, cores, options.penetration, c);
 }
 
+}  // namespace detail
 }  // namespace proxima

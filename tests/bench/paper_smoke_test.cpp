@@ -19,6 +19,7 @@
 // prints a WARNING; Bullet's default 0.04 margin was caught that way).
 // Timing figures are not asserted: they are benchmarks, not tests.
 #include <gtest/gtest.h>
+#include "support/sanitizers.h"
 #include <unistd.h>
 
 #include <filesystem>
@@ -73,11 +74,7 @@ TEST(PaperSmoke, QuickRunWritesItsFilesAndProximaMeetsTheStandard) {
   fs::remove_all(dir);
   proxima::bench::PaperOptions options;
   options.quick = true;
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  options.full_robustness = false;
-#else
-  options.full_robustness = true;
-#endif
+  options.full_robustness = !proxima::test::kUnderSanitizers;
   options.out_dir = dir.string();
   std::ostringstream log;
   const int rc = proxima::bench::run_paper(options, log);

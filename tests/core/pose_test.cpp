@@ -16,6 +16,8 @@
 #include <vector>
 
 #include "proxima/query/batch.h"
+#include "proxima/query/body_distance.h"
+#include "proxima/shape/primitives.h"
 #include "proxima/query/compound_distance.h"
 #include "proxima/query/distance.h"
 #include "proxima/scene/scene.h"
@@ -220,6 +222,67 @@ TEST(Pose, RigidPosesAreCheckedOnceAndAnswerAsPlainPoses) {
     }
     ASSERT_EQ(plain_cache.vertices_a, rigid_cache.vertices_a) << "step " << i;
     ASSERT_EQ(plain_cache.vertices_b, rigid_cache.vertices_b) << "step " << i;
+  }
+}
+
+
+// Bodies take RigidPoses too (issue 28: a robot's placed geometries are
+// checked once per configuration, not once per pair): the overload answers
+// as the Pose overload, bit for bit, along a tracked walk with float32
+// rotations (re-orthonormalized by both) on rounded, compound and convex
+// bodies; the Pose overload still refuses a bad pose with its words, after
+// its paired fast test.
+TEST(Pose, RigidPosesOfBodiesAnswerAsPlainPoses) {
+  const Pose skewed(Mat3(Mat3::Identity() * 1.001), Vec3(3, 0, 0));
+  const Body sphere = make_sphere(0.5);
+  EXPECT_NE(message_of([&] { (void)distance(sphere, skewed, sphere, Pose{}); })
+                .find("distance: pose_a: rotation is not orthonormal"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] { (void)distance(sphere, Pose{}, sphere, skewed); })
+                .find("distance: pose_b: rotation is not orthonormal"),
+            std::string::npos);
+
+  std::mt19937 rng(2828);
+  std::normal_distribution<double> g;
+  std::vector<Vec3> points;
+  for (int i = 0; i < 30; ++i) points.emplace_back(g(rng), g(rng), g(rng));
+  std::vector<CompoundPiece> pieces;
+  pieces.push_back({std::make_shared<const ConvexPolytope>(cube_points()), Pose{}});
+  pieces.push_back({std::make_shared<const ConvexPolytope>(points),
+                    Pose::from_translation(Vec3(2.5, 0, 0))});
+  const std::vector<Body> bodies = {Body(ConvexPolytope(points), 0.1), make_box(Vec3(1, 0.5, 0.3)),
+                                    Body(CompoundBody(std::move(pieces)))};
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    for (std::size_t j = 0; j < bodies.size(); ++j) {
+      BodyCache plain_cache;
+      BodyCache rigid_cache;
+      const RigidPose rigid_a(Pose::from_translation(Vec3(0.1, -0.2, 0.3)));
+      for (int k = 0; k < 120; ++k) {
+        const double t = 0.05 * k;
+        const Mat3 turn =
+            Eigen::AngleAxisd(0.07 * k, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+        const Mat3 r = k % 3 == 0 ? Mat3(turn.cast<float>().cast<double>()) : turn;
+        // From apart (radius 5) to overlapping (radius 1).
+        const double radius = 5.0 - 4.0 * k / 120.0;
+        const Pose pose_b(r, Vec3(radius * std::cos(t), radius * std::sin(t), std::sin(3 * t)));
+        const BodyResult p = distance(bodies[i], rigid_a.pose(), bodies[j], pose_b, {},
+                                      &plain_cache);
+        const BodyResult q =
+            distance(bodies[i], rigid_a, bodies[j], RigidPose(pose_b), {}, &rigid_cache);
+        const std::string where = "bodies " + std::to_string(i) + ", " + std::to_string(j) +
+                                  ", step " + std::to_string(k);
+        ASSERT_EQ(p.status, q.status) << where;
+        ASSERT_EQ(p.distance, q.distance) << where;
+        ASSERT_EQ(p.depth, q.depth) << where;
+        ASSERT_EQ(p.lower_bound, q.lower_bound) << where;
+        ASSERT_EQ(p.point_a, q.point_a) << where;
+        ASSERT_EQ(p.point_b, q.point_b) << where;
+        ASSERT_EQ(p.normal, q.normal) << where;
+        ASSERT_EQ(p.piece_a, q.piece_a) << where;
+        ASSERT_EQ(p.piece_b, q.piece_b) << where;
+        ASSERT_EQ(p.iterations, q.iterations) << where;
+      }
+    }
   }
 }
 

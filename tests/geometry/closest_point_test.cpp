@@ -19,6 +19,7 @@
 #include "proxima/geometry/closest_point.h"
 
 #include <gtest/gtest.h>
+#include "support/sanitizers.h"
 
 #include <algorithm>
 #include <array>
@@ -736,17 +737,7 @@ void check_query(const Query& q, const KernelTolerance<double>& tol, Tally& tall
 // find memory errors and undefined behaviour, which do not need the
 // statistics, and the exact rationals' allocations make them about 25 times
 // slower than a release build.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kQueryDivisor = 4;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr int kQueryDivisor = 4;
-#else
-constexpr int kQueryDivisor = 1;
-#endif
-#else
-constexpr int kQueryDivisor = 1;
-#endif
+constexpr int kQueryDivisor = test::kUnderSanitizers ? 4 : 1;
 constexpr int queries(int n) { return n / kQueryDivisor; }
 
 // ---------------------------------------------------------------------------

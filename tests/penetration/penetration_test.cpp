@@ -1143,10 +1143,12 @@ TEST(PenetrationTracking, RotationAndForeignCachesAreNeverWrong) {
 // translation per step, each from tiny to large (log-uniform), so that the
 // walk crosses many changes of the answer's facet and re-anchors; pulled
 // back towards A when it wanders off. `warm`: the steps answered from the
-// kept surface (PenetrationResult::tracked for a turned B).
+// kept surface (PenetrationResult::tracked for a turned B); `cached`: the
+// steps answered by the last answer's facet alone (cached_facet), without
+// the supports' rings, checked against the twin as every other step.
 void turning_walk(const Points& a, const Points& b_local, std::uint64_t seed, int steps,
                   double max_angle, double max_step, double reach, int exact_every,
-                  int& warm) {
+                  int& warm, std::int64_t* cached = nullptr) {
   Rng rng(seed);
   const ConvexPolytope pa(a), pb(b_local);
   const double scale = std::max(max_abs_coordinate(a), max_abs_coordinate(b_local));
@@ -1174,6 +1176,7 @@ void turning_walk(const Points& a, const Points& b_local, std::uint64_t seed, in
     }
     warm += r.tracked;
   }
+  if (cached != nullptr) *cached = cache.cached_facets;
 }
 
 TEST(PenetrationTurning, WalksOfRoundHullsStayCertified) {
@@ -1185,8 +1188,12 @@ TEST(PenetrationTurning, WalksOfRoundHullsStayCertified) {
   // Most steps answer from the kept surface (the path this test is for).
   EXPECT_GE(warm, 150);
   // Small turns and steps, as a robot's trajectory or a resting contact.
-  EXPECT_NO_FATAL_FAILURE(turning_walk(a, b, 2, 300, 2e-3, 2e-3, 0.5, 100, warm));
+  std::int64_t cached = 0;
+  EXPECT_NO_FATAL_FAILURE(turning_walk(a, b, 2, 300, 2e-3, 2e-3, 0.5, 100, warm, &cached));
   EXPECT_GE(warm, 250);
+  // Small turns keep the depth's facet: most of those steps are answered by
+  // it alone (issue 28), each against the enumeration twin above.
+  EXPECT_GE(cached, 150);
 }
 
 TEST(PenetrationTurning, WalksOfBoxesCubesAndThinBodiesStayCertified) {

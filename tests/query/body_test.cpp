@@ -24,6 +24,7 @@
 #include "support/exact_oracle.h"
 #include "support/generators.h"
 #include "support/penetration_oracle.h"
+#include "support/sanitizers.h"
 
 namespace proxima {
 namespace {
@@ -31,12 +32,7 @@ namespace {
 using test::Points;
 using test::Rng;
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kCountDivisor = 4;  // ASan+UBSan: same kinds of cases, fewer of each
-#else
-constexpr int kCountDivisor = 1;
-#endif
-constexpr int count(int n) { return std::max(1, n / kCountDivisor); }
+constexpr int count(int n) { return test::sanitized_count(n, 4); }
 
 constexpr double kBand = 64.0 * kUnitRoundoff;
 

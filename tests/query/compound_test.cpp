@@ -21,6 +21,7 @@
 
 #include "proxima/query/distance.h"
 #include "support/generators.h"
+#include "support/sanitizers.h"
 
 namespace proxima {
 namespace {
@@ -28,12 +29,7 @@ namespace {
 using test::Points;
 using test::Rng;
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kCountDivisor = 6;  // ASan+UBSan: same kinds of cases, fewer of each
-#else
-constexpr int kCountDivisor = 1;
-#endif
-constexpr int count(int n) { return std::max(1, n / kCountDivisor); }
+constexpr int count(int n) { return test::sanitized_count(n, 6); }
 
 constexpr double kBandUlps = 64.0;
 constexpr double kRelativeTolerance = 1e-12;

@@ -39,16 +39,12 @@
 #include "support/exact_oracle.h"
 #include "support/generators.h"
 #include "support/regression_clouds.h"
+#include "support/sanitizers.h"
 
 namespace proxima::test {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kCountDivisor = 4;  // ASan+UBSan: same kinds of cases, fewer of each
-#else
-constexpr int kCountDivisor = 1;
-#endif
-constexpr int count(int n) { return std::max(1, n / kCountDivisor); }
+constexpr int count(int n) { return sanitized_count(n, 4); }
 
 constexpr std::array<Algorithm, 3> kAlgorithms = {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk};
 
@@ -1134,7 +1130,7 @@ TEST(DistanceRegression, ScalesFrom1eMinus300To1e300) {
   int cases = 0;
   int near_cases = 0;
   // Every 25 decades; every 75 under ASan, where the oracle is slow.
-  constexpr int kDecades = kCountDivisor == 1 ? 25 : 75;
+  constexpr int kDecades = kUnderSanitizers ? 75 : 25;
   for (int e = -300; e <= 300; e += kDecades) {
     const double s = std::pow(10.0, e);
     const Points a = scaled(a0, s);

@@ -5,6 +5,7 @@
 // random inputs, and the paper's extreme scales.
 #include "support/exact_oracle.h"
 #include "support/generators.h"
+#include "support/sanitizers.h"
 
 #include <gtest/gtest.h>
 
@@ -15,13 +16,9 @@
 namespace proxima::test {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr int kRandomPairs = 40;  // ASan and UBSan make exact arithmetic ~5x slower
-constexpr int kPaperRepeats = 3;
-#else
-constexpr int kRandomPairs = 300;
-constexpr int kPaperRepeats = 10;
-#endif
+// Exact arithmetic runs about 5x slower under ASan and UBSan.
+constexpr int kRandomPairs = kUnderSanitizers ? 40 : 300;
+constexpr int kPaperRepeats = kUnderSanitizers ? 3 : 10;
 
 // Runs one candidate source directly (not through the fallback chain).
 std::optional<ExactDistance> via_cgal(const Points& a, const Points& b, std::string* why = nullptr) {

@@ -11,7 +11,9 @@
 // read) and not ours to fix.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)  // a GCC-only warning; clang would warn about the pragma
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include <CGAL/Gmpzf.h>
 #include <CGAL/Polytope_distance_d.h>
 #include <CGAL/Polytope_distance_d_traits_3.h>
@@ -168,7 +170,9 @@ inline mpq_class to_rational(const CGAL::Gmpzf& z) {
 // the solver is instantiated, here.)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
+#if !defined(__clang__)  // a GCC-only warning; clang would warn about the pragma
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 std::optional<ExactDistance> cgal_distance(const Points& a, const Points& b, const std::vector<QPoint>& qa,
                                                   const std::vector<QPoint>& qb, std::string* why) {
   using Kernel = CGAL::Simple_cartesian<double>;

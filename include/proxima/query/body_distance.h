@@ -109,4 +109,20 @@ struct BodyResult : DistanceResult {
 BodyResult distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options = {}, BodyCache* cache = nullptr);
 
+// The same for poses checked once (RigidPose, proxima/core/pose.h: a robot's
+// link poses against every pair they take part in): the rigid-pose check
+// of the overload above is not paid again; the answer is the one that
+// overload gives for the RigidPoses' poses, bit for bit.
+BodyResult distance(const Body& a, const RigidPose& pose_a, const Body& b, const RigidPose& pose_b,
+                    const DistanceOptions& options = {}, BodyCache* cache = nullptr);
+
+namespace detail {
+// distance() on Bodies for poses already under the contract of
+// proxima/core/pose.h (a batch's poses checked before its queries, a
+// robot's placed geometries), so that the check is not paid again.
+BodyResult distance_of_rigid_poses(const Body& a, const Pose& pose_a, const Body& b,
+                                   const Pose& pose_b, const DistanceOptions& options,
+                                   BodyCache* cache);
+}  // namespace detail
+
 }  // namespace proxima

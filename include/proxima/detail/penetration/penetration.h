@@ -263,6 +263,9 @@ struct PenetrationCache {
   // expansions of pruned groups (a translation towards them).
   std::int64_t enumerations = 0;
   std::int64_t expansions = 0;
+  // Turned-B answers whose facet was the last answer's, evaluated alone
+  // without the supports' rings (solve_expanding's cached_facet).
+  std::int64_t cached_facets = 0;
   // What the query needs of each hull whatever the pose, in its own frame:
   // face normals and the radius of a ball about the centroid inside it.
   // A normal is first a fast one (a triangle's rounded cross product,
