@@ -49,6 +49,17 @@ double placed_magnitude(std::span<const Vec3> vertices, const Pose& pose);
 // scale of Gjk.ScaleInvariance and DistanceAccuracy.ScalesAndFarFromOrigin.
 inline constexpr double kTerminationGapUlps = 16.0;
 
+// Answers of distance() whose distance is within this many contact bands
+// of zero have their witness pair's distance recomputed in double-double
+// and their status decided from it (query/extended_distance.h): there a
+// double's error of a few u R is a sizeable share of the band, while well
+// above it the status cannot change and the standard's absolute term
+// already bounds the error. The tracked fast path (d far above the band)
+// pays one comparison. GJK labels an answer it could not certify by the
+// same range (gjk.cpp, bounded_status): touching within it, where the
+// recomputation decides, undecided beyond.
+inline constexpr double kExtendedBands = 16.0;
+
 // Slack of a pruning test in a hierarchy traversal (compound pieces, mesh
 // triangles and boxes), in units of u times the query's magnitude R (the
 // largest of the bodies' magnitude bounds): a pair is pruned only when its

@@ -170,6 +170,62 @@ FeatureClosest closest_of_features(const FourPoints& pa, int na, const FourPoint
   return best;
 }
 
+// The direction along which the support of C certifies the polished
+// features' distance: their closest points' difference v, made exact in
+// the directions the features span. v = point_a - point_b is a difference
+// of points each rounded by about u R, so its direction is off by u R / |v|;
+// along a needle of length L that tilt moves the support value by L u R /
+// |v|, more than |v| itself while |v| < sqrt(L u R): the gap test could
+// not pass, the support point came back from the features themselves, and
+// the polish stopped with a lower bound of 0 and GJK's answer 11,800 bands
+// above a distance of 6e-5 bands (GjkRegression.StalledNeedlesReachTheDistance).
+// The directions the closest features span are exact (differences of
+// their vertices): the normal of an edge pair or of a face is their cross
+// product, accurate to a few u whatever |v| (face_normal), and for a vertex
+// on an edge v's component along the edge is removed. Any direction gives a
+// valid lower bound (the support plane separates by that much); this one
+// gives the distance of the features.
+Vec3 certifying_direction(const GjkFrame& frame, const Polished& f, const Vec3& v) {
+  const auto edges = [](const std::array<std::int32_t, 3>& ids, int n, auto&& point,
+                        std::array<Vec3, 2>& out) {
+    for (int k = 1; k < n; ++k)
+      out[idx(k - 1)] = detail::exponent_free(Vec3(point(ids[idx(k)]) - point(ids[0])));
+    return std::max(n - 1, 0);
+  };
+  std::array<Vec3, 2> ea;
+  std::array<Vec3, 2> eb;
+  const int ka = edges(f.ids_a, f.na, [&](std::int32_t id) { return frame.a.vertex(id); }, ea);
+  const int kb = edges(f.ids_b, f.nb, [&](std::int32_t id) { return frame.b_point(id); }, eb);
+  // Two spanning directions: a face's two edges, or an edge from each side.
+  const Vec3* plane[2] = {nullptr, nullptr};
+  if (ka == 2) {
+    plane[0] = &ea[0];
+    plane[1] = &ea[1];
+  } else if (kb == 2) {
+    plane[0] = &eb[0];
+    plane[1] = &eb[1];
+  } else if (ka == 1 && kb == 1) {
+    plane[0] = &ea[0];
+    plane[1] = &eb[0];
+  }
+  if (plane[0] != nullptr) {
+    Vec3 n = detail::face_normal(*plane[0], *plane[1]).n;
+    // Edges parallel to within the kernels' threshold span a line only.
+    if (n.squaredNorm() > kParallelSinFactor * kParallelSinFactor * kUnitRoundoff * kUnitRoundoff *
+                              plane[0]->squaredNorm() * plane[1]->squaredNorm()) {
+      const double along = n.dot(v);
+      if (along < 0.0) n = -n;
+      if (along != 0.0) return n;
+    }
+  }
+  const Vec3* line = ka >= 1 ? &ea[0] : kb >= 1 ? &eb[0] : nullptr;
+  if (line != nullptr && line->squaredNorm() > 0.0) {
+    const Vec3 n = v - (v.dot(*line) / line->squaredNorm()) * *line;
+    if (n.squaredNorm() > 0.0) return n;
+  }
+  return v;
+}
+
 template <class Support>
 Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, double tol,
                         Simplex& simplex, SupportPoint w, Support& support, int& iterations,
@@ -192,6 +248,9 @@ Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, d
     if (!add(ids_a, na, simplex.p[idx(k)].ia) || !add(ids_b, nb, simplex.p[idx(k)].ib))
       return out;
   }
+  // Whether the features of the last round were already searched along
+  // their certifying direction without a decrease: then nothing is left.
+  bool retried = false;
   for (;;) {
     if (!add(ids_a, na, w.ia) || !add(ids_b, nb, w.ib)) return out;
     FourPoints pa;
@@ -200,53 +259,76 @@ Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, d
     for (int k = 0; k < nb; ++k) pb[idx(k)] = frame.b_point(ids_b[idx(k)]) * frame.inv_unit;
     const FeatureClosest f = closest_of_features(pa, na, pb, nb, kernel_tol);
     const ClosestPoints<double>& c = f.c;
-    if (!(c.distance_squared < simplex.vv)) return out;
-    // The features reduced to the kernel's active vertices (at most three
-    // a side: the kernels take triangles).
-    out.have = true;
-    out.na = 0;
-    out.nb = 0;
+    // The features as searched (at most three a side) and reduced to the
+    // kernel's active vertices (at most three a side: the kernels take
+    // triangles).
+    Polished searched;
+    searched.na = std::min(na, 3);
+    searched.nb = std::min(nb, 3);
+    std::copy_n(ids_a.begin(), searched.na, searched.ids_a.begin());
+    std::copy_n(ids_b.begin(), searched.nb, searched.ids_b.begin());
+    Polished features;
     for (int i = 0; i < na; ++i) {
       if (!(f.active_a & (1u << i))) continue;
-      out.ids_a[idx(out.na)] = ids_a[idx(i)];
-      out.coef_a[idx(out.na++)] = f.coef_a[idx(i)];
+      features.ids_a[idx(features.na)] = ids_a[idx(i)];
+      features.coef_a[idx(features.na++)] = f.coef_a[idx(i)];
     }
     for (int j = 0; j < nb; ++j) {
       if (!(f.active_b & (1u << j))) continue;
-      out.ids_b[idx(out.nb)] = ids_b[idx(j)];
-      out.coef_b[idx(out.nb++)] = f.coef_b[idx(j)];
+      features.ids_b[idx(features.nb)] = ids_b[idx(j)];
+      features.coef_b[idx(features.nb++)] = f.coef_b[idx(j)];
     }
-    std::copy(out.ids_a.begin(), out.ids_a.end(), ids_a.begin());
-    std::copy(out.ids_b.begin(), out.ids_b.end(), ids_b.begin());
-    na = out.na;
-    nb = out.nb;
-    // The simplex: the pairs of active vertices, at most four of them
-    // (points of C for the contact classification's seed and the cache;
-    // the final points come from the coefficients above). A crossing or
-    // parallel pair has more: any four are points of C all the same.
-    Simplex next;
-    for (int i = 0; i < na && next.size < 4; ++i) {
-      for (int j = 0; j < nb && next.size < 4; ++j) {
-        next.p[idx(next.size)] = frame.point(ids_a[idx(i)], ids_b[idx(j)]);
-        next.lambda[idx(next.size++)] = out.coef_a[idx(i)] * out.coef_b[idx(j)];
+    std::copy(features.ids_a.begin(), features.ids_a.end(), ids_a.begin());
+    std::copy(features.ids_b.begin(), features.ids_b.end(), ids_b.begin());
+    na = features.na;
+    nb = features.nb;
+    const bool decrease = c.distance_squared < simplex.vv;
+    if (decrease) {
+      retried = false;
+      out = features;
+      out.have = true;
+      // The simplex: the pairs of active vertices, at most four of them
+      // (points of C for the contact classification's seed and the cache;
+      // the final points come from the coefficients above). A crossing or
+      // parallel pair has more: any four are points of C all the same.
+      Simplex next;
+      for (int i = 0; i < na && next.size < 4; ++i) {
+        for (int j = 0; j < nb && next.size < 4; ++j) {
+          next.p[idx(next.size)] = frame.point(ids_a[idx(i)], ids_b[idx(j)]);
+          next.lambda[idx(next.size++)] = out.coef_a[idx(i)] * out.coef_b[idx(j)];
+        }
       }
-    }
-    next.v = c.point_a - c.point_b;
-    next.vv = c.distance_squared;
-    simplex = next;
-    if (simplex.vv <= tol * tol) {
-      out.contact = true;
+      next.v = c.point_a - c.point_b;
+      next.vv = c.distance_squared;
+      simplex = next;
+      if (simplex.vv <= tol * tol) {
+        out.contact = true;
+        return out;
+      }
+    } else if (retried) {
       return out;
+    } else {
+      // The features realize |v| as well as the kernels can tell, and the
+      // support along v brought nothing closer: v's direction may be
+      // rounding's (certifying_direction); search once along theirs, as
+      // searched: a support point that the kernels put on the features'
+      // face but not in their closest feature (a nearly flat face, the
+      // origin's foot on its diagonal) spans the plane whose normal the
+      // closest feature alone leaves undecided
+      // (GjkRegression.FlatFaceAboveATouchingApexReachesIt).
+      retried = true;
     }
     if (iterations >= options.max_iterations) {
       out.capped = true;
       return out;
     }
     const double v_norm = std::sqrt(simplex.vv);
-    w = support(-simplex.v);
+    const Vec3 n = certifying_direction(frame, decrease ? features : searched,
+                                        Vec3(c.point_a - c.point_b));
+    w = support(-n);
     ++iterations;
     w_max2 = std::max(w_max2, w.w.squaredNorm());
-    lower = std::max(lower, simplex.v.dot(w.w) / v_norm);
+    lower = std::max(lower, n.dot(w.w) / n.norm());
     // Only the gap certifies: support points already in the features with
     // the gap open mean the kernels' reductions (a needle's width below
     // 4 u R) hide the answer, not that v is optimal
@@ -258,6 +340,30 @@ Polished polish_stalled(const GjkFrame& frame, const DistanceOptions& options, d
       return out;
     }
   }
+}
+
+// The status of an answer that did not reach the contact band, from what
+// it certifies (docs/accuracy.md): separated when its lower bound or its
+// closed gap certifies the distance and that is above the band; touching
+// when the distance is within the band. An answer left uncertified (a
+// stall that neither the polish nor the stall plane's normal could close)
+// within kExtendedBands bands is touching too: distance() recomputes its
+// witness pair in double-double there and decides the status from it
+// (query/extended_distance.h). Farther out nothing decides it, and its
+// bounds [lower_bound, distance] are all it knows: iteration_cap, the
+// status of an undecided answer whose bounds hold, never a touching
+// answer thousands of bands from contact
+// (GjkStatus.FollowsTheCertifiedBoundsOnEveryExit). The band there is at
+// least that of GJK's own frame, so that an answer re-solved with the
+// exact R's smaller band (distance.cpp, finish_query) keeps the
+// refinement's range.
+Status bounded_status(double distance, double contact_tolerance, const GjkFrame& frame,
+                      bool separation_certified) {
+  if (distance > contact_tolerance && separation_certified) return Status::separated;
+  if (distance <= contact_tolerance) return Status::touching;
+  const double refined = detail::kExtendedBands *
+                         std::max(contact_tolerance, contact_band(frame.magnitude));
+  return distance <= refined ? Status::touching : Status::iteration_cap;
 }
 
 // ---------------------------------------------------------------------------
@@ -313,8 +419,13 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
       certified = true;
       break;
     }
-    if (simplex.contains(w.ia, w.ib)) {  // nothing new: v is exact for this simplex
-      certified = true;
+    if (simplex.contains(w.ia, w.ib)) {
+      // Nothing new, with the gap open: v is the simplex's closest point,
+      // but its direction, a difference of rounded points, failed the
+      // support test, which certifies nothing. Polished like a stall
+      // (certifying_direction), it is certified or left undecided there.
+      stall_point = w;
+      rounding_stall = true;
       break;
     }
     Simplex next = simplex;
@@ -437,10 +548,7 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     result.point_b = point_b;
     result.distance = ((point_b - point_a) * frame.inv_unit).norm() * frame.unit;
     result.lower_bound = std::clamp(lower * frame.unit, 0.0, result.distance);
-    if (!contact) {
-      status = result.distance > contact_tolerance && separation_certified ? Status::separated
-                                                                           : Status::touching;
-    }
+    if (!contact) status = bounded_status(result.distance, contact_tolerance, frame, separation_certified);
     if (capped) status = Status::iteration_cap;
     // Within the band the points' difference is rounding noise: keep the
     // last search direction there.

@@ -17,19 +17,41 @@
 
 namespace proxima::detail {
 
+// Rounding of a point of C = A - B as GJK forms it, a - (R y + t), in units
+// of u times the query's magnitude R: the three products and three sums of
+// R y + t (each coordinate off by at most 4 u (|R| |y| + |t|) <= 4 u R),
+// the subtraction, and the same for B's placed centroid and the centroids'
+// and radii's own rounding (polytope.cpp), with room to spare. It only has
+// to keep the unit within a small factor of the largest computed point.
+inline constexpr double kPointRoundingUlps = 16.0;
+
 struct GjkFrame {
   const ConvexPolytope& a;
   const ConvexPolytope& b;
   const Pose& b_in_a;
   double magnitude = 0.0;  // bound on the largest coordinate magnitude in A's frame
-  double unit = 1.0;       // a power of two near it
+  double unit = 1.0;       // a power of two near the largest point of C (below)
   double inv_unit = 1.0;   // exact reciprocal
 
   GjkFrame(const ConvexPolytope& pa, const ConvexPolytope& pb, const Pose& pose)
       : a(pa), b(pb), b_in_a(pose) {
     // B's coordinates in A's frame are bounded without mapping its vertices.
     magnitude = std::max(a.scale(), magnitude_bound(pose, b.scale()));
-    const PowerOfTwoUnit u = power_of_two_unit(magnitude);
+    // The unit follows the points GJK computes with, the differences a - b,
+    // not R: they are at most the centroids' distance plus both radii (in
+    // the max norm: no square to overflow near 2^1018), plus their
+    // rounding. Where a pose translation cancels large local coordinates
+    // (a point at 3e93 in its own frame placed at -3e93: C is a box of size
+    // 50 and R is 1e94), a unit near R made C's points 1e-93 in size, the
+    // solver's squared face normals (fourth powers) underflowed to zero,
+    // and GJK never enclosed the origin of a box around it: it hit the
+    // iteration cap (GjkRegression.CancelledTranslationConverges). With this
+    // unit C's points are at most 1 and at least the rounding 16 u R, so no
+    // square, cube or fourth power of them over- or underflows.
+    const double spread = (a.centroid() - pose.apply(b.centroid())).cwiseAbs().maxCoeff() +
+                          a.bounding_radius() + b.bounding_radius() +
+                          kPointRoundingUlps * kUnitRoundoff * magnitude;
+    const PowerOfTwoUnit u = power_of_two_unit(spread);
     unit = u.unit;
     inv_unit = u.inverse;
   }

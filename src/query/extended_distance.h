@@ -7,18 +7,15 @@
 // u R, as much as the band itself, and the status would follow rounding.
 #pragma once
 
+#include "core/accuracy.h"
 #include "proxima/core/types.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima::detail {
 
-// Answers whose distance is within this many contact bands of zero are
-// recomputed (distance() calls refine_distance_extended for them): there a
-// double's error of a few u R is a sizeable share of the band, while well
-// above it the status cannot change and the standard's absolute term
-// already bounds the error. The tracked fast path (d far above the band)
-// pays one comparison.
-inline constexpr double kExtendedBands = 16.0;
+// The answers within detail::kExtendedBands contact bands of zero
+// (core/accuracy.h) are recomputed: distance() calls
+// refine_distance_extended for them.
 
 // Recomputes the distance between `result`'s witness features (hull ids
 // of a and of b) placed at the world poses, in double-double: the placed

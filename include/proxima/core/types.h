@@ -65,7 +65,9 @@ enum class Status : std::uint8_t {
   separated,      // distance > 64 u R: the hulls do not touch
   touching,       // distance <= 64 u R: in contact at machine precision
   intersecting,   // the hulls overlap; distance reported as 0
-  iteration_cap,  // the loop stopped at options.max_iterations; bounds still valid
+  iteration_cap,  // undecided, bounds still valid: the loop stopped at
+                  // options.max_iterations, or (GJK, Enhanced GJK) rounding hid an
+                  // answer more than 16 bands from contact that it could not certify
 };
 
 inline const char* to_string(Status s) {
