@@ -11,7 +11,7 @@
 
 namespace proxima::test {
 
-// gcc defines __SANITIZE_ADDRESS__; clang (the sanitizer build's compiler)
+// gcc defines __SANITIZE_ADDRESS__; clang
 // answers __has_feature(address_sanitizer) instead.
 #if defined(__SANITIZE_ADDRESS__)
 inline constexpr bool kUnderSanitizers = true;
