@@ -20,6 +20,7 @@
 #include "proxima/query/distance.h"
 #include "support/generators.h"
 #include "support/same_bits.h"
+#include "support/scene_bodies.h"
 
 namespace proxima {
 namespace {
@@ -98,17 +99,7 @@ struct Lockstep {
   std::vector<double> magnitude;
   std::vector<double> scale;
 
-  explicit Lockstep(double margin) {
-    for (const BroadPhase bp : {BroadPhase::sweep_and_prune, BroadPhase::dynamic_aabb_tree}) {
-      for (const int threads : {1, 2}) {
-        SceneOptions o;
-        o.margin = margin;
-        o.broad_phase = bp;
-        o.threads = threads;
-        scenes.emplace_back(o);
-      }
-    }
-  }
+  explicit Lockstep(double margin) : scenes(test::lockstep_scenes(margin)) {}
 
   template <class Body>
   BodyId add(const Body& body, const Pose& pose, double body_scale) {
