@@ -74,6 +74,16 @@ double band_of(const Points& a, const Points& b) {
   const double d_exact = exact.origin == OriginInM::inside && !exact.flat ? exact.depth() : 0.0;
   if (r.lower_bound > d_exact + tol + 1e-12 * d_exact) return fail("lower bound above the depth");
   if (r.upper_bound < d_exact - tol - 1e-12 * d_exact) return fail("upper bound below the depth");
+  // The certificate of an intersecting answer contains the exact depth, in
+  // exact arithmetic (the squares of its bounds against depth*^2), not only
+  // within the band (issue 25: exact_cases.jsonl line 2, the depth's upper
+  // bound 2e-21 below the exact depth 1.05e-6).
+  if (r.status == PenetrationStatus::intersecting && exact.origin == OriginInM::inside &&
+      !exact.flat) {
+    const mpq_class lower(r.lower_bound), upper(r.upper_bound);
+    if (lower * lower > exact.depth_squared) return fail("lower bound above the exact depth");
+    if (upper * upper < exact.depth_squared) return fail("upper bound below the exact depth");
+  }
   // The overlap along the normal is the depth.
   const double overlap = support_value(a, r.normal) + support_value(b, -r.normal);
   if (std::abs(overlap - r.depth) > kRel * r.depth + 2 * tol)

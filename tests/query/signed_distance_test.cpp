@@ -62,6 +62,21 @@ Points random_body(Rng& rng, int n) {
   return ::testing::AssertionSuccess();
 }
 
+// The certificate of an intersecting answer contains minus the exact depth,
+// decided exactly: depth_lower_bound^2 <= depth*^2 <= depth_upper_bound^2.
+::testing::AssertionResult contains_exact_depth(const DistanceResult& r, const ExactDepth& exact) {
+  const mpq_class lower(r.depth_lower_bound), upper(r.depth_upper_bound);
+  if (r.depth_lower_bound > 0.0 && lower * lower > exact.depth_squared)
+    return ::testing::AssertionFailure()
+           << "depth_lower_bound " << r.depth_lower_bound << " above the exact depth "
+           << exact.depth();
+  if (upper * upper < exact.depth_squared)
+    return ::testing::AssertionFailure()
+           << "depth_upper_bound " << r.depth_upper_bound << " below the exact depth "
+           << exact.depth();
+  return ::testing::AssertionSuccess();
+}
+
 // The certificate holds around `exact` within the band.
 ::testing::AssertionResult brackets(const DistanceResult& r, double exact, double band) {
   const double slack = band + kRel * std::abs(exact);
@@ -275,6 +290,7 @@ TEST(SignedDistanceOracle, RandomOverlapsAreMinusTheExactDepth) {
         ASSERT_LE(r.signed_distance(), 0.0) << trial;
         ASSERT_TRUE(within_bound(r.depth, exact.depth_squared, kRel, band))
             << trial << ": depth " << r.depth << ", exact " << d;
+        ASSERT_TRUE(contains_exact_depth(r, exact)) << trial;
       } else {
         ASSERT_LE(d, band) << trial;
       }
@@ -315,6 +331,24 @@ TEST(SignedDistanceRegression, DepthJustAboveTheBandIsIntersecting) {
   EXPECT_EQ(r.status, Status::intersecting);
   EXPECT_NEAR(r.signed_distance(), -exact.depth(), 1e-28);
   EXPECT_TRUE(brackets(r, -exact.depth(), 0.0));
+}
+
+TEST(SignedDistanceRegression, ThinPrismOverlapCertificateContainsTheExactDepth) {
+  // Story (issue 25, ../shared/repro/exact_cases.jsonl line 2): prisms of
+  // size 2e-5 overlapping by 1.05e-6 through nearly coplanar caps. The
+  // depth was right to 2e-21 (a hundredth of the band), but its upper
+  // bound was the overlap along the normal as computed in double, 2.1e-21
+  // below the exact depth: the certificate [-1.0525151238521467e-06,
+  // -1.0525151238514655e-06] excluded the exact -1.0525151238521488e-06.
+  // The upper bound now adds the value's rounding slack.
+  const Points a = coplanar_prism_a(), b = coplanar_prism_b();
+  const ConvexPolytope pa(a), pb(b);
+  const DistanceResult r = distance(pa, Pose::identity(), pb, Pose::identity());
+  const ExactDepth exact = exact_depth(a, b);
+  ASSERT_EQ(exact.origin, OriginInM::inside);
+  EXPECT_EQ(r.status, Status::intersecting);
+  EXPECT_TRUE(within_bound(r.depth, exact.depth_squared, kRel, band_of(a, b)));
+  EXPECT_TRUE(contains_exact_depth(r, exact));
 }
 
 // Overlaps within two bands of the band, of solids of size 1e-5 to 1e5, a

@@ -279,9 +279,10 @@ struct DistanceResult {
   Feature feature_b;
   // The penetration depth: the length of the shortest translation of B
   // after which a plane separates the hulls (they then touch), with a
-  // certificate depth_lower_bound <= exact depth <= depth_upper_bound (up
-  // to the contact band 64 u R; the upper bound is the overlap of the
-  // supports along normal). Computed for intersecting answers (with
+  // certificate depth_lower_bound <= exact depth <= depth_upper_bound (the
+  // lower bound is certified less the contact band 64 u R, the upper bound
+  // is the overlap of the supports along normal plus that band, so that
+  // the exact depth is inside, rounding included). Computed for intersecting answers (with
   // DistanceOptions::penetration, the default); 0, 0, 0 for separated and
   // touching ones. (With the depth, a touching answer of the algorithm is
   // checked by it: an overlap deeper than the contact band that the contact

@@ -32,8 +32,10 @@
 //   feature_a, feature_b the two faces of the Minkowski face (a face and a
 //           vertex, or two edges); for a face, the vertex ids of the fan
 //           triangle of the face that holds the witness point;
-//   lower_bound <= depth* <= upper_bound (up to 64 u R), upper_bound the
-//           overlap h_A(n) + h_B(-n) along the reported normal.
+//   lower_bound <= depth* <= upper_bound, each with its rounding slack
+//           64 u R (a certified lower bound less the band; the overlap
+//           h_A(n) + h_B(-n) along the reported normal plus the band;
+//           a depth refined exactly near the band has bounds within 8 u).
 //
 // Degenerate bodies. Lower-dimensional hulls are valid. When M is flat (two
 // coplanar polygons, a segment crossing a polygon in its plane, crossing
@@ -119,7 +121,7 @@ struct PenetrationResult {
   PenetrationStatus status = PenetrationStatus::separated;
   double depth = 0.0;           // >= 0; the exact depth within the accuracy standard
   double lower_bound = 0.0;     // lower_bound <= exact depth (up to 64 u R)
-  double upper_bound = 0.0;     // exact depth <= upper_bound: the overlap along normal
+  double upper_bound = 0.0;     // exact depth <= upper_bound: the overlap along normal + band
   Vec3 normal = Vec3::UnitX();  // unit, from A towards B, A's frame
   Vec3 point_a = Vec3::Zero();  // deepest point of A, A's frame
   Vec3 point_b = Vec3::Zero();  // deepest point of B, A's frame
