@@ -159,6 +159,9 @@ int main(int argc, char** argv) {
                    "last: reading stops there)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  query->add_flag("--extended-precision", options.extended_precision,
+                  "Full relative accuracy: each separated or touching answer's witness pair "
+                  "recomputed in double-double (docs/accuracy.md)");
   query
       ->add_option("--threads", threads,
                    "Threads answering blocks of queries; answers stay in input order")
@@ -195,6 +198,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
       ->capture_default_str();
   distance->add_flag("--json", distance_command.json, "One JSON object instead of the table");
+  distance->add_flag("--extended-precision", distance_command.options.extended_precision,
+                     "Full relative accuracy: the witness pair's distance recomputed in "
+                     "double-double (docs/accuracy.md)");
   std::string distance_as;
   const auto kinds = CLI::IsMember({"mesh", "hull", "pieces"});
   distance

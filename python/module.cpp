@@ -477,9 +477,11 @@ triangle mesh (no depth is defined for it: use the mesh's hull or convex pieces)
       "distance",
       [](const ConvexPolytope& a, py::object pose_a, const ConvexPolytope& b, py::object pose_b,
          PyDistanceCache* cache, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations, bool penetration) {
-        const DistanceOptions options = make_options(
-            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
+         double absolute_tolerance, int max_iterations, bool penetration,
+         bool extended_precision) {
+        DistanceOptions options = make_options(algorithm, relative_tolerance, absolute_tolerance,
+                                               max_iterations, penetration);
+        options.extended_precision = extended_precision;
         const Pose pa = to_pose(pose_a, "pose_a");
         const Pose pb = to_pose(pose_b, "pose_b");
         if (cache == nullptr) return distance(a, pa, b, pb, options, nullptr);
@@ -494,6 +496,7 @@ triangle mesh (no depth is defined for it: use the mesh's hull or convex pieces)
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
       py::arg("penetration") = defaults.penetration,
+      py::arg("extended_precision") = defaults.extended_precision,
       R"doc(Minimum distance, closest points and features of hulls a and b placed at pose_a and pose_b.
 
 Poses: None (identity), a 4x4 or 3x4 rigid matrix, a scipy Rotation, a (rotation, translation)
@@ -501,15 +504,18 @@ pair (rotation: a 3x3 matrix or a scipy Rotation) or a Pose. A quaternion names 
 Pose.from_wxyz(q, t) or Pose.from_xyzw(q, t) (ROS, scipy); a bare one in a pair is refused.
 cache: a DistanceCache updated in place (tracking) or None (cold).
 algorithm: 'hybrid' (the paper), 'gjk' or 'enhanced_gjk'. The tolerances and the iteration cap are
-DistanceOptions' fields. Returns a DistanceResult.)doc");
+DistanceOptions' fields. extended_precision: full relative accuracy, the witness pair's distance
+recomputed in double-double (docs/accuracy.md). Returns a DistanceResult.)doc");
 
   m.def(
       "distance_batch",
       [](const ConvexPolytope& a, py::object poses_a, const ConvexPolytope& b, py::object poses_b,
          py::object caches, int threads, const std::string& algorithm, double relative_tolerance,
-         double absolute_tolerance, int max_iterations, bool penetration) {
-        const DistanceOptions options = make_options(
-            algorithm, relative_tolerance, absolute_tolerance, max_iterations, penetration);
+         double absolute_tolerance, int max_iterations, bool penetration,
+         bool extended_precision) {
+        DistanceOptions options = make_options(algorithm, relative_tolerance, absolute_tolerance,
+                                               max_iterations, penetration);
+        options.extended_precision = extended_precision;
         py::ssize_t k = batch_size(poses_a);
         if (k < 0) k = batch_size(poses_b);
         const std::vector<Pose> pa = to_poses(poses_a, k, "poses_a");
@@ -574,6 +580,7 @@ DistanceOptions' fields. Returns a DistanceResult.)doc");
       py::arg("absolute_tolerance") = defaults.absolute_tolerance,
       py::arg("max_iterations") = defaults.max_iterations,
       py::arg("penetration") = defaults.penetration,
+      py::arg("extended_precision") = defaults.extended_precision,
       R"doc(K distance queries of one pair of polytopes, run on the thread pool without the GIL.
 
 poses_a, poses_b: (K, 4, 4) or (K, 3, 4) arrays of rigid matrices; one of them may be a single pose (4x4, a

@@ -60,6 +60,12 @@ inline constexpr double kTerminationGapUlps = 16.0;
 // recomputation decides, undecided beyond.
 inline constexpr double kExtendedBands = 16.0;
 
+// The standard's relative term (DESIGN.md: |distance - d*| <= 1e-12 d* +
+// 64 u R): how far an answer computed in double may be from the exact
+// distance besides the band, which an answer recomputed in extended
+// precision must not contradict (query/distance.cpp, refine_near_band).
+inline constexpr double kStandardRelative = 1e-12;
+
 // Slack of a pruning test in a hierarchy traversal (compound pieces, mesh
 // triangles and boxes), in units of u times the query's magnitude R (the
 // largest of the bodies' magnitude bounds): a pair is pruned only when its

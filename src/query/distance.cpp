@@ -89,8 +89,21 @@ double band_floor(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolyt
                                         const DistanceOptions& options, double band_bound,
                                         const DistanceCache& c, DistanceResult& result) {
   Vec3 normal;
-  if (!detail::refine_distance_extended(a, pose_a, b, pose_b, result, normal)) return;
+  const DistanceResult in_double = result;
+  if (!detail::refine_distance_extended(a, pose_a, b, pose_b, result, normal,
+                                        options.extended_precision))
+    return;
   const double d = result.distance;
+  // The answer in double is within its tolerance (relative_tolerance, at
+  // least the standard's relative term) and the band of the exact
+  // distance; a recomputed distance farther from it than that is not the
+  // bodies' (the affine hulls of a wrong feature pair can come closer than
+  // the features, with a gap that agrees): keep the answer in double.
+  const double relative = std::max(detail::kStandardRelative, options.relative_tolerance);
+  if (!(std::abs(d - in_double.distance) <= 2.0 * (relative * in_double.distance + band_bound))) {
+    result = in_double;
+    return;
+  }
   bool separated = d > band_bound;
   if (!separated && d > band_floor(a, pose_a, b, pose_b, options, c)) {
     const double r_exact = std::max(world_magnitude(a, pose_a), world_magnitude(b, pose_b));
@@ -132,7 +145,7 @@ double band_floor(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolyt
       result = run(a, b, b_in_a, options, exact_band, c);
     }
   }
-  if (result.distance <= detail::kExtendedBands * band_bound &&
+  if ((result.distance <= detail::kExtendedBands * band_bound || options.extended_precision) &&
       (result.status == Status::separated || result.status == Status::touching)) [[unlikely]] {
     refine_near_band(a, pose_a, b, pose_b, options, band_bound, c, result);
   }

@@ -239,7 +239,8 @@ double round_down(Dd x) { return x.lo < 0.0 ? std::nextafter(x.hi, -HUGE_VAL) : 
 }  // namespace
 
 bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                              const Pose& pose_b, DistanceResult& result, Vec3& normal) {
+                              const Pose& pose_b, DistanceResult& result, Vec3& normal,
+                              bool certify_lower_bound) {
   const double magnitude =
       std::max(pose_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * a.scale(),
                pose_b.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
@@ -264,7 +265,17 @@ bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const
   const double agree = kAgreeUlps * 0x1p-104 * 2.0;
   // The gap is a lower bound whatever the pair; it must meet the pair's
   // distance for that distance to be the bodies'.
-  if (!(std::abs(nearest(pair.distance - gap)) <= agree)) return false;
+  if (!(std::abs(nearest(pair.distance - gap)) <= agree)) {
+    // Not the pair that realizes the distance (or not within this
+    // precision: the four vertices of a face rounded off its plane). The
+    // gap is still a lower bound, certified where the one in double was
+    // up to rounding: the certificate takes it when asked to be exact.
+    if (certify_lower_bound) {
+      result.lower_bound = std::clamp(round_down(gap - Dd{agree, 0.0}) * unit.unit, 0.0,
+                                      result.lower_bound);
+    }
+    return false;
+  }
   const Dd distance = less(pair.distance, gap) ? gap : pair.distance;
   result.distance = nearest(distance) * unit.unit;
   // The gap less its own rounding bound: a contact at exactly 0 must not

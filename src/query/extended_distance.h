@@ -27,10 +27,14 @@ namespace proxima::detail {
 // in double ties with the best. When the two agree (the feature pair is
 // right), `result.distance` and `result.lower_bound` take them, rounded,
 // `normal` the pair's unit normal (world frame, from A towards B), and it
-// returns true; otherwise `result` is unchanged. The caller decides the
-// status from the new distance. For a separated or touching `result` with
+// returns true; otherwise `result` is unchanged, but for its lower bound
+// when `certify_lower_bound` (DistanceOptions::extended_precision): the
+// gap is a lower bound whatever the pair, and then replaces the one in
+// double (up to rounding) when it is lower. The caller decides the status
+// from the new distance. For a separated or touching `result` with
 // witness features.
 bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                              const Pose& pose_b, DistanceResult& result, Vec3& normal);
+                              const Pose& pose_b, DistanceResult& result, Vec3& normal,
+                              bool certify_lower_bound = false);
 
 }  // namespace proxima::detail

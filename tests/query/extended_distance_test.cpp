@@ -130,5 +130,129 @@ TEST(ExtendedDistance, CrossingEdgesNearTheBand) {
   EXPECT_GE(tally.separated, 20);
 }
 
+// ---------------------------------------------------------------------------
+// DistanceOptions::extended_precision: full relative accuracy at any
+// distance (issue 25 §4), on the adversarial near-contact families where
+// the standard's absolute term 64 u R is most of the answer's error.
+
+// The relative accuracy asked with the option (issue 25 §4's suite); the
+// double-double recomputation is within a few ulps where its feature pair
+// is right, and the families below keep their gaps at least 100 bands
+// above contact, where the relative term is the whole standard.
+constexpr double kExtendedRelative = 1e-9;
+
+struct ExtendedTally {
+  int cases = 0;
+  int off_outside = 0;  // answers without the option outside kExtendedRelative
+};
+
+// Every algorithm, both orders, with the option: separated, the distance
+// within kExtendedRelative of the exact one and the lower bound below it
+// (decided exactly). Without it (hybrid), counts the answers outside
+// kExtendedRelative: the family must be one where doubles run out.
+void check_extended(const Points& a, const Points& b, ExactOracle& oracle, ExtendedTally& tally,
+                    const std::string& what) {
+  const std::optional<ExactDistance> exact = oracle.distance(a, b);
+  ASSERT_TRUE(exact) << oracle.last_error();
+  ASSERT_FALSE(exact->is_zero()) << what;
+  ++tally.cases;
+  const ConvexPolytope pa(a), pb(b);
+  const DistanceResult plain = distance(pa, Pose::identity(), pb, Pose::identity());
+  tally.off_outside += !within_bound(plain.distance, exact->distance_squared, kExtendedRelative, 0.0);
+  for (const Algorithm alg : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
+    DistanceOptions options;
+    options.algorithm = alg;
+    options.extended_precision = true;
+    for (const bool swapped : {false, true}) {
+      const DistanceResult r = swapped ? distance(pb, Pose::identity(), pa, Pose::identity(), options)
+                                       : distance(pa, Pose::identity(), pb, Pose::identity(), options);
+      const std::string where = what + ", " + to_string(alg) + (swapped ? ", swapped" : "") +
+                                ", exact " + g(exact->distance()) + ", answer " + g(r.distance) +
+                                ", without the option " + g(plain.distance);
+      EXPECT_EQ(r.status, Status::separated) << where;
+      EXPECT_TRUE(within_bound(r.distance, exact->distance_squared, kExtendedRelative, 0.0)) << where;
+      const mpq_class lower(r.lower_bound);
+      EXPECT_LE(lower * lower, exact->distance_squared) << where << ", lower bound " << g(r.lower_bound);
+      EXPECT_LE(r.lower_bound, r.distance) << where;
+    }
+  }
+}
+
+// A gap of 100 bands to 1e-6 of R (log-uniform).
+double gap_of(Rng& rng, double r) {
+  const double band = kContactBandUlps * kUnitRoundoff * r;
+  return log_uniform(rng, 100.0 * band, 1e-6 * r);
+}
+
+// A box's edge and a tetrahedron's edge nearly parallel (1e-6 to 1e-2
+// rad), a small gap apart, 1e2 to 1e6 sizes from the origin.
+TEST(ExtendedPrecision, NearlyParallelEdgesAtOneBillionth) {
+  Rng rng(25041);
+  ExactOracle oracle;
+  ExtendedTally tally;
+  for (int trial = 0; trial < 12; ++trial) {
+    const double size = uniform(rng, 1.0, 10.0);
+    const Vec3 centre = log_uniform(rng, 1e2, 1e6) * size * random_unit_vector(rng);
+    const Mat3 turn = random_rotation(rng);
+    const Points a = transformed(box(Vec3(size, size, size)), turn, centre);
+    const Vec3 out = (turn.col(0) + turn.col(1)).normalized();
+    const Vec3 across = (turn.col(0) - turn.col(1)).normalized();
+    const double angle = log_uniform(rng, 1e-6, 1e-2);
+    const Vec3 dir = std::cos(angle) * turn.col(2) + std::sin(angle) * across;
+    const Vec3 side = out.cross(dir).normalized();
+    const double gap = gap_of(rng, centre.cwiseAbs().maxCoeff() + 2 * size);
+    const Vec3 m = centre + size * (turn.col(0) + turn.col(1)) + gap * out;
+    const Points b = {m - 0.5 * size * dir, m + 0.5 * size * dir, m + size * (out + 0.2 * side),
+                      m + size * (out - 0.2 * side)};
+    check_extended(a, b, oracle, tally, "trial " + std::to_string(trial) + ", angle " + g(angle));
+  }
+  EXPECT_GE(tally.off_outside, 3);
+}
+
+// A box tilted by 1e-6 to 1e-2 rad above a box's face, its lowest corner
+// a small gap above it (near-parallel faces), 1e2 to 1e6 sizes from the
+// origin.
+TEST(ExtendedPrecision, NearlyParallelFacesAtOneBillionth) {
+  Rng rng(25042);
+  ExactOracle oracle;
+  ExtendedTally tally;
+  for (int trial = 0; trial < 12; ++trial) {
+    const double size = uniform(rng, 1.0, 10.0);
+    const Vec3 centre = log_uniform(rng, 1e2, 1e6) * size * random_unit_vector(rng);
+    const Mat3 turn = random_rotation(rng);
+    const Points a = transformed(box(Vec3(size, size, 0.5 * size)), turn, centre);
+    const Mat3 tilt = Mat3(Eigen::AngleAxisd(log_uniform(rng, 1e-6, 1e-2), random_unit_vector(rng)));
+    const Points b_local = transformed(box(Vec3(0.3 * size, 0.4 * size, 0.2 * size)), turn * tilt,
+                                       Vec3::Zero());
+    const Vec3 n = turn.col(2);
+    const double gap = gap_of(rng, centre.cwiseAbs().maxCoeff() + 2 * size);
+    const Points b = place_along(a, translated(b_local, centre), n, gap);
+    check_extended(a, b, oracle, tally, "trial " + std::to_string(trial));
+  }
+  EXPECT_GE(tally.off_outside, 3);
+}
+
+// The paper's second stress experiment (cubes of edge 2000 and 1e-15
+// scaled by 1e39, 1e-10 apart), and random clouds 1e3 to 1e8 of their
+// size from the origin, a small gap apart along a random direction.
+TEST(ExtendedPrecision, PaperCubesAndFarCloudsAtOneBillionth) {
+  Rng rng(25043);
+  ExactOracle oracle;
+  ExtendedTally tally;
+  for (int trial = 0; trial < 6; ++trial) {
+    const BodyPair cubes = paper_cubes(rng);
+    check_extended(cubes.a, cubes.b, oracle, tally, "paper cubes " + std::to_string(trial));
+  }
+  for (int trial = 0; trial < 12; ++trial) {
+    const Vec3 centre = log_uniform(rng, 1e3, 1e8) * random_unit_vector(rng);
+    const Points a = translated(points_on_sphere(rng, uniform_int(rng, 8, 30)), centre);
+    const Points b0 = translated(points_in_cube(rng, uniform_int(rng, 8, 30), 0.7), centre);
+    const Points b = place_along(a, b0, random_unit_vector(rng),
+                                 gap_of(rng, centre.cwiseAbs().maxCoeff() + 2.0));
+    check_extended(a, b, oracle, tally, "far clouds " + std::to_string(trial));
+  }
+  EXPECT_GE(tally.off_outside, 3);
+}
+
 }  // namespace
 }  // namespace proxima::test
