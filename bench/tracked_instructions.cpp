@@ -16,7 +16,9 @@
 // (the same poses without a cache, as the paper's cold experiment calls
 // distance()). The poses are those of bench/distance_bench.cpp. A third
 // argument `rigid` gives the queries poses checked once (RigidPose), so that
-// the rigid-pose check of every query is not counted.
+// the rigid-pose check of every query is not counted; `extended` asks every
+// query for DistanceOptions::extended_precision (its cost against the same
+// mode without it).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -48,11 +50,13 @@ constexpr int kSteps = 10000;
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3 && !(argc == 4 && std::strcmp(argv[3], "rigid") == 0)) {
+  const bool rigid_poses = argc == 4 && std::strcmp(argv[3], "rigid") == 0;
+  const bool extended = argc == 4 && std::strcmp(argv[3], "extended") == 0;
+  if (argc != 3 && !rigid_poses && !extended) {
     std::fprintf(
         stderr,
         "usage: tracked_instructions translation|rotation|fast_rotation|random|cold_random|cold "
-        "N [rigid]\n");
+        "N [rigid|extended]\n");
     return 2;
   }
   const char* mode = argv[1];
@@ -84,7 +88,9 @@ int main(int argc, char** argv) {
   double sum = 0.0;
   const bool cold = std::strcmp(mode, "cold_random") == 0;
   const bool no_cache = std::strcmp(mode, "cold") == 0;
-  if (argc == 4) {
+  proxima::DistanceOptions options;
+  options.extended_precision = extended;
+  if (rigid_poses) {
     std::vector<proxima::RigidPose> rigid(poses.begin(), poses.end());
     const proxima::RigidPose identity;
     for (const proxima::RigidPose& pose : rigid) {
@@ -94,7 +100,7 @@ int main(int argc, char** argv) {
   } else {
     for (const Pose& pose : poses) {
       if (cold) cache.reset();
-      sum += proxima::distance(a, Pose::identity(), b, pose, {}, no_cache ? nullptr : &cache)
+      sum += proxima::distance(a, Pose::identity(), b, pose, options, no_cache ? nullptr : &cache)
                  .distance;
     }
   }

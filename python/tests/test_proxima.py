@@ -97,6 +97,24 @@ def test_vertex_to_vertex_along_the_diagonal():
     np.testing.assert_array_equal(a.vertices[r.feature_b.vertices[0]], [-0.5, -0.5, -0.5])
 
 
+def test_extended_precision_keyword():
+    # Unit cubes, faces parallel and about 1e-9 apart, 1e3 from the origin:
+    # the exact distance of the given doubles is the difference of B's least
+    # x and A's largest (exact in double: Sterbenz), 1e-12 of R, that
+    # the standard's absolute term 64 u R (7e-12) leaves right to 1%.
+    cube = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    pa = cube + 1e3
+    pb = cube + 1e3 + [1.0 + 1e-9, 0.0, 0.0]
+    exact = pb[:, 0].min() - pa[:, 0].max()
+    a, b = proxima.ConvexPolytope(pa), proxima.ConvexPolytope(pb)
+    ext = proxima.distance(a, None, b, None, extended_precision=True)
+    assert ext.status == "separated"
+    assert ext.lower_bound <= exact <= ext.distance
+    assert abs(ext.distance - exact) <= 4 * np.spacing(exact)
+    rows = proxima.distance_batch(a, None, b, np.eye(4)[None], extended_precision=True)
+    assert rows["distance"][0] == ext.distance
+
+
 def test_overlap_and_contact():
     a = proxima.ConvexPolytope(cube())
     b = proxima.ConvexPolytope(cube())

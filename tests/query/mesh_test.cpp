@@ -397,6 +397,26 @@ TEST(MeshDistanceExact, FeaturesOfAHandCase) {
   EXPECT_TRUE(r.normal.isApprox(Vec3(0, 0, 1)));
 }
 
+// DistanceOptions::extended_precision is refused between two meshes (their
+// triangle kernels have no recomputation: it would be ignored), and
+// honoured for a mesh and a convex body (the convex query recomputes).
+TEST(MeshDistanceExact, ExtendedPrecisionIsRefusedBetweenMeshesOnly) {
+  const MeshData a{{{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}, {{0, 1, 2}}};
+  const MeshData b{{{1, 1, 1}, {1, 1, 3}, {2, 1, 3}}, {{0, 1, 2}}};
+  DistanceOptions options;
+  options.extended_precision = true;
+  try {
+    (void)distance(a.build(), Pose(), b.build(), Pose(), options);
+    ADD_FAILURE() << "extended_precision between meshes was not refused";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("extended_precision"), std::string::npos) << e.what();
+  }
+  const ConvexPolytope tetra(b.vertices);
+  const MeshResult r = distance(a.build(), Pose(), tetra, Pose(), options);
+  EXPECT_EQ(r.distance, 1.0);
+  EXPECT_EQ(r.status, Status::separated);
+}
+
 TEST(MeshDistanceExact, DegenerateTrianglesAreSegmentsAndPoints) {
   // A: a point (three equal vertices) and a segment (collinear); B: a face.
   const MeshData a{{{0, 0, 2}, {5, 5, 3}, {6, 5, 3}, {7, 5, 3}}, {{0, 0, 0}, {1, 2, 3}}};
