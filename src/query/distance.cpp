@@ -90,9 +90,16 @@ double band_floor(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolyt
                                         const DistanceCache& c, DistanceResult& result) {
   Vec3 normal;
   const DistanceResult in_double = result;
-  if (!detail::refine_distance_extended(a, pose_a, b, pose_b, result, normal,
-                                        options.extended_precision))
+  const detail::ExtendedOutcome outcome = detail::refine_distance_extended(
+      a, pose_a, b, pose_b, result, normal, options.extended_precision);
+  if (outcome == detail::ExtendedOutcome::lower_bound_only) {
+    // Positive: certified along `normal`, the answer's normal now (a
+    // rounded body trusts the normal of a core answer whose lower bound
+    // is positive).
+    result.normal = pose_a.rotation.transpose() * normal;
     return;
+  }
+  if (outcome != detail::ExtendedOutcome::refined) return;
   const double d = result.distance;
   // The answer in double is within its tolerance (relative_tolerance, at
   // least the standard's relative term) and the band of the exact

@@ -238,23 +238,24 @@ double round_down(Dd x) { return x.lo < 0.0 ? std::nextafter(x.hi, -HUGE_VAL) : 
 
 }  // namespace
 
-bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                              const Pose& pose_b, DistanceResult& result, Vec3& normal,
-                              bool certify_lower_bound) {
+ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a,
+                                         const ConvexPolytope& b, const Pose& pose_b,
+                                         DistanceResult& result, Vec3& normal,
+                                         bool certify_lower_bound) {
   const double magnitude =
       std::max(pose_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * a.scale(),
                pose_b.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
-  if (!(magnitude > 0.0)) return false;
+  if (!(magnitude > 0.0)) return ExtendedOutcome::unchanged;
   const detail::PowerOfTwoUnit unit = detail::power_of_two_unit(magnitude);
   const double s = unit.inverse;
   const PlacedFeature fa = place(a, pose_a, result.feature_a, s);
   const PlacedFeature fb = place(b, pose_b, result.feature_b, s);
   PairDistance pair;
-  if (!pair_distance(fa, fb, pair)) return false;
+  if (!pair_distance(fa, fb, pair)) return ExtendedOutcome::unchanged;
   const Dd length = sqrt(dot(pair.normal, pair.normal));
   // A pair at distance 0 (or below any direction's rounding) certifies
   // nothing beyond the answer it came with.
-  if (!(length.hi > 0.0)) return false;
+  if (!(length.hi > 0.0)) return ExtendedOutcome::unchanged;
   std::vector<int> ids;
   const int hint_a = std::max<std::int32_t>(result.feature_a.vertices[0], 0);
   const int hint_b = std::max<std::int32_t>(result.feature_b.vertices[0], 0);
@@ -263,18 +264,31 @@ bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const
   const Dd gap = (bottom_b - top_a) / length;
   // In units of s: the coordinates are below 2.
   const double agree = kAgreeUlps * 0x1p-104 * 2.0;
+  // The pair's unit normal (world frame, from A towards B), along which
+  // the gap is certified.
+  const Vec3 n(nearest(pair.normal[0] / length), nearest(pair.normal[1] / length),
+               nearest(pair.normal[2] / length));
+  normal = n / n.norm();
   // The gap is a lower bound whatever the pair; it must meet the pair's
   // distance for that distance to be the bodies'.
   if (!(std::abs(nearest(pair.distance - gap)) <= agree)) {
     // Not the pair that realizes the distance (or not within this
     // precision: the four vertices of a face rounded off its plane). The
-    // gap is still a lower bound, certified where the one in double was
-    // up to rounding: the certificate takes it when asked to be exact.
-    if (certify_lower_bound) {
-      result.lower_bound = std::clamp(round_down(gap - Dd{agree, 0.0}) * unit.unit, 0.0,
-                                      result.lower_bound);
+    // gap less its rounding bound is still a lower bound, certified where
+    // the one in double is up to rounding.
+    const double certified =
+        std::clamp(round_down(gap - Dd{agree, 0.0}) * unit.unit, 0.0, result.distance);
+    if (certify_lower_bound && result.lower_bound > 0.0) {
+      result.lower_bound = std::min(certified, result.lower_bound);
+      return ExtendedOutcome::unchanged;
     }
-    return false;
+    // A contact answer's lower bound 0 (the algorithm stopped at the band
+    // without a support gap) takes a positive certified one.
+    if (result.lower_bound == 0.0 && certified > 0.0) {
+      result.lower_bound = certified;
+      return ExtendedOutcome::lower_bound_only;
+    }
+    return ExtendedOutcome::unchanged;
   }
   const Dd distance = less(pair.distance, gap) ? gap : pair.distance;
   result.distance = nearest(distance) * unit.unit;
@@ -284,10 +298,7 @@ bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const
   // BodyOracle.TouchingCoresTakeTheNormalOfTheirContact).
   result.lower_bound =
       std::clamp(round_down(gap - Dd{agree, 0.0}) * unit.unit, 0.0, result.distance);
-  const Vec3 n(nearest(pair.normal[0] / length), nearest(pair.normal[1] / length),
-               nearest(pair.normal[2] / length));
-  normal = n / n.norm();
-  return true;
+  return ExtendedOutcome::refined;
 }
 
 }  // namespace proxima::detail

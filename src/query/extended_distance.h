@@ -7,6 +7,8 @@
 // u R, as much as the band itself, and the status would follow rounding.
 #pragma once
 
+#include <cstdint>
+
 #include "core/accuracy.h"
 #include "proxima/core/types.h"
 #include "proxima/shape/polytope.h"
@@ -17,6 +19,13 @@ namespace proxima::detail {
 // (core/accuracy.h) are recomputed: distance() calls
 // refine_distance_extended for them.
 
+// What refine_distance_extended changed.
+enum class ExtendedOutcome : std::uint8_t {
+  unchanged,         // nothing (but a lower bound lowered to the certified gap, see below)
+  refined,           // distance, lower bound and `normal`
+  lower_bound_only,  // a contact's lower bound 0 raised to the certified gap along `normal`
+};
+
 // Recomputes the distance between `result`'s witness features (hull ids
 // of a and of b) placed at the world poses, in double-double: the placed
 // coordinates R y + t to 2^-104 of their magnitude, the feature pair's
@@ -26,15 +35,19 @@ namespace proxima::detail {
 // normal computed in double-double over the vertices whose support value
 // in double ties with the best. When the two agree (the feature pair is
 // right), `result.distance` and `result.lower_bound` take them, rounded,
-// `normal` the pair's unit normal (world frame, from A towards B), and it
-// returns true; otherwise `result` is unchanged, but for its lower bound
-// when `certify_lower_bound` (DistanceOptions::extended_precision): the
-// gap is a lower bound whatever the pair, and then replaces the one in
-// double (up to rounding) when it is lower. The caller decides the status
-// from the new distance. For a separated or touching `result` with
-// witness features.
-bool refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                              const Pose& pose_b, DistanceResult& result, Vec3& normal,
-                              bool certify_lower_bound = false);
+// `normal` the pair's unit normal (world frame, from A towards B): refined.
+// Otherwise the gap, less its rounding bound, is still a lower bound
+// whatever the pair: with `certify_lower_bound`
+// (DistanceOptions::extended_precision) it replaces the lower bound in
+// double (up to rounding) when lower (unchanged); without, it replaces a
+// lower bound of 0 when positive (lower_bound_only: a contact answer whose
+// algorithm stopped at the band without a support gap), `normal` the
+// direction it is certified along. The caller decides the status from a
+// refined distance. For a separated or touching `result` with witness
+// features.
+ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& pose_a,
+                                         const ConvexPolytope& b, const Pose& pose_b,
+                                         DistanceResult& result, Vec3& normal,
+                                         bool certify_lower_bound = false);
 
 }  // namespace proxima::detail

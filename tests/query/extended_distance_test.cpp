@@ -130,6 +130,51 @@ TEST(ExtendedDistance, CrossingEdgesNearTheBand) {
   EXPECT_GE(tally.separated, 20);
 }
 
+// Issue 25 §4's third item: a contact answer (the algorithm stopped at the
+// band, with no support gap) had the lower bound 0 when the double-double
+// recomputation refused its pair, which it does for resting faces: a
+// turned box's face has four vertices that rounding puts off one plane, so
+// the gap along the witness triangle's normal misses the pair's distance.
+// About half of these touching answers had the lower bound 0 though the
+// exact distance is positive; the gap along the pair's normal, certified,
+// is now their lower bound (and the normal it holds along theirs).
+TEST(ExtendedDistance, RestingFacesNearTheBandGetACertifiedLowerBound) {
+  Rng rng(25006);
+  ExactOracle oracle;
+  int touching_apart = 0, positive = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    const double size = uniform(rng, 1.0, 10.0);
+    const Vec3 centre = log_uniform(rng, 1.0, 1e6) * size * random_unit_vector(rng);
+    const Mat3 turn = random_rotation(rng);
+    const Points a = transformed(box(Vec3(size, 0.7 * size, 0.4 * size)), turn, centre);
+    const double band = kContactBandUlps * kUnitRoundoff * (centre.cwiseAbs().maxCoeff() + 2 * size);
+    const double k = trial % 2 == 0 ? 0.3 : 0.7;
+    const Points b = transformed(box(Vec3(0.25 * size, 0.3 * size, 0.2 * size)), turn,
+                                 centre + (1.25 * size + k * band) * turn.col(0));
+    const std::optional<ExactDistance> exact = oracle.distance(a, b);
+    ASSERT_TRUE(exact) << oracle.last_error();
+    const ConvexPolytope pa(a), pb(b);
+    for (const Algorithm alg : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
+      DistanceOptions options;
+      options.algorithm = alg;
+      const DistanceResult r = distance(pa, Pose::identity(), pb, Pose::identity(), options);
+      const std::string where = "trial " + std::to_string(trial) + ", " + to_string(alg) +
+                                ", exact " + g(exact->distance()) + ", lower bound " +
+                                g(r.lower_bound);
+      const mpq_class lower(r.lower_bound);
+      EXPECT_LE(lower * lower, exact->distance_squared) << where;
+      if (r.status != Status::touching || exact->is_zero()) continue;
+      ++touching_apart;
+      positive += r.lower_bound > 0.0;
+      // The normal is the direction the bound is certified along: out of
+      // A's face.
+      EXPECT_GT(r.normal.dot(turn.col(0)), 0.999) << where;
+    }
+  }
+  EXPECT_GE(touching_apart, 20);
+  EXPECT_EQ(positive, touching_apart);
+}
+
 // ---------------------------------------------------------------------------
 // DistanceOptions::extended_precision: full relative accuracy at any
 // distance (issue 25 §4), on the adversarial near-contact families where
