@@ -414,7 +414,10 @@ void bind_compound_and_scene(py::module_& m) {
            "margin: pairs at distance <= margin are reported. broad_phase: 'dynamic_aabb_tree' or "
            "'sweep_and_prune'. threads: narrow-phase threads (1: the calling thread, 0: all "
            "cores). penetration: overlapping pairs get their depth (signed distance); off by "
-           "default in a scene, where it costs 5 to 60 us per overlapping pair and step.")
+           "default in a scene (a single distance() computes it by default), where it costs many "
+           "times a tracked distance per overlapping pair and step. A scene whose options differ "
+           "from the defaults in algorithm, relative_tolerance or max_iterations refuses a "
+           "TriangleMesh body in add() (InvalidInput): the mesh query cannot honour them.")
       .def(
           "add",
           [](PyScene& s, py::handle body, py::object pose, double padding) {

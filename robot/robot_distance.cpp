@@ -11,6 +11,7 @@
 #include <numbers>
 #include <string>
 
+#include "core/accuracy.h"
 #include "query/parallel_ranges.h"
 
 namespace proxima {
@@ -139,10 +140,19 @@ bool by_geometries(const RobotPairResult& x, const RobotPairResult& y) {
 RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
                                std::span<const Obstacle> obstacles,
                                const RobotQueryOptions& options, RobotQueryState* state) {
-  // std::isfinite first: an ordered comparison with NaN raises FE_INVALID.
-  if (!std::isfinite(options.margin) || options.margin < 0) {
-    throw InvalidInput("robot query: margin " + std::to_string(options.margin) +
-                       " is not a finite value >= 0");
+  detail::check_finite_non_negative(options.margin, "robot query", "options.margin");
+  detail::check_distance_options(options.distance, "robot query", "options.distance");
+  // A pair with a mesh is answered by the mesh query, which cannot honour
+  // every distance option: refused before any pair, not at the first mesh
+  // pair queried (only when an option differs from what meshes take).
+  if (!detail::mesh_options_plainly_valid(options.distance, detail::MeshOptionUse::triangle_pairs)) {
+    const auto refuse_for_meshes = [&](const Body& body) {
+      if (body.kind() == Body::Kind::mesh)
+        detail::check_mesh_options(options.distance, "robot query",
+                                   detail::MeshOptionUse::triangle_pairs, "options.distance");
+    };
+    for (const RobotGeometry& g : robot.geometries()) refuse_for_meshes(g.body);
+    for (const Obstacle& o : obstacles) refuse_for_meshes(o.body);
   }
   RobotQueryState local;
   RobotQueryState& s = state != nullptr ? *state : local;
@@ -321,7 +331,7 @@ RobotBatchDistances robot_distances_batch(const Robot& robot, const RowMatrixXd&
     throw InvalidInput("robot batch: the configurations have " + std::to_string(q.cols()) +
                        " columns, the robot " + std::to_string(robot.dof()) + " variables");
   }
-  if (threads < 0) throw InvalidInput("robot batch: threads " + std::to_string(threads) + " < 0");
+  detail::check_at_least(threads, 0, "robot batch", "threads", "0: all cores");
   RobotBatchDistances out;
   const auto k = static_cast<std::size_t>(q.rows());
   out.min_signed_distance.resize(q.rows());
