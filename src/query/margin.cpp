@@ -15,7 +15,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <tuple>
 #include <utility>
 
 #include "proxima/detail/narrowphase/hybrid.h"
@@ -159,6 +158,25 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
   return out;
 }
 
+// A body placed at `pose` within the supported magnitude (its core's
+// scale plus its radius, as Body::scale()), or refused by name; the message
+// is built out of line, off the path of every query.
+[[gnu::noinline, gnu::cold]] void refuse_reach(const Body& body, double reach, const char* name) {
+  char message[200];
+  std::snprintf(message, sizeof message,
+                "within_margin: body %s with radius %g reaches coordinates of magnitude %g, "
+                "beyond the supported %g",
+                name, body.radius(), reach, kMaxMagnitude);
+  throw InvalidInput(message);
+}
+
+inline void check_reach(const Body& body, const Pose& pose, const char* name) {
+  const double scale = body.mesh() != nullptr ? body.mesh()->scale() + body.radius() : body.scale();
+  const double reach = magnitude_bound(pose, scale);
+  if (!(reach <= kMaxMagnitude)) [[unlikely]]
+    refuse_reach(body, reach, name);
+}
+
 }  // namespace
 
 namespace detail {
@@ -285,27 +303,35 @@ namespace detail {
 MarginResult within_margin_of_rigid_poses(const Body& a, const Pose& pa, const Body& b,
                                           const Pose& pb, double margin,
                                           const DistanceOptions& options, BodyCache& cache) {
-  for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
-    const double reach = magnitude_bound(*pose, body->scale());
-    if (!(reach <= kMaxMagnitude)) [[unlikely]] {
-      char message[200];
-      std::snprintf(message, sizeof message,
-                    "within_margin: body %s with radius %g reaches coordinates of magnitude %g, "
-                    "beyond the supported %g",
-                    name, body->radius(), reach, kMaxMagnitude);
-      throw InvalidInput(message);
-    }
+  check_reach(a, pa, "a");
+  check_reach(b, pb, "b");
+  const double radii = a.radius() + b.radius();
+  if (a.mesh() != nullptr && b.mesh() != nullptr) [[likely]] {
+    // Two mesh bodies (a planner's mesh links): their one pair of meshes,
+    // each at its body's pose, straight to the mesh query, without the
+    // pieces' mesh list (Body::meshes(), a call_once on every query), the
+    // placements and the spheres' test that only pieces need, and the
+    // answer returned where it was made. mesh_pairs_within answers the same
+    // (one pair: no sphere test, the pose as it is), field by field
+    // (Margin.MeshBodiesAnswerAsTheirMeshes).
+    if (cache.mesh.size() != 1) [[unlikely]]
+      cache.mesh.assign(1, MeshCache{});
+    MarginResult r = detail::within_margin_of_rigid_poses(*a.mesh(), pa, *b.mesh(), pb,
+                                                          margin + radii, options,
+                                                          cache.mesh.data());
+    if (r.status == MarginStatus::within) cache.mesh_closest = 0;
+    if (radii != 0.0) add_radii(r, margin, a.radius(), b.radius());
+    return r;
   }
-  BodyCache& c = cache;
-  const double core_margin = margin + a.radius() + b.radius();
+  const double core_margin = margin + radii;
   MarginResult r;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
     r = detail::within_margin_of_rigid_poses(*a.convex(), pa, *b.convex(), pb, core_margin,
-                                             options, c.convex);
+                                             options, cache.convex);
   } else if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
-    r = mesh_pairs_within(a, pa, b, pb, core_margin, options, c);
+    r = mesh_pairs_within(a, pa, b, pb, core_margin, options, cache);
   } else {
-    r = within_margin(*a.compound(), pa, *b.compound(), pb, core_margin, options, &c.compound);
+    r = within_margin(*a.compound(), pa, *b.compound(), pb, core_margin, options, &cache.compound);
     // A convex body met a compound as its one-piece wrapper: no pieces.
     if (a.kind() == Body::Kind::convex) r.piece_a = -1;
     if (b.kind() == Body::Kind::convex) r.piece_b = -1;

@@ -230,6 +230,54 @@ TEST(Margin, MeshPairsAgreeWithTheFullQuery) {
   EXPECT_GT(beyond, 60);
 }
 
+// Two mesh bodies take their own path to the mesh query (no pieces, no
+// placements): the answer is the mesh query's, field by field, cold and
+// tracked along a motion (one BodyCache against one MeshCache), and a
+// rounded pair's verdict is the cores' with the margin plus both radii.
+TEST(Margin, MeshBodiesAnswerAsTheirMeshes) {
+  Rng rng(2608);
+  const auto mesh_a = hull_mesh(rng, 60);
+  const auto mesh_b = hull_mesh(rng, 40);
+  const Body a(mesh_a), b(mesh_b);
+  const Body rounded_a(mesh_a, 0.03), rounded_b(mesh_b, 0.02);
+  BodyCache body_cache;
+  MeshCache mesh_cache;
+  int within = 0, beyond = 0;
+  Pose pb(test::random_rotation(rng), Vec3(2.4, 0.1, -0.2));
+  const Mat3 turn = test::random_small_rotation(rng, 0.03);
+  for (int step = 0; step < 100; ++step) {
+    pb.translation.x() -= 0.03;
+    pb.rotation = checked_pose(Pose(turn * pb.rotation, pb.translation), "step").rotation;
+    const double m = step % 3 == 0 ? 0.0 : 0.04 * (step % 3);
+    for (const bool tracked : {false, true}) {
+      const MarginResult got = within_margin(a, Pose::identity(), b, pb, m, {},
+                                             tracked ? &body_cache : nullptr);
+      const MarginResult want = within_margin(*mesh_a, Pose::identity(), *mesh_b, pb, m, {},
+                                              tracked ? &mesh_cache : nullptr);
+      EXPECT_EQ(got.status, want.status) << step;
+      EXPECT_EQ(got.lower_bound, want.lower_bound) << step;
+      EXPECT_EQ(got.upper_bound, want.upper_bound) << step;
+      EXPECT_EQ(got.point_a, want.point_a) << step;
+      EXPECT_EQ(got.point_b, want.point_b) << step;
+      EXPECT_EQ(got.triangle_a, want.triangle_a) << step;
+      EXPECT_EQ(got.triangle_b, want.triangle_b) << step;
+      EXPECT_EQ(got.piece_a, -1);
+      EXPECT_EQ(got.piece_b, -1);
+      EXPECT_EQ(got.pairs_tested, want.pairs_tested) << step;
+      (got.is_within() ? within : beyond) += 1;
+    }
+    const MarginResult rounded = within_margin(rounded_a, Pose::identity(), rounded_b, pb, m);
+    const MarginResult cores = within_margin(*mesh_a, Pose::identity(), *mesh_b, pb, m + 0.05);
+    EXPECT_EQ(rounded.status, cores.status) << step;
+    EXPECT_EQ(rounded.margin, m);
+  }
+  EXPECT_GT(within, 20);
+  EXPECT_GT(beyond, 20);
+  // The tracked queries kept the body's one mesh cache warm.
+  ASSERT_EQ(body_cache.mesh.size(), 1u);
+  EXPECT_FALSE(body_cache.mesh.front().is_cold());
+}
+
 // Degenerate contacts, hand-computed: boxes whose faces are coplanar
 // (touching exactly), two triangles crossing, and a body inside a closed
 // mesh (no surfaces meet) against the same inside an open one.
