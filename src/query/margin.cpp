@@ -31,6 +31,33 @@ namespace {
 // covers all of them with room, as the compound pruning's slack does.
 constexpr double kSphereSlackUlps = 256.0;
 
+// A certified lower bound on the distance between two hulls from their
+// boxes (ConvexPolytope::box_center, box_half; both must have one), B placed in A's frame by
+// `relative`, or 0 when it cannot prove them beyond `margin`. Any
+// orthonormal axis separates the boxes' projections by at most their
+// distance, so the gaps along A's three axes, and along B's, each bound it
+// from below, and so does the root of the sum of their squares within one
+// frame (the mesh roots' bound, query/mesh_pair.h). The boxes, their
+// placement and the gaps round by a few u R each: prune_slack(R) covers
+// them. The largest single gap is tried first: it needs no square, which
+// would overflow for margins beyond 1e153 (a sum that is not finite proves
+// nothing).
+double box_gap_lower_bound(const ConvexPolytope& a, const ConvexPolytope& b,
+                           const Pose& relative, double margin, double magnitude) {
+  const double slack = detail::prune_slack(magnitude);
+  const Vec3 d = relative.rotation * b.box_center() + relative.translation - a.box_center();
+  const Mat3 abs_rotation = relative.rotation.cwiseAbs();
+  const Vec3 gaps_a = d.cwiseAbs() - a.box_half() - abs_rotation * b.box_half();
+  const Vec3 gaps_b =
+      (relative.rotation.transpose() * d).cwiseAbs() - b.box_half() - abs_rotation.transpose() * a.box_half();
+  const double largest = std::max(gaps_a.maxCoeff(), gaps_b.maxCoeff());
+  if (largest - slack > margin) return largest - slack;
+  if (!(largest - slack > 0.0)) return 0.0;
+  const double sum = std::max(gaps_a.cwiseMax(0.0).squaredNorm(), gaps_b.cwiseMax(0.0).squaredNorm());
+  if (!std::isfinite(sum)) return 0.0;
+  return std::max(0.0, std::sqrt(sum) - slack);
+}
+
 // The verdict of a full distance answer (the fallback, and the twin's
 // rule): touching and intersecting are within any margin; a separated or
 // capped answer is within when its closest points are at most margin +
@@ -214,18 +241,22 @@ MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& p
     throw InvalidInput(message);
   }
   const double band = contact_band(magnitude, options.absolute_tolerance);
-  // Far apart: the bounding spheres prove it without the hulls.
+  // Far apart: the bounding spheres prove it without the hulls, and then
+  // the boxes (a long link's sphere reaches far beyond it).
   const double gap = sphere_gap_lower_bound(pose_a.apply(a.centroid()), a.bounding_radius(),
                                             pose_b.apply(b.centroid()), b.bounding_radius());
-  if (gap > margin) {
+  const Pose relative = pose_a.inverse() * pose_b;
+  const double box_gap = gap > margin || !a.has_box() || !b.has_box()
+                             ? gap
+                             : box_gap_lower_bound(a, b, relative, margin, magnitude);
+  if (box_gap > margin) {
     MarginResult out;
     out.margin = margin;
-    out.lower_bound = gap;
+    out.lower_bound = box_gap;
     return out;
   }
   if (options.algorithm == Algorithm::hybrid) {
-    const DistanceResult r =
-        hybrid_within(a, b, pose_a.inverse() * pose_b, options, band, margin, cache);
+    const DistanceResult r = hybrid_within(a, b, relative, options, band, margin, cache);
     const bool proved_within = r.distance <= margin + band;
     if (proved_within || r.lower_bound > margin) {
       MarginResult out;

@@ -139,6 +139,46 @@ TEST(Margin, ConvexAndRoundedAgreeWithTheFullQuery) {
 
 // The early exit: a margin far above or below the distance is proved in
 // fewer iterations than the full query needs.
+// Long thin hulls (a robot's links), whose bounding spheres reach far
+// beyond them: the boxes' bound decides many poses the spheres cannot
+// (no hull query: pairs_tested 0), at scales from 2^-300 to 2^300, and
+// every verdict and bound is the twin's.
+TEST(Margin, BoxesOfLongHullsProveBeyondWithoutTheHulls) {
+  Rng rng(2609);
+  int by_boxes = 0, within = 0;
+  for (int k = 0; k < 100; ++k) {
+    const double unit = std::ldexp(1.0, 200 * (k % 4) - 300);
+    const auto rod = [&](double length) {
+      // On a sphere, so that every point is a vertex: hulls of more than
+      // kTableMinVertices vertices keep a box (polytope.h).
+      test::Points p = test::points_on_sphere(rng, 48);
+      for (Vec3& v : p) v = unit * Vec3(length * v.x(), 0.1 * v.y(), 0.1 * v.z());
+      return Body(ConvexPolytope(p));
+    };
+    const Body a = rod(test::uniform(rng, 1.0, 3.0));
+    const Body b = rod(test::uniform(rng, 1.0, 3.0));
+    const Pose pa(test::random_rotation(rng), unit * Vec3(test::uniform(rng, -1, 1), 0.0, 0.0));
+    const Pose pb(test::random_rotation(rng),
+                  unit * Vec3(test::uniform(rng, -2.5, 2.5), test::uniform(rng, -2.5, 2.5),
+                              test::uniform(rng, -1.0, 1.0)));
+    const Twin twin = twin_of(a, pa, b, pb);
+    const double band = band_of(a, pa, b, pb);
+    for (const double m : {0.0, unit * test::uniform(rng, 0.0, 0.3)}) {
+      const MarginResult got = within_margin(a, pa, b, pb, m);
+      expect_agrees(got, m, twin, band, "rods", k);
+      const ConvexPolytope& ca = *a.convex();
+      const ConvexPolytope& cb = *b.convex();
+      const double sphere = detail::sphere_gap_lower_bound(
+          pa.apply(ca.centroid()), ca.bounding_radius(), pb.apply(cb.centroid()),
+          cb.bounding_radius());
+      if (got.status == MarginStatus::beyond && got.pairs_tested == 0 && !(sphere > m)) ++by_boxes;
+      within += got.is_within() ? 1 : 0;
+    }
+  }
+  EXPECT_GT(by_boxes, 30);
+  EXPECT_GT(within, 6);
+}
+
 TEST(Margin, StopsAtTheFirstProof) {
   Rng rng(2602);
   int fewer = 0;
