@@ -48,10 +48,8 @@ test-release: setup
 test: test-release asan
 	@echo "== release build: long sweeps, peer tests, examples, Python, packaging, docs =="
 	ctest --preset release -j $(JOBS)
-	@echo "== unit tests, ASan + UBSan build =="
+	@echo "== unit tests, ASan + UBSan build (and the fuzz corpus replayed) =="
 	ctest --preset asan -j $(JOBS)
-	@echo "== fuzz smoke run of the mesh readers (20 s) =="
-	bash scripts/fuzz 20
 
 # ThreadSanitizer: builds batch_test alone (the batch queries' threads) and runs it.
 tsan: setup
@@ -89,5 +87,9 @@ clean:
 	rm -rf build out
 
 # Fuzzes the mesh readers for 30 s (clang, libFuzzer + ASan + UBSan).
+# Fuzzing the mesh readers (libFuzzer, its own clang build): a random
+# search, so it is not part of `make test`, which replays the corpus
+# (fuzz/corpus) under the sanitizers; CI (.ci/run) fuzzes 20 s after it.
+FUZZ_SECONDS ?= 30
 fuzz: setup
-	bash scripts/fuzz 30
+	bash scripts/fuzz $(FUZZ_SECONDS)
