@@ -52,6 +52,18 @@ proxima::Algorithm parse_algorithm(const std::string& name) {
   if (name == "enhanced_gjk") return proxima::Algorithm::enhanced_gjk;
   return proxima::Algorithm::hybrid;
 }
+// Four numbers in the wrong order are another rotation: the order is a
+// named choice, the same flag on every command that reads quaternions, and
+// no default (unset: every quaternion must name its order itself, and a bare
+// one is refused with both of its readings).
+const std::vector<std::string> kQuaternionOrders = {"wxyz", "xyzw"};
+// How a mesh file becomes a body (--as): never silently its hull.
+const std::vector<std::string> kBodyKinds = {"mesh", "hull", "pieces"};
+
+std::optional<proxima::QuaternionOrder> parse_order(const std::string& name) {
+  if (name.empty()) return std::nullopt;
+  return name == "xyzw" ? proxima::QuaternionOrder::xyzw : proxima::QuaternionOrder::wxyz;
+}
 
 int run_query_command(const std::string& file, const proxima::DistanceOptions& options, int threads,
                       std::optional<proxima::QuaternionOrder> order, std::uint64_t max_line_bytes) {
@@ -94,6 +106,276 @@ int run_query_command(const std::string& file, const proxima::DistanceOptions& o
   return kExitOk;
 }
 
+// Each subcommand: its arguments as CLI11 binds them (the addresses stay
+// put: one object per subcommand, in main), the function that declares its
+// options, and the one that runs it once parsed.
+struct QueryArgs {
+  CLI::App* app = nullptr;
+  std::string file = "-";
+  std::string algorithm = "hybrid";
+  proxima::DistanceOptions options;
+  int threads = 1;
+  std::string order;
+  std::uint64_t max_line_bytes = proxima::cli::kDefaultMaxLineBytes;
+};
+
+void add_query(CLI::App& app, QueryArgs& a) {
+  a.app = app.add_subcommand(
+      "query",
+      "Answer distance queries in JSON Lines, one answer line per query line, in order "
+      "(format: docs/query-format.md)");
+  a.app->footer(
+      "Example:\n"
+      "  echo '{\"id\":1,\"a\":{\"vertices\":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]]},"
+      "\"b\":{\"vertices\":[[3,0,0],[4,0,0],[3,1,0],[3,0,1]]}}' | proxima query");
+  a.app->add_option("FILE", a.file, "Input file of queries; '-' or none reads standard input");
+  a.app->add_option("--algorithm", a.algorithm, "Algorithm answering the queries")
+      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
+      ->capture_default_str();
+  a.app
+      ->add_option("--max-iterations", a.options.max_iterations,
+                   "Iteration cap per query; a capped answer says \"iteration_cap\": true")
+      ->check(CLI::Range(1, kMaxIterationsLimit))
+      ->capture_default_str();
+  a.app
+      ->add_option("--quaternion-order", a.order,
+                   "Order of a body's bare \"rotation\" numbers: wxyz (scalar first) or xyzw "
+                   "(scalar last, as ROS and scipy write them). Without it a rotation must name "
+                   "its order: {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, z, w]}")
+      ->check(CLI::IsMember(kQuaternionOrders));
+  a.app
+      ->add_option("--max-line-size", a.max_line_bytes,
+                   "Refuse a query line longer than this many bytes (its error answer is the "
+                   "last: reading stops there)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  a.app
+      ->add_option("--threads", a.threads,
+                   "Threads answering blocks of queries; answers stay in input order")
+      ->check(CLI::Range(1, kMaxThreads))
+      ->capture_default_str();
+}
+
+int run(QueryArgs& a) {
+  a.options.algorithm = parse_algorithm(a.algorithm);
+  return run_query_command(a.file, a.options, a.threads, parse_order(a.order), a.max_line_bytes);
+}
+
+struct DistanceArgs {
+  CLI::App* app = nullptr;
+  proxima::cli::DistanceCommand command;
+  std::string algorithm = "hybrid";
+  std::string order;
+  std::string as;
+};
+
+void add_distance(CLI::App& app, DistanceArgs& a) {
+  a.app = app.add_subcommand(
+      "distance",
+      "Distance, closest points, normal and witness features between two mesh files (OBJ, "
+      "OFF, STL, PLY, XYZ), each read as its convex hull, a triangle mesh or a compound of "
+      "hulls (--as)");
+  a.app->add_option("A", a.command.file_a, "First body's mesh file")->required();
+  a.app->add_option("B", a.command.file_b, "Second body's mesh file")->required();
+  a.app
+      ->add_option("--pose-a", a.command.pose_a,
+                   "Pose of A: translation x y z, then optionally a rotation quaternion in the "
+                   "order --quaternion-order names (required with one)")
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
+  a.app
+      ->add_option("--pose-b", a.command.pose_b,
+                   "Pose of B: translation x y z, then optionally a rotation quaternion in the "
+                   "order --quaternion-order names (required with one)")
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
+  a.app
+      ->add_option("--quaternion-order", a.order,
+                   "Order of the quaternion in --pose-a/--pose-b: wxyz (qw qx qy qz) or xyzw "
+                   "(qx qy qz qw, as ROS and scipy write them); no default")
+      ->check(CLI::IsMember(kQuaternionOrders));
+  a.app->add_option("--algorithm", a.algorithm, "Algorithm answering the query")
+      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
+      ->capture_default_str();
+  a.app->add_flag("--json", a.command.json, "One JSON object instead of the table");
+  a.app
+      ->add_option("--as", a.as,
+                   "How both files become bodies: mesh (the surface as given), hull (the convex "
+                   "hull of every point) or pieces (one hull per OBJ group). Default: the hull "
+                   "of a convex file or a point cloud; a non-convex file with faces must be named")
+      ->check(CLI::IsMember(kBodyKinds));
+  a.app->add_option("--as-a", a.command.as_a, "--as for file A only")->check(CLI::IsMember(kBodyKinds));
+  a.app->add_option("--as-b", a.command.as_b, "--as for file B only")->check(CLI::IsMember(kBodyKinds));
+  a.app
+      ->add_option("--max-file-size", a.command.max_file_bytes,
+                   "Refuse an input file larger than this many bytes")
+      ->capture_default_str();
+  a.app->footer(
+      "Example:\n"
+      "  proxima distance a.obj b.stl --pose-b 0 0 2 0.7071067811865476 0 0 0.7071067811865476 "
+      "--quaternion-order wxyz --json");
+}
+
+int run(DistanceArgs& a) {
+  a.command.options.algorithm = parse_algorithm(a.algorithm);
+  a.command.quaternion_order = parse_order(a.order);
+  if (a.command.as_a.empty()) a.command.as_a = a.as;
+  if (a.command.as_b.empty()) a.command.as_b = a.as;
+  return proxima::cli::run_distance(a.command, std::cout, std::cerr);
+}
+
+struct HullArgs {
+  CLI::App* app = nullptr;
+  proxima::cli::HullCommand command;
+};
+
+void add_hull(CLI::App& app, HullArgs& a) {
+  a.app = app.add_subcommand("hull", "Hull statistics of a mesh file, and its export as OBJ or OFF");
+  a.app->add_option("FILE", a.command.file, "Mesh file (OBJ, OFF, STL, PLY, XYZ)")->required();
+  a.app->add_option("--out", a.command.out_file,
+                   "Write the hull here; the format from the extension")
+      ->check(CLI::Validator(
+          [](const std::string& path) {
+            return proxima::cli::export_format(path).empty()
+                       ? std::string("the hull is written as .obj or .off, not '" + path + "'")
+                       : std::string();
+          },
+          "FILE.obj|FILE.off"));
+  a.app->add_flag("--json", a.command.json, "One JSON object instead of the table");
+  a.app->add_option("--max-file-size", a.command.max_file_bytes,
+                   "Refuse an input file larger than this many bytes")
+      ->capture_default_str();
+  a.app->footer("Example:\n  proxima hull body.stl --out hull.off");
+}
+
+struct ViewArgs {
+  CLI::App* app = nullptr;
+  proxima::cli::ViewCommand command;
+  std::string order;
+  std::string algorithm = "hybrid";
+};
+
+void add_view(CLI::App& app, ViewArgs& a) {
+  a.app = app.add_subcommand(
+      "view",
+      "Write one self-contained HTML page (three.js inline, no network) showing two bodies, "
+      "their closest points, witness features, normal and certificate, or one scene step "
+      "(docs/viewer.md)");
+  a.app->add_option("A", a.command.file_a, "First body's mesh file");
+  a.app->add_option("B", a.command.file_b, "Second body's mesh file");
+  a.app->add_option("--pose-a", a.command.pose_a, "Pose of A, as for `proxima distance`")
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
+  a.app->add_option("--pose-b", a.command.pose_b, "Pose of B, as for `proxima distance`")
+      ->expected(3, 7)
+      ->type_name("x y z [q q q q]");
+  a.app->add_option("--as", a.command.as,
+                   "How A and B become bodies, as for `proxima distance`: mesh (the surface as "
+                   "given), hull (the convex hull of every point) or pieces (one hull per OBJ "
+                   "group). Default: the hull of a convex file or a point cloud; a non-convex "
+                   "file with faces must be named")
+      ->check(CLI::IsMember(kBodyKinds));
+  a.app->add_option("--query", a.command.query_file,
+                   "A file ('-': standard input) holding one `proxima query` line, then "
+                   "optionally its answer line; without one the query is answered here");
+  a.app->add_option("--scene", a.command.scene_file,
+                   "A file of JSON Lines, one body per line ({\"vertices\": ..., \"rotation\": "
+                   "..., \"translation\": ...}): one step of a Scene, close pairs coloured by "
+                   "distance");
+  a.app->add_option("--margin", a.command.margin,
+                   "With --scene: pairs within this distance are drawn")
+      ->capture_default_str();
+  a.app->add_option("--quaternion-order", a.order,
+                   "Order of the bare quaternions (poses, query rotations): wxyz or xyzw; no "
+                   "default")
+      ->check(CLI::IsMember(kQuaternionOrders));
+  a.app->add_option("--algorithm", a.algorithm, "Algorithm answering the query")
+      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
+      ->capture_default_str();
+  a.app->add_option("--max-file-size", a.command.max_file_bytes,
+                   "Refuse an input file larger than this many bytes")
+      ->capture_default_str();
+  a.app->add_option("-o,--out", a.command.out_file, "The page to write ('-': standard output)")
+      ->required();
+  a.app->footer(
+      "Examples:\n"
+      "  proxima view a.obj b.stl --pose-b 0 0 2 --out pair.html\n"
+      "  proxima view --query query.jsonl --out query.html\n"
+      "  proxima view --scene bodies.jsonl --margin 0.1 --out scene.html");
+}
+
+int run(ViewArgs& a) {
+  // Exactly one input: two files, a query file or a scene file.
+  const bool files = !a.command.file_a.empty();
+  const int inputs = (files ? 1 : 0) + (a.command.query_file.empty() ? 0 : 1) +
+                     (a.command.scene_file.empty() ? 0 : 1);
+  if (inputs != 1 || (files && a.command.file_b.empty())) {
+    std::cerr << "proxima view: give two mesh files A B, or --query FILE, or --scene FILE "
+                 "(exactly one of them)\n";
+    return kExitUsage;
+  }
+  if (!files && (!a.command.pose_a.empty() || !a.command.pose_b.empty())) {
+    std::cerr << "proxima view: --pose-a and --pose-b go with two mesh files\n";
+    return kExitUsage;
+  }
+  a.command.options.algorithm = parse_algorithm(a.algorithm);
+  a.command.quaternion_order = parse_order(a.order);
+  return proxima::cli::run_view(a.command, std::cout, std::cerr);
+}
+
+struct RobotArgs {
+  CLI::App* app = nullptr;
+  proxima::cli::RobotCommand command;
+};
+
+void add_robot(CLI::App& app, RobotArgs& a) {
+  a.app = app.add_subcommand(
+      "robot",
+      "A robot from its URDF (and SRDF): answer JSON Lines of configurations with the minimum "
+      "signed distance, the close pairs and the gradient (docs/robotics.md)");
+  a.app->add_option("FILE", a.command.file,
+                    "Input file of configurations; '-' or none reads standard input");
+  a.app->add_option("--urdf", a.command.urdf, "The robot's URDF")->required();
+  a.app->add_option("--srdf", a.command.srdf,
+                    "Its SRDF: the disable_collisions pairs are not tested");
+  a.app->add_option("--package-dir", a.command.package_dirs,
+                    "Where package:// URIs point: NAME=DIR, or a directory holding packages "
+                    "(repeatable)");
+  a.app->add_option("--mesh-as", a.command.mesh_as,
+                    "How a collision mesh becomes a body: hull, mesh or pieces")
+      ->check(CLI::IsMember(std::vector<std::string>{"hull", "mesh", "pieces"}))
+      ->capture_default_str();
+  a.app->add_option("--margin", a.command.margin,
+                    "Pairs whose signed distance is at most this are listed")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  a.app->add_flag("--gradients", a.command.gradients,
+                  "Answer each pair's gradient with respect to the joint vector");
+  a.app->add_option("--environment", a.command.environment,
+                    "JSON Lines of obstacles, one body per line as a query's (\"vertices\", "
+                    "\"triangles\", \"radius\", \"pose\") with an optional \"name\"");
+  a.app->add_option("--view", a.command.view_out,
+                    "Write a viewer page of the last configuration (close pairs drawn, excluded "
+                    "pairs never shown as collisions)");
+  a.app->footer(
+      "Example:\n"
+      "  echo '{\"id\":1,\"q\":[0,-0.78,0,-2.36,0,1.57,0.78,0.01]}' |\n"
+      "    proxima robot --urdf panda.urdf --srdf panda.srdf --package-dir NAME=DIR --gradients\n"
+      "Each line: {\"id\": any, \"q\": [numbers] or {\"joint name\": number, ...}}.");
+}
+
+int run(RobotArgs& a) {
+  std::ios::sync_with_stdio(false);
+  if (a.command.file == "-") return proxima::cli::run_robot(a.command, std::cin, std::cout, std::cerr);
+  std::ifstream in(a.command.file, std::ios::binary);
+  std::error_code ec;
+  if (!in || std::filesystem::is_directory(a.command.file, ec)) {
+    std::cerr << "proxima robot: cannot open '" << a.command.file << "'\n";
+    return kExitFailure;
+  }
+  return proxima::cli::run_robot(a.command, in, std::cout, std::cerr);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -113,211 +395,16 @@ int main(int argc, char** argv) {
   CLI::App* demo = app.add_subcommand(
       "demo", "Build two seeded polytopes, print their hulls and the distance by each algorithm");
   demo->footer("Example:\n  proxima demo");
-
-  CLI::App* query = app.add_subcommand(
-      "query",
-      "Answer distance queries in JSON Lines, one answer line per query line, in order "
-      "(format: docs/query-format.md)");
-  std::string file = "-";
-  std::string algorithm = "hybrid";
-  proxima::DistanceOptions options;
-  int threads = 1;
-  // Four numbers in the wrong order are another rotation: the order is a
-  // named choice, the same flag on every command that reads quaternions,
-  // and no default (unset: every quaternion must name its order itself, and
-  // a bare one is refused with both of its readings).
-  const std::vector<std::string> orders = {"wxyz", "xyzw"};
-  const auto parse_order = [](const std::string& name) -> std::optional<proxima::QuaternionOrder> {
-    if (name.empty()) return std::nullopt;
-    return name == "xyzw" ? proxima::QuaternionOrder::xyzw : proxima::QuaternionOrder::wxyz;
-  };
-  std::string query_order;
-  std::string distance_order;
-  query->footer(
-      "Example:\n"
-      "  echo '{\"id\":1,\"a\":{\"vertices\":[[0,0,0],[1,0,0],[0,1,0],[0,0,1]]},"
-      "\"b\":{\"vertices\":[[3,0,0],[4,0,0],[3,1,0],[3,0,1]]}}' | proxima query");
-  query->add_option("FILE", file, "Input file of queries; '-' or none reads standard input");
-  query->add_option("--algorithm", algorithm, "Algorithm answering the queries")
-      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
-      ->capture_default_str();
-  query
-      ->add_option("--max-iterations", options.max_iterations,
-                   "Iteration cap per query; a capped answer says \"iteration_cap\": true")
-      ->check(CLI::Range(1, kMaxIterationsLimit))
-      ->capture_default_str();
-  query
-      ->add_option("--quaternion-order", query_order,
-                   "Order of a body's bare \"rotation\" numbers: wxyz (scalar first) or xyzw "
-                   "(scalar last, as ROS and scipy write them). Without it a rotation must name "
-                   "its order: {\"wxyz\": [w, x, y, z]} or {\"xyzw\": [x, y, z, w]}")
-      ->check(CLI::IsMember(orders));
-  std::uint64_t max_line_bytes = proxima::cli::kDefaultMaxLineBytes;
-  query
-      ->add_option("--max-line-size", max_line_bytes,
-                   "Refuse a query line longer than this many bytes (its error answer is the "
-                   "last: reading stops there)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  query
-      ->add_option("--threads", threads,
-                   "Threads answering blocks of queries; answers stay in input order")
-      ->check(CLI::Range(1, kMaxThreads))
-      ->capture_default_str();
-
-  CLI::App* distance = app.add_subcommand(
-      "distance",
-      "Distance, closest points, normal and witness features between two mesh files (OBJ, "
-      "OFF, STL, PLY, XYZ), each read as its convex hull, a triangle mesh or a compound of "
-      "hulls (--as)");
-  proxima::cli::DistanceCommand distance_command;
-  std::string distance_algorithm = "hybrid";
-  distance->add_option("A", distance_command.file_a, "First body's mesh file")->required();
-  distance->add_option("B", distance_command.file_b, "Second body's mesh file")->required();
-  distance
-      ->add_option("--pose-a", distance_command.pose_a,
-                   "Pose of A: translation x y z, then optionally a rotation quaternion in the "
-                   "order --quaternion-order names (required with one)")
-      ->expected(3, 7)
-      ->type_name("x y z [q q q q]");
-  distance
-      ->add_option("--pose-b", distance_command.pose_b,
-                   "Pose of B: translation x y z, then optionally a rotation quaternion in the "
-                   "order --quaternion-order names (required with one)")
-      ->expected(3, 7)
-      ->type_name("x y z [q q q q]");
-  distance
-      ->add_option("--quaternion-order", distance_order,
-                   "Order of the quaternion in --pose-a/--pose-b: wxyz (qw qx qy qz) or xyzw "
-                   "(qx qy qz qw, as ROS and scipy write them); no default")
-      ->check(CLI::IsMember(orders));
-  distance->add_option("--algorithm", distance_algorithm, "Algorithm answering the query")
-      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
-      ->capture_default_str();
-  distance->add_flag("--json", distance_command.json, "One JSON object instead of the table");
-  std::string distance_as;
-  const auto kinds = CLI::IsMember({"mesh", "hull", "pieces"});
-  distance
-      ->add_option("--as", distance_as,
-                   "How both files become bodies: mesh (the surface as given), hull (the convex "
-                   "hull of every point) or pieces (one hull per OBJ group). Default: the hull "
-                   "of a convex file or a point cloud; a non-convex file with faces must be named")
-      ->check(kinds);
-  distance->add_option("--as-a", distance_command.as_a, "--as for file A only")->check(kinds);
-  distance->add_option("--as-b", distance_command.as_b, "--as for file B only")->check(kinds);
-  distance
-      ->add_option("--max-file-size", distance_command.max_file_bytes,
-                   "Refuse an input file larger than this many bytes")
-      ->capture_default_str();
-  distance->footer(
-      "Example:\n"
-      "  proxima distance a.obj b.stl --pose-b 0 0 2 0.7071067811865476 0 0 0.7071067811865476 "
-      "--quaternion-order wxyz --json");
-
-  CLI::App* hull =
-      app.add_subcommand("hull", "Hull statistics of a mesh file, and its export as OBJ or OFF");
-  proxima::cli::HullCommand hull_command;
-  hull->add_option("FILE", hull_command.file, "Mesh file (OBJ, OFF, STL, PLY, XYZ)")->required();
-  hull->add_option("--out", hull_command.out_file,
-                   "Write the hull here; the format from the extension")
-      ->check(CLI::Validator(
-          [](const std::string& path) {
-            return proxima::cli::export_format(path).empty()
-                       ? std::string("the hull is written as .obj or .off, not '" + path + "'")
-                       : std::string();
-          },
-          "FILE.obj|FILE.off"));
-  hull->add_flag("--json", hull_command.json, "One JSON object instead of the table");
-  hull->add_option("--max-file-size", hull_command.max_file_bytes,
-                   "Refuse an input file larger than this many bytes")
-      ->capture_default_str();
-  hull->footer("Example:\n  proxima hull body.stl --out hull.off");
-
-  CLI::App* view = app.add_subcommand(
-      "view",
-      "Write one self-contained HTML page (three.js inline, no network) showing two bodies, "
-      "their closest points, witness features, normal and certificate, or one scene step "
-      "(docs/viewer.md)");
-  proxima::cli::ViewCommand view_command;
-  std::string view_order;
-  std::string view_algorithm = "hybrid";
-  view->add_option("A", view_command.file_a, "First body's mesh file");
-  view->add_option("B", view_command.file_b, "Second body's mesh file");
-  view->add_option("--pose-a", view_command.pose_a, "Pose of A, as for `proxima distance`")
-      ->expected(3, 7)
-      ->type_name("x y z [q q q q]");
-  view->add_option("--pose-b", view_command.pose_b, "Pose of B, as for `proxima distance`")
-      ->expected(3, 7)
-      ->type_name("x y z [q q q q]");
-  view->add_option("--as", view_command.as,
-                   "How A and B become bodies, as for `proxima distance`: mesh (the surface as "
-                   "given), hull (the convex hull of every point) or pieces (one hull per OBJ "
-                   "group). Default: the hull of a convex file or a point cloud; a non-convex "
-                   "file with faces must be named")
-      ->check(kinds);
-  view->add_option("--query", view_command.query_file,
-                   "A file ('-': standard input) holding one `proxima query` line, then "
-                   "optionally its answer line; without one the query is answered here");
-  view->add_option("--scene", view_command.scene_file,
-                   "A file of JSON Lines, one body per line ({\"vertices\": ..., \"rotation\": "
-                   "..., \"translation\": ...}): one step of a Scene, close pairs coloured by "
-                   "distance");
-  view->add_option("--margin", view_command.margin,
-                   "With --scene: pairs within this distance are drawn")
-      ->capture_default_str();
-  view->add_option("--quaternion-order", view_order,
-                   "Order of the bare quaternions (poses, query rotations): wxyz or xyzw; no "
-                   "default")
-      ->check(CLI::IsMember(orders));
-  view->add_option("--algorithm", view_algorithm, "Algorithm answering the query")
-      ->check(CLI::IsMember(std::vector<std::string>{"hybrid", "gjk", "enhanced_gjk"}))
-      ->capture_default_str();
-  view->add_option("--max-file-size", view_command.max_file_bytes,
-                   "Refuse an input file larger than this many bytes")
-      ->capture_default_str();
-  view->add_option("-o,--out", view_command.out_file, "The page to write ('-': standard output)")
-      ->required();
-  view->footer(
-      "Examples:\n"
-      "  proxima view a.obj b.stl --pose-b 0 0 2 --out pair.html\n"
-      "  proxima view --query query.jsonl --out query.html\n"
-      "  proxima view --scene bodies.jsonl --margin 0.1 --out scene.html");
-
-  CLI::App* robot = app.add_subcommand(
-      "robot",
-      "A robot from its URDF (and SRDF): answer JSON Lines of configurations with the minimum "
-      "signed distance, the close pairs and the gradient (docs/robotics.md)");
-  proxima::cli::RobotCommand robot_command;
-  robot->add_option("FILE", robot_command.file,
-                    "Input file of configurations; '-' or none reads standard input");
-  robot->add_option("--urdf", robot_command.urdf, "The robot's URDF")->required();
-  robot->add_option("--srdf", robot_command.srdf,
-                    "Its SRDF: the disable_collisions pairs are not tested");
-  robot->add_option("--package-dir", robot_command.package_dirs,
-                    "Where package:// URIs point: NAME=DIR, or a directory holding packages "
-                    "(repeatable)");
-  robot->add_option("--mesh-as", robot_command.mesh_as,
-                    "How a collision mesh becomes a body: hull, mesh or pieces")
-      ->check(CLI::IsMember(std::vector<std::string>{"hull", "mesh", "pieces"}))
-      ->capture_default_str();
-  robot->add_option("--margin", robot_command.margin,
-                    "Pairs whose signed distance is at most this are listed")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  robot->add_flag("--gradients", robot_command.gradients,
-                  "Answer each pair's gradient with respect to the joint vector");
-  robot->add_option("--environment", robot_command.environment,
-                    "JSON Lines of obstacles, one body per line as a query's (\"vertices\", "
-                    "\"triangles\", \"radius\", \"pose\") with an optional \"name\"");
-  robot->add_option("--view", robot_command.view_out,
-                    "Write a viewer page of the last configuration (close pairs drawn, excluded "
-                    "pairs never shown as collisions)");
-  robot->footer(
-      "Example:\n"
-      "  echo '{\"id\":1,\"q\":[0,-0.78,0,-2.36,0,1.57,0.78,0.01]}' |\n"
-      "    proxima robot --urdf panda.urdf --srdf panda.srdf --package-dir NAME=DIR --gradients\n"
-      "Each line: {\"id\": any, \"q\": [numbers] or {\"joint name\": number, ...}}.");
-
+  QueryArgs query;
+  add_query(app, query);
+  DistanceArgs distance;
+  add_distance(app, distance);
+  HullArgs hull;
+  add_hull(app, hull);
+  ViewArgs view;
+  add_view(app, view);
+  RobotArgs robot;
+  add_robot(app, robot);
   proxima::cli::RobotSrdfCommand robot_srdf_command;
   CLI::App* robot_srdf = proxima::cli::add_robot_srdf(app, robot_srdf_command);
 
@@ -331,52 +418,12 @@ int main(int argc, char** argv) {
 
   try {
     if (*demo) return proxima::cli::run_demo();
-    if (*query) {
-      options.algorithm = parse_algorithm(algorithm);
-      return run_query_command(file, options, threads, parse_order(query_order), max_line_bytes);
-    }
-    if (*distance) {
-      distance_command.options.algorithm = parse_algorithm(distance_algorithm);
-      distance_command.quaternion_order = parse_order(distance_order);
-      if (distance_command.as_a.empty()) distance_command.as_a = distance_as;
-      if (distance_command.as_b.empty()) distance_command.as_b = distance_as;
-      return proxima::cli::run_distance(distance_command, std::cout, std::cerr);
-    }
-    if (*hull) return proxima::cli::run_hull(hull_command, std::cout, std::cerr);
-    if (*robot) {
-      std::ios::sync_with_stdio(false);
-      if (robot_command.file == "-") {
-        return proxima::cli::run_robot(robot_command, std::cin, std::cout, std::cerr);
-      }
-      std::ifstream in(robot_command.file, std::ios::binary);
-      std::error_code ec;
-      if (!in || std::filesystem::is_directory(robot_command.file, ec)) {
-        std::cerr << "proxima robot: cannot open '" << robot_command.file << "'\n";
-        return kExitFailure;
-      }
-      return proxima::cli::run_robot(robot_command, in, std::cout, std::cerr);
-    }
-    if (*robot_srdf) {
-      return proxima::cli::run_robot_srdf(robot_srdf_command, std::cout, std::cerr);
-    }
-    if (*view) {
-      // Exactly one input: two files, a query file or a scene file.
-      const bool files = !view_command.file_a.empty();
-      const int inputs = (files ? 1 : 0) + (view_command.query_file.empty() ? 0 : 1) +
-                         (view_command.scene_file.empty() ? 0 : 1);
-      if (inputs != 1 || (files && view_command.file_b.empty())) {
-        std::cerr << "proxima view: give two mesh files A B, or --query FILE, or --scene FILE "
-                     "(exactly one of them)\n";
-        return kExitUsage;
-      }
-      if (!files && (!view_command.pose_a.empty() || !view_command.pose_b.empty())) {
-        std::cerr << "proxima view: --pose-a and --pose-b go with two mesh files\n";
-        return kExitUsage;
-      }
-      view_command.options.algorithm = parse_algorithm(view_algorithm);
-      view_command.quaternion_order = parse_order(view_order);
-      return proxima::cli::run_view(view_command, std::cout, std::cerr);
-    }
+    if (*query.app) return run(query);
+    if (*distance.app) return run(distance);
+    if (*hull.app) return proxima::cli::run_hull(hull.command, std::cout, std::cerr);
+    if (*robot.app) return run(robot);
+    if (*robot_srdf) return proxima::cli::run_robot_srdf(robot_srdf_command, std::cout, std::cerr);
+    if (*view.app) return run(view);
   } catch (const std::exception& e) {
     std::cerr << "proxima: " << e.what() << "\n";
     return kExitFailure;

@@ -222,7 +222,10 @@ void bind_bodies(py::module_& m) {
       "(two polytopes "
       "or two compounds take the overloads above). cache: a BodyCache or None. Returns a "
       "BodyResult. penetration=False skips the depth of overlapping cores: their signed value "
-      "is then 0 with bounds [-inf, 0] (signed distance minus the radii). A ConvexPolytope met "
+      "is then 0 with bounds [-inf, 0] (signed distance minus the radii). With a TriangleMesh on "
+      "either side the triangle pairs are solved in closed form: only absolute_tolerance applies, "
+      "another algorithm, relative_tolerance or max_iterations than the defaults is refused "
+      "(InvalidInput naming the field), and an overlap has no depth. A ConvexPolytope met "
       "with a compound is wrapped on every call (O(N)): for "
       "tracked queries, wrap it once as a Body.");
 }

@@ -133,10 +133,9 @@ ImpactOptions sweep_options(const Scene& s, double target_separation, double tol
   return options;
 }
 
-}  // namespace
+// --- Compound bodies and their queries -----------------------------------------
 
-void bind_compound_and_scene(py::module_& m) {
-  // --- Compound bodies --------------------------------------------------------
+void bind_compounds(py::module_& m) {
   py::class_<CompoundBody, std::shared_ptr<CompoundBody>>(
       m, "CompoundBody",
       "A non-convex body as a union of convex pieces, each a ConvexPolytope at its own pose in "
@@ -219,6 +218,9 @@ void bind_compound_and_scene(py::module_& m) {
       "Reads a mesh file as a compound body: one convex piece per OBJ group; a non-convex group "
       "is hulled and reported in its LoadedPiece.input_was_convex (no warning).");
 
+}
+
+void bind_compound_queries(py::module_& m) {
   // Every method holds the cache's in-use flag: the compound distance uses
   // the cache without the GIL.
   py::class_<PyCompoundCache>(
@@ -318,7 +320,12 @@ void bind_compound_and_scene(py::module_& m) {
       py::arg("algorithm") = to_string(defaults.algorithm),
       "The slow twin of the compound distance: every piece pair, cold. For checks.");
 
-  // --- Scenes -----------------------------------------------------------------
+}
+
+// --- Scenes ----------------------------------------------------------------------
+
+// The types a Scene answers with.
+void bind_scene_results(py::module_& m) {
   py::class_<ClosePair>(m, "ClosePair", "A pair of bodies within the scene's margin (a < b).")
       .def_readonly("a", &ClosePair::a, "Body id.")
       .def_readonly("b", &ClosePair::b, "Body id.")
@@ -384,15 +391,12 @@ void bind_compound_and_scene(py::module_& m) {
       .def_readonly("filtered_pairs", &SceneStats::filtered_pairs,
                     "Pairs whose boxes overlapped but that the pair filters dropped.");
 
-  // Every method holds the scene's in-use flag (step() and
-  // close_pairs_all_pairs() run without the GIL; anything else at the same
-  // time would race with them).
-  py::class_<PyScene>(
-      m, "Scene",
-      "Many bodies (ConvexPolytope or CompoundBody) moved by the caller; step() returns the "
-      "pairs within the margin, with tracked distance queries (each pair's cache kept across "
-      "steps). Use from one thread at a time: a call while another thread's call is running "
-      "raises RuntimeError.")
+}
+
+// The Scene's construction, its bodies' addition, paddings and poses.
+void bind_scene_bodies(py::class_<PyScene>& scene) {
+  const DistanceOptions defaults;
+  scene
       .def(py::init([](double margin, const std::string& broad_phase, int threads,
                        const std::string& algorithm, double relative_tolerance,
                        double absolute_tolerance, int max_iterations, bool penetration) {
@@ -414,7 +418,10 @@ void bind_compound_and_scene(py::module_& m) {
            "margin: pairs at distance <= margin are reported. broad_phase: 'dynamic_aabb_tree' or "
            "'sweep_and_prune'. threads: narrow-phase threads (1: the calling thread, 0: all "
            "cores). penetration: overlapping pairs get their depth (signed distance); off by "
-           "default in a scene, where it costs 5 to 60 us per overlapping pair and step.")
+           "default in a scene (a single distance() computes it by default), where it costs many "
+           "times a tracked distance per overlapping pair and step. A scene whose options differ "
+           "from the defaults in algorithm, relative_tolerance or max_iterations refuses a "
+           "TriangleMesh body in add() (InvalidInput): the mesh query cannot honour them.")
       .def(
           "add",
           [](PyScene& s, py::handle body, py::object pose, double padding) {
@@ -471,7 +478,12 @@ void bind_compound_and_scene(py::module_& m) {
           },
           py::arg("ids"), py::arg("poses"),
           "Moves many bodies at once: ids (K,) and poses (K, 4, 4). All or nothing: an unknown "
-          "id or a bad pose raises before any body moves.")
+          "id or a bad pose raises before any body moves.");
+}
+
+// The Scene's pair filters, removal, membership and readers.
+void bind_scene_filters(py::class_<PyScene>& scene) {
+  scene
       .def(
           "set_filter",
           [](PyScene& s, BodyId id, std::uint32_t group, std::uint32_t mask) {
@@ -566,7 +578,12 @@ void bind_compound_and_scene(py::module_& m) {
             const InUse in_use(s, "Scene");
             return s.options().margin;
           },
-          "The query margin.")
+          "The query margin.");
+}
+
+// The Scene's queries: step, the margin checks, the nearest pair, a body's close pairs.
+void bind_scene_queries(py::class_<PyScene>& scene) {
+  scene
       .def(
           "step",
           [](PyScene& s) {
@@ -646,7 +663,12 @@ void bind_compound_and_scene(py::module_& m) {
           },
           py::arg("id"), py::arg("margin"),
           "Every body within margin of body id (touching and intersecting included), as "
-          "ClosePair (min id, max id), by increasing other id.")
+          "ClosePair (min id, max id), by increasing other id.");
+}
+
+// The Scene's motions and sweeps (time of impact), the all-pairs twins, its repr.
+void bind_scene_motion(py::class_<PyScene>& scene) {
+  scene
       .def(
           "set_end_pose",
           [](PyScene& s, BodyId id, py::object pose) {
@@ -750,6 +772,27 @@ void bind_compound_and_scene(py::module_& m) {
         return "proxima.Scene(bodies=" + std::to_string(s.body_count()) +
                ", margin=" + py::repr(py::float_(s.options().margin)).cast<std::string>() + ")";
       });
+}
+
+}  // namespace
+
+void bind_compound_and_scene(py::module_& m) {
+  bind_compounds(m);
+  bind_compound_queries(m);
+  bind_scene_results(m);
+  // Every method holds the scene's in-use flag (step() and
+  // close_pairs_all_pairs() run without the GIL; anything else at the same
+  // time would race with them).
+  py::class_<PyScene> scene(
+      m, "Scene",
+      "Many bodies (ConvexPolytope or CompoundBody) moved by the caller; step() returns the "
+      "pairs within the margin, with tracked distance queries (each pair's cache kept across "
+      "steps). Use from one thread at a time: a call while another thread's call is running "
+      "raises RuntimeError.");
+  bind_scene_bodies(scene);
+  bind_scene_filters(scene);
+  bind_scene_queries(scene);
+  bind_scene_motion(scene);
 }
 
 }  // namespace proxima::python

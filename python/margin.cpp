@@ -36,7 +36,10 @@ TriangleMesh, Body) with cache a BodyCache; cache None is cold. The caches are t
 query's: one kept by distance() serves this query and the other way round.
 Returns a MarginResult: status 'within' (point_a, point_b: a witness pair at most margin + band
 apart, band = 64 u R + absolute_tolerance), 'beyond' (lower_bound > margin, certified) or
-'undecided' (neither proof at the iteration cap). Poses and options as in distance().)doc";
+'undecided' (neither proof at the iteration cap). Poses and options as in distance(): with a
+TriangleMesh on either side, another algorithm, relative_tolerance or max_iterations than the
+defaults is refused (InvalidInput naming the field), since its triangle pairs are solved in
+closed form.)doc";
 
 constexpr const char* kIntersectsDoc =
     R"doc(Whether bodies a and b touch or intersect: within_margin with margin 0 (same arguments, same MarginResult).)doc";

@@ -61,16 +61,10 @@ readings, since in the other order it is another rotation. Bad input raises prox
 ValueError) with the C++ message; a missing file raises FileNotFoundError.
 )doc";
 
-}  // namespace
-}  // namespace proxima
+using namespace proxima::python;
 
-PYBIND11_MODULE(_proxima, m) {
-  using namespace proxima;
-  using namespace proxima::python;
-  // The package proxima re-exports every name: classes and functions say they are proxima.X.
-  m.attr("__name__") = "proxima";
-  m.doc() = kModuleDoc;
-
+// InvalidInput, FileError and NonConvexInputWarning.
+void bind_exceptions(py::module_& m) {
   const auto invalid_input =
       py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
   invalid_input.doc() =
@@ -85,6 +79,10 @@ PYBIND11_MODULE(_proxima, m) {
       "is not convex (see LoadedPolytope.input_was_convex): the hull of all points is used.",
       PyExc_UserWarning, nullptr));
 
+}
+
+// Pose.
+void bind_pose(py::module_& m) {
   // --- Pose -----------------------------------------------------------------
   py::class_<Pose>(m, "Pose", "A rigid motion: x -> rotation @ x + translation.")
       .def(py::init<>(), "The identity.")
@@ -192,6 +190,10 @@ PYBIND11_MODULE(_proxima, m) {
                py::repr(vec3_array(p.translation)).cast<std::string>() + ")";
       });
 
+}
+
+// ConvexPolytope.
+void bind_polytope(py::module_& m) {
   // --- ConvexPolytope -------------------------------------------------------
   // Held by shared_ptr: a Scene or a CompoundBody keeps the polytopes it is given.
   py::class_<ConvexPolytope, std::shared_ptr<ConvexPolytope>>(
@@ -319,6 +321,10 @@ PYBIND11_MODULE(_proxima, m) {
                ", faces=" + std::to_string(p.face_count()) + ")";
       });
 
+}
+
+// Reading a polytope from a file.
+void bind_polytope_files(py::module_& m) {
   py::class_<LoadedPolytope>(m, "LoadedPolytope",
                              "A polytope read from a file, with how convex the input was.")
       .def_property_readonly(
@@ -350,6 +356,10 @@ PYBIND11_MODULE(_proxima, m) {
       },
       py::arg("path"), "The points of a mesh file (OBJ, OFF, STL, PLY, XYZ) as an (N, 3) array.");
 
+}
+
+// The distance cache, features and results.
+void bind_results(py::module_& m) {
   // --- Cache, features, results ---------------------------------------------
   py::class_<PyDistanceCache>(
       m, "DistanceCache",
@@ -471,6 +481,10 @@ origin (3). Exact where the witness pair is unique, else one-sided (a subgradien
 InvalidInput for an intersecting answer computed without the depth, or for an overlap with a
 triangle mesh (no depth is defined for it: use the mesh's hull or convex pieces).)doc");
 
+}
+
+// distance() and distance_batch() of two polytopes.
+void bind_distance_queries(py::module_& m) {
   // --- Queries --------------------------------------------------------------
   const DistanceOptions defaults;
   m.def(
@@ -585,6 +599,24 @@ signed_lower_bound, signed_upper_bound, point_a (K, 3),
 point_b (K, 3), normal (K, 3), feature_a_type (str), feature_a_vertices (K, 3; -1 unused),
 feature_a_face, the same for b, iterations. Row k equals distance(a, poses_a[k], b, poses_b[k]).)doc");
 
+}
+
+}  // namespace
+}  // namespace proxima
+
+PYBIND11_MODULE(_proxima, m) {
+  using namespace proxima;
+  using namespace proxima::python;
+  // The package proxima re-exports every name: classes and functions say they are proxima.X.
+  m.attr("__name__") = "proxima";
+  m.doc() = kModuleDoc;
+
+  bind_exceptions(m);
+  bind_pose(m);
+  bind_polytope(m);
+  bind_polytope_files(m);
+  bind_results(m);
+  bind_distance_queries(m);
   // Before the scene: Scene.sweep's ImpactPair holds an ImpactResult, whose
   // type must be known when its property is bound (for its signature).
   bind_time_of_impact(m);

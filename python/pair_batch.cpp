@@ -99,15 +99,10 @@ bool all_polytopes(const py::sequence& seq) {
   return true;
 }
 
-}  // namespace
-
-void bind_pair_batch(py::module_& m) {
+// The PairBatch's construction and distance().
+void bind_pair_batch_distance(py::class_<PyPairBatch>& batch) {
   const DistanceOptions defaults;
-  py::class_<PyPairBatch>(
-      m, "PairBatch",
-      "K pairs of bodies (a[k], b[k]), answered together by distance(): one Python "
-      "call, the queries on the thread pool without the GIL, each pair's cache kept "
-      "inside the object from call to call (tracking). Use from one thread at a time.")
+  batch
       .def(
           py::init([](py::object a, py::object b) {
             const py::sequence list_a = body_list(a, "a");
@@ -209,7 +204,13 @@ point_b, normal, features, iterations). Row k equals
 distance(a[k], poses_a[k], b[k], poses_b[k], cache=<pair k's cache>).
 out: None (new arrays), or the dict of an earlier answer of this batch: its arrays are
 filled again in place and the same dict is returned, so that a loop allocates nothing
-(a bad out raises ValueError before any cache or array changes).)doc")
+(a bad out raises ValueError before any cache or array changes).)doc");
+}
+
+// The PairBatch's margin checks, reset and readers.
+void bind_pair_batch_margins(py::class_<PyPairBatch>& batch) {
+  const DistanceOptions defaults;
+  batch
       .def(
           "within_margin",
           [](PyPairBatch& s, py::object poses_a, py::object poses_b, double margin, int threads,
@@ -276,6 +277,18 @@ margin, cache=<pair k's cache>).)doc")
         const InUse in_use(s, "PairBatch");
         return "proxima.PairBatch(pairs=" + std::to_string(s.size()) + ")";
       });
+}
+
+}  // namespace
+
+void bind_pair_batch(py::module_& m) {
+  py::class_<PyPairBatch> batch(
+      m, "PairBatch",
+      "K pairs of bodies (a[k], b[k]), answered together by distance(): one Python "
+      "call, the queries on the thread pool without the GIL, each pair's cache kept "
+      "inside the object from call to call (tracking). Use from one thread at a time.");
+  bind_pair_batch_distance(batch);
+  bind_pair_batch_margins(batch);
 }
 
 }  // namespace proxima::python

@@ -81,9 +81,8 @@ RobotQueryOptions make_robot_options(double margin, bool gradients, bool self, b
   return options;
 }
 
-}  // namespace
-
-void bind_robot(py::module_& m) {
+// The answers of a robot query.
+void bind_robot_results(py::module_& m) {
   py::class_<RobotPairResult>(m, "RobotPair", "One pair of a robot query (Robot.distances).")
       .def_readonly("geometry_a", &RobotPairResult::geometry_a,
                     "The robot geometry (index into Robot.geometry_names).")
@@ -130,19 +129,11 @@ void bind_robot(py::module_& m) {
           },
           "The gradient of min_signed_distance (the closest pair's), or None.");
 
-  py::class_<PyRobot>(m, "Robot",
-                      R"doc(A robot from its URDF (and SRDF): kinematics and signed distances.
+}
 
-    robot = proxima.Robot("panda.urdf", srdf="panda.srdf",
-                          package_dirs=["example-robot-data=/path/to/example-robot-data"])
-    r = robot.distances(q, margin=0.05, gradients=True)
-
-q: a 1-D array of length dof in the order of joint_names (the URDF's <joint> order, the moving
-joints that mimic none), or a dict naming every joint of joint_names.
-package_dirs: "NAME=DIR" (package NAME is DIR) or a directory holding packages (ROS_PACKAGE_PATH).
-mesh_as: "hull" (default), "mesh" or "pieces"; link_mesh_as: {link name: mode} overrides.
-The robot keeps its environment (set_environment) and its per-pair caches between calls
-(tracking along a trajectory); reset() makes it cold.)doc")
+// The Robot's construction from its URDF and its model (names, pairs, limits).
+void bind_robot_model(py::class_<PyRobot>& robot) {
+  robot
       .def(py::init([](const std::string& urdf, const std::optional<std::string>& srdf,
                        const std::vector<std::string>& package_dirs, const std::string& mesh_as,
                        const std::map<std::string, std::string>& link_mesh_as,
@@ -216,7 +207,12 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
           "Lower limit of each joint of q (-inf for a continuous joint).")
       .def_property_readonly(
           "upper_limits", [](const PyRobot& r) { return vector_array(r.robot->upper_limits()); },
-          "Upper limit of each joint of q (inf for a continuous joint).")
+          "Upper limit of each joint of q (inf for a continuous joint).");
+}
+
+// The Robot's kinematics, environment and distance queries.
+void bind_robot_queries(py::class_<PyRobot>& robot) {
+  robot
       .def(
           "forward_kinematics",
           [](const PyRobot& r, py::handle q, py::handle base) {
@@ -303,6 +299,27 @@ The robot keeps its environment (set_environment) and its per-pair caches betwee
           py::arg("base") = py::none(),
           "K configurations (K, dof) on the thread pool: (minima (K,), gradients (K, dof) or "
           "None). Row k equals distances(q[k]).min_signed_distance and its gradient.");
+}
+
+}  // namespace
+
+void bind_robot(py::module_& m) {
+  bind_robot_results(m);
+  py::class_<PyRobot> robot(m, "Robot",
+                      R"doc(A robot from its URDF (and SRDF): kinematics and signed distances.
+
+    robot = proxima.Robot("panda.urdf", srdf="panda.srdf",
+                          package_dirs=["example-robot-data=/path/to/example-robot-data"])
+    r = robot.distances(q, margin=0.05, gradients=True)
+
+q: a 1-D array of length dof in the order of joint_names (the URDF's <joint> order, the moving
+joints that mimic none), or a dict naming every joint of joint_names.
+package_dirs: "NAME=DIR" (package NAME is DIR) or a directory holding packages (ROS_PACKAGE_PATH).
+mesh_as: "hull" (default), "mesh" or "pieces"; link_mesh_as: {link name: mode} overrides.
+The robot keeps its environment (set_environment) and its per-pair caches between calls
+(tracking along a trajectory); reset() makes it cold.)doc");
+  bind_robot_model(robot);
+  bind_robot_queries(robot);
 }
 
 }  // namespace proxima::python

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <string>
 
+#include "core/accuracy.h"
 #include "query/parallel_ranges.h"
 
 namespace proxima {
@@ -136,182 +137,252 @@ bool by_geometries(const RobotPairResult& x, const RobotPairResult& y) {
 
 }  // namespace
 
-RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
-                               std::span<const Obstacle> obstacles,
-                               const RobotQueryOptions& options, RobotQueryState* state) {
-  // std::isfinite first: an ordered comparison with NaN raises FE_INVALID.
-  if (!std::isfinite(options.margin) || options.margin < 0) {
-    throw InvalidInput("robot query: margin " + std::to_string(options.margin) +
-                       " is not a finite value >= 0");
-  }
-  RobotQueryState local;
-  RobotQueryState& s = state != nullptr ? *state : local;
-  const auto& geometries = robot.geometries();
-  const auto& pairs = robot.self_pairs();
-  const std::size_t n_geometries = geometries.size();
-  if (s.robot_ != &robot || s.obstacles_ != obstacles.size() || s.self_.size() != pairs.size() ||
-      s.motion_.size() != n_geometries) {
-    s.reset();
-    s.robot_ = &robot;
-    s.obstacles_ = obstacles.size();
-    s.self_.resize(pairs.size());
-    s.environment_.resize(n_geometries * obstacles.size());
-    s.self_bound_.assign(pairs.size(), -kInfinity);
-    s.environment_bound_.assign(n_geometries * obstacles.size(), -kInfinity);
-    s.motion_.assign(n_geometries, kInfinity);
-    s.obstacle_poses_.resize(obstacles.size());
-    s.obstacle_cores_.assign(obstacles.size(), nullptr);
-    s.obstacle_radii_.assign(obstacles.size(), 0.0);
-    s.obstacle_motion_.assign(obstacles.size(), kInfinity);
-    s.self_normal_.assign(pairs.size(), Vec3::Zero());
-    s.environment_normal_.assign(n_geometries * obstacles.size(), Vec3::Zero());
-  }
-  std::swap(s.link_poses_, s.previous_link_poses_);
-  robot.forward_kinematics(q, options.base, s.link_poses_);
-  const bool moved_before = s.previous_link_poses_.size() == s.link_poses_.size();
-  const auto& spheres = robot.geometry_spheres();
-  s.geometry_poses_.resize(n_geometries);
-  s.centers_.resize(n_geometries);
-  s.box_centers_.resize(n_geometries);
-  const auto& boxes = robot.geometry_boxes();
-  for (std::size_t g = 0; g < n_geometries; ++g) {
-    const auto link = static_cast<std::size_t>(geometries[g].link);
-    s.geometry_poses_[g] = s.link_poses_[link] * geometries[g].origin;
-    s.box_centers_[g] = s.geometry_poses_[g].apply(boxes[g].center);
-    s.centers_[g] = s.link_poses_[link].apply(spheres[g].center);
-    s.motion_[g] = moved_before ? motion(s.previous_link_poses_[link], s.link_poses_[link],
-                                         spheres[g].center, spheres[g].radius)
-                                : kInfinity;
-  }
-  for (std::size_t o = 0; o < obstacles.size(); ++o) {
-    // An obstacle replaced by another body (or radius) starts over.
-    const void* core = core_of(obstacles[o].body);
-    if (core != s.obstacle_cores_[o] || obstacles[o].body.radius() != s.obstacle_radii_[o]) {
-      s.obstacle_cores_[o] = core;
-      s.obstacle_radii_[o] = obstacles[o].body.radius();
-      s.obstacle_motion_[o] = kInfinity;
-    } else {
-      s.obstacle_motion_[o] =
-          motion(s.obstacle_poses_[o], obstacles[o].pose,
-                 obstacles[o].pose.inverse().apply(obstacles[o].center), obstacles[o].radius);
-    }
-    s.obstacle_poses_[o] = obstacles[o].pose;
-  }
-  s.obstacle_box_centers_.resize(obstacles.size());
-  for (std::size_t o = 0; o < obstacles.size(); ++o) {
-    s.obstacle_box_centers_[o] = obstacles[o].pose.apply(obstacles[o].box.center);
-  }
-  const auto geometry_box = [&](std::size_t g) {
-    return WorldBox{s.box_centers_[g], &s.geometry_poses_[g].rotation, &boxes[g].half_extents,
-                    geometries[g].body.radius()};
-  };
+namespace detail {
 
-  RobotDistances out;
-  const auto report = [&](RobotPairResult&& pair, double& category_min, std::int32_t index,
-                          std::int32_t& last) {
+// One robot_distances call, in the order of its concepts: the options
+// checked, the state sized for this robot and its obstacles, the bodies
+// placed at q (and each pair's bound decayed by the motion since the last
+// query), then the self pairs and the environment pairs, each queried only
+// while its bound is below what it could still change.
+class RobotQuery {
+ public:
+  RobotQuery(const Robot& robot, std::span<const Obstacle> obstacles,
+             const RobotQueryOptions& options, RobotQueryState& state)
+      : robot_(robot),
+        obstacles_(obstacles),
+        options_(options),
+        s_(state),
+        geometries_(robot.geometries()),
+        pairs_(robot.self_pairs()),
+        spheres_(robot.geometry_spheres()),
+        boxes_(robot.geometry_boxes()) {}
+
+  RobotDistances run(std::span<const double> q) {
+    check_options();
+    size_state();
+    place(q);
+    decay_bounds();
+    if (options_.self && !pairs_.empty()) self_pairs();
+    // The self part was visited from the last closest pair on: back to
+    // self_pairs() order.
+    std::sort(out_.close_pairs.begin(), out_.close_pairs.end(), by_geometries);
+    const std::size_t self_reported = out_.close_pairs.size();
+    if (options_.environment && !obstacles_.empty() && !geometries_.empty()) {
+      environment_pairs();
+      std::sort(out_.close_pairs.begin() + static_cast<std::ptrdiff_t>(self_reported),
+                out_.close_pairs.end(), by_geometries);
+    }
+    return std::move(out_);
+  }
+
+ private:
+  void check_options() const {
+    check_finite_non_negative(options_.margin, "robot query", "options.margin");
+    check_distance_options(options_.distance, "robot query", "options.distance");
+    // A pair with a mesh is answered by the mesh query, which cannot honour
+    // every distance option: refused before any pair, not at the first mesh
+    // pair queried (only when an option differs from what meshes take).
+    if (!mesh_options_plainly_valid(options_.distance, MeshOptionUse::triangle_pairs)) {
+      const auto refuse_for_meshes = [&](const Body& body) {
+        if (body.kind() == Body::Kind::mesh)
+          check_mesh_options(options_.distance, "robot query", MeshOptionUse::triangle_pairs,
+                             "options.distance");
+      };
+      for (const RobotGeometry& g : geometries_) refuse_for_meshes(g.body);
+      for (const Obstacle& o : obstacles_) refuse_for_meshes(o.body);
+    }
+  }
+
+  // A state of another robot or obstacle count starts over, cold.
+  void size_state() {
+    const std::size_t n_geometries = geometries_.size();
+    if (s_.robot_ == &robot_ && s_.obstacles_ == obstacles_.size() &&
+        s_.self_.size() == pairs_.size() && s_.motion_.size() == n_geometries)
+      return;
+    s_.reset();
+    s_.robot_ = &robot_;
+    s_.obstacles_ = obstacles_.size();
+    s_.self_.resize(pairs_.size());
+    s_.environment_.resize(n_geometries * obstacles_.size());
+    s_.self_bound_.assign(pairs_.size(), -kInfinity);
+    s_.environment_bound_.assign(n_geometries * obstacles_.size(), -kInfinity);
+    s_.motion_.assign(n_geometries, kInfinity);
+    s_.obstacle_poses_.resize(obstacles_.size());
+    s_.obstacle_cores_.assign(obstacles_.size(), nullptr);
+    s_.obstacle_radii_.assign(obstacles_.size(), 0.0);
+    s_.obstacle_motion_.assign(obstacles_.size(), kInfinity);
+    s_.self_normal_.assign(pairs_.size(), Vec3::Zero());
+    s_.environment_normal_.assign(n_geometries * obstacles_.size(), Vec3::Zero());
+  }
+
+  // Forward kinematics at q: every geometry's pose, sphere and box centre,
+  // and how far it moved since the last query; each obstacle's motion.
+  void place(std::span<const double> q) {
+    const std::size_t n_geometries = geometries_.size();
+    std::swap(s_.link_poses_, s_.previous_link_poses_);
+    robot_.forward_kinematics(q, options_.base, s_.link_poses_);
+    const bool moved_before = s_.previous_link_poses_.size() == s_.link_poses_.size();
+    s_.geometry_poses_.resize(n_geometries);
+    s_.centers_.resize(n_geometries);
+    s_.box_centers_.resize(n_geometries);
+    for (std::size_t g = 0; g < n_geometries; ++g) {
+      const auto link = static_cast<std::size_t>(geometries_[g].link);
+      s_.geometry_poses_[g] = s_.link_poses_[link] * geometries_[g].origin;
+      s_.box_centers_[g] = s_.geometry_poses_[g].apply(boxes_[g].center);
+      s_.centers_[g] = s_.link_poses_[link].apply(spheres_[g].center);
+      s_.motion_[g] = moved_before ? motion(s_.previous_link_poses_[link], s_.link_poses_[link],
+                                            spheres_[g].center, spheres_[g].radius)
+                                   : kInfinity;
+    }
+    for (std::size_t o = 0; o < obstacles_.size(); ++o) {
+      // An obstacle replaced by another body (or radius) starts over.
+      const void* core = core_of(obstacles_[o].body);
+      if (core != s_.obstacle_cores_[o] || obstacles_[o].body.radius() != s_.obstacle_radii_[o]) {
+        s_.obstacle_cores_[o] = core;
+        s_.obstacle_radii_[o] = obstacles_[o].body.radius();
+        s_.obstacle_motion_[o] = kInfinity;
+      } else {
+        s_.obstacle_motion_[o] =
+            motion(s_.obstacle_poses_[o], obstacles_[o].pose,
+                   obstacles_[o].pose.inverse().apply(obstacles_[o].center), obstacles_[o].radius);
+      }
+      s_.obstacle_poses_[o] = obstacles_[o].pose;
+    }
+    s_.obstacle_box_centers_.resize(obstacles_.size());
+    for (std::size_t o = 0; o < obstacles_.size(); ++o) {
+      s_.obstacle_box_centers_[o] = obstacles_[o].pose.apply(obstacles_[o].box.center);
+    }
+  }
+
+  // Each pair's bound decays by the motion first (every pair, queried or
+  // not, whatever options.self and options.environment say), so that it
+  // stays a bound at the next query too.
+  void decay_bounds() {
+    for (std::size_t p = 0; p < pairs_.size(); ++p) {
+      s_.self_bound_[p] -= s_.motion_[static_cast<std::size_t>(pairs_[p].a)] +
+                           s_.motion_[static_cast<std::size_t>(pairs_[p].b)];
+    }
+    for (std::size_t g = 0; g < geometries_.size(); ++g) {
+      for (std::size_t o = 0; o < obstacles_.size(); ++o) {
+        s_.environment_bound_[g * obstacles_.size() + o] -= s_.motion_[g] + s_.obstacle_motion_[o];
+      }
+    }
+  }
+
+  WorldBox geometry_box(std::size_t g) const {
+    return WorldBox{s_.box_centers_[g], &s_.geometry_poses_[g].rotation, &boxes_[g].half_extents,
+                    geometries_[g].body.radius()};
+  }
+
+  // Records a queried pair: its category's minimum (and the pair that gave
+  // it, `last`), the closest overall, and the close pairs within the margin.
+  void report(RobotPairResult&& pair, double& category_min, std::int32_t index,
+              std::int32_t& last) {
     const double sd = pair.result.signed_distance();
-    const bool closest = sd < out.min_signed_distance;
+    const bool closest = sd < out_.min_signed_distance;
     if (sd < category_min) {
       category_min = sd;
       last = index;
     }
-    const bool within = !options.minimum_only && sd <= options.margin;
+    const bool within = !options_.minimum_only && sd <= options_.margin;
     if (!closest && !within) return;
-    if (options.gradients) fill_gradient(robot, s.link_poses_, pair);
+    if (options_.gradients) fill_gradient(robot_, s_.link_poses_, pair);
     if (closest) {
-      out.min_signed_distance = sd;
-      out.closest = pair;
+      out_.min_signed_distance = sd;
+      out_.closest = pair;
     }
-    if (within) out.close_pairs.push_back(std::move(pair));
-  };
-  // Each pair's bound decays by the motion first (every pair, queried or
-  // not, whatever options.self and options.environment say), so that it
-  // stays a bound at the next query too.
-  for (std::size_t p = 0; p < pairs.size(); ++p) {
-    s.self_bound_[p] -= s.motion_[static_cast<std::size_t>(pairs[p].a)] +
-                        s.motion_[static_cast<std::size_t>(pairs[p].b)];
-  }
-  for (std::size_t g = 0; g < n_geometries; ++g) {
-    for (std::size_t o = 0; o < obstacles.size(); ++o) {
-      s.environment_bound_[g * obstacles.size() + o] -= s.motion_[g] + s.obstacle_motion_[o];
-    }
+    if (within) out_.close_pairs.push_back(std::move(pair));
   }
 
-  if (options.self && !pairs.empty()) {
+  void self_pairs() {
     // The last closest pair first: its distance is likely the smallest
     // again, and it prunes the others.
-    const std::int32_t first = s.last_self_ >= 0 ? s.last_self_ : 0;
+    const std::int32_t first = s_.last_self_ >= 0 ? s_.last_self_ : 0;
     std::int32_t last = -1;
-    const auto n = static_cast<std::int32_t>(pairs.size());
+    const auto n = static_cast<std::int32_t>(pairs_.size());
     for (std::int32_t k = 0; k < n; ++k) {
       const std::int32_t p = k == 0 ? first : (k <= first ? k - 1 : k);
-      const GeometryPair& pair = pairs[static_cast<std::size_t>(p)];
+      const GeometryPair& pair = pairs_[static_cast<std::size_t>(p)];
       const auto a = static_cast<std::size_t>(pair.a), b = static_cast<std::size_t>(pair.b);
-      double& bound = s.self_bound_[static_cast<std::size_t>(p)];
-      const double threshold = options.minimum_only ? out.min_self
-                                                    : std::max(options.margin, out.min_self);
+      double& bound = s_.self_bound_[static_cast<std::size_t>(p)];
+      const double threshold = options_.minimum_only ? out_.min_self
+                                                     : std::max(options_.margin, out_.min_self);
       if (bound > threshold) continue;
-      bound = std::max(
-          bound, sphere_bound(s.centers_[a], spheres[a].radius, s.centers_[b], spheres[b].radius));
+      bound = std::max(bound, sphere_bound(s_.centers_[a], spheres_[a].radius, s_.centers_[b],
+                                           spheres_[b].radius));
       if (bound > threshold) continue;
-      Vec3& normal = s.self_normal_[static_cast<std::size_t>(p)];
+      Vec3& normal = s_.self_normal_[static_cast<std::size_t>(p)];
       bound = std::max(bound, box_bound(geometry_box(a), geometry_box(b), normal));
       if (bound > threshold) continue;
-      ++out.pairs_queried;
+      ++out_.pairs_queried;
       RobotPairResult result;
       result.geometry_a = pair.a;
       result.geometry_b = pair.b;
-      result.result =
-          distance(geometries[a].body, s.geometry_poses_[a], geometries[b].body,
-                   s.geometry_poses_[b], options.distance, &s.self_[static_cast<std::size_t>(p)]);
+      result.result = distance(geometries_[a].body, s_.geometry_poses_[a], geometries_[b].body,
+                               s_.geometry_poses_[b], options_.distance,
+                               &s_.self_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
       normal = result.result.normal;
-      report(std::move(result), out.min_self, p, last);
+      report(std::move(result), out_.min_self, p, last);
     }
-    if (last >= 0) s.last_self_ = last;
+    if (last >= 0) s_.last_self_ = last;
   }
-  // The self part was visited from `first` on: back to self_pairs() order.
-  std::sort(out.close_pairs.begin(), out.close_pairs.end(), by_geometries);
-  const std::size_t self_reported = out.close_pairs.size();
 
-  if (options.environment && !obstacles.empty() && n_geometries > 0) {
-    const auto n_obstacles = static_cast<std::int32_t>(obstacles.size());
-    const auto n = static_cast<std::int32_t>(n_geometries) * n_obstacles;
-    const std::int32_t first = s.last_environment_ >= 0 ? s.last_environment_ : 0;
+  void environment_pairs() {
+    const auto n_obstacles = static_cast<std::int32_t>(obstacles_.size());
+    const auto n = static_cast<std::int32_t>(geometries_.size()) * n_obstacles;
+    const std::int32_t first = s_.last_environment_ >= 0 ? s_.last_environment_ : 0;
     std::int32_t last = -1;
     for (std::int32_t k = 0; k < n; ++k) {
       const std::int32_t p = k == 0 ? first : (k <= first ? k - 1 : k);
       const auto g = static_cast<std::size_t>(p / n_obstacles);
       const auto o = static_cast<std::size_t>(p % n_obstacles);
-      double& bound = s.environment_bound_[static_cast<std::size_t>(p)];
-      const double threshold = options.minimum_only
-                                   ? out.min_environment
-                                   : std::max(options.margin, out.min_environment);
+      double& bound = s_.environment_bound_[static_cast<std::size_t>(p)];
+      const double threshold = options_.minimum_only
+                                   ? out_.min_environment
+                                   : std::max(options_.margin, out_.min_environment);
       if (bound > threshold) continue;
-      bound = std::max(bound, obstacle_box_bound(s.centers_[g], spheres[g].radius, obstacles[o]));
+      bound = std::max(bound, obstacle_box_bound(s_.centers_[g], spheres_[g].radius, obstacles_[o]));
       if (bound > threshold) continue;
-      Vec3& normal = s.environment_normal_[static_cast<std::size_t>(p)];
-      const WorldBox obstacle_box{s.obstacle_box_centers_[o], &obstacles[o].pose.rotation,
-                                  &obstacles[o].box.half_extents, obstacles[o].body.radius()};
+      Vec3& normal = s_.environment_normal_[static_cast<std::size_t>(p)];
+      const WorldBox obstacle_box{s_.obstacle_box_centers_[o], &obstacles_[o].pose.rotation,
+                                  &obstacles_[o].box.half_extents, obstacles_[o].body.radius()};
       bound = std::max(bound, box_bound(geometry_box(g), obstacle_box, normal));
       if (bound > threshold) continue;
-      ++out.pairs_queried;
+      ++out_.pairs_queried;
       RobotPairResult result;
       result.geometry_a = static_cast<std::int32_t>(g);
       result.geometry_b = static_cast<std::int32_t>(o);
       result.environment = true;
       result.result =
-          distance(geometries[g].body, s.geometry_poses_[g], obstacles[o].body, obstacles[o].pose,
-                   options.distance, &s.environment_[static_cast<std::size_t>(p)]);
+          distance(geometries_[g].body, s_.geometry_poses_[g], obstacles_[o].body,
+                   obstacles_[o].pose, options_.distance,
+                   &s_.environment_[static_cast<std::size_t>(p)]);
       bound = result.result.signed_lower_bound();
       normal = result.result.normal;
-      report(std::move(result), out.min_environment, p, last);
+      report(std::move(result), out_.min_environment, p, last);
     }
-    if (last >= 0) s.last_environment_ = last;
-    std::sort(out.close_pairs.begin() + static_cast<std::ptrdiff_t>(self_reported),
-              out.close_pairs.end(), by_geometries);
+    if (last >= 0) s_.last_environment_ = last;
   }
-  return out;
+
+  const Robot& robot_;
+  std::span<const Obstacle> obstacles_;
+  const RobotQueryOptions& options_;
+  RobotQueryState& s_;
+  const std::vector<RobotGeometry>& geometries_;
+  const std::vector<GeometryPair>& pairs_;
+  const std::vector<BoundingSphere>& spheres_;
+  const std::vector<BoundingBox>& boxes_;
+  RobotDistances out_;
+};
+
+}  // namespace detail
+
+RobotDistances robot_distances(const Robot& robot, std::span<const double> q,
+                               std::span<const Obstacle> obstacles,
+                               const RobotQueryOptions& options, RobotQueryState* state) {
+  RobotQueryState local;
+  return detail::RobotQuery(robot, obstacles, options, state != nullptr ? *state : local).run(q);
 }
 
 RobotBatchDistances robot_distances_batch(const Robot& robot, const RowMatrixXd& q,
@@ -321,7 +392,7 @@ RobotBatchDistances robot_distances_batch(const Robot& robot, const RowMatrixXd&
     throw InvalidInput("robot batch: the configurations have " + std::to_string(q.cols()) +
                        " columns, the robot " + std::to_string(robot.dof()) + " variables");
   }
-  if (threads < 0) throw InvalidInput("robot batch: threads " + std::to_string(threads) + " < 0");
+  detail::check_at_least(threads, 0, "robot batch", "threads", "0: all cores");
   RobotBatchDistances out;
   const auto k = static_cast<std::size_t>(q.rows());
   out.min_signed_distance.resize(q.rows());

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "proxima/robot/robot_distance.h"
+#include "core/accuracy.h"
 
 namespace proxima {
 
@@ -56,14 +57,10 @@ struct LinkPairRecord {
 }  // namespace
 
 SrdfProposal propose_disabled_pairs(const Robot& robot, const SrdfProposalOptions& options) {
-  if (options.samples < 1 && options.configurations.size() == 0) {
-    throw InvalidInput("SRDF proposal: samples " + std::to_string(options.samples) + " < 1");
-  }
-  // std::isfinite first: an ordered comparison with NaN raises FE_INVALID.
-  if (!std::isfinite(options.margin) || options.margin < 0) {
-    throw InvalidInput("SRDF proposal: margin " + std::to_string(options.margin) +
-                       " is not a finite value >= 0");
-  }
+  if (options.configurations.size() == 0)
+    detail::check_at_least(options.samples, 1, "SRDF proposal", "options.samples",
+                           "without options.configurations");
+  detail::check_finite_non_negative(options.margin, "SRDF proposal", "options.margin");
   const Robot bare = without_disabled_pairs(robot);
   const auto n_links = static_cast<std::size_t>(bare.links().size());
   std::vector<LinkPairRecord> records(n_links * n_links);

@@ -71,6 +71,21 @@ def test_gradient_of_a_mesh_overlap_names_the_real_reason():
     assert g.shape == (2, 6)
 
 
+def test_options_a_mesh_cannot_honour_are_refused_by_name():
+    # Issue 24: distance() and within_margin() with a mesh took algorithm,
+    # relative_tolerance and max_iterations and silently ignored them.
+    mesh = proxima.TriangleMesh(*cube())
+    ball = proxima.sphere(0.2)
+    at = proxima.Pose.from_translation((2, 0, 0))
+    for field, value in (("algorithm", "gjk"), ("relative_tolerance", 1e-6), ("max_iterations", 8)):
+        with pytest.raises(proxima.InvalidInput, match=f"options.{field} .* does not apply to a triangle mesh"):
+            proxima.distance(mesh, None, ball, at, **{field: value})
+        with pytest.raises(proxima.InvalidInput, match=f"options.{field} .* does not apply to a triangle mesh"):
+            proxima.within_margin(ball, None, mesh, at, 0.1, **{field: value})
+    # absolute_tolerance applies: the contact band widens.
+    assert proxima.distance(mesh, None, ball, at, absolute_tolerance=2.0).status == "touching"
+
+
 def test_bad_arrays_are_named():
     v, f = cube()
     with pytest.raises(ValueError, match="integer vertex indices"):

@@ -478,7 +478,7 @@ def test_batch_errors(bodies):
     scaled[6, :3, :3] *= 2
     with pytest.raises(ValueError, match=r"poses_b\[6\].*not a rotation"):
         proxima.distance_batch(a, pa, b, scaled)
-    with pytest.raises(proxima.InvalidInput, match="threads must be >= 0"):
+    with pytest.raises(proxima.InvalidInput, match=r"threads must be at least 0 \(0: all cores\), got -1"):
         proxima.distance_batch(a, pa, b, pb, threads=-1)
     with pytest.raises(proxima.InvalidInput, match="max_iterations must be at least 1"):
         proxima.distance_batch(a, np.tile(np.eye(4), (500, 1, 1)), b, None, max_iterations=0, threads=2)

@@ -11,23 +11,6 @@
 #include <string>
 
 namespace proxima::detail {
-namespace {
-
-// Finite and >= 0, -0.0 included, decided on the bits: a comparison of a
-// NaN raises FE_INVALID, which a caller's trap turns into SIGFPE instead of
-// the refusal (Pose.DistanceOptionsAreCheckedExactly).
-bool finite_non_negative(double x) {
-  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
-  return bits < 0x7ff0000000000000ULL || bits == 0x8000000000000000ULL;
-}
-
-[[noreturn]] void refuse(const char* who, const char* field, double value) {
-  char what[200];
-  std::snprintf(what, sizeof what, "%s.%s must be finite and >= 0, got %g", who, field, value);
-  throw InvalidInput(what);
-}
-
-}  // namespace
 
 double placed_magnitude(const Vec3& y, const Pose& pose) {
   return pose.apply(y).cwiseAbs().maxCoeff();
@@ -39,15 +22,48 @@ double placed_magnitude(std::span<const Vec3> vertices, const Pose& pose) {
   return r;
 }
 
-void check_distance_options(const DistanceOptions& options, const char* who) {
+void check_distance_options(const DistanceOptions& options, const char* who, const char* path) {
+  // The field's name is built only for a refusal: the queries check their
+  // options on every call.
+  const auto field = [path](const char* name) { return std::string(path) + "." + name; };
   if (!finite_non_negative(options.relative_tolerance))
-    refuse(who, "relative_tolerance", options.relative_tolerance);
+    refuse_not_finite_non_negative(who, field("relative_tolerance").c_str(),
+                                   options.relative_tolerance, nullptr);
   if (!finite_non_negative(options.absolute_tolerance))
-    refuse(who, "absolute_tolerance", options.absolute_tolerance);
-  if (options.max_iterations < 1) {
-    throw InvalidInput(std::string(who) + ".max_iterations must be at least 1, got " +
-                       std::to_string(options.max_iterations));
+    refuse_not_finite_non_negative(who, field("absolute_tolerance").c_str(),
+                                   options.absolute_tolerance, nullptr);
+  if (options.max_iterations < 1)
+    refuse_below(who, field("max_iterations").c_str(), options.max_iterations, 1, nullptr);
+}
+
+void check_mesh_options(const DistanceOptions& options, const char* who, MeshOptionUse use,
+                        const char* path) {
+  check_distance_options(options, who, path);
+  if (mesh_options_plainly_valid(options, use)) return;
+  const DistanceOptions defaults;
+  const auto refuse = [&](const char* field, const std::string& value, const char* why,
+                          const std::string& default_value) {
+    throw InvalidInput(std::string(who) + ": " + path + "." + field + " " + value +
+                       " does not apply to a triangle mesh (" + why + "): leave it at " +
+                       default_value);
+  };
+  const auto number = [](double x) {
+    char s[64];
+    std::snprintf(s, sizeof s, "%g", x);
+    return std::string(s);
+  };
+  if (use == MeshOptionUse::triangle_pairs) {
+    if (options.algorithm != defaults.algorithm)
+      refuse("algorithm", to_string(options.algorithm),
+             "its triangle pairs are solved in closed form", to_string(defaults.algorithm));
+    if (options.max_iterations != defaults.max_iterations)
+      refuse("max_iterations", std::to_string(options.max_iterations),
+             "its triangle pairs are solved in closed form, without iterations",
+             std::to_string(defaults.max_iterations));
   }
+  refuse("relative_tolerance", number(options.relative_tolerance),
+         "its search stops at the bound of its hull to the relative tolerance 1e-12",
+         number(defaults.relative_tolerance));
 }
 
 }  // namespace proxima::detail

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <span>
 
+#include "core/checks.h"
 #include "proxima/core/types.h"
 
 namespace proxima::detail {
@@ -80,11 +81,44 @@ inline constexpr double kPruneSlackUlps = 512.0;
 inline double prune_slack(double magnitude) { return kPruneSlackUlps * kUnitRoundoff * magnitude; }
 
 // The checks of DistanceOptions, the same for every entry point that takes
-// them: relative_tolerance and absolute_tolerance finite and >= 0 (-0.0
-// included), max_iterations at least 1. Throws InvalidInput naming the field
-// and its value, after `who` ("distance: options", "Scene:
-// options.distance").
-void check_distance_options(const DistanceOptions& options, const char* who);
+// them (core/checks.h's rules and wording): relative_tolerance and
+// absolute_tolerance finite and >= 0 (-0.0 included), max_iterations at
+// least 1. Throws InvalidInput naming `who`, the options' `path` and the
+// field ("distance: options.max_iterations must be at least 1, got 0";
+// "Scene: options.distance.relative_tolerance ...").
+void check_distance_options(const DistanceOptions& options, const char* who,
+                            const char* path = "options");
+
+// What a query on triangle meshes takes of DistanceOptions. Its triangle
+// pairs are solved in closed form (no algorithm, no iterations), and its
+// search stops at the hull's bound to the relative tolerance 1e-12
+// (mesh_pair.h, kHullStopRelative): it honours absolute_tolerance, and
+// penetration false (it computes no depth: the default true is answered as
+// false is, documented at MeshResult). A query whose leaves are the convex
+// query between each triangle and a polytope (distance(TriangleMesh,
+// ConvexPolytope)) honours algorithm and max_iterations there too.
+enum class MeshOptionUse : std::uint8_t {
+  triangle_pairs,  // mesh-mesh, a Body pair with a mesh, the mesh margin queries
+  convex_leaves,   // distance(TriangleMesh, ConvexPolytope)
+};
+
+// True when the fields that `use` cannot honour are at their defaults
+// (compared on the bits: no floating-point comparison). O(1), for the hot
+// path: call check_mesh_options only when it fails.
+inline bool mesh_options_plainly_valid(const DistanceOptions& options, MeshOptionUse use) {
+  const DistanceOptions defaults;
+  return std::bit_cast<std::uint64_t>(options.relative_tolerance) ==
+             std::bit_cast<std::uint64_t>(defaults.relative_tolerance) &&
+         (use == MeshOptionUse::convex_leaves || (options.algorithm == defaults.algorithm &&
+                                                  options.max_iterations == defaults.max_iterations));
+}
+
+// check_distance_options, then the refusal of a non-default value of a
+// field that `use` cannot honour, naming the field, its value and the body
+// kind ("mesh distance: options.algorithm gjk does not apply to a triangle
+// mesh ..."). Never ignored: a caller who set it expects it to act.
+void check_mesh_options(const DistanceOptions& options, const char* who, MeshOptionUse use,
+                        const char* path = "options");
 
 // True when every DistanceOptions check passes, decided on the bits with no
 // floating-point comparison (a NaN compared raises FE_INVALID, which a

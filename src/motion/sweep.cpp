@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <string>
 
+#include "core/accuracy.h"
 #include "time_of_impact.h"
 
 namespace proxima {
@@ -17,19 +18,12 @@ namespace proxima {
 namespace detail {
 
 void check_impact_options(const ImpactOptions& options, const char* who) {
-  const double target = options.target_separation;
-  if (!std::isfinite(target) || target < 0.0) {
-    throw InvalidInput(std::string(who) +
-                       ": options.target_separation must be finite and >= 0, not " +
-                       std::to_string(target));
-  }
-  if (!std::isfinite(options.tolerance) || options.tolerance < 0.0) {
-    throw InvalidInput(std::string(who) +
-                       ": options.tolerance must be finite and >= 0 (0: default)");
-  }
-  if (options.max_iterations < 1) {
-    throw InvalidInput(std::string(who) + ": options.max_iterations must be at least 1");
-  }
+  check_finite_non_negative(options.target_separation, who, "options.target_separation");
+  check_finite_non_negative(options.tolerance, who, "options.tolerance", "0: the default");
+  check_at_least(options.max_iterations, 1, who, "options.max_iterations");
+  // The distance queries of the steps would refuse them too, but only
+  // after the first steps: refused before any, by their full name.
+  check_distance_options(options.distance, who, "options.distance");
 }
 
 }  // namespace detail

@@ -9,6 +9,7 @@
 #include "proxima/motion/time_of_impact.h"
 
 #include "advancement.h"
+#include "core/accuracy.h"
 #include "piece_advancement.h"
 #include "proxima/query/body_distance.h"
 #include "sweep.h"
@@ -44,6 +45,12 @@ ImpactResult time_of_impact(const Body& a, const Motion& motion_a, const Body& b
                             const Motion& motion_b, const ImpactOptions& options,
                             BodyCache* cache) {
   detail::check_impact_options(options, "time_of_impact");
+  // The answer at t of a pair with a mesh is the mesh query's, which cannot
+  // honour every distance option: refused before any step.
+  if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
+    detail::check_mesh_options(options.distance, "time_of_impact",
+                               detail::MeshOptionUse::triangle_pairs, "options.distance");
+  }
   BodyCache local;
   BodyCache& c = cache != nullptr ? *cache : local;
   const double ra = a.radius();

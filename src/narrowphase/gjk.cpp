@@ -370,26 +370,16 @@ Status bounded_status(double distance, double contact_tolerance, const GjkFrame&
 // The loop shared by both variants.
 // ---------------------------------------------------------------------------
 
-// `simplex` is solved on entry (at least one point); `iterations` counts the
-// support evaluations made so far; `direction` is the search direction used
-// so far (from A towards B), the normal reported when no better one exists.
-// `deep` receives the contact classification's tetrahedron around the origin
-// when it certifies intersection (classify_contact). `cached_face_a` and
-// `cached_face_b` are a previous answer's witness faces (-1 for none).
-// `witnesses` false leaves the features default (vertex -1): for a caller
-// that keeps only the status, iterations and simplex (the contact unit).
-template <class Support>
-DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
-                       double contact_tolerance, Simplex& simplex, int iterations, Vec3 direction,
-                       Support& support, Points& deep, std::int32_t cached_face_a = -1,
-                       std::int32_t cached_face_b = -1, bool witnesses = true) {
-  const double tol = contact_tolerance * frame.inv_unit;
-  double lower = 0.0;  // certified lower bound, scaled units
+// The state of GJK's loop: the certified lower bound (scaled units), the
+// largest |w|^2 seen (the termination slack's magnitude), the last search
+// direction (from A towards B), the support evaluations so far, how the
+// loop ended, and on a stall the support point that did not decrease |v|
+// and, when it spans one, the plane of the stalled simplex.
+struct GjkLoop {
+  double lower = 0.0;
   double w_max2 = 0.0;
-  for (int k = 0; k < simplex.size; ++k)
-    w_max2 = std::max(w_max2, simplex.p[idx(k)].w.squaredNorm());
-  direction = direction.squaredNorm() > 0.0 ? Vec3(direction.normalized()) : Vec3(Vec3::UnitX());
-
+  Vec3 direction = Vec3::UnitX();
+  int iterations = 0;
   bool contact = false;
   bool capped = false;
   // The gap test passed, or the support point was already in the simplex
@@ -399,6 +389,24 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
   bool stalled = false;
   SupportPoint stall_point;  // the support point that did not decrease |v|
   bool rounding_stall = false;
+};
+
+// The descent: the support point along -v joins the simplex while |v|
+// decreases, until contact, the certified gap, the cap, or a stall.
+template <class Support>
+[[gnu::always_inline]] inline void descend(const DistanceOptions& options, double tol,
+                                           Simplex& simplex, Support& support, GjkLoop& s) {
+  double& lower = s.lower;
+  double& w_max2 = s.w_max2;
+  Vec3& direction = s.direction;
+  int& iterations = s.iterations;
+  bool& contact = s.contact;
+  bool& capped = s.capped;
+  bool& certified = s.certified;
+  std::array<SupportPoint, 3>& stall_plane = s.stall_plane;
+  bool& stalled = s.stalled;
+  SupportPoint& stall_point = s.stall_point;
+  bool& rounding_stall = s.rounding_stall;
   for (;;) {
     if (simplex.encloses_origin || simplex.vv <= tol * tol) {
       contact = true;
@@ -448,7 +456,24 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
     }
     simplex = next;
   }
+}
 
+// After a stall (below), one more lower bound or the polished features.
+template <class Support>
+[[gnu::always_inline]] inline Polished settle_stall(const GjkFrame& frame,
+                                                    const DistanceOptions& options, double tol,
+                                                    Simplex& simplex, Support& support,
+                                                    GjkLoop& s) {
+  double& lower = s.lower;
+  double& w_max2 = s.w_max2;
+  int& iterations = s.iterations;
+  bool& contact = s.contact;
+  bool& capped = s.capped;
+  bool& certified = s.certified;
+  const std::array<SupportPoint, 3>& stall_plane = s.stall_plane;
+  const bool stalled = s.stalled;
+  const SupportPoint& stall_point = s.stall_point;
+  const bool rounding_stall = s.rounding_stall;
   // Stalled: the loop left because |v| did not decrease at this precision
   // while the support point beyond v was new, so |v| may be far above the
   // distance, and its lower bound from v's direction may be 0. On a flat
@@ -482,33 +507,31 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
       lower = std::max(lower, n.dot(w.w) / n_norm);
     }
   }
-  const bool separation_certified = certified || lower > tol;
+  return polished;
+}
 
-  Status status = Status::separated;
-  if (contact) {
-    // The classification grows its polytope from any points of C. A polished
-    // simplex of four points (two edges' vertex pairs) is flat, not a
-    // tetrahedron around the origin: three of them seed it.
-    Simplex seed = simplex;
-    if (seed.size == 4 && !seed.encloses_origin) seed.size = 3;
-    status = detail::classify_contact(seed, tol, support, iterations, options.max_iterations, deep);
-    // A touching contact whose tetrahedron encloses the origin (by rounding,
-    // or within the band): the origin is within tol of a face of it (else
-    // the classification would have certified depth), so that face's
-    // closest points are the witnesses. Its barycentric weights of the
-    // origin would only give rounding noise from a sliver tetrahedron.
-    if (status == Status::touching && simplex.encloses_origin)
-      detail::apply(simplex, detail::nearest_face(simplex.p));
-  }
+// GJK's closest points from the original coordinates, and the hull ids
+// they combine (ids_used of each side, padded).
+struct GjkPoints {
+  Vec3 point_a = Vec3::Zero();
+  Vec3 local_b = Vec3::Zero();  // in B's frame
+  std::array<std::int32_t, 4> ids_a{};
+  std::array<std::int32_t, 4> ids_b{};
+  int ids_used = 0;
+};
 
+[[gnu::always_inline]] inline GjkPoints gjk_points(const GjkFrame& frame, const Simplex& simplex,
+                                                   const Polished& polished) {
+  GjkPoints out;
+  Vec3& point_a = out.point_a;
+  Vec3& local_b = out.local_b;
+  std::array<std::int32_t, 4>& ids_a = out.ids_a;
+  std::array<std::int32_t, 4>& ids_b = out.ids_b;
+  int& ids_used = out.ids_used;
   // Closest points from the original coordinates (the weights are
   // unit-free): sums of hull points with weights summing to one. B's is
   // formed in B's frame and mapped once (the pose is affine).
-  Vec3 point_a = Vec3::Zero();
-  Vec3 local_b = Vec3::Zero();
-  std::array<std::int32_t, 4> ids_a{};
-  std::array<std::int32_t, 4> ids_b{};
-  int ids_used = simplex.size;
+  ids_used = simplex.size;
   if (polished.have) {
     // The polished features' own coefficients (polish_stalled). Padded
     // with repeats of the last id: the witness rule takes distinct ids.
@@ -530,6 +553,63 @@ DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
       ids_b[idx(k)] = sp.ib;
     }
   }
+  return out;
+}
+
+// `simplex` is solved on entry (at least one point); `iterations` counts the
+// support evaluations made so far; `direction` is the search direction used
+// so far (from A towards B), the normal reported when no better one exists.
+// `deep` receives the contact classification's tetrahedron around the origin
+// when it certifies intersection (classify_contact). `cached_face_a` and
+// `cached_face_b` are a previous answer's witness faces (-1 for none).
+// `witnesses` false leaves the features default (vertex -1): for a caller
+// that keeps only the status, iterations and simplex (the contact unit).
+template <class Support>
+DistanceResult run_gjk(const GjkFrame& frame, const DistanceOptions& options,
+                       double contact_tolerance, Simplex& simplex, int iterations, Vec3 direction,
+                       Support& support, Points& deep, std::int32_t cached_face_a = -1,
+                       std::int32_t cached_face_b = -1, bool witnesses = true) {
+  const double tol = contact_tolerance * frame.inv_unit;
+  GjkLoop loop;
+  loop.iterations = iterations;
+  for (int k = 0; k < simplex.size; ++k)
+    loop.w_max2 = std::max(loop.w_max2, simplex.p[idx(k)].w.squaredNorm());
+  loop.direction =
+      direction.squaredNorm() > 0.0 ? Vec3(direction.normalized()) : Vec3(Vec3::UnitX());
+  descend(options, tol, simplex, support, loop);
+  const Polished polished = settle_stall(frame, options, tol, simplex, support, loop);
+  const bool contact = loop.contact;
+  const bool capped = loop.capped;
+  const bool certified = loop.certified;
+  const double lower = loop.lower;
+  iterations = loop.iterations;
+  direction = loop.direction;
+
+  const bool separation_certified = certified || lower > tol;
+
+  Status status = Status::separated;
+  if (contact) {
+    // The classification grows its polytope from any points of C. A polished
+    // simplex of four points (two edges' vertex pairs) is flat, not a
+    // tetrahedron around the origin: three of them seed it.
+    Simplex seed = simplex;
+    if (seed.size == 4 && !seed.encloses_origin) seed.size = 3;
+    status = detail::classify_contact(seed, tol, support, iterations, options.max_iterations, deep);
+    // A touching contact whose tetrahedron encloses the origin (by rounding,
+    // or within the band): the origin is within tol of a face of it (else
+    // the classification would have certified depth), so that face's
+    // closest points are the witnesses. Its barycentric weights of the
+    // origin would only give rounding noise from a sliver tetrahedron.
+    if (status == Status::touching && simplex.encloses_origin)
+      detail::apply(simplex, detail::nearest_face(simplex.p));
+  }
+
+  const GjkPoints points = gjk_points(frame, simplex, polished);
+  const Vec3& point_a = points.point_a;
+  const Vec3& local_b = points.local_b;
+  const std::array<std::int32_t, 4>& ids_a = points.ids_a;
+  const std::array<std::int32_t, 4>& ids_b = points.ids_b;
+  const int ids_used = points.ids_used;
   const Vec3 point_b = frame.b_in_a.apply(local_b);
 
   DistanceResult result;

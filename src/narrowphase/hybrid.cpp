@@ -382,6 +382,183 @@ bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const V
   return !std::islessequal(shift + std::sqrt(turn2) * reach, kStaleMotion * size);
 }
 
+// The pair a query starts from: the cached features, unless B moved far
+// since (then the pair says nothing: moved_far), or the support points
+// along the line of centres (a cold cache fails the first load and skips
+// the test of its pose, which a cold query would pay for nothing). Returns
+// whether the start was warm.
+template <bool kScaled, class APoint, class BPoint>
+[[gnu::always_inline]] inline bool start_pair(const ConvexPolytope& a, const ConvexPolytope& b,
+                                              const Pose& b_in_a, const DistanceCache& cache,
+                                              double scale, const APoint& a_point,
+                                              const BPoint& b_point, FeatureSet& fa,
+                                              FeatureSet& fb, std::int32_t& hint_a,
+                                              std::int32_t& hint_b) {
+  const int count_a = a.vertex_count();
+  const int count_b = b.vertex_count();
+  const bool warm = load_feature(cache.vertices_a, count_a, fa, a_point) &&
+                    load_feature(cache.vertices_b, count_b, fb, b_point) &&
+                    !moved_far(a, b, b_in_a, cache);
+  if (!warm) {
+    // Moved far: exactly the cold query (the stale hints are not used).
+    // In scaled units too: its dot products with vertices must not overflow.
+    const Mat3& rot = b_in_a.rotation;
+    Vec3 towards_b = rot * b.centroid() + b_in_a.translation - a.centroid();
+    if constexpr (kScaled) towards_b *= scale;
+    const Vec3 dir = towards_b.squaredNorm() > 0.0 ? towards_b : Vec3::UnitX();
+    hint_a = support_without_hint(a, dir);
+    hint_b = support_without_hint(b, minus_transpose_times(rot, dir));
+    fa.clear();
+    fb.clear();
+    fa.push(hint_a, a_point(hint_a));
+    fb.push(hint_b, b_point(hint_b));
+  }
+  return warm;
+}
+
+// The support bounds of the loop below, in local units: contact at
+// `contact_tolerance`; the margin query's proofs (hybrid_within) at
+// `yes_at` and `no_above`; and u R, the unit of the termination slack.
+struct LoopLimits {
+  double contact_tolerance;
+  double yes_at;
+  double no_above;
+  double ulp_r;
+};
+
+// How the loop ended: the certified support gap, the last search direction,
+// the iterations, and whether it stopped in contact or at the cap.
+struct LoopEnd {
+  double lower = 0.0;
+  Vec3 last_direction = Vec3::UnitX();
+  int iterations = 0;
+  bool contact = false;
+  bool capped = false;
+};
+
+// The paper's loop (DESIGN.md steps 2-3): from the pair (fa, fb) and its
+// local answer `loc`, the support points along the closest points'
+// direction give the certified lower bound (van den Bergen's test), and the
+// body whose support point is further out joins its feature first, kept
+// only when the local distance strictly decreases; it ends in contact, at
+// the termination test, at the cap, or when neither body improves (the
+// pair is optimal at machine precision).
+template <bool kMargin, class APoint, class BPoint>
+[[gnu::always_inline]] inline LoopEnd iterate(const ConvexPolytope& a, const ConvexPolytope& b,
+                                              const Mat3& rot, const DistanceOptions& options,
+                                              const KernelTolerance<double>& tol,
+                                              const LoopLimits& limits, bool scan_a, bool scan_b,
+                                              const APoint& a_point, const BPoint& b_point,
+                                              FeatureSet& fa, FeatureSet& fb, Local& loc,
+                                              std::int32_t& hint_a, std::int32_t& hint_b) {
+  LoopEnd e;
+  for (;;) {
+    const double d = std::sqrt(loc.distance_squared);
+    if constexpr (kMargin) {
+      if (d <= limits.yes_at) break;
+    }
+    if (d <= limits.contact_tolerance) {
+      e.contact = true;
+      break;
+    }
+    const Vec3 w =
+        search_direction(fa, fb, loc.point_b - loc.point_a, d);  // unit, from A towards B
+    e.last_direction = w;
+    hint_a = support_point(a, w, hint_a, scan_a);
+    hint_b = support_point(b, minus_transpose_times(rot, w), hint_b, scan_b);
+    const Vec3 pa = a_point(hint_a);
+    const Vec3 pb = b_point(hint_b);
+    const double wa = w.dot(pa);
+    const double wb = w.dot(pb);
+    e.lower = std::max(e.lower, wb - wa);
+    if constexpr (kMargin) {
+      if (e.lower > limits.no_above) break;
+    }
+    // The margin query converges only to machine precision: a gap within
+    // Re d proves nothing about the margin.
+    if (d - e.lower <= (kMargin ? 0.0 : options.relative_tolerance * d) + kTerminationGapUlps * limits.ulp_r) break;
+    if (e.iterations >= options.max_iterations) {
+      e.capped = true;
+      break;
+    }
+    ++e.iterations;
+
+    // Try the body whose support point is further out first, then the other.
+    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.point_a);
+    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.point_b) - wb;
+    bool improved = false;
+    for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
+      const bool use_a = (attempt == 0) == (gain_a >= gain_b);
+      if ((use_a ? gain_a : gain_b) <= 0.0) continue;
+      // The support point joins its feature in place, and leaves it again
+      // if the pair does not improve (no copies of the feature sets).
+      FeatureSet& grown = use_a ? fa : fb;
+      grown.push(use_a ? hint_a : hint_b, use_a ? pa : pb);
+      const Local next = local_distance(fa, fb, tol);
+      if (!(next.distance_squared < loc.distance_squared)) {
+        grown.pop();
+        continue;  // unstable: no progress at this precision
+      }
+      fa.reduce(next.active_a);
+      fb.reduce(next.active_b);
+      loc = next;
+      improved = true;
+    }
+    if (!improved) break;  // the pair is optimal at machine precision
+  }
+  return e;
+}
+
+// The witness features of the answer (witness_features.h) from the final
+// pair (fa, fb) and its closest points `loc` (local units; `unit` maps them
+// back), and the faces the cache keeps for the next query.
+template <bool kScaled>
+[[gnu::always_inline]] inline void witness_pair(const ConvexPolytope& a, const ConvexPolytope& b,
+                                                const Pose& b_in_a, const FeatureSet& fa,
+                                                const FeatureSet& fb, const Local& loc,
+                                                double r_local, double unit, bool locate,
+                                                DistanceCache& cache, DistanceResult& result) {
+  const Mat3& rot = b_in_a.rotation;
+  const Vec3& tr = b_in_a.translation;
+  const double witness_band = detail::witness_band(r_local * unit);
+  // The tracked edge: rule 1 keeps both vertices when the closest point is
+  // farther than the band from each of them, and rule 2 needs their ids
+  // only. A's frame is A's own (unscaled: the same arithmetic as
+  // witness_feature's); B's point is tested in A's frame, with the margin
+  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
+  // and the whole rule applied there.
+  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
+                                      const Vec3& x, double bands, Feature& out) {
+    if constexpr (kScaled) {
+      return false;
+    } else {
+      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
+             detail::hull_edge(poly, f.id[0], f.id[1], out);
+    }
+  };
+  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
+    result.feature_a = detail::witness_feature(
+        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+        [&] {
+          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
+        },
+        locate);
+  }
+  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
+    result.feature_b = detail::witness_feature(
+        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+        [&] {
+          // The outward side only matters on a polygon.
+          return detail::WitnessPoint{
+              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
+              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+        },
+        locate);
+  }
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
+}
+
 // The algorithm on coordinates multiplied by `scale`, a power of two, when
 // kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
 // in the caller's units, like the result returned. The unscaled instance is
@@ -431,26 +608,8 @@ template <bool kScaled, bool kMargin = false>
 
   FeatureSet fa;
   FeatureSet fb;
-  // A warm start from the cached pair, unless B moved far since (then the
-  // pair says nothing: moved_far). A cold cache fails the first load and
-  // skips the test of its pose, which a cold query would pay for nothing.
-  const bool warm = load_feature(cache.vertices_a, count_a, fa, a_point) &&
-                    load_feature(cache.vertices_b, count_b, fb, b_point) &&
-                    !moved_far(a, b, b_in_a, cache);
-  if (!warm) {
-    // Moved far: exactly the cold query (the stale hints are not used).
-    // Cold start: the support points along the line of centres.
-    // In scaled units too: its dot products with vertices must not overflow.
-    Vec3 towards_b = rot * b.centroid() + tr - a.centroid();
-    if constexpr (kScaled) towards_b *= scale;
-    const Vec3 dir = towards_b.squaredNorm() > 0.0 ? towards_b : Vec3::UnitX();
-    hint_a = support_without_hint(a, dir);
-    hint_b = support_without_hint(b, minus_transpose_times(rot, dir));
-    fa.clear();
-    fb.clear();
-    fa.push(hint_a, a_point(hint_a));
-    fb.push(hint_b, b_point(hint_b));
-  }
+  const bool warm = start_pair<kScaled>(a, b, b_in_a, cache, scale, a_point, b_point, fa, fb,
+                                        hint_a, hint_b);
 
   // After a cold start small bodies are scanned (kColdLoopScanVertices).
   const bool scan_a = !warm && count_a <= kColdLoopScanVertices;
@@ -460,64 +619,14 @@ template <bool kScaled, bool kMargin = false>
   fb.reduce(loc.active_b);
 
   DistanceResult result;
-  double lower = 0.0;
-  Vec3 last_direction = Vec3::UnitX();
-  int iterations = 0;
-  bool contact = false;
-  for (;;) {
-    const double d = std::sqrt(loc.distance_squared);
-    if constexpr (kMargin) {
-      if (d <= yes_at) break;
-    }
-    if (d <= contact_tolerance) {
-      contact = true;
-      break;
-    }
-    const Vec3 w =
-        search_direction(fa, fb, loc.point_b - loc.point_a, d);  // unit, from A towards B
-    last_direction = w;
-    hint_a = support_point(a, w, hint_a, scan_a);
-    hint_b = support_point(b, minus_transpose_times(rot, w), hint_b, scan_b);
-    const Vec3 pa = a_point(hint_a);
-    const Vec3 pb = b_point(hint_b);
-    const double wa = w.dot(pa);
-    const double wb = w.dot(pb);
-    lower = std::max(lower, wb - wa);
-    if constexpr (kMargin) {
-      if (lower > no_above) break;
-    }
-    // The margin query converges only to machine precision: a gap within
-    // Re d proves nothing about the margin.
-    if (d - lower <= (kMargin ? 0.0 : options.relative_tolerance * d) + kTerminationGapUlps * ulp_r) break;
-    if (iterations >= options.max_iterations) {
-      result.status = Status::iteration_cap;
-      break;
-    }
-    ++iterations;
-
-    // Try the body whose support point is further out first, then the other.
-    const double gain_a = fa.contains(hint_a) ? 0.0 : wa - w.dot(loc.point_a);
-    const double gain_b = fb.contains(hint_b) ? 0.0 : w.dot(loc.point_b) - wb;
-    bool improved = false;
-    for (int attempt = 0; attempt < 2 && !improved; ++attempt) {
-      const bool use_a = (attempt == 0) == (gain_a >= gain_b);
-      if ((use_a ? gain_a : gain_b) <= 0.0) continue;
-      // The support point joins its feature in place, and leaves it again
-      // if the pair does not improve (no copies of the feature sets).
-      FeatureSet& grown = use_a ? fa : fb;
-      grown.push(use_a ? hint_a : hint_b, use_a ? pa : pb);
-      const Local next = local_distance(fa, fb, tol);
-      if (!(next.distance_squared < loc.distance_squared)) {
-        grown.pop();
-        continue;  // unstable: no progress at this precision
-      }
-      fa.reduce(next.active_a);
-      fb.reduce(next.active_b);
-      loc = next;
-      improved = true;
-    }
-    if (!improved) break;  // the pair is optimal at machine precision
-  }
+  const LoopEnd end = iterate<kMargin>(
+      a, b, rot, options, tol, LoopLimits{contact_tolerance, yes_at, no_above, ulp_r}, scan_a,
+      scan_b, a_point, b_point, fa, fb, loc, hint_a, hint_b);
+  const double lower = end.lower;
+  const Vec3& last_direction = end.last_direction;
+  const int iterations = end.iterations;
+  const bool contact = end.contact;
+  if (end.capped) result.status = Status::iteration_cap;
 
   const double d = std::sqrt(loc.distance_squared);
   result.iterations = iterations;
@@ -567,43 +676,7 @@ template <bool kScaled, bool kMargin = false>
 
   // The witness features by the rule all algorithms share
   // (witness_features.h), in each hull's own frame and units.
-  const double witness_band = detail::witness_band(r_local * unit);
-  // The tracked edge: rule 1 keeps both vertices when the closest point is
-  // farther than the band from each of them, and rule 2 needs their ids
-  // only. A's frame is A's own (unscaled: the same arithmetic as
-  // witness_feature's); B's point is tested in A's frame, with the margin
-  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
-  // and the whole rule applied there.
-  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
-                                      const Vec3& x, double bands, Feature& out) {
-    if constexpr (kScaled) {
-      return false;
-    } else {
-      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
-             detail::hull_edge(poly, f.id[0], f.id[1], out);
-    }
-  };
-  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
-    result.feature_a = detail::witness_feature(
-        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
-        [&] {
-          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
-        },
-        locate);
-  }
-  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
-    result.feature_b = detail::witness_feature(
-        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
-        [&] {
-          // The outward side only matters on a polygon.
-          return detail::WitnessPoint{
-              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
-              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-        },
-        locate);
-  }
-  cache.face_a = result.feature_a.face;
-  cache.face_b = result.feature_b.face;
+  witness_pair<kScaled>(a, b, b_in_a, fa, fb, loc, r_local, unit, locate, cache, result);
 
   // An answer the hybrid could not certify is cross-checked (contact.h).
   if (needs_cross_check(result, options, magnitude)) [[unlikely]]

@@ -342,6 +342,223 @@ void add_edge_candidates_brute_force(Query& q, Candidates& out) {
 // come from the query's scratch buffer (solve_cold).
 constexpr std::size_t kScratchArcBytes = 4096;
 
+// A solid B's arcs, one per edge, computed once on first use (each is met
+// from several arcs of A), by adjacency slot of either direction (an arc
+// read backwards is the same arc for the crossing test); a polygon's or a
+// segment's arcs (up to four) each time.
+class ArcsOfB {
+ public:
+  explicit ArcsOfB(Query& q)
+      : q_(q),
+        memo_(q.b.dimension() == 3),
+        offsets_(q.b.adjacency_offsets()),
+        adjacency_(q.b.adjacency()),
+        faces_(q.b.adjacency_faces()),
+        slot_ready_(memo_ ? q.b.adjacency().size() : 0, 0, q.memory) {
+    // Storage only (not value-initialized): with pruning a query reads a
+    // few of B's slots, and writing all of them (80 bytes each) would make
+    // a large cold query pay the page faults of the fresh allocation. From
+    // the scratch buffer when small; else from the heap (the buffer's next
+    // blocks double in size: a large body's arcs would take a fresh block,
+    // and its page faults, every query).
+    const std::size_t slots = slot_ready_.size();
+    if (slots * sizeof(Arc) <= kScratchArcBytes) {
+      slot_arc_ = std::pmr::polymorphic_allocator<Arc>(q.memory).allocate(slots);
+      std::uninitialized_default_construct_n(slot_arc_, slots);
+    } else {
+      heap_arcs_ = std::make_unique_for_overwrite<Arc[]>(slots);
+      slot_arc_ = heap_arcs_.get();
+    }
+  }
+
+  // The arcs of B's edge j -> k, whose adjacency slot (of j) is `slot`,
+  // into ys; returns their count.
+  int arcs(int j, std::int32_t k, std::size_t slot, std::array<Arc, 4>& ys) {
+    if (!memo_) return arcs_of_b(q_, j, k, ys);
+    if (!slot_ready_[slot]) {
+      // Both directions of the edge at once: k -> j's slot (its left face
+      // is j -> k's right one) gets the same arc read backwards, (q, p,
+      // -k), what arcs_of_b gives for it.
+      const auto back = static_cast<std::size_t>(
+          std::find(adjacency_.begin() + offsets_[static_cast<std::size_t>(k)],
+                    adjacency_.begin() + offsets_[static_cast<std::size_t>(k) + 1], j) -
+          adjacency_.begin());
+      const int count = arcs_of_b(q_, j, k, faces_[slot], faces_[back], ys);
+      slot_ready_[slot] = slot_ready_[back] = count == 1 ? 1 : 2;
+      slot_arc_[slot] = ys[0];
+      slot_arc_[back] = {ys[0].q, ys[0].p, -ys[0].k, ys[0].tolerance};
+    }
+    ys[0] = slot_arc_[slot];
+    return slot_ready_[slot] == 1 ? 1 : 0;
+  }
+
+ private:
+  Query& q_;
+  const bool memo_;
+  const std::span<const std::int32_t> offsets_;
+  const std::span<const std::int32_t> adjacency_;
+  const std::span<const std::int32_t> faces_;
+  std::pmr::vector<char> slot_ready_;
+  std::unique_ptr<Arc[]> heap_arcs_;
+  Arc* slot_arc_ = nullptr;
+};
+
+// Whether every edge at A's vertex v (adjacency slots [slot_begin,
+// slot_end)) is pruned at once: the faces to the left of v -> w over its
+// neighbours w are all the faces around v, so both faces of every edge at
+// v; the bound below (the per-edge one, with the least over all of them)
+// is at most each edge's. Saves finding each edge's right face (a scan of
+// its other end's neighbours) away from the answer. `near`: a vertex of B
+// near B's support along -n for the normals n near v's cell (near_hint).
+bool vertex_edges_pruned(Query& q, int v, std::size_t slot_begin, std::size_t slot_end,
+                         int near) {
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const auto faces_a = q.a.adjacency_faces();
+  const Vec3 av = q.point_a(v);
+  const Vec3 wc = av - q.centroid_b, wr = av - q.reference_b;
+  double mc = kInfinity, mr = kInfinity;
+  bool all = true;
+  for (std::size_t at = slot_begin; at < slot_end && all; ++at) {
+    const int f = faces_a[at];
+    all = f >= 0;
+    if (!all) break;
+    const auto i = static_cast<std::size_t>(f);
+    mc = std::min(mc, face_lower(sa.normals[i], sa.error[i], wc, q.reach));
+    mr = std::min(mr, face_lower(sa.normals[i], sa.error[i], wr, q.reach));
+  }
+  // The faces of A - B of the edges at v have their normals in v's cell of
+  // A's Gauss map, the spherical polygon of the normals of the faces around
+  // v: inside the cap about their normalized sum that holds them all.
+  const auto cone = [&] {
+    Vec3 sum = Vec3::Zero();
+    double error = 0.0;
+    for (std::size_t at = slot_begin; at < slot_end; ++at) {
+      const auto i = static_cast<std::size_t>(faces_a[at]);
+      sum += sa.normals[i];
+      error = std::max(error, sa.error[i]);
+    }
+    const double length = sum.norm();
+    if (!(length > 0.25)) return whole_sphere();
+    const Vec3 c = sum / length;
+    double spread = 0.0;
+    for (std::size_t at = slot_begin; at < slot_end; ++at)
+      spread = std::max(spread, (sa.normals[static_cast<std::size_t>(faces_a[at])] - c).norm());
+    spread += error + kConeSlack;
+    if (!(spread < kMaxConeChord)) return whole_sphere();
+    return PenetrationCache::Bound{c, spread, 0.0};
+  };
+  double lower = std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity);
+  if (all && slot_begin < slot_end && !above_bound(q, lower)) {
+    // The same with B's point at the hint (near_hint).
+    const Vec3 wh = av - q.point_b(near);
+    double mh = kInfinity;
+    for (std::size_t at = slot_begin; at < slot_end; ++at) {
+      const auto i = static_cast<std::size_t>(faces_a[at]);
+      mh = std::min(mh, face_lower(sa.normals[i], sa.error[i], wh, q.reach));
+    }
+    if (mh >= 0.0) lower = std::max(lower, mh);
+  }
+  return all && slot_begin < slot_end &&
+         pruned_by(q, lower, PenetrationCache::Group::vertex_a, v, -1, cone);
+}
+
+// Whether A's edge v -> w (faces l on its left, r on its right) is pruned
+// from the faces' stored normals, without the arc: every n on the arc from
+// nL to nR is c1 nL + c2 nR with c1, c2 >= 0 and c1 + c2 >= 1, so n.w >=
+// min(nL.w, nR.w) when that is >= 0 (arc_minimum).
+bool edge_pruned_by_faces(Query& q, int v, int w_end, int l, int r) {
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const auto il = static_cast<std::size_t>(l), ir = static_cast<std::size_t>(r);
+  const auto least = [&](const Vec3& w) {
+    return std::min(face_lower(sa.normals[il], sa.error[il], w, q.reach),
+                    face_lower(sa.normals[ir], sa.error[ir], w, q.reach));
+  };
+  const Vec3 av = q.point_a(v);
+  const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
+  const double lower =
+      std::max(m >= 0.0 ? m + q.inradius_b : -kInfinity, m2 >= 0.0 ? m2 : -kInfinity);
+  return pruned_by(q, lower, PenetrationCache::Group::edge_a, v, w_end, [&] {
+    return cone_of_arc(sa.normals[il], sa.error[il], sa.normals[ir], sa.error[ir]);
+  });
+}
+
+// Whether A's edge e, with its nx arcs xs (faces l and r, -1 for none), is
+// pruned by the bounds of its arcs against B's centroid, reference point
+// and the point at `near` (near_hint).
+bool edge_pruned_by_arcs(Query& q, const std::array<int, 2>& e, int l, int r,
+                         const std::array<Arc, 4>& xs, int nx, int near) {
+  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  const Vec3 w = q.point_a(e[0]) - q.centroid_b;
+  const Vec3 w2 = q.point_a(e[0]) - q.reference_b;
+  // The arcs' ends: the faces' normals as arcs_of_a read them (error 0
+  // once face_plane's), and for a polygon the in-plane normal from them,
+  // normalized (twice the error at most).
+  const double error = l >= 0 && r >= 0
+                           ? 2.0 * std::max(sa.error[static_cast<std::size_t>(l)],
+                                            sa.error[static_cast<std::size_t>(r)])
+                           : 0.0;
+  double lower = kInfinity, lower2 = kInfinity;
+  for (int i = 0; i < nx; ++i) {
+    const Arc& x = xs[static_cast<std::size_t>(i)];
+    lower = std::min(lower, arc_minimum(x, w, error, q.reach));
+    lower2 = std::min(lower2, arc_minimum(x, w2, error, q.reach));
+  }
+  double arc_lower = std::max(lower + q.inradius_b, lower2);
+  if (!above_bound(q, arc_lower)) {
+    const Vec3 wh = q.point_a(e[0]) - q.point_b(near);
+    double lower3 = kInfinity;
+    for (int i = 0; i < nx; ++i)
+      lower3 = std::min(lower3, arc_minimum(xs[static_cast<std::size_t>(i)], wh, error, q.reach));
+    arc_lower = std::max(arc_lower, lower3);
+  }
+  return pruned_by(q, arc_lower, PenetrationCache::Group::edge_a, e[0], e[1], [&] {
+    // A solid's one arc; a polygon's or a segment's half or whole circle:
+    // anywhere.
+    return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
+  });
+}
+
+// The chain of B cells that arc x of A's edge e crosses, from B's support
+// along -x.p (from `start`), breadth first over B's adjacency; each
+// crossing edge of B becomes a candidate with e once. `chain` and
+// `visited` are scratch (visited is all 0 on entry and on return).
+void walk_arc(Query& q, const Arc& x, const std::array<int, 2>& e, const std::array<Arc, 4>& xs,
+              int nx, int start, ArcsOfB& arcs_b, std::pmr::vector<std::int32_t>& chain,
+              std::pmr::vector<char>& visited, Candidates& out) {
+  const auto offsets = q.b.adjacency_offsets();
+  std::array<Arc, 4> ys;
+  chain.clear();
+  chain.push_back(start);
+  visited[static_cast<std::size_t>(start)] = 1;
+  for (std::size_t head = 0; head < chain.size(); ++head) {
+    const int j = chain[head];
+    const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
+    const auto nbrs = q.b.neighbors(j);
+    for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
+      const std::int32_t k = nbrs[slot - slot0];
+      const int ny = arcs_b.arcs(j, k, slot, ys);
+      bool crosses = false;
+      for (int m = 0; m < ny && !crosses; ++m)
+        crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
+      if (!crosses) continue;
+      // Each crossing edge once: from its first-visited end.
+      if (!visited[static_cast<std::size_t>(k)]) {
+        visited[static_cast<std::size_t>(k)] = 1;
+        chain.push_back(k);
+        add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                           std::max(j, static_cast<int>(k)), ys, ny, out);
+      } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head), k) ==
+                 chain.begin() + static_cast<std::ptrdiff_t>(head)) {
+        // k was reached from another cell of this chain, not expanded yet:
+        // the edge j-k is another crossing of the arc.
+        add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
+                           std::max(j, static_cast<int>(k)), ys, ny, out);
+      }
+    }
+  }
+  for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
+}
+
 // The overlay walk: for each arc of A, the chain of B cells it crosses.
 void add_edge_candidates_walk(Query& q, Candidates& out) {
   // Visited B vertices of the current arc (the queue too).
@@ -357,32 +574,8 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
     const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
     return near >= 0 ? static_cast<int>(near) : hint;
   };
-  std::array<Arc, 4> xs, ys;
-  // A solid B's arcs, one per edge, computed once on first use (each is
-  // met from several arcs of A), by adjacency slot of either direction
-  // (an arc read backwards is the same arc for the crossing test).
-  const bool memo = q.b.dimension() == 3;
-  const auto offsets = q.b.adjacency_offsets();
-  const auto adjacency_b = q.b.adjacency();
-  const auto faces_b = q.b.adjacency_faces();
-  // Storage only (not value-initialized): with pruning a query reads a
-  // few of B's slots, and writing all of them (80 bytes each) would make a
-  // large cold query pay the page faults of the fresh allocation.
-  // From the scratch buffer when small; else from the heap (the buffer's
-  // next blocks double in size: a large body's arcs would take a fresh
-  // block, and its page faults, every query).
-  const std::size_t slots = memo ? q.b.adjacency().size() : 0;
-  std::unique_ptr<Arc[]> heap_arcs;
-  Arc* slot_arc = nullptr;
-  if (slots * sizeof(Arc) <= kScratchArcBytes) {
-    slot_arc = std::pmr::polymorphic_allocator<Arc>(q.memory).allocate(slots);
-    std::uninitialized_default_construct_n(slot_arc, slots);
-  } else {
-    heap_arcs = std::make_unique_for_overwrite<Arc[]>(slots);
-    slot_arc = heap_arcs.get();
-  }
-  std::pmr::vector<char> slot_ready(slots, 0, q.memory);
-  const PenetrationCache::HullNormals& sa = *q.shapes_a;
+  std::array<Arc, 4> xs;
+  ArcsOfB arcs_b(q);
   const bool solid_a = q.a.dimension() == 3;
   const auto offsets_a = q.a.adjacency_offsets();
   const auto adjacency_a = q.a.adjacency();
@@ -398,179 +591,29 @@ void add_edge_candidates_walk(Query& q, Candidates& out) {
     const int only_w = q.only != nullptr ? q.only->edges_a[static_cast<std::size_t>(item)][1] : -1;
     const auto slot_begin = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v)]);
     const auto slot_end = static_cast<std::size_t>(offsets_a[static_cast<std::size_t>(v) + 1]);
-    if (q.prune && solid_a && only_w < 0) {
-      // All edges at v at once: the faces to the left of v -> w over its
-      // neighbours w are all the faces around v, so both faces of every
-      // edge at v; the bound below (the per-edge one, with the least over
-      // all of them) is at most each edge's. Saves finding each edge's
-      // right face (a scan of its other end's neighbours) away from the
-      // answer.
-      const Vec3 av = q.point_a(v);
-      const Vec3 wc = av - q.centroid_b, wr = av - q.reference_b;
-      double mc = kInfinity, mr = kInfinity;
-      bool all = true;
-      for (std::size_t at = slot_begin; at < slot_end && all; ++at) {
-        const int f = faces_a[at];
-        all = f >= 0;
-        if (!all) break;
-        const auto i = static_cast<std::size_t>(f);
-        mc = std::min(mc, face_lower(sa.normals[i], sa.error[i], wc, q.reach));
-        mr = std::min(mr, face_lower(sa.normals[i], sa.error[i], wr, q.reach));
-      }
-      // The faces of A - B of the edges at v have their normals in v's
-      // cell of A's Gauss map, the spherical polygon of the normals of the
-      // faces around v: inside the cap about their normalized sum that
-      // holds them all.
-      const auto cone = [&] {
-        Vec3 sum = Vec3::Zero();
-        double error = 0.0;
-        for (std::size_t at = slot_begin; at < slot_end; ++at) {
-          const auto i = static_cast<std::size_t>(faces_a[at]);
-          sum += sa.normals[i];
-          error = std::max(error, sa.error[i]);
-        }
-        const double length = sum.norm();
-        if (!(length > 0.25)) return whole_sphere();
-        const Vec3 c = sum / length;
-        double spread = 0.0;
-        for (std::size_t at = slot_begin; at < slot_end; ++at)
-          spread = std::max(spread, (sa.normals[static_cast<std::size_t>(faces_a[at])] - c).norm());
-        spread += error + kConeSlack;
-        if (!(spread < kMaxConeChord)) return whole_sphere();
-        return PenetrationCache::Bound{c, spread, 0.0};
-      };
-      double lower =
-          std::max(mc >= 0.0 ? mc + q.inradius_b : -kInfinity, mr >= 0.0 ? mr : -kInfinity);
-      if (all && slot_begin < slot_end && !above_bound(q, lower)) {
-        // The same with B's point at the hint (near_hint).
-        const Vec3 wh = av - q.point_b(near_hint(v));
-        double mh = kInfinity;
-        for (std::size_t at = slot_begin; at < slot_end; ++at) {
-          const auto i = static_cast<std::size_t>(faces_a[at]);
-          mh = std::min(mh, face_lower(sa.normals[i], sa.error[i], wh, q.reach));
-        }
-        if (mh >= 0.0) lower = std::max(lower, mh);
-      }
-      if (all && slot_begin < slot_end &&
-          pruned_by(q, lower, PenetrationCache::Group::vertex_a, v, -1, cone))
-        continue;
-    }
+    if (q.prune && solid_a && only_w < 0 &&
+        vertex_edges_pruned(q, v, slot_begin, slot_end, near_hint(v)))
+      continue;
     for (std::size_t at = slot_begin; at < slot_end; ++at) {
       const int w_end = adjacency_a[at];
       if (!(v < w_end) || (only_w >= 0 && w_end != only_w)) continue;
       const std::array<int, 2> e = {v, w_end};
       const int l = q.a.dimension() >= 2 ? faces_a[at] : -1;
       const int r = q.a.dimension() >= 2 ? left_face(q.a, w_end, v) : -1;
-      if (q.prune && solid_a && l >= 0 && r >= 0) {
-        // First from the faces' stored normals, without the arc: every n
-        // on the arc from nL to nR is c1 nL + c2 nR with c1, c2 >= 0 and
-        // c1 + c2 >= 1, so n.w >= min(nL.w, nR.w) when that is >= 0
-        // (arc_minimum).
-        const auto il = static_cast<std::size_t>(l), ir = static_cast<std::size_t>(r);
-        const auto least = [&](const Vec3& w) {
-          return std::min(face_lower(sa.normals[il], sa.error[il], w, q.reach),
-                          face_lower(sa.normals[ir], sa.error[ir], w, q.reach));
-        };
-        const Vec3 av = q.point_a(v);
-        const double m = least(av - q.centroid_b), m2 = least(av - q.reference_b);
-        const double lower =
-            std::max(m >= 0.0 ? m + q.inradius_b : -kInfinity, m2 >= 0.0 ? m2 : -kInfinity);
-        if (pruned_by(q, lower, PenetrationCache::Group::edge_a, v, w_end, [&] {
-              return cone_of_arc(sa.normals[il], sa.error[il], sa.normals[ir], sa.error[ir]);
-            }))
-          continue;
-      }
+      if (q.prune && solid_a && l >= 0 && r >= 0 && edge_pruned_by_faces(q, v, w_end, l, r))
+        continue;
       const int nx = arcs_of_a(q, v, w_end, l, r, xs);
-      if (q.prune && nx > 0) {
-        const Vec3 w = q.point_a(e[0]) - q.centroid_b;
-        const Vec3 w2 = q.point_a(e[0]) - q.reference_b;
-        // The arcs' ends: the faces' normals as arcs_of_a read them (error
-        // 0 once face_plane's), and for a polygon the in-plane normal from
-        // them, normalized (twice the error at most).
-        const double error = l >= 0 && r >= 0
-                                 ? 2.0 * std::max(sa.error[static_cast<std::size_t>(l)],
-                                                  sa.error[static_cast<std::size_t>(r)])
-                                 : 0.0;
-        double lower = kInfinity, lower2 = kInfinity;
-        for (int i = 0; i < nx; ++i) {
-          const Arc& x = xs[static_cast<std::size_t>(i)];
-          lower = std::min(lower, arc_minimum(x, w, error, q.reach));
-          lower2 = std::min(lower2, arc_minimum(x, w2, error, q.reach));
-        }
-        double arc_lower = std::max(lower + q.inradius_b, lower2);
-        if (!above_bound(q, arc_lower)) {
-          const Vec3 wh = q.point_a(e[0]) - q.point_b(near_hint(v));
-          double lower3 = kInfinity;
-          for (int i = 0; i < nx; ++i)
-            lower3 =
-                std::min(lower3, arc_minimum(xs[static_cast<std::size_t>(i)], wh, error, q.reach));
-          arc_lower = std::max(arc_lower, lower3);
-        }
-        if (pruned_by(q, arc_lower, PenetrationCache::Group::edge_a, v, w_end, [&] {
-              // A solid's one arc; a polygon's or a segment's half or
-              // whole circle: anywhere.
-              return nx == 1 ? cone_of_arc(xs[0].p, 0.0, xs[0].q, 0.0) : whole_sphere();
-            }))
-          continue;
-      }
+      if (q.prune && nx > 0 && edge_pruned_by_arcs(q, e, l, r, xs, nx, near_hint(v))) continue;
       for (int i = 0; i < nx; ++i) {
         const Arc& x = xs[static_cast<std::size_t>(i)];
-        // The B cell of direction p: B's support along -p.
-        // From the support found for a face through v, when one was
-        // evaluated (for a solid A, p is the normal of such a face).
+        // The B cell of direction p: B's support along -p. From the
+        // support found for a face through v, when one was evaluated (for
+        // a solid A, p is the normal of such a face).
         const std::int32_t near = q.near_b == nullptr ? -1 : q.near_b[v];
         const int start = support_hill_climb_through_plateaus(q.b, q.rotation_t * (-x.p),
                                                               near >= 0 ? near : hint);
         hint = start;
-        chain.clear();
-        chain.push_back(start);
-        visited[static_cast<std::size_t>(start)] = 1;
-        for (std::size_t head = 0; head < chain.size(); ++head) {
-          const int j = chain[head];
-          const auto slot0 = static_cast<std::size_t>(offsets[static_cast<std::size_t>(j)]);
-          const auto nbrs = q.b.neighbors(j);
-          for (std::size_t slot = slot0; slot < slot0 + nbrs.size(); ++slot) {
-            const std::int32_t k = nbrs[slot - slot0];
-            int ny = 0;
-            if (memo) {
-              if (!slot_ready[slot]) {
-                // Both directions of the edge at once: k -> j's slot (its
-                // left face is j -> k's right one) gets the same arc read
-                // backwards, (q, p, -k), what arcs_of_b gives for it.
-                const auto back = static_cast<std::size_t>(
-                    std::find(adjacency_b.begin() + offsets[static_cast<std::size_t>(k)],
-                              adjacency_b.begin() + offsets[static_cast<std::size_t>(k) + 1], j) -
-                    adjacency_b.begin());
-                const int count = arcs_of_b(q, j, k, faces_b[slot], faces_b[back], ys);
-                slot_ready[slot] = slot_ready[back] = count == 1 ? 1 : 2;
-                slot_arc[slot] = ys[0];
-                slot_arc[back] = {ys[0].q, ys[0].p, -ys[0].k, ys[0].tolerance};
-              }
-              ny = slot_ready[slot] == 1 ? 1 : 0;
-              ys[0] = slot_arc[slot];
-            } else {
-              ny = arcs_of_b(q, j, k, ys);
-            }
-            bool crosses = false;
-            for (int m = 0; m < ny && !crosses; ++m)
-              crosses = arcs_may_cross(x, ys[static_cast<std::size_t>(m)]);
-            if (!crosses) continue;
-            // Each crossing edge once: from its first-visited end.
-            if (!visited[static_cast<std::size_t>(k)]) {
-              visited[static_cast<std::size_t>(k)] = 1;
-              chain.push_back(k);
-              add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
-                                 std::max(j, static_cast<int>(k)), ys, ny, out);
-            } else if (std::find(chain.begin(), chain.begin() + static_cast<std::ptrdiff_t>(head),
-                                 k) == chain.begin() + static_cast<std::ptrdiff_t>(head)) {
-              // k was reached from another cell of this chain, not expanded
-              // yet: the edge j-k is another crossing of the arc.
-              add_edge_candidate(q, e[0], e[1], xs, nx, std::min(j, static_cast<int>(k)),
-                                 std::max(j, static_cast<int>(k)), ys, ny, out);
-            }
-          }
-        }
-        for (const std::int32_t j : chain) visited[static_cast<std::size_t>(j)] = 0;
+        walk_arc(q, x, e, xs, nx, start, arcs_b, chain, visited, out);
       }
     }
   }

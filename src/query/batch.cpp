@@ -72,10 +72,7 @@ void run_batch(const char* who, std::size_t n, PairOf pair, Query query,
   check_size(who, poses_b.size(), n, "poses_b");
   check_size(who, results.size(), n, "results");
   if (!caches.empty()) check_size(who, caches.size(), n, "caches (when not empty)");
-  if (threads < 0) {
-    throw InvalidInput(std::string(who) + ": threads must be >= 0 (0: all cores), got " +
-                       std::to_string(threads));
-  }
+  detail::check_at_least(threads, 0, who, "threads", "0: all cores");
   for (std::size_t k = 0; k < n; ++k) {
     const auto p = pair(k);
     if (p.a == nullptr || p.b == nullptr) {
@@ -127,8 +124,8 @@ auto distance_with(const DistanceOptions& options) {
 // The margin query of one pair, for run_batch; the margin and the options
 // are checked once, in the calling thread, before anything is written.
 auto within_margin_with(double margin, const DistanceOptions& options, const char* who) {
-  detail::check_margin(margin, who);
-  detail::check_distance_options(options, (std::string(who) + ": options").c_str());
+  detail::check_finite_non_negative(margin, who, "margin");
+  detail::check_distance_options(options, who);
   return [margin, &options](const auto& p, const Pose& pose_a, const Pose& pose_b, auto* cache,
                             bool rigid) {
     // A convex pair or a Body row with a cache, in a batch whose poses all

@@ -516,8 +516,8 @@ class MarginSearch {
 MarginResult within_margin(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b,
                            const Pose& pose_b, double margin, const DistanceOptions& options,
                            CompoundCache* cache) {
-  detail::check_margin(margin, "within_margin");
-  detail::check_distance_options(options, "within_margin: options");
+  detail::check_finite_non_negative(margin, "within_margin", "margin");
+  detail::check_distance_options(options, "within_margin");
   return MarginSearch(a, checked_pose(pose_a, "within_margin: pose_a"), b,
                       checked_pose(pose_b, "within_margin: pose_b"), margin, options, cache)
       .run();

@@ -177,7 +177,7 @@ double band_floor(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolyt
     const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b, const Pose& pose_b,
     const DistanceOptions& options, DistanceCache& c) {
   if (!detail::distance_options_plainly_valid(options)) [[unlikely]] {
-    detail::check_distance_options(options, "distance: options");
+    detail::check_distance_options(options, "distance");
   }
 
   // The contact band 64 u R + Ae, first with a cheap bound on R. A distance

@@ -119,6 +119,11 @@ void add_radii(MarginResult& r, double margin, double radius_a, double radius_b)
 MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
                                const Pose& pose_b, double margin, const DistanceOptions& options,
                                BodyCache& cache) {
+  // The triangle pairs take only absolute_tolerance: a field they cannot
+  // honour is refused here, where every Body margin query with a mesh
+  // (single, batch, scene) passes.
+  if (!detail::mesh_options_plainly_valid(options, detail::MeshOptionUse::triangle_pairs))
+    [[unlikely]] detail::check_mesh_options(options, "within_margin", detail::MeshOptionUse::triangle_pairs);
   const std::vector<Body::MeshOfPiece>& ma = a.meshes();
   const std::vector<Body::MeshOfPiece>& mb = b.meshes();
   const std::size_t pairs = ma.size() * mb.size();
@@ -216,16 +221,6 @@ double sphere_gap_lower_bound(const Vec3& center_a, double radius_a, const Vec3&
   return d - radius_a - radius_b - kSphereSlackUlps * kUnitRoundoff * reach;
 }
 
-void check_margin(double margin, const char* what) {
-  const std::uint64_t bits = std::bit_cast<std::uint64_t>(margin);
-  if (!(bits < 0x7ff0000000000000ULL || bits == 0x8000000000000000ULL)) {
-    char message[160];
-    std::snprintf(message, sizeof message, "%s: margin must be finite and >= 0, got %g", what,
-                  margin);
-    throw InvalidInput(message);
-  }
-}
-
 MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& pose_a,
                                           const ConvexPolytope& b, const Pose& pose_b,
                                           double margin, const DistanceOptions& options,
@@ -302,8 +297,8 @@ namespace {
 MarginResult within_margin(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
                            const Pose& pose_b, double margin, const DistanceOptions& options,
                            DistanceCache* cache) {
-  detail::check_margin(margin, "within_margin");
-  detail::check_distance_options(options, "within_margin: options");
+  detail::check_finite_non_negative(margin, "within_margin", "margin");
+  detail::check_distance_options(options, "within_margin");
   if (cache == nullptr || !detail::are_rigid(pose_a, pose_b)) [[unlikely]]
     return convex_within_slow(a, pose_a, b, pose_b, margin, options, cache);
   return detail::within_margin_of_rigid_poses(a, pose_a, b, pose_b, margin, options, *cache);
@@ -318,8 +313,8 @@ MarginResult within_margin(const Body& a, const Pose& pose_a, const Body& b, con
     BodyCache cold;
     return within_margin(a, pose_a, b, pose_b, margin, options, &cold);
   }
-  detail::check_margin(margin, "within_margin");
-  detail::check_distance_options(options, "within_margin: options");
+  detail::check_finite_non_negative(margin, "within_margin", "margin");
+  detail::check_distance_options(options, "within_margin");
   // Both poses in one paired test (as the convex query), no copies when
   // they are rigid.
   if (detail::are_rigid(pose_a, pose_b)) [[likely]]

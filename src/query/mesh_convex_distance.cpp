@@ -63,6 +63,7 @@ ConvexQuery make_query(const TriangleMesh& a, const Pose& pose_a, const ConvexPo
                 options,
                 {},
                 false};
+  detail::check_mesh_options(options, "mesh distance", detail::MeshOptionUse::convex_leaves);
   const Pose rel = q.pose_a.inverse() * q.pose_b;
   q.rotation = rel.rotation;
   q.translation = rel.translation;

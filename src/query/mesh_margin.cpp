@@ -155,8 +155,8 @@ class MarginSearch {
 MarginResult within_margin(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
                            const Pose& pose_b, double margin, const DistanceOptions& options,
                            MeshCache* cache) {
-  detail::check_margin(margin, "within_margin");
-  detail::check_distance_options(options, "within_margin: options");
+  detail::check_finite_non_negative(margin, "within_margin", "margin");
+  detail::check_mesh_options(options, "within_margin", detail::MeshOptionUse::triangle_pairs);
   return detail::within_margin_of_rigid_poses(a, checked_pose(pose_a, "within_margin: pose_a"), b,
                                               checked_pose(pose_b, "within_margin: pose_b"),
                                               margin, options, cache);

@@ -121,7 +121,7 @@ inline Query make_query(const TriangleMesh& a, const Pose& pose_a, const Triangl
                  const Pose& pose_b, const DistanceOptions& options) {
   const Pose pa = checked_pose(pose_a, "mesh distance: pose_a");
   const Pose pb = checked_pose(pose_b, "mesh distance: pose_b");
-  detail::check_distance_options(options, "mesh distance: options");
+  detail::check_mesh_options(options, "mesh distance", detail::MeshOptionUse::triangle_pairs);
   return make_query_of_rigid_poses(a, pa, b, pb, options);
 }
 
@@ -509,6 +509,9 @@ inline bool contained_point(const Query& q, Vec3& point) {
 // kLowerBoundUlps takes half).
 constexpr double kHullStopRelative = 1e-12;
 constexpr double kHullStopUlps = 32.0;
+// The mesh queries refuse any other relative_tolerance (core/accuracy.h,
+// check_mesh_options), whose message names this one.
+static_assert(kHullStopRelative == DistanceOptions{}.relative_tolerance);
 
 // What the meshes' hulls (TriangleMesh::hull()) tell a query.
 struct HullBound {

@@ -252,10 +252,15 @@ double cost_of(const Aabb& b) {
   return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
 }
 
-// after - before for costs after >= before; 0 when both are infinite
-// (overflowed areas), where the difference would be NaN.
+// after - before for costs after >= before, with overflowed (infinite)
+// areas taken as the largest double: 0 when both overflowed, where the
+// difference would be NaN. Clamping, not a branch around the subtraction:
+// a compiler may evaluate both sides of a branch (clang does, unless told
+// that floating-point exceptions may trap), and inf - inf raises the
+// invalid-operation flag that the tests trap.
 double growth(double after, double before) {
-  return std::isinf(after) && std::isinf(before) ? 0.0 : after - before;
+  constexpr double kLargest = std::numeric_limits<double>::max();
+  return std::min(after, kLargest) - std::min(before, kLargest);
 }
 
 bool contains(const Aabb& outer, const Aabb& inner) {

@@ -8,16 +8,9 @@
 namespace proxima {
 
 Scene::Scene(const SceneOptions& options) : impl_(std::make_unique<Impl>()) {
-  if (!std::isfinite(options.margin) || options.margin < 0.0) {
-    throw InvalidInput("Scene: options.margin must be finite and >= 0, got " +
-                       std::to_string(options.margin));
-  }
-  if (options.threads < 0) {
-    throw InvalidInput("Scene: options.threads must be >= 0 (0: all cores), got " +
-                       std::to_string(options.threads));
-  }
-  const DistanceOptions& d = options.distance;
-  detail::check_distance_options(d, "Scene: options.distance");
+  detail::check_finite_non_negative(options.margin, "Scene", "options.margin");
+  detail::check_at_least(options.threads, 0, "Scene", "options.threads", "0: all cores");
+  detail::check_distance_options(options.distance, "Scene", "options.distance");
   impl_->options = options;
   impl_->finder = detail::make_pair_finder(options.broad_phase);
 }
@@ -39,6 +32,12 @@ BodyId Scene::add(std::shared_ptr<const ConvexPolytope> body, const Pose& pose) 
 
 BodyId Scene::add(const proxima::Body& body, const Pose& pose, double padding) {
   checked_padding(padding, "Scene::add");
+  // Its pairs are answered by the mesh query, which cannot honour every
+  // distance option: refused as the mesh comes in, not at a later step.
+  if (body.kind() == proxima::Body::Kind::mesh) {
+    detail::check_mesh_options(impl_->options.distance, "Scene::add",
+                               detail::MeshOptionUse::triangle_pairs, "options.distance");
+  }
   if (body.kind() != proxima::Body::Kind::mesh && body.radius() == 0.0 && padding == 0.0) {
     // A plain body: the adds above, keeping the Body as given (its
     // approximation error, for body()).

@@ -136,10 +136,7 @@ class BodyCacheSlot {
 };
 
 inline double checked_padding(double padding, const std::string& who) {
-  if (!std::isfinite(padding) || padding < 0.0) {
-    throw InvalidInput(who + ": padding must be finite and >= 0, got " + std::to_string(padding));
-  }
-  return padding;
+  return detail::check_finite_non_negative(padding, who.c_str(), "padding");
 }
 
 }  // namespace proxima::scene_impl

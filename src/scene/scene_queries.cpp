@@ -78,10 +78,7 @@ std::vector<ClosePair> Scene::pairs_within(BodyId id, double margin) {
   Impl& s = *impl_;
   s.live_body(id, "pairs_within");
   Impl::Body& body = s.bodies[slot(id)];
-  if (!(margin >= 0.0) || !std::isfinite(margin)) {
-    throw InvalidInput("Scene::pairs_within: margin must be finite and >= 0, got " +
-                       std::to_string(margin));
-  }
+  detail::check_finite_non_negative(margin, "Scene::pairs_within", "margin");
   const Aabb box = s.world_box(body, margin);
   std::vector<ClosePair> out;
   Impl::PairState scratch;

@@ -5,6 +5,8 @@
 // meshes of a body's pieces (the closed triangle meshes of their hulls).
 #include "proxima/shape/body.h"
 
+#include "core/checks.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -18,12 +20,7 @@ namespace {
 // name. Finiteness on the bits first: no comparison with a NaN, which
 // would raise FE_INVALID under a caller's traps.
 double checked_length(double value, const char* what) {
-  if (!is_finite_bits(value) || value < 0.0) {
-    char message[160];
-    std::snprintf(message, sizeof message, "Body: %s must be finite and >= 0, got %g", what, value);
-    throw InvalidInput(message);
-  }
-  return value;
+  return detail::check_finite_non_negative(value, "Body", what);
 }
 
 // A hull as a closed triangle mesh with the hull's vertex ids: each face

@@ -16,6 +16,8 @@
 // bodies, signed or not, moves by at most its sum over both.
 #include "proxima/shape/primitives.h"
 
+#include "core/checks.h"
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -39,12 +41,7 @@ constexpr double kCornerUlps = 16.0;
 // Finite (on the bits: no comparison with a NaN, which would raise
 // FE_INVALID under a caller's traps) and >= 0.
 void check_length(double value, const char* function, const char* argument) {
-  if (!is_finite_bits(value) || value < 0.0) {
-    char message[200];
-    std::snprintf(message, sizeof message, "%s: %s must be finite and >= 0, got %g", function,
-                  argument, value);
-    throw InvalidInput(message);
-  }
+  detail::check_finite_non_negative(value, function, argument);
 }
 
 PolygonApproximation approximation(double radius, int sides) {
@@ -68,12 +65,7 @@ void add_polygon(std::vector<Vec3>& points, const PolygonApproximation& p, doubl
 
 PolygonApproximation polygon_sides(double radius, double tolerance) {
   check_length(radius, "polygon_sides", "radius");
-  if (!is_finite_bits(tolerance) || !(tolerance > 0.0)) {
-    char message[160];
-    std::snprintf(message, sizeof message,
-                  "polygon_sides: tolerance must be finite and > 0, got %g", tolerance);
-    throw InvalidInput(message);
-  }
+  detail::check_finite_positive(tolerance, "polygon_sides", "tolerance");
   if (radius == 0.0) return approximation(0.0, 3);
   // The corners reach at most twice the radius (a triangle's): refused
   // where that overflows, before an infinite corner times sin(0) is NaN.

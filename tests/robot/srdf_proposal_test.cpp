@@ -227,7 +227,7 @@ TEST(SrdfProposal, BadOptionsAreRefusedNamingTheProblem) {
   };
   proxima::SrdfProposalOptions options;
   options.samples = 0;
-  EXPECT_NE(message(options).find("samples 0"), std::string::npos) << message(options);
+  EXPECT_NE(message(options).find("options.samples must be at least 1 (without options.configurations), got 0"), std::string::npos) << message(options);
   options.samples = 10;
   options.margin = -1;
   EXPECT_NE(message(options).find("margin"), std::string::npos) << message(options);

@@ -116,6 +116,17 @@ inline const char* to_string(Algorithm a) {
   return "unknown";
 }
 
+// The options of a distance query. Convex, rounded and compound bodies
+// honour every field. A query with a triangle mesh (distance of two
+// TriangleMeshes, a Body pair with a mesh, their margin queries, a time of
+// impact or a scene pair with a mesh, a robot's mesh geometry) solves its
+// triangle pairs in closed form and stops its search at its hull's bound to
+// the relative tolerance 1e-12: it honours absolute_tolerance, and refuses
+// with InvalidInput (naming the field and the triangle mesh) any other
+// algorithm, relative_tolerance or max_iterations than the defaults;
+// distance(TriangleMesh, ConvexPolytope), whose leaves are the convex query,
+// honours algorithm and max_iterations there and refuses only another
+// relative_tolerance. No mesh query computes a depth (penetration: below).
 struct DistanceOptions {
   Algorithm algorithm = Algorithm::hybrid;
   // Re of the paper's eq. 19: stop when distance - lower_bound <= Re * distance.
@@ -142,6 +153,10 @@ struct DistanceOptions {
   // reported as without it, distance 0, signed_distance() 0 in the
   // certificate [-infinity, 0] (depth_upper_bound +infinity: not computed);
   // for a caller that only needs the status (a scene of resting contacts).
+  // The default differs in SceneOptions::distance, which turns it off
+  // (proxima/scene/scene.h says why); the margin queries never compute a
+  // depth (their answer has none), and the mesh queries answer an overlap
+  // as with false (MeshResult).
   bool penetration = true;
 };
 

@@ -95,7 +95,10 @@ struct BodyResult : DistanceResult {
 // depth of an overlap involving a mesh is not computed: the cores'
 // signed value is then 0 with certificate [-infinity, 0] (so
 // signed_distance() is minus the radii, and signed_upper_bound() is
-// certified). Each pair of meshes is tracked by its own MeshCache.
+// certified). Each pair of meshes is tracked by its own MeshCache. Such a
+// pair takes the mesh query's options (proxima/core/types.h,
+// DistanceOptions): a non-default algorithm, relative_tolerance or
+// max_iterations is refused with InvalidInput naming the field.
 //
 // Compound bodies: the signed distance is the smallest over piece pairs of
 // the pair's signed distance (the deepest overlapping pair when cores

@@ -107,7 +107,11 @@ struct MarginResult {
 // other. With Algorithm::hybrid (the default) the loop stops at the first
 // proof; GJK and Enhanced GJK answer through their full distance query.
 // Throws InvalidInput for a bad margin, pose or options (named). `cache`
-// may be null (cold).
+// may be null (cold). options.penetration does not apply (a margin answer
+// has no depth): either value gives the same answer. The queries with a
+// triangle mesh below take the mesh query's options (proxima/core/types.h,
+// DistanceOptions): another algorithm, relative_tolerance or max_iterations
+// than the defaults is refused with InvalidInput naming the field.
 MarginResult within_margin(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
                            const Pose& pose_b, double margin, const DistanceOptions& options = {},
                            DistanceCache* cache = nullptr);
@@ -175,9 +179,6 @@ MarginResult within_margin_of_rigid_poses(const Body& a, const Pose& pose_a, con
 // margin query, which ends it for bodies far apart.
 double sphere_gap_lower_bound(const Vec3& center_a, double radius_a, const Vec3& center_b,
                               double radius_b);
-// The margin, refused by name unless finite and >= 0 (decided on the bits:
-// no comparison of a NaN, which a caller's traps would turn into SIGFPE).
-void check_margin(double margin, const char* what);
 }  // namespace detail
 
 }  // namespace proxima

@@ -103,8 +103,9 @@ struct MeshResult : DistanceResult {
 // The distance is that of the exact closest points of the two triangle
 // sets within the accuracy standard (R the largest coordinate magnitude of
 // both meshes in the world frame or in A's). Uses options.absolute_tolerance;
-// the other fields do not apply. Throws InvalidInput for a pose outside the
-// contract of pose.h.
+// a non-default algorithm, relative_tolerance or max_iterations does not
+// apply and is refused with InvalidInput naming the field, as are a pose
+// outside the contract of pose.h and options outside their checks.
 MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const TriangleMesh& b,
                     const Pose& pose_b, const DistanceOptions& options = {},
                     MeshCache* cache = nullptr);
@@ -129,6 +130,10 @@ MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const T
 // the mesh). The depth is not computed (distance 0, depth_upper_bound +infinity). A
 // rounded body (core plus radius r, body.h) is the core's answer offset by
 // r along the normal: the closest triangle is the same.
+//
+// options.algorithm and max_iterations apply to the convex query at each
+// leaf; a relative_tolerance other than the default is refused (the search
+// stops at A's hull's bound to 1e-12), as in the mesh-mesh query.
 //
 // The cache keeps the last closest triangle (triangle_a), whose distance is
 // the first upper bound; any cache is range-checked (never wrong).

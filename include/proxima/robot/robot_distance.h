@@ -120,6 +120,10 @@ struct RobotDistances {
   int pairs_queried = 0;
 };
 
+namespace detail {
+class RobotQuery;  // one robot_distances call (robot/robot_distance.cpp)
+}  // namespace detail
+
 // The coherence of one robot's queries, owned by the caller;
 // default-constructed means cold. Sized for the robot and obstacle count
 // of the query it is given to (and reset when they change). One thread at a
@@ -131,9 +135,7 @@ class RobotQueryState {
   const std::vector<Pose>& link_poses() const { return link_poses_; }
 
  private:
-  friend RobotDistances robot_distances(const Robot&, std::span<const double>,
-                                        std::span<const Obstacle>, const RobotQueryOptions&,
-                                        RobotQueryState*);
+  friend class detail::RobotQuery;
   const Robot* robot_ = nullptr;
   std::size_t obstacles_ = 0;
   std::vector<BodyCache> self_;
