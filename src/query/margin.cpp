@@ -340,6 +340,11 @@ MarginResult within_margin_of_rigid_poses(const Body& a, const Pose& pa, const B
     // answer returned where it was made. mesh_pairs_within answers the same
     // (one pair: no sphere test, the pose as it is), field by field
     // (Margin.MeshBodiesAnswerAsTheirMeshes).
+    // The options the triangle pairs cannot honour are refused, as
+    // mesh_pairs_within refuses them.
+    if (!detail::mesh_options_plainly_valid(options, detail::MeshOptionUse::triangle_pairs))
+      [[unlikely]] detail::check_mesh_options(options, "within_margin",
+                                              detail::MeshOptionUse::triangle_pairs);
     if (cache.mesh.size() != 1) [[unlikely]]
       cache.mesh.assign(1, MeshCache{});
     MarginResult r = detail::within_margin_of_rigid_poses(*a.mesh(), pa, *b.mesh(), pb,
