@@ -15,7 +15,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <tuple>
 #include <utility>
 
 #include "proxima/detail/narrowphase/hybrid.h"
@@ -31,6 +30,33 @@ namespace {
 // few u of itself), and the norm and subtractions add a few u more. 256 u
 // covers all of them with room, as the compound pruning's slack does.
 constexpr double kSphereSlackUlps = 256.0;
+
+// A certified lower bound on the distance between two hulls from their
+// boxes (ConvexPolytope::box_center, box_half; both must have one), B placed in A's frame by
+// `relative`, or 0 when it cannot prove them beyond `margin`. Any
+// orthonormal axis separates the boxes' projections by at most their
+// distance, so the gaps along A's three axes, and along B's, each bound it
+// from below, and so does the root of the sum of their squares within one
+// frame (the mesh roots' bound, query/mesh_pair.h). The boxes, their
+// placement and the gaps round by a few u R each: prune_slack(R) covers
+// them. The largest single gap is tried first: it needs no square, which
+// would overflow for margins beyond 1e153 (a sum that is not finite proves
+// nothing).
+double box_gap_lower_bound(const ConvexPolytope& a, const ConvexPolytope& b,
+                           const Pose& relative, double margin, double magnitude) {
+  const double slack = detail::prune_slack(magnitude);
+  const Vec3 d = relative.rotation * b.box_center() + relative.translation - a.box_center();
+  const Mat3 abs_rotation = relative.rotation.cwiseAbs();
+  const Vec3 gaps_a = d.cwiseAbs() - a.box_half() - abs_rotation * b.box_half();
+  const Vec3 gaps_b =
+      (relative.rotation.transpose() * d).cwiseAbs() - b.box_half() - abs_rotation.transpose() * a.box_half();
+  const double largest = std::max(gaps_a.maxCoeff(), gaps_b.maxCoeff());
+  if (largest - slack > margin) return largest - slack;
+  if (!(largest - slack > 0.0)) return 0.0;
+  const double sum = std::max(gaps_a.cwiseMax(0.0).squaredNorm(), gaps_b.cwiseMax(0.0).squaredNorm());
+  if (!std::isfinite(sum)) return 0.0;
+  return std::max(0.0, std::sqrt(sum) - slack);
+}
 
 // The verdict of a full distance answer (the fallback, and the twin's
 // rule): touching and intersecting are within any margin; a separated or
@@ -164,6 +190,25 @@ MarginResult mesh_pairs_within(const Body& a, const Pose& pose_a, const Body& b,
   return out;
 }
 
+// A body placed at `pose` within the supported magnitude (its core's
+// scale plus its radius, as Body::scale()), or refused by name; the message
+// is built out of line, off the path of every query.
+[[gnu::noinline, gnu::cold]] void refuse_reach(const Body& body, double reach, const char* name) {
+  char message[200];
+  std::snprintf(message, sizeof message,
+                "within_margin: body %s with radius %g reaches coordinates of magnitude %g, "
+                "beyond the supported %g",
+                name, body.radius(), reach, kMaxMagnitude);
+  throw InvalidInput(message);
+}
+
+inline void check_reach(const Body& body, const Pose& pose, const char* name) {
+  const double scale = body.mesh() != nullptr ? body.mesh()->scale() + body.radius() : body.scale();
+  const double reach = magnitude_bound(pose, scale);
+  if (!(reach <= kMaxMagnitude)) [[unlikely]]
+    refuse_reach(body, reach, name);
+}
+
 }  // namespace
 
 namespace detail {
@@ -191,18 +236,22 @@ MarginResult within_margin_of_rigid_poses(const ConvexPolytope& a, const Pose& p
     throw InvalidInput(message);
   }
   const double band = contact_band(magnitude, options.absolute_tolerance);
-  // Far apart: the bounding spheres prove it without the hulls.
+  // Far apart: the bounding spheres prove it without the hulls, and then
+  // the boxes (a long link's sphere reaches far beyond it).
   const double gap = sphere_gap_lower_bound(pose_a.apply(a.centroid()), a.bounding_radius(),
                                             pose_b.apply(b.centroid()), b.bounding_radius());
-  if (gap > margin) {
+  const Pose relative = pose_a.inverse() * pose_b;
+  const double box_gap = gap > margin || !a.has_box() || !b.has_box()
+                             ? gap
+                             : box_gap_lower_bound(a, b, relative, margin, magnitude);
+  if (box_gap > margin) {
     MarginResult out;
     out.margin = margin;
-    out.lower_bound = gap;
+    out.lower_bound = box_gap;
     return out;
   }
   if (options.algorithm == Algorithm::hybrid) {
-    const DistanceResult r =
-        hybrid_within(a, b, pose_a.inverse() * pose_b, options, band, margin, cache);
+    const DistanceResult r = hybrid_within(a, b, relative, options, band, margin, cache);
     const bool proved_within = r.distance <= margin + band;
     if (proved_within || r.lower_bound > margin) {
       MarginResult out;
@@ -280,27 +329,40 @@ namespace detail {
 MarginResult within_margin_of_rigid_poses(const Body& a, const Pose& pa, const Body& b,
                                           const Pose& pb, double margin,
                                           const DistanceOptions& options, BodyCache& cache) {
-  for (const auto& [body, pose, name] : {std::tuple(&a, &pa, "a"), std::tuple(&b, &pb, "b")}) {
-    const double reach = magnitude_bound(*pose, body->scale());
-    if (!(reach <= kMaxMagnitude)) [[unlikely]] {
-      char message[200];
-      std::snprintf(message, sizeof message,
-                    "within_margin: body %s with radius %g reaches coordinates of magnitude %g, "
-                    "beyond the supported %g",
-                    name, body->radius(), reach, kMaxMagnitude);
-      throw InvalidInput(message);
-    }
+  check_reach(a, pa, "a");
+  check_reach(b, pb, "b");
+  const double radii = a.radius() + b.radius();
+  if (a.mesh() != nullptr && b.mesh() != nullptr) [[likely]] {
+    // Two mesh bodies (a planner's mesh links): their one pair of meshes,
+    // each at its body's pose, straight to the mesh query, without the
+    // pieces' mesh list (Body::meshes(), a call_once on every query), the
+    // placements and the spheres' test that only pieces need, and the
+    // answer returned where it was made. mesh_pairs_within answers the same
+    // (one pair: no sphere test, the pose as it is), field by field
+    // (Margin.MeshBodiesAnswerAsTheirMeshes).
+    // The options the triangle pairs cannot honour are refused, as
+    // mesh_pairs_within refuses them.
+    if (!detail::mesh_options_plainly_valid(options, detail::MeshOptionUse::triangle_pairs))
+      [[unlikely]] detail::check_mesh_options(options, "within_margin",
+                                              detail::MeshOptionUse::triangle_pairs);
+    if (cache.mesh.size() != 1) [[unlikely]]
+      cache.mesh.assign(1, MeshCache{});
+    MarginResult r = detail::within_margin_of_rigid_poses(*a.mesh(), pa, *b.mesh(), pb,
+                                                          margin + radii, options,
+                                                          cache.mesh.data());
+    if (r.status == MarginStatus::within) cache.mesh_closest = 0;
+    if (radii != 0.0) add_radii(r, margin, a.radius(), b.radius());
+    return r;
   }
-  BodyCache& c = cache;
-  const double core_margin = margin + a.radius() + b.radius();
+  const double core_margin = margin + radii;
   MarginResult r;
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
     r = detail::within_margin_of_rigid_poses(*a.convex(), pa, *b.convex(), pb, core_margin,
-                                             options, c.convex);
+                                             options, cache.convex);
   } else if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
-    r = mesh_pairs_within(a, pa, b, pb, core_margin, options, c);
+    r = mesh_pairs_within(a, pa, b, pb, core_margin, options, cache);
   } else {
-    r = within_margin(*a.compound(), pa, *b.compound(), pb, core_margin, options, &c.compound);
+    r = within_margin(*a.compound(), pa, *b.compound(), pb, core_margin, options, &cache.compound);
     // A convex body met a compound as its one-piece wrapper: no pieces.
     if (a.kind() == Body::Kind::convex) r.piece_a = -1;
     if (b.kind() == Body::Kind::convex) r.piece_b = -1;

@@ -188,40 +188,47 @@ MarginResult within_margin_of_rigid_poses(const TriangleMesh& a, const Pose& pa,
     r.lower_bound = std::max(0.0, search.lower_scaled() * unit);
     if (r.lower_bound > margin) return r;
   }
-  // The hulls hold the surfaces: hulls beyond the margin prove the meshes
-  // beyond it; otherwise the
-  // hulls' closest points aim the slab bound of the traversal. Only within
-  // the convex query's range of placed magnitudes (as hull_bound).
-  double hull_lower = 0.0;
-  Vec3 hull_direction = Vec3::Zero();  // world frame
-  if (std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())) <= kMaxMagnitude) {
-    DistanceCache local;
-    const MarginResult hull = detail::within_margin_of_rigid_poses(
-        a.hull(), pa, b.hull(), pb, margin, options, cache != nullptr ? cache->hull : local);
-    if (hull.status == MarginStatus::beyond) {
-      r.lower_bound = hull.lower_bound;
-      return r;
-    }
-    hull_lower = hull.lower_bound;
-    if (hull.upper_bound > 0.0) hull_direction = hull.point_b - hull.point_a;
-  }
-  if (hull_direction != Vec3::Zero()) q.set_slab(q.pose_a.rotation.transpose() * hull_direction);
-  const bool same_pair = cache != nullptr;
-  // The last witness (or closest) pair first: a colliding pair often still
-  // collides there.
-  bool found = same_pair && cache->triangle_a >= 0 && cache->triangle_a < a.triangle_count() &&
-               cache->triangle_b >= 0 && cache->triangle_b < b.triangle_count() &&
+  // The last witness pair first, before the hulls: a pair within on the
+  // last query is often still within (a planner's next step), and then
+  // its one triangle pair answers without the hulls' query.
+  bool found = cache != nullptr && cache->triangle_a >= 0 &&
+               cache->triangle_a < a.triangle_count() && cache->triangle_b >= 0 &&
+               cache->triangle_b < b.triangle_count() &&
                search.test(a_triangle(q, cache->triangle_a), b_triangle(q, cache->triangle_b));
-  if (!found) found = search.traverse();
+  // The hulls hold the surfaces: hulls beyond the margin prove the meshes
+  // beyond it; otherwise the hulls' closest points aim the slab bound of
+  // the traversal. Only within the convex query's range of placed
+  // magnitudes (as hull_bound).
+  double hull_lower = 0.0;
+  if (!found) {
+    Vec3 hull_direction = Vec3::Zero();  // world frame
+    if (std::max(magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale())) <=
+        kMaxMagnitude) {
+      DistanceCache local;
+      const MarginResult hull = detail::within_margin_of_rigid_poses(
+          a.hull(), pa, b.hull(), pb, margin, options, cache != nullptr ? cache->hull : local);
+      if (hull.status == MarginStatus::beyond) {
+        r.lower_bound = hull.lower_bound;
+        r.pairs_tested = search.tested();
+        return r;
+      }
+      hull_lower = hull.lower_bound;
+      if (hull.upper_bound > 0.0) hull_direction = hull.point_b - hull.point_a;
+    }
+    if (hull_direction != Vec3::Zero()) q.set_slab(q.pose_a.rotation.transpose() * hull_direction);
+    found = search.traverse();
+  }
   r.pairs_tested = search.tested();
   if (found) {
+    // The witness pair as the fast kernel that accepted it finds it (any
+    // pair within margin + band proves the verdict; the slow twin's
+    // features are not needed).
     const Triangles ta = a_triangle(q, search.witness_a());
     const Triangles tb = b_triangle(q, search.witness_b());
-    const ClosestPoints<double> points =
-        closest_triangle_triangle(ta.v[0], ta.v[1], ta.v[2], tb.v[0], tb.v[1], tb.v[2], q.tol);
+    const detail::Candidate<true> points = detail::triangle_closest_points(ta.fast, tb.fast, q.tol);
     r.status = MarginStatus::within;
-    r.point_a = pa.apply(times_pow2(points.point_a, q.exponent));
-    r.point_b = pa.apply(times_pow2(points.point_b, q.exponent));
+    r.point_a = pa.apply(times_pow2(Vec3(points.on_a.x, points.on_a.y, points.on_a.z), q.exponent));
+    r.point_b = pa.apply(times_pow2(Vec3(points.on_b.x, points.on_b.y, points.on_b.z), q.exponent));
     r.upper_bound = (r.point_b - r.point_a).norm();
     r.triangle_a = search.witness_a();
     r.triangle_b = search.witness_b();

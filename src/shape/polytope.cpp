@@ -264,6 +264,20 @@ void ConvexPolytope::measure() {
   centroid_ = times_pow2(mean, exponent);
   bounding_radius_ = std::ldexp(radius, exponent);
   scale_ = max_abs_coordinate(vertices);
+  if (vertex_count_ <= kTableMinVertices) return;  // no box (polytope.h)
+  Vec3 lo = vertices.front(), hi = vertices.front();
+  for (const Vec3& v : vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  box_at_ = static_cast<std::uint32_t>(ints_at_ + (int_count() + 1) / 2);
+  const Vec3 center = 0.5 * lo + 0.5 * hi;
+  const Vec3 half = 0.5 * hi - 0.5 * lo;
+  double* box = data_.get() + box_at_;
+  for (int k = 0; k < 3; ++k) {
+    box[k] = center[k];
+    box[3 + k] = half[k];
+  }
 }
 
 std::size_t ConvexPolytope::int_count() const {
@@ -302,7 +316,8 @@ void ConvexPolytope::build_table() {
 }
 
 std::size_t ConvexPolytope::doubles_for(std::int32_t vertex_count, std::size_t int_count) {
-  return 3 * static_cast<std::size_t>(vertex_count) + (int_count + 1) / 2;
+  return 3 * static_cast<std::size_t>(vertex_count) + (int_count + 1) / 2 +
+         (vertex_count > kTableMinVertices ? 6 : 0);  // the box
 }
 
 void ConvexPolytope::allocate(std::size_t doubles) {
@@ -321,6 +336,7 @@ ConvexPolytope::ConvexPolytope(const ConvexPolytope& other)
       triangles_only_(other.triangles_only_),
       identity_input_(other.identity_input_),
       table_side_(other.table_side_),
+      box_at_(other.box_at_),
       centroid_(other.centroid_),
       bounding_radius_(other.bounding_radius_),
       scale_(other.scale_) {
@@ -330,6 +346,9 @@ ConvexPolytope::ConvexPolytope(const ConvexPolytope& other)
   std::uninitialized_copy(v.begin(), v.end(), reinterpret_cast<Vec3*>(data_.get()));
   std::uninitialized_copy(other.ints(), other.ints() + other.int_count(),
                           const_cast<std::int32_t*>(ints()));
+  if (box_at_ != 0)
+    std::uninitialized_copy(other.data_.get() + box_at_, other.data_.get() + box_at_ + 6,
+                            data_.get() + box_at_);
 }
 
 ConvexPolytope::ConvexPolytope(ConvexPolytope&& other) noexcept { take(other); }
@@ -351,6 +370,7 @@ void ConvexPolytope::take(ConvexPolytope& other) noexcept {
   identity_input_ = std::exchange(other.identity_input_, true);
   table_side_ = std::exchange(other.table_side_, 0);
   centroid_ = other.centroid_;
+  box_at_ = std::exchange(other.box_at_, 0);
   bounding_radius_ = other.bounding_radius_;
   scale_ = other.scale_;
 }

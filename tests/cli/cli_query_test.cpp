@@ -885,6 +885,123 @@ TEST(CliQuery, RadiusMakesRoundedBodies) {
   EXPECT_EQ(answers[4].at("error"), "line 5: b.radius is not a number (it is a string)");
 }
 
+// Issue 26: a "margin" field asks for the margin (or, at 0, boolean)
+// answer, the twin of the distance answer of the same line without it:
+// random posed hulls, rounded hulls and meshes (a closed tetrahedron, one
+// open triangle), each asked at margins below, at and above its distance;
+// touching boxes within at margin 0; bad margins named.
+TEST(CliQuery, MarginFieldAnswersAsTheDistanceLine) {
+  REQUIRE_CLI();
+  std::mt19937_64 gen(26);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const std::vector<Vec3> tetra = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const Json tetra_triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  constexpr int kPairs = 30;
+  std::vector<Json> bodies;  // the line without its margin, one per pair
+  for (int i = 0; i < kPairs; ++i) {
+    Json line = {{"id", i}};
+    for (const char* side : {"a", "b"}) {
+      std::vector<Vec3> points;
+      Json body;
+      if (i % 3 == 2) {
+        // A mesh: the tetrahedron (closed) or a single triangle (open).
+        points = tetra;
+        body["triangles"] = side[0] == 'a' ? tetra_triangles : Json::array({{0, 1, 2}});
+      } else {
+        for (int k = 0; k < 6 + static_cast<int>(gen() % 20); ++k)
+          points.emplace_back(unit(gen), unit(gen), unit(gen));
+      }
+      body["vertices"] = points_json(points);
+      if (i % 3 == 1) body["radius"] = 0.1 * (unit(gen) + 1.0);
+      body["rotation"] = {{"wxyz", {unit(gen), unit(gen), unit(gen), unit(gen)}}};
+      const double spread = side[0] == 'a' ? 0.3 : 2.5;
+      body["translation"] = {spread * unit(gen), spread * unit(gen), spread * unit(gen)};
+      line[side] = body;
+    }
+    bodies.push_back(line);
+  }
+  const TempFile distance_file(lines_of(bodies));
+  const CliRun distances = run_cli("query " + shell_quote(distance_file.path()));
+  ASSERT_EQ(distances.exit_code, 0);
+  const std::vector<Json> reference = parse_answers(distances.out);
+  ASSERT_EQ(reference.size(), static_cast<std::size_t>(kPairs));
+
+  // Margins 0, half and twice the distance, and the distance plus or minus
+  // a thousandth of it: every verdict is decided outside the band.
+  std::vector<Json> queries;
+  std::vector<std::pair<int, double>> asked;
+  for (int i = 0; i < kPairs; ++i) {
+    const double d = reference[static_cast<std::size_t>(i)].at("distance").get<double>();
+    for (const double m : {0.0, 0.5 * d, 0.999 * d, 1.001 * d, 2.0 * d}) {
+      Json line = bodies[static_cast<std::size_t>(i)];
+      line["margin"] = m;
+      queries.push_back(line);
+      asked.emplace_back(i, m);
+    }
+  }
+  const TempFile margin_file(lines_of(queries));
+  const CliRun run = run_cli("query " + shell_quote(margin_file.path()));
+  ASSERT_EQ(run.exit_code, 0);
+  const std::vector<Json> answers = parse_answers(run.out);
+  ASSERT_EQ(answers.size(), queries.size());
+  int within = 0, beyond = 0, intersecting = 0;
+  for (std::size_t k = 0; k < answers.size(); ++k) {
+    const auto [i, m] = asked[k];
+    const Json& distance = reference[static_cast<std::size_t>(i)];
+    const Json& answer = answers[k];
+    SCOPED_TRACE("pair " + std::to_string(i) + " margin " + format_17g(m) + ": " + answer.dump());
+    EXPECT_EQ(answer.at("id"), i);
+    EXPECT_EQ(answer.at("margin").get<double>(), m);
+    EXPECT_EQ(answer.contains("triangle_a"), i % 3 == 2);
+    const double d = distance.at("distance").get<double>();
+    const bool contact = distance.at("status") != "separated";
+    const bool want = contact || d <= m;
+    EXPECT_EQ(answer.at("within").get<bool>(), want);
+    EXPECT_EQ(answer.at("status"), want ? "within" : "beyond");
+    // The certificate: a witness pair within the margin (plus the band),
+    // or a lower bound above the margin and at most the distance.
+    const double band = 64.0 * kUnitRoundoff * 16.0;  // R below 16 here
+    if (want) {
+      const double upper = answer.at("upper_bound").get<double>();
+      EXPECT_LE(upper, m + band);
+      EXPECT_NEAR((point_of(answer, "point_b") - point_of(answer, "point_a")).norm(), upper, band);
+    } else {
+      const double lower = answer.at("lower_bound").get<double>();
+      EXPECT_GT(lower, m);
+      EXPECT_LE(lower, d + band);
+    }
+    (want ? within : beyond) += 1;
+    intersecting += contact ? 1 : 0;
+  }
+  // The seeded set holds both verdicts and overlapping pairs.
+  EXPECT_GT(within, 40);
+  EXPECT_GT(beyond, 20);
+  EXPECT_GT(intersecting, 0);
+
+  // Touching unit cubes are within at margin 0; bad margins are named.
+  const std::string cube = R"("vertices": [[0,0,0],[1,0,0],[0,1,0],[1,1,0],[0,0,1],[1,0,1],[0,1,1],[1,1,1]])";
+  const std::string text =
+      "{\"id\": \"touch\", \"margin\": 0, \"a\": {" + cube + "}, \"b\": {" + cube +
+      R"(, "translation": [1, 0.5, 0]}})"
+      "\n"
+      "{\"margin\": -1, \"a\": {" + cube + "}, \"b\": {" + cube + "}}\n" +
+      "{\"margin\": \"near\", \"a\": {" + cube + "}, \"b\": {" + cube + "}}\n" +
+      "{\"margin\": 0.1, \"a\": {" + cube + "}, \"b\": {" + cube +
+      R"(, "translation": [3, 0, 0], "linear_velocity": [-1, 0, 0]}})"
+      "\n";
+  const TempFile file(text);
+  const CliRun checks = run_cli("query " + shell_quote(file.path()));
+  ASSERT_EQ(checks.exit_code, 0);
+  const std::vector<Json> lines = parse_answers(checks.out);
+  ASSERT_EQ(lines.size(), 4U) << checks.out;
+  EXPECT_EQ(lines[0].at("status"), "within");
+  EXPECT_EQ(lines[0].at("upper_bound").get<double>(), 0.0);
+  EXPECT_EQ(lines[1].at("error"), "line 2: margin is negative: it must be >= 0");
+  EXPECT_EQ(lines[2].at("error"), "line 3: margin is not a number (it is a string)");
+  EXPECT_NE(lines[3].at("error").get<std::string>().find("target_separation"), std::string::npos)
+      << lines[3].dump();
+}
+
 // Issue 13: a body with a motion makes the line a time-of-impact query.
 // Two unit cubes, B from x = 5 to x = -5 (pose_end) or at velocity -10:
 // the faces meet at t = 0.3; with a contact offset of 0.5 at t = 0.25; B

@@ -139,6 +139,46 @@ TEST(Margin, ConvexAndRoundedAgreeWithTheFullQuery) {
 
 // The early exit: a margin far above or below the distance is proved in
 // fewer iterations than the full query needs.
+// Long thin hulls (a robot's links), whose bounding spheres reach far
+// beyond them: the boxes' bound decides many poses the spheres cannot
+// (no hull query: pairs_tested 0), at scales from 2^-300 to 2^300, and
+// every verdict and bound is the twin's.
+TEST(Margin, BoxesOfLongHullsProveBeyondWithoutTheHulls) {
+  Rng rng(2609);
+  int by_boxes = 0, within = 0;
+  for (int k = 0; k < 100; ++k) {
+    const double unit = std::ldexp(1.0, 200 * (k % 4) - 300);
+    const auto rod = [&](double length) {
+      // On a sphere, so that every point is a vertex: hulls of more than
+      // kTableMinVertices vertices keep a box (polytope.h).
+      test::Points p = test::points_on_sphere(rng, 48);
+      for (Vec3& v : p) v = unit * Vec3(length * v.x(), 0.1 * v.y(), 0.1 * v.z());
+      return Body(ConvexPolytope(p));
+    };
+    const Body a = rod(test::uniform(rng, 1.0, 3.0));
+    const Body b = rod(test::uniform(rng, 1.0, 3.0));
+    const Pose pa(test::random_rotation(rng), unit * Vec3(test::uniform(rng, -1, 1), 0.0, 0.0));
+    const Pose pb(test::random_rotation(rng),
+                  unit * Vec3(test::uniform(rng, -2.5, 2.5), test::uniform(rng, -2.5, 2.5),
+                              test::uniform(rng, -1.0, 1.0)));
+    const Twin twin = twin_of(a, pa, b, pb);
+    const double band = band_of(a, pa, b, pb);
+    for (const double m : {0.0, unit * test::uniform(rng, 0.0, 0.3)}) {
+      const MarginResult got = within_margin(a, pa, b, pb, m);
+      expect_agrees(got, m, twin, band, "rods", k);
+      const ConvexPolytope& ca = *a.convex();
+      const ConvexPolytope& cb = *b.convex();
+      const double sphere = detail::sphere_gap_lower_bound(
+          pa.apply(ca.centroid()), ca.bounding_radius(), pb.apply(cb.centroid()),
+          cb.bounding_radius());
+      if (got.status == MarginStatus::beyond && got.pairs_tested == 0 && !(sphere > m)) ++by_boxes;
+      within += got.is_within() ? 1 : 0;
+    }
+  }
+  EXPECT_GT(by_boxes, 30);
+  EXPECT_GT(within, 6);
+}
+
 TEST(Margin, StopsAtTheFirstProof) {
   Rng rng(2602);
   int fewer = 0;
@@ -228,6 +268,54 @@ TEST(Margin, MeshPairsAgreeWithTheFullQuery) {
   }
   EXPECT_GT(within, 60);
   EXPECT_GT(beyond, 60);
+}
+
+// Two mesh bodies take their own path to the mesh query (no pieces, no
+// placements): the answer is the mesh query's, field by field, cold and
+// tracked along a motion (one BodyCache against one MeshCache), and a
+// rounded pair's verdict is the cores' with the margin plus both radii.
+TEST(Margin, MeshBodiesAnswerAsTheirMeshes) {
+  Rng rng(2608);
+  const auto mesh_a = hull_mesh(rng, 60);
+  const auto mesh_b = hull_mesh(rng, 40);
+  const Body a(mesh_a), b(mesh_b);
+  const Body rounded_a(mesh_a, 0.03), rounded_b(mesh_b, 0.02);
+  BodyCache body_cache;
+  MeshCache mesh_cache;
+  int within = 0, beyond = 0;
+  Pose pb(test::random_rotation(rng), Vec3(2.4, 0.1, -0.2));
+  const Mat3 turn = test::random_small_rotation(rng, 0.03);
+  for (int step = 0; step < 100; ++step) {
+    pb.translation.x() -= 0.03;
+    pb.rotation = checked_pose(Pose(turn * pb.rotation, pb.translation), "step").rotation;
+    const double m = step % 3 == 0 ? 0.0 : 0.04 * (step % 3);
+    for (const bool tracked : {false, true}) {
+      const MarginResult got = within_margin(a, Pose::identity(), b, pb, m, {},
+                                             tracked ? &body_cache : nullptr);
+      const MarginResult want = within_margin(*mesh_a, Pose::identity(), *mesh_b, pb, m, {},
+                                              tracked ? &mesh_cache : nullptr);
+      EXPECT_EQ(got.status, want.status) << step;
+      EXPECT_EQ(got.lower_bound, want.lower_bound) << step;
+      EXPECT_EQ(got.upper_bound, want.upper_bound) << step;
+      EXPECT_EQ(got.point_a, want.point_a) << step;
+      EXPECT_EQ(got.point_b, want.point_b) << step;
+      EXPECT_EQ(got.triangle_a, want.triangle_a) << step;
+      EXPECT_EQ(got.triangle_b, want.triangle_b) << step;
+      EXPECT_EQ(got.piece_a, -1);
+      EXPECT_EQ(got.piece_b, -1);
+      EXPECT_EQ(got.pairs_tested, want.pairs_tested) << step;
+      (got.is_within() ? within : beyond) += 1;
+    }
+    const MarginResult rounded = within_margin(rounded_a, Pose::identity(), rounded_b, pb, m);
+    const MarginResult cores = within_margin(*mesh_a, Pose::identity(), *mesh_b, pb, m + 0.05);
+    EXPECT_EQ(rounded.status, cores.status) << step;
+    EXPECT_EQ(rounded.margin, m);
+  }
+  EXPECT_GT(within, 20);
+  EXPECT_GT(beyond, 20);
+  // The tracked queries kept the body's one mesh cache warm.
+  ASSERT_EQ(body_cache.mesh.size(), 1u);
+  EXPECT_FALSE(body_cache.mesh.front().is_cold());
 }
 
 // Degenerate contacts, hand-computed: boxes whose faces are coplanar

@@ -432,7 +432,8 @@ TEST(MeshDistanceExact, DegenerateTrianglesAreSegmentsAndPoints) {
 
 // The traversal's fast triangle-triangle kernel against its slow twin in
 // rational arithmetic: random pairs, and the hard ones: touching, crossing,
-// parallel and coplanar pairs, shared vertices, degenerate triangles.
+// parallel and coplanar pairs, shared vertices, degenerate triangles; and
+// the points it gives as a witness.
 TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
   Rng rng(31);
   const auto q = [](const Vec3& v) {
@@ -472,6 +473,21 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
       } else {
         ASSERT_GE(d, std::sqrt(bound) - (1e-12 * d + 64 * kU * 2.0))
             << "trial " << trial << " bound " << factor << ": reported beyond the bound";
+      }
+    }
+    // The witness points of the margin query (triangle_closest_points):
+    // one on each triangle, as far apart as the fast distance, each within
+    // rounding of its triangle (exact distance to it, in rationals, on every
+    // tenth pair).
+    const detail::Candidate<true> w = detail::triangle_closest_points(a, b, tol);
+    const Vec3 on_a(w.on_a.x, w.on_a.y, w.on_a.z), on_b(w.on_b.x, w.on_b.y, w.on_b.z);
+    ASSERT_LE(std::abs((on_b - on_a).norm() - fast), 64 * kU * 2.0) << "trial " << trial;
+    if (trial % 10 == 0) {
+      for (const auto& [x, t] : {std::pair(on_a, 0), std::pair(on_b, 3)}) {
+        const auto off = closest_triangle_triangle<Rational>(q(x), q(x), q(x), q(p[t]),
+                                                             q(p[t + 1]), q(p[t + 2]));
+        ASSERT_LE(off.distance_squared, Rational(64 * kU * 2.0) * Rational(64 * kU * 2.0))
+            << "trial " << trial << ": a witness point off its triangle";
       }
     }
     zero += d == 0.0 ? 1 : 0;

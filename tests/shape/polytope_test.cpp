@@ -956,6 +956,39 @@ TEST(Polytope, DerivedArraysCopiesAndMoves) {
   }
 }
 
+// The box of a hull of more than kTableMinVertices vertices (the margin
+// query's second bound): it holds every vertex, to within a few u of its
+// faces, at scales 2^-900 to 2^900; copies and moves keep it; small hulls
+// keep none.
+TEST(Polytope, BoxHoldsTheVerticesAndSurvivesCopiesAndMoves) {
+  Rng rng(2610);
+  EXPECT_FALSE(ConvexPolytope(sphere_points(rng, 8)).has_box());
+  for (const int exponent : {-900, 0, 900}) {
+    Points p = sphere_points(rng, 200);
+    for (Vec3& v : p) v = std::ldexp(1.0, exponent) * Vec3(3.0 * v.x(), v.y() + 0.5, 0.2 * v.z());
+    const ConvexPolytope hull(p);
+    ASSERT_TRUE(hull.has_box());
+    const Vec3 lo = hull.box_center() - hull.box_half();
+    const Vec3 hi = hull.box_center() + hull.box_half();
+    const double rounding = 8.0 * kUnitRoundoff * hull.scale();
+    Vec3 low = hull.vertices()[0], high = low;
+    for (const Vec3& v : hull.vertices()) {
+      low = low.cwiseMin(v);
+      high = high.cwiseMax(v);
+    }
+    EXPECT_LE((lo - low).cwiseAbs().maxCoeff(), rounding) << exponent;
+    EXPECT_LE((hi - high).cwiseAbs().maxCoeff(), rounding) << exponent;
+    ConvexPolytope copy = hull;
+    EXPECT_EQ(copy.box_center(), hull.box_center());
+    EXPECT_EQ(copy.box_half(), hull.box_half());
+    const ConvexPolytope moved(std::move(copy));
+    EXPECT_FALSE(copy.has_box());  // NOLINT(bugprone-use-after-move): the documented state
+    EXPECT_EQ(moved.box_half(), hull.box_half());
+    copy = moved;
+    EXPECT_EQ(copy.box_center(), hull.box_center());
+  }
+}
+
 TEST(Polytope, SinglePoint) {
   const Points pts = {{0.1, -2.5, 3e7}};
   const ConvexPolytope p(pts);

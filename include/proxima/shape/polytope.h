@@ -162,6 +162,18 @@ class ConvexPolytope {
   const Vec3& centroid() const { return centroid_; }
   // Largest distance from the centroid to a vertex.
   double bounding_radius() const { return bounding_radius_; }
+  // The box of the hull vertices in the polytope's own frame, as a center
+  // and half extents (halves of the extreme coordinates, so no sum
+  // overflows; within a few u of the exact box): after the sphere, the
+  // first bound of a margin query. Kept by hulls of more than
+  // kTableMinVertices vertices only (has_box()), in the one allocation:
+  // a small hull's query costs little more than the box test would, and
+  // its memory stays within twice its vertices plus adjacency.
+  bool has_box() const { return box_at_ != 0; }
+  Vec3 box_center() const { return Vec3(data_[box_at_], data_[box_at_ + 1], data_[box_at_ + 2]); }
+  Vec3 box_half() const {
+    return Vec3(data_[box_at_ + 3], data_[box_at_ + 4], data_[box_at_ + 5]);
+  }
   // Largest absolute coordinate of a hull vertex (the R of the accuracy
   // standard in the polytope's own frame): the magnitude that rounding errors
   // scale with. Every tolerance is relative to it (or to bounding_radius()
@@ -202,8 +214,10 @@ class ConvexPolytope {
   // the 32-bit arrays in this order: adjacency offsets (vertex_count + 1),
   // adjacency, adjacency faces (adjacency_size each), face offsets
   // (face_count + 1, absent when every face is a triangle), face vertices,
-  // input index (vertex_count, absent when it is the identity). Positions in
-  // the 32-bit part follow from the counts.
+  // input index (vertex_count, absent when it is the identity), the support
+  // table; then, for a hull of more than kTableMinVertices vertices, the
+  // box (six doubles at box_at_). Positions in the 32-bit part follow from
+  // the counts.
   static std::size_t size(std::int32_t n) { return static_cast<std::size_t>(n); }
   const Vec3* vertex_data() const { return reinterpret_cast<const Vec3*>(data_.get()); }
   // The 32-bit part starts ints_at_ doubles into the allocation: a stored
@@ -233,7 +247,8 @@ class ConvexPolytope {
   static std::size_t doubles_for(std::int32_t vertex_count, std::size_t int_count);
   void allocate(std::size_t doubles);
   void take(ConvexPolytope& other) noexcept;  // moves other's state here, leaves it empty
-  // centroid_, bounding_radius_ and scale_ from the stored vertices.
+  // centroid_, bounding_radius_, the box and scale_ from the stored
+  // vertices.
   void measure();
 
   std::unique_ptr<double[]> data_;
@@ -246,6 +261,9 @@ class ConvexPolytope {
   bool triangles_only_ = true;
   bool identity_input_ = true;
   std::int16_t table_side_ = 0;  // 0: no table
+  // Where the box's six doubles start in the allocation, after the 32-bit
+  // part (0: no box). In the padding before centroid_: no larger object.
+  std::uint32_t box_at_ = 0;
   Vec3 centroid_ = Vec3::Zero();
   double bounding_radius_ = 0.0;
   double scale_ = 0.0;
