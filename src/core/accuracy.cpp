@@ -60,6 +60,11 @@ void check_mesh_options(const DistanceOptions& options, const char* who, MeshOpt
       refuse("max_iterations", std::to_string(options.max_iterations),
              "its triangle pairs are solved in closed form, without iterations",
              std::to_string(defaults.max_iterations));
+    if (options.extended_precision)
+      refuse("extended_precision", "true",
+             "its triangle pairs' kernels have no extended recomputation; a mesh against a convex "
+             "body has it",
+             "false");
   }
   refuse("relative_tolerance", number(options.relative_tolerance),
          "its search stops at the bound of its hull to the relative tolerance 1e-12",

@@ -102,7 +102,9 @@ void check_distance_options(const DistanceOptions& options, const char* who,
 // penetration false (it computes no depth: the default true is answered as
 // false is, documented at MeshResult). A query whose leaves are the convex
 // query between each triangle and a polytope (distance(TriangleMesh,
-// ConvexPolytope)) honours algorithm and max_iterations there too.
+// ConvexPolytope)) honours algorithm, max_iterations and extended_precision
+// there too (the triangle pairs' closed-form kernels have no extended
+// recomputation).
 enum class MeshOptionUse : std::uint8_t {
   triangle_pairs,  // mesh-mesh, a Body pair with a mesh, the mesh margin queries
   convex_leaves,   // distance(TriangleMesh, ConvexPolytope)
@@ -116,7 +118,8 @@ inline bool mesh_options_plainly_valid(const DistanceOptions& options, MeshOptio
   return std::bit_cast<std::uint64_t>(options.relative_tolerance) ==
              std::bit_cast<std::uint64_t>(defaults.relative_tolerance) &&
          (use == MeshOptionUse::convex_leaves || (options.algorithm == defaults.algorithm &&
-                                                  options.max_iterations == defaults.max_iterations));
+                                                  options.max_iterations == defaults.max_iterations &&
+                                                  !options.extended_precision));
 }
 
 // check_distance_options, then the refusal of a non-default value of a

@@ -100,14 +100,6 @@ struct Query {
 // multiplication's cost instead of a libm call.
 inline Query make_query_of_rigid_poses(const TriangleMesh& a, const Pose& pa, const TriangleMesh& b,
                                        const Pose& pb, const DistanceOptions& options) {
-  // Refused, not ignored: the triangle pairs' kernels have no extended
-  // precision recomputation (a mesh against a convex body has it, through
-  // the convex query).
-  if (options.extended_precision) [[unlikely]] {
-    throw InvalidInput(
-        "mesh distance: options.extended_precision is not offered between two triangle meshes "
-        "(it is for a mesh and a convex body)");
-  }
   const Pose rel = pa.inverse() * pb;
   Query q{a, b, rel.rotation, rel.translation, {}, 1.0, 0, 0.0, 0.0, 1.0, 1.0, {}, {}, {}, {}};
   q.magnitude = std::max({magnitude_bound(pa, a.scale()), magnitude_bound(pb, b.scale()), a.scale(),
