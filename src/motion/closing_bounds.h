@@ -383,6 +383,20 @@ inline double fixed_plane_step(double plane, const Vec3& d, const Vec3& origin_f
   return step;
 }
 
+// The rounding of |w_r x e| (e unit, each product a few u of |w_r|) as
+// a fraction of |w_r|: 1e-14 is about 45 u, and an arc rate a few u too
+// small would let an edge's support be passed by that much.
+inline constexpr double kTurnRateSlack = 1e-14;
+
+// The longest s for which the arc bound of edge_pair_step's comment (below),
+// (k s + g s^2 / 2) / (rho0 - wr s), stays within `margin`: the root of
+// g s^2 / 2 + (k + margin wr) s - margin rho0, written without
+// cancellation (wr > 0 and margin > 0, so the denominator is positive).
+inline double edge_turn_span(double k, double g, double margin, double rho0, double wr) {
+  const double p = k + margin * wr;
+  return 2.0 * margin * rho0 / (p + std::sqrt(p * p + 2.0 * g * margin * rho0));
+}
+
 // The step that the plane through two edges allows (an edge-edge witness
 // pair), exact at first order where the planes above charge the edges'
 // fastest ends. Let e_a(s), e_b(s) be the two edges' unit directions
@@ -403,14 +417,25 @@ inline double fixed_plane_step(double plane, const Vec3& d, const Vec3& origin_f
 // |w_a| |p - T_a| + |w_b| |q - T_b| (T the reference points), |D(s)| <=
 // |D(0)| + V s, |D''| <= |w_a|^2 |p - T_a| + |w_b|^2 |q - T_b|. rho
 // depends only on the relative turn w_r = w_b - w_a: rho(s) >= rho(0) -
-// |w_r| s, kept >= rho(0) / 2 by the horizon. Seen from either body, m
-// turns at most at |w_r| / rho (the other edge turns at |w_r| about it),
-// so by time s it has turned at most -ln(1 - |w_r| s / rho(0)) (as an
-// arc, more than the chord of the cone margins): each edge holds its
-// body's support while that is below the edge's cone margin (cone_margin
-// of its two vertices along m), i.e. for s <= rho(0) (1 - e^-margin) /
-// |w_r|. The witness points are the query's (off the edge lines by a few
-// u R in the body frames, which stays so as they move: inside the band),
+// |w_r| s, kept >= rho(0) / 2 by the horizon. Each edge holds its body's
+// support while the arc that m has turned through, seen from that body,
+// is below the edge's cone margin (cone_margin of its two vertices along
+// m; an arc is more than the chord the margins bound). Seen from A, e_a
+// stands still and e_b turns at w_r x e_b, so m = c / rho turns at most at
+// |w_r x e_b(s)| / rho(s) (the projection in m' only shortens c'); that
+// is at most |w_r| / rho, so by time s the arc is at most -ln(1 - |w_r| s
+// / rho(0)), and the edge holds for s <= rho(0) (1 - e^-margin) / |w_r|.
+// Where the relative turn is about the other edge's own line (a bar
+// spinning about an axis along the cube edge it sweeps over: w_r x e_a =
+// 0, so m stands still in the bar) the arc is far shorter, and that
+// matters for a sliver whose two long edges are 1e-4 rad apart: its cone
+// margin is 1e-4, and the bound by |w_r| alone held each step to a turn
+// of 1e-4 rad (issue 25, toi_spin_wrap.sh). The finer bound, from A
+// (B alike with a and b swapped): e_b turns at |w_b|, so |w_r x e_b(s)|
+// <= k + g s with k = |w_r x e_b(0)|, g = |w_r| |w_b|, and the arc is at
+// most (k s + g s^2 / 2) / (rho(0) - |w_r| s) (edge_turn_span). The
+// witness points are the query's (off the edge lines by a few u R in the
+// body frames, which stays so as they move: inside the band),
 // and m(0) comes from edges nearly perpendicular only (rho(0) >= 1/2), so
 // that its rounding, times |D| and the edges' lengths, stays inside the
 // band too; `keep_off` (twice the band, and the target) is kept off.
@@ -518,9 +543,20 @@ inline double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3
     k.margin_a = margin_a;
     k.margin_b = margin_b;
   }
-  const double margin = std::min(margin_a, margin_b);
-  if (!(margin > 0.0)) return 0.0;
-  span = std::min(span, margin * (1.0 - 0.5 * margin) * rho / wr);
+  if (!(margin_a > 0.0) || !(margin_b > 0.0)) return 0.0;
+  // Each edge's span: the longer of the two arc bounds (both hold), the
+  // coarse one s <= rho(0) (1 - e^-margin) / |w_r| with 1 - e^-x >= x (1 -
+  // x / 2) (margins are <= 1), and edge_turn_span's.
+  const Vec3 w_r = wb - wa;
+  const double slack = kTurnRateSlack * wr;
+  const double seen_from_a = fast_norm(w_r.cross(edge_b)) / fast_norm(edge_b) + slack;
+  const double seen_from_b = fast_norm(w_r.cross(edge_a)) / fast_norm(edge_a) + slack;
+  const auto edge_span = [&](double margin, double rate0, double growth) {
+    return std::max(margin * (1.0 - 0.5 * margin) * rho / wr,
+                    edge_turn_span(rate0, growth, margin, rho, wr));
+  };
+  span = std::min({span, edge_span(margin_a, seen_from_a, wr * nb),
+                   edge_span(margin_b, seen_from_b, wr * na)});
   return std::min(step, span);
 }
 

@@ -857,13 +857,14 @@ TEST(TimeOfImpact, AVelocityMotionTurnsAtItsRateThroughAnyAngle) {
   const Motion still = Motion::fixed(Pose::identity());
   ImpactOptions options;
   options.tolerance = 1e-9;
-  // The bar is a sliver (0.01 by 100): its lowest feature near the cube
-  // flips between its two long edges, 1e-4 rad apart, which limits each
-  // step's span (the edges' cone margins) to about 1e-4 / w, and the
-  // advancement to a few hundred steps whatever the turn (the same with a
-  // slow turn the shorter way); the cap is raised so that the test is of
-  // the motion, not of that.
-  options.max_iterations = 4096;
+  // At the default cap (256 steps): the bar is a sliver (0.01 by 100)
+  // whose two long edges are 1e-4 rad apart, and the edge pair's plane
+  // held each step to a turn of 1e-4 rad (the bar edge's cone margin over
+  // the relative turn |w|), so every contact case ended iteration_cap
+  // about 0.001 of distance short of the cube. The turn is about the cube
+  // edge's own line, along which the plane's normal stands still in the
+  // bar (edge_pair_step's finer arc bound): a few tens of steps now.
+  ASSERT_EQ(options.max_iterations, 256);
   // {w, the end of the sampled span (past the true contact, or 1)}.
   const std::pair<double, double> cases[] = {
       {3.0, 1.0}, {3.2, 1.0}, {4.0, 1.0}, {2 * M_PI, 1.0}, {1000.0, 0.01}};
@@ -895,10 +896,17 @@ TEST(TimeOfImpact, AVelocityMotionTurnsAtItsRateThroughAnyAngle) {
       break;
     }
     const ImpactResult r = time_of_impact(cube, still, bar, spin, options);
+    // The reproducer's query: every option at its default.
+    const ImpactResult plain = time_of_impact(cube, still, bar, spin);
     if (first > 1.0) {
       EXPECT_EQ(r.status, ImpactStatus::separated);
+      EXPECT_EQ(plain.status, ImpactStatus::separated);
       continue;
     }
+    EXPECT_EQ(plain.status, ImpactStatus::contact);
+    EXPECT_LE(plain.t, first);
+    EXPECT_LE(plain.at_t.distance,
+              detail::kDefaultImpactTolerance * (cube.bounding_radius() + bar.bounding_radius()));
     ASSERT_EQ(r.status, ImpactStatus::contact);
     EXPECT_LE(r.t, first);
     // Within the tolerance of the distance at t: the tip of the contact,
