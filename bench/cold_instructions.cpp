@@ -18,7 +18,9 @@
 // `tracked` runs the same poses in sweep order with one DistanceCache (the
 // tracked depth, for comparison; stride 1 is penetration_peers' tracked
 // sweep). With `--passes P` first, it also times P passes (thread CPU
-// time) and prints the median ns per query.
+// time) and prints the median ns per query. A last argument `extended`
+// asks every query for DistanceOptions::extended_precision (its cost
+// against the same run without it).
 #include <time.h>
 
 #include <algorithm>
@@ -44,6 +46,8 @@ int main(int argc, char** argv) {
   using namespace proxima;
   int passes = 0;
   int arg = 1;
+  const bool extended = argc > 2 && std::strcmp(argv[argc - 1], "extended") == 0;
+  if (extended) --argc;
   if (argc > 2 && std::strcmp(argv[1], "--passes") == 0) {
     passes = std::atoi(argv[2]);
     arg = 3;
@@ -52,7 +56,7 @@ int main(int argc, char** argv) {
       (argc - arg == 3 && std::strcmp(argv[arg + 2], "overlapping") != 0 &&
        std::strcmp(argv[arg + 2], "tracked") != 0)) {
     std::fprintf(stderr,
-                 "usage: cold_instructions [--passes P] N [stride] [overlapping|tracked]\n");
+                 "usage: cold_instructions [--passes P] N [stride] [overlapping|tracked] [extended]\n");
     return 2;
   }
   const int n = std::atoi(argv[arg]);
@@ -76,10 +80,12 @@ int main(int argc, char** argv) {
   // A cold query is distance() without a cache.
   DistanceCache cache;
   DistanceCache* const cache_or_null = tracked ? &cache : nullptr;
+  DistanceOptions options;
+  options.extended_precision = extended;
   double sum = 0.0;
   int overlapping = 0;
   for (const Pose& p : poses) {
-    const DistanceResult r = distance(bodies.a, Pose::identity(), bodies.b, p, {}, cache_or_null);
+    const DistanceResult r = distance(bodies.a, Pose::identity(), bodies.b, p, options, cache_or_null);
     sum += r.signed_distance();
     overlapping += r.status == Status::intersecting ? 1 : 0;
   }
@@ -92,7 +98,7 @@ int main(int argc, char** argv) {
       double s = 0.0;
       cache.reset();
       for (const Pose& p : poses)
-        s += distance(bodies.a, Pose::identity(), bodies.b, p, {}, cache_or_null).signed_distance();
+        s += distance(bodies.a, Pose::identity(), bodies.b, p, options, cache_or_null).signed_distance();
       ns.push_back((thread_cpu_ns() - t0) / static_cast<double>(poses.size()));
       if (s != sum) std::printf("pass %d: the sum differs (%a)\n", k, s);
     }

@@ -519,7 +519,7 @@ Pose.from_wxyz(q, t) or Pose.from_xyzw(q, t) (ROS, scipy); a bare one in a pair 
 cache: a DistanceCache updated in place (tracking) or None (cold).
 algorithm: 'hybrid' (the paper), 'gjk' or 'enhanced_gjk'. The tolerances and the iteration cap are
 DistanceOptions' fields. extended_precision: full relative accuracy, the witness pair's distance
-recomputed in double-double (docs/accuracy.md). Returns a DistanceResult.)doc");
+(an overlap's depth) recomputed in double-double (docs/accuracy.md). Returns a DistanceResult.)doc");
 
   m.def(
       "distance_batch",

@@ -235,6 +235,16 @@ constexpr double kAgreeUlps = 4096.0;
 // The double nearest to x, and the largest double not above it.
 double nearest(Dd x) { return x.hi + x.lo; }
 double round_down(Dd x) { return x.lo < 0.0 ? std::nextafter(x.hi, -HUGE_VAL) : x.hi; }
+// The smallest double not below x.
+double round_up(Dd x) { return x.lo > 0.0 ? std::nextafter(x.hi, HUGE_VAL) : x.hi; }
+
+// The power-of-two unit of the two bodies placed at their poses: a bound
+// on their world coordinates (magnitude_bound's terms), brought near 1.
+double placed_bound(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                    const Pose& pose_b) {
+  return std::max(pose_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * a.scale(),
+                  pose_b.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
+}
 
 }  // namespace
 
@@ -242,9 +252,7 @@ ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& po
                                          const ConvexPolytope& b, const Pose& pose_b,
                                          DistanceResult& result, Vec3& normal,
                                          bool certify_lower_bound) {
-  const double magnitude =
-      std::max(pose_a.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * a.scale(),
-               pose_b.translation.cwiseAbs().maxCoeff() + std::sqrt(3.0) * b.scale());
+  const double magnitude = placed_bound(a, pose_a, b, pose_b);
   if (!(magnitude > 0.0)) return ExtendedOutcome::unchanged;
   const detail::PowerOfTwoUnit unit = detail::power_of_two_unit(magnitude);
   const double s = unit.inverse;
@@ -299,6 +307,62 @@ ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& po
   result.lower_bound =
       std::clamp(round_down(gap - Dd{agree, 0.0}) * unit.unit, 0.0, result.distance);
   return ExtendedOutcome::refined;
+}
+
+bool refine_depth_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                           const Pose& pose_b, double band, double relative,
+                           DistanceResult& result) {
+  const double magnitude = placed_bound(a, pose_a, b, pose_b);
+  if (!(magnitude > 0.0) || !(result.depth > 0.0)) return false;
+  const detail::PowerOfTwoUnit unit = detail::power_of_two_unit(magnitude);
+  const double s = unit.inverse;
+  const PlacedFeature fa = place(a, pose_a, result.feature_a, s);
+  const PlacedFeature fb = place(b, pose_b, result.feature_b, s);
+  PairDistance pair;
+  if (!pair_distance(fa, fb, pair)) return false;
+  const Dd length = sqrt(dot(pair.normal, pair.normal));
+  if (!(length.hi > 0.0)) return false;
+  // N along the answer's normal (world frame, from A towards B), so that
+  // the overlap along it is h_A(N) + h_B(-N).
+  DdVec normal = pair.normal;
+  const Vec3 answer = pose_a.rotation * result.normal;
+  const double side = answer.dot(Vec3(normal[0].hi, normal[1].hi, normal[2].hi));
+  if (!(side != 0.0)) return false;
+  if (side < 0.0) normal = {-normal[0], -normal[1], -normal[2]};
+  std::vector<int> ids;
+  const int hint_a = std::max<std::int32_t>(result.feature_a.vertices[0], 0);
+  const int hint_b = std::max<std::int32_t>(result.feature_b.vertices[0], 0);
+  const Dd top_a = extreme(a, pose_a, s, normal, 1.0, hint_a, ids);
+  const Dd bottom_b = extreme(b, pose_b, s, normal, -1.0, hint_b, ids);
+  const Dd overlap = (top_a - bottom_b) / length;
+  // The rounding bound of the overlap and of the face's offset, as the
+  // distance's gap (in units of s).
+  const double agree = kAgreeUlps * 0x1p-104 * 2.0;
+  // An upper bound on the exact depth whatever the face: the depth is the
+  // least overlap over unit directions (the origin's distance to the
+  // boundary of A - B).
+  const double upper = round_up(overlap + Dd{agree, 0.0}) * unit.unit;
+  if (!(std::abs(nearest(pair.distance - overlap)) <= agree)) {
+    // Not a face of A - B along N within this precision: its overlap
+    // still bounds the depth from above, where that is no looser.
+    if (upper >= result.depth && upper < result.depth_upper_bound) result.depth_upper_bound = upper;
+    return false;
+  }
+  const double depth = nearest(overlap) * unit.unit;
+  // The double depth is within its tolerance of the exact one; a face
+  // farther from it than that is not the deepest (a face whose value
+  // ties with the least in double, beyond this precision's reach).
+  if (!(std::abs(depth - result.depth) <= 2.0 * (relative * result.depth + band))) {
+    if (upper >= result.depth && upper < result.depth_upper_bound) result.depth_upper_bound = upper;
+    return false;
+  }
+  result.depth = depth;
+  result.depth_upper_bound = upper;
+  result.depth_lower_bound = std::min(result.depth_lower_bound, depth);
+  const Vec3 n(nearest(normal[0] / length), nearest(normal[1] / length),
+               nearest(normal[2] / length));
+  result.normal = pose_a.rotation.transpose() * (n / n.norm());
+  return true;
 }
 
 }  // namespace proxima::detail

@@ -50,4 +50,27 @@ ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& po
                                          DistanceResult& result, Vec3& normal,
                                          bool certify_lower_bound = false);
 
+// The penetration depth of an intersecting `result` (A's frame, as
+// finish_signed_distance holds it; `pose_a`, `pose_b` the world poses)
+// with DistanceOptions::extended_precision: its Minkowski face, the
+// witness features (a face of one body and a vertex of the other, or two
+// edges), placed in the world in double-double, gives the face's normal N
+// and its offset, the distance of the features' affine hulls; the
+// overlap of the supports along N, h_A(N) + h_B(-N) over the vertices tied
+// with the double supports (the exact maximizers are among them, as for
+// the distance), is an upper bound on the exact depth whatever the face,
+// computed to a few 2^-104 of the coordinates. When the two agree (the
+// features are the supports along N: a face of A - B), the face's offset
+// is its exact value within that error, and when it is within the double
+// answer's own tolerance (`band` the contact band of the query, relative
+// tolerance as options give) of the double depth, it replaces it:
+// `result.depth` the offset rounded, `depth_upper_bound` the overlap plus
+// its rounding bound, `normal` (A's frame) N. Otherwise only a tighter
+// upper bound along N is kept. The lower bound is the algorithm's: it is
+// certified over every face of A - B, which a recomputation of one face
+// cannot be. Returns whether the depth was replaced.
+bool refine_depth_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                           const Pose& pose_b, double band, double relative,
+                           DistanceResult& result);
+
 }  // namespace proxima::detail

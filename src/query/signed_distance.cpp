@@ -13,6 +13,7 @@
 #include "proxima/detail/penetration/penetration.h"
 #include "proxima/query/signed_distance.h"
 #include "proxima/shape/support.h"
+#include "query/extended_distance.h"
 
 namespace proxima {
 namespace detail {
@@ -122,6 +123,21 @@ bool touching_certified(const ConvexPolytope& a, const Pose& pose_a, const Conve
          within(Vec3(-(b_in_a.rotation * b.face_plane(fb.face).normal)));
 }
 
+// With DistanceOptions::extended_precision, an intersecting answer's
+// depth recomputed in double-double along its face of A - B
+// (query/extended_distance.h), against the band of the magnitude bound
+// (the accept window is a bound on the double answer's error: the wider
+// band only widens it).
+void refine_depth(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                  const Pose& pose_b, const DistanceOptions& options, DistanceResult& result) {
+  if (!options.extended_precision || result.status != Status::intersecting) return;
+  const double band = contact_band(
+      std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
+      options.absolute_tolerance);
+  refine_depth_extended(a, pose_a, b, pose_b, band,
+                        std::max(kStandardRelative, options.relative_tolerance), result);
+}
+
 }  // namespace
 
 void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
@@ -171,9 +187,11 @@ void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const C
     result.distance = 0.0;
     result.lower_bound = 0.0;
     take_depth(p, result);
+    refine_depth(a, pose_a, b, pose_b, options, result);
     return;
   }
   take_depth(penetration_depth(a, b, b_in_a, cache.penetration.get_or_create(), contact_seed(cache)), result);
+  refine_depth(a, pose_a, b, pose_b, options, result);
 }
 
 bool tracked_overlap(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,

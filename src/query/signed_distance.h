@@ -31,13 +31,15 @@ void finish_signed_distance(const ConvexPolytope& a, const Pose& pose_a, const C
                             DistanceCache& cache, DistanceResult& result);
 
 // Whether tracked_overlap may answer for the pair: its last depth was
-// penetrating, with options.penetration and the hybrid. Inline: distance()
-// asks it of every query, and a pair that overlapped once and separated
-// since pays only this test (not a call that fails).
+// penetrating, with options.penetration and the hybrid, without
+// extended_precision (whose depth finish_signed_distance recomputes).
+// Inline: distance() asks it of every query, and a pair that overlapped
+// once and separated since pays only this test (not a call that fails).
 inline bool overlap_trackable(const DistanceOptions& options, const DistanceCache& cache) {
   const PenetrationCache* depth_cache = cache.penetration.get();
   return depth_cache != nullptr && depth_cache->last_status == PenetrationStatus::intersecting &&
-         options.penetration && options.algorithm == Algorithm::hybrid;
+         options.penetration && options.algorithm == Algorithm::hybrid &&
+         !options.extended_precision;
 }
 
 // Before distance()'s algorithm runs, for a pair that distance() found

@@ -15,6 +15,7 @@
 #include "proxima/query/distance.h"
 #include "support/exact_oracle.h"
 #include "support/generators.h"
+#include "support/penetration_oracle.h"
 
 namespace proxima::test {
 namespace {
@@ -295,6 +296,102 @@ TEST(ExtendedPrecision, PaperCubesAndFarCloudsAtOneBillionth) {
     const Points b = place_along(a, b0, random_unit_vector(rng),
                                  gap_of(rng, centre.cwiseAbs().maxCoeff() + 2.0));
     check_extended(a, b, oracle, tally, "far clouds " + std::to_string(trial));
+  }
+  EXPECT_GE(tally.off_outside, 3);
+}
+
+// The penetration depth with the option (issue 25 §4, the depth's half):
+// the deepest face of A - B recomputed in double-double, its value within
+// kExtendedRelative of the exact depth and the certificate's upper bound
+// as tight, on overlaps whose depth in double is off by a few u R.
+
+struct DepthTally {
+  int cases = 0;
+  int off_outside = 0;  // depths without the option outside kExtendedRelative
+};
+
+// Both orders, with the option: intersecting, the depth within
+// kExtendedRelative of the exact one, depth_lower_bound <= exact <=
+// depth_upper_bound (decided exactly) and the upper bound within
+// kExtendedRelative of it. Without the option, counts the depths outside
+// kExtendedRelative.
+void check_extended_depth(const Points& a, const Points& b, DepthTally& tally,
+                          const std::string& what) {
+  const ExactDepth exact = exact_depth(a, b);
+  ASSERT_FALSE(exact.flat) << what;
+  ASSERT_EQ(exact.origin, OriginInM::inside) << what;
+  const double truth = exact.depth();
+  ++tally.cases;
+  const ConvexPolytope pa(a), pb(b);
+  const DistanceResult plain = distance(pa, Pose::identity(), pb, Pose::identity());
+  tally.off_outside += !within_bound(plain.depth, exact.depth_squared, kExtendedRelative, 0.0);
+  DistanceOptions options;
+  options.extended_precision = true;
+  for (const bool swapped : {false, true}) {
+    const DistanceResult r = swapped ? distance(pb, Pose::identity(), pa, Pose::identity(), options)
+                                     : distance(pa, Pose::identity(), pb, Pose::identity(), options);
+    const std::string where = what + (swapped ? ", swapped" : "") + ", exact " + g(truth) +
+                              ", answer " + g(r.depth) + " in [" + g(r.depth_lower_bound) + ", " +
+                              g(r.depth_upper_bound) + "], without the option " + g(plain.depth);
+    ASSERT_EQ(r.status, Status::intersecting) << where;
+    EXPECT_TRUE(within_bound(r.depth, exact.depth_squared, kExtendedRelative, 0.0)) << where;
+    const mpq_class lower(r.depth_lower_bound), upper(r.depth_upper_bound);
+    EXPECT_TRUE(r.depth_lower_bound <= 0.0 || lower * lower <= exact.depth_squared) << where;
+    EXPECT_GE(upper * upper, exact.depth_squared) << where;
+    EXPECT_TRUE(within_bound(r.depth_upper_bound, exact.depth_squared, kExtendedRelative, 0.0))
+        << where;
+    EXPECT_LE(r.depth_lower_bound, r.depth) << where;
+    EXPECT_LE(r.depth, r.depth_upper_bound) << where;
+  }
+}
+
+// An overlap of 100 bands to 1e-7 of the size (log-uniform): above the
+// bands where the depth in double is already refined exactly, and small
+// enough that its few u of the size are past 1e-9 of it.
+double overlap_of(Rng& rng, double size, double r) {
+  const double band = kContactBandUlps * kUnitRoundoff * r;
+  return log_uniform(rng, 100.0 * band, 1e-7 * size);
+}
+
+// A box tilted by 1e-5 to 1e-2 rad pressed into a box's face, its lowest
+// corner a small depth below it (near-parallel faces), 1 to 1e3 sizes
+// from the origin.
+TEST(ExtendedPrecision, DepthOfNearlyParallelFacesAtOneBillionth) {
+  Rng rng(25044);
+  DepthTally tally;
+  for (int trial = 0; trial < 12; ++trial) {
+    const double size = uniform(rng, 1.0, 10.0);
+    const Vec3 centre = log_uniform(rng, 1.0, 1e3) * size * random_unit_vector(rng);
+    const Mat3 turn = random_rotation(rng);
+    const Points a = transformed(box(Vec3(size, size, 0.5 * size)), turn, centre);
+    const double angle = log_uniform(rng, 1e-5, 1e-2);
+    const Mat3 tilt = Mat3(Eigen::AngleAxisd(angle, random_unit_vector(rng)));
+    const Points b_local = transformed(box(Vec3(0.3 * size, 0.4 * size, 0.2 * size)), turn * tilt,
+                                       Vec3::Zero());
+    const double overlap = overlap_of(rng, size, centre.cwiseAbs().maxCoeff() + 2.0 * size);
+    const Points b = place_along(a, translated(b_local, centre), turn.col(2), -overlap);
+    check_extended_depth(a, b, tally, "trial " + std::to_string(trial) + ", angle " + g(angle));
+  }
+  EXPECT_GE(tally.off_outside, 3);
+}
+
+// Random clouds 1 to 1e4 of their size from the origin, one pushed into
+// the other by a small depth along their closest points' normal (from
+// 0.1 apart along a random direction: the witness features then face each
+// other, and the pair overlaps).
+TEST(ExtendedPrecision, DepthOfCloudsAtOneBillionth) {
+  Rng rng(25045);
+  DepthTally tally;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Vec3 centre = log_uniform(rng, 1.0, 1e4) * random_unit_vector(rng);
+    const Points a = translated(points_on_sphere(rng, uniform_int(rng, 8, 20)), centre);
+    const Points b0 = translated(points_in_cube(rng, uniform_int(rng, 8, 20), 0.7), centre);
+    const Points apart = place_along(a, b0, random_unit_vector(rng), 0.1);
+    const DistanceResult d =
+        distance(ConvexPolytope(a), Pose::identity(), ConvexPolytope(apart), Pose::identity());
+    const double overlap = overlap_of(rng, 1.0, centre.cwiseAbs().maxCoeff() + 2.0);
+    const Points b = translated(apart, -(d.distance + overlap) * d.normal);
+    check_extended_depth(a, b, tally, "clouds " + std::to_string(trial));
   }
   EXPECT_GE(tally.off_outside, 3);
 }

@@ -165,9 +165,14 @@ struct DistanceOptions {
   // and takes them when the two agree, so that the distance is within a
   // few ulps of the exact distance of the given doubles whenever the
   // feature pair is right, and the certificate [lower_bound, distance] is
-  // that tight. Off (the default): answers within 16 bands of touching are
-  // recomputed so, the others keep the standard's absolute term 64 u R.
-  // It costs about 10,000 instructions per answer, off the tracked path.
+  // that tight. An intersecting answer's depth between two convex
+  // polytopes likewise: its face of A - B recomputed in double-double, the depth within a few ulps of the
+  // exact depth whenever the face is the deepest, and depth_upper_bound
+  // that tight (depth_lower_bound stays the algorithm's). Off (the
+  // default): answers within 16 bands of touching are recomputed so, the
+  // others keep the standard's absolute term 64 u R. It costs about
+  // 10,000 instructions per answer, off the tracked path (an overlapping
+  // pair under the option does not take the tracked depth's shortcut).
   bool extended_precision = false;
 };
 
