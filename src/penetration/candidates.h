@@ -99,6 +99,15 @@ bool above_bound(const Query& q, double lower) {
   return q.prune && lower > q.bound + q.prune_margin + kValueSlackUlps * kUnitRoundoff;
 }
 
+// Edge pairs whose cross product is below this share of their lengths'
+// product (the sine of their angle) are skipped as parallel, like an
+// exactly zero product (the next test): normalizing a product that small
+// would scale its rounding (a few u of the lengths' product) by more than
+// 2^150. The cutoff is far below the sines whose normals carry
+// information (above a few u), so it drops only pairs parallel within
+// rounding.
+constexpr double kParallelEdgeSine = 0x1p-200;
+
 // Balls around a pruned group's normals (PenetrationCache::Bound). Slack
 // on a ball's radius for the roundings of its centre and of the distances
 // to it (a few u each).
@@ -158,7 +167,7 @@ void add_edge_candidate(Query& q, int a0, int a1, const std::array<Arc, 4>& xa, 
   const Vec3 eb = detail::exponent_free(yb[0].k);
   Vec3 n = ea.cross(eb);
   const double length = n.norm();
-  if (!(length > 0x1p-200 * ea.norm() * eb.norm()) || !(length > 0.0)) return;
+  if (!(length > kParallelEdgeSine * ea.norm() * eb.norm()) || !(length > 0.0)) return;
   n /= length;
   Vec3 middle = arc_middle(xa, na);
   if (middle.squaredNorm() == 0) middle = arc_middle(yb, nb);

@@ -13,6 +13,16 @@
 namespace proxima {
 namespace {
 
+// The rounding of a lower bound moved by delta (entry_value, bound): c.delta
+// with |c| <= 1, the min and the sums, a few u of |delta| in all; taken as
+// 2^-44 = 512 u of |delta|, far above it, so that a moved bound never
+// exceeds the values it bounds.
+constexpr double kMovedBoundSlack = 0x1p-44;
+// A node's normal-ball radius rounded up by this, relative and absolute:
+// the computed norm |n - c| is within a few u of the exact one (unit
+// normals: |n - c| <= 2), and 2^-48 = 32 u covers it.
+constexpr double kRadiusRoundUp = 0x1p-48;
+
 // B's translation since the enumeration: delta = t - t_enumeration and its
 // length (computed in the query's unit: no overflow, no underflow); t and
 // the unit for the groups, each anchored at its own translation.
@@ -37,7 +47,8 @@ double entry_value(const PenetrationCache::Facet& f, const Moved& m) {
 double entry_value(const PenetrationCache::Bound& b, const Moved& m) {
   const Vec3 delta = m.t - b.anchor;
   const double length = (delta * m.inverse).norm() * m.unit;
-  return b.lower - std::min(length, b.center.dot(delta) + b.spread * length) - 0x1p-44 * length;
+  return b.lower - std::min(length, b.center.dot(delta) + b.spread * length) -
+         kMovedBoundSlack * length;
 }
 const Vec3& entry_normal(const PenetrationCache::Facet& f) { return f.normal; }
 const Vec3& entry_normal(const PenetrationCache::Bound& b) { return b.center; }
@@ -72,7 +83,7 @@ void make_node(const std::vector<Entry>& entries, std::vector<PenetrationCache::
   }
   // Rounded up: the norm is within a few u of the exact one (normals are
   // unit, so |n - c| <= 2), and the query adds its own slack.
-  radius = radius * (1.0 + 0x1p-48) + 0x1p-48;
+  radius = radius * (1.0 + kRadiusRoundUp) + kRadiusRoundUp;
   PenetrationCache::Node& node = nodes[static_cast<std::size_t>(at)];
   node.center = center;
   node.radius = radius;
@@ -195,7 +206,7 @@ struct TreeSearch {
     const double length = (delta * inverse).norm() * unit;
     // Rounding of c.delta (|c| <= 1) and of the sum: a few u of |delta|.
     const double gain = std::min(length, node.center.dot(delta) + node.radius * length);
-    return node.least_offset - gain - 0x1p-44 * length;
+    return node.least_offset - gain - kMovedBoundSlack * length;
   }
 
   double visit(int at, double node_bound) {

@@ -77,6 +77,12 @@
 namespace proxima {
 namespace {
 
+// The fingerprint's weight of the face count beside the vertex count: V +
+// 1e6 F is an exact integer in a double and tells (V, F) pairs apart
+// while V < 1e6 (hulls of more vertices may collide on it; the sums of
+// coordinates are the fingerprint's other half).
+constexpr double kFaceCountWeight = 1e6;
+
 // The fingerprint of a pair: sizes and a few coordinates, so that a cache
 // of another pair of polytopes built at the same addresses is not trusted.
 std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope& b) {
@@ -85,8 +91,9 @@ std::array<double, 4> fingerprint(const ConvexPolytope& a, const ConvexPolytope&
     const Vec3& last = p.vertex(p.vertex_count() - 1);
     return first.x() + 2 * first.y() + 3 * first.z() + 5 * last.x() + 7 * last.y() + 11 * last.z();
   };
-  return {static_cast<double>(a.vertex_count()) + 1e6 * a.face_count(),
-          static_cast<double>(b.vertex_count()) + 1e6 * b.face_count(), sum(a), sum(b)};
+  return {static_cast<double>(a.vertex_count()) + kFaceCountWeight * a.face_count(),
+          static_cast<double>(b.vertex_count()) + kFaceCountWeight * b.face_count(), sum(a),
+          sum(b)};
 }
 
 // The faces of A - B whose values are within this many u (scaled units)
@@ -135,6 +142,15 @@ void remember_faces(const Query& q, PenetrationCache& cache, const Pose& b_in_a,
   cache.last = cache.facets[best];
 }
 
+// The first direction of a cold enumeration, the centroids' difference in
+// the query's scaled units (coordinates up to about 1), is replaced by an
+// axis when its squared length is not above this. Any unit direction gives
+// an upper bound (h_A(n) + h_B(-n) bounds the depth), so the direction only
+// has to normalize to a unit one: its squared length, whose root
+// normalize() divides by, must stay clear of underflow, which 2^-400 is by
+// far; a difference that small is the centroids' rounding (a few u) anyway.
+constexpr double kMinFirstDirectionSquared = 0x1p-400;
+
 // `record`: keep the pruned groups in cache->bounds (PenetrationCache).
 PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const Pose& b_in_a,
                              const PenetrationCache::Facet* start, bool record) {
@@ -158,7 +174,7 @@ PenetrationResult solve_cold(Query& q, bool walk, PenetrationCache* cache, const
     q.prune = true;
     if (cache != nullptr) q.prune_margin = cache->prune_margin * q.inverse;
     Vec3 d = start != nullptr ? start->normal : Vec3(q.centroid_b - q.centroid_a);
-    if (!(d.squaredNorm() > 0x1p-400)) d = Vec3::UnitZ();
+    if (!(d.squaredNorm() > kMinFirstDirectionSquared)) d = Vec3::UnitZ();
     d.normalize();
     first = evaluate(q, {}, d, start != nullptr ? start->support_a : -1,
                      start != nullptr ? start->support_b : -1);

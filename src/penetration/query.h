@@ -52,6 +52,14 @@ constexpr double kTieUlps = 64.0;
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
+// The fast face normals (HullNormals, fast_normals): a fan triangle's edges
+// p, q of at least 2^-450 (their squares 2^-900 and above: no subnormal
+// rounding in p2 or q2), and |p x q| >= 2^-10 |p||q| (a sine above 2^-10,
+// compared as squares: no square root), since the normal's error bound
+// grows as |p||q| / |p x q|; other faces take face_plane's exact normal.
+constexpr double kMinFastEdgeSquared = 0x1p-900;
+constexpr double kMinFastSineSquared = 0x1p-20;
+
 struct Arc {
   Vec3 p, q;         // unit endpoints
   Vec3 k;            // axis: p x q along +k
@@ -203,7 +211,7 @@ struct Query {
         // >= 2^-10 |p||q| as squares (no square root); |p||q| <= (p2 +
         // q2) / 2 in the error bound; one rounding more from multiplying
         // by 1 / |c| (within the 8 u).
-        if (std::min(p2, q2) > 0x1p-900 && c2 >= 0x1p-20 * (p2 * q2)) {
+        if (std::min(p2, q2) > kMinFastEdgeSquared && c2 >= kMinFastSineSquared * (p2 * q2)) {
           const double inverse_length = 1.0 / std::sqrt(c2);
           const Vec3 n = c * inverse_length;
           const double e = (16.0 * (p2 + q2) * inverse_length + 8.0) * u;

@@ -108,13 +108,19 @@ bool track(Query& q, PenetrationCache& cache, const Pose& b_in_a, PenetrationRes
 // just passed it. Doubling, from 32 steps, keeps those expansions rare
 // (bench/penetration_peers' sweep, B through A and back).
 constexpr double kMarginSteps = 32.0;
+// The margin's floor as a share of the bodies' radii: a B that barely
+// moves (its last step near 0) still keeps the faces within 1/1024 of the
+// radii of the best value, so that its next small steps are tracked
+// rather than enumerated again.
+constexpr double kMarginRadiiShare = 0x1p-10;
 
 double translation_margin(const ConvexPolytope& a, const ConvexPolytope& b,
                           const PenetrationCache& cache, const Pose& b_in_a) {
   const double radii = a.bounding_radius() + b.bounding_radius();
   const double step = (b_in_a.translation - cache.previous_translation).norm();
-  return std::min(std::max({2.0 * cache.prune_margin, kMarginSteps * step, 0x1p-10 * radii}),
-                  0.5 * radii);
+  return std::min(
+      std::max({2.0 * cache.prune_margin, kMarginSteps * step, kMarginRadiiShare * radii}),
+      0.5 * radii);
 }
 
 // Expands the pruned groups whose bound at B's translation is below `best`

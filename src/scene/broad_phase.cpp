@@ -594,6 +594,13 @@ constexpr double kDotErrorUlps = 8.0;
 constexpr double kCertifiedScaleMin = 0x1p-400;
 constexpr double kCertifiedScaleMax = 0x1p400;
 
+// allowance_of's margin shrunk by 2^-30 (below): its own rounding (a
+// division and a root, a few u relative) and that of the caller's
+// comparison of |d' - d|^2 with its square are far below 2^-30 relative,
+// and an allowance a hair short only makes a climb run that could have
+// been skipped.
+constexpr double kAllowanceShrink = 1.0 - 0x1p-30;
+
 // The allowance of vertex v as the support in direction d (v the climb's
 // answer, v_dot its computed dot product): how far (Euclidean) another
 // direction d' may be from d with no neighbour's computed dot product
@@ -605,9 +612,10 @@ constexpr double kCertifiedScaleMax = 0x1p400;
 // (d' - d).(v - w) >= g - 2e - u g - |d' - d| |v - w|, and the computed d'.w
 // cannot exceed the computed d'.v while that stays above 2e:
 // |d' - d| < (g - 4e - u g) / |v - w|. The least of these over the
-// neighbours, shrunk by 2^-30 for its own rounding and that of the caller's
-// |d' - d|^2. -1 when a neighbour leaves no margin (a plateau: coplanar
-// neighbours tie); infinite for a vertex without neighbours.
+// neighbours, shrunk by 2^-30 (kAllowanceShrink) for its own rounding and
+// that of the caller's |d' - d|^2. -1 when a neighbour leaves no margin (a
+// plateau: coplanar neighbours tie); infinite for a vertex without
+// neighbours.
 double allowance_of(const ConvexPolytope& body, const Vec3& d, std::int32_t v, double v_dot) {
   const double scale = body.scale();
   if (!(scale > kCertifiedScaleMin && scale < kCertifiedScaleMax)) return -1.0;
@@ -623,7 +631,7 @@ double allowance_of(const ConvexPolytope& body, const Vec3& d, std::int32_t v, d
     if (!(length2 > 0.0)) return -1.0;  // an edge too short to square
     least = std::min(least, margin / std::sqrt(length2));
   }
-  return least * (1.0 - 0x1p-30);
+  return least * kAllowanceShrink;
 }
 }  // namespace
 
