@@ -55,8 +55,9 @@ int main(int argc, char** argv) {
   if (argc - arg < 1 || argc - arg > 3 ||
       (argc - arg == 3 && std::strcmp(argv[arg + 2], "overlapping") != 0 &&
        std::strcmp(argv[arg + 2], "tracked") != 0)) {
-    std::fprintf(stderr,
-                 "usage: cold_instructions [--passes P] N [stride] [overlapping|tracked] [extended]\n");
+    std::fprintf(
+        stderr,
+        "usage: cold_instructions [--passes P] N [stride] [overlapping|tracked] [extended]\n");
     return 2;
   }
   const int n = std::atoi(argv[arg]);
@@ -85,7 +86,8 @@ int main(int argc, char** argv) {
   double sum = 0.0;
   int overlapping = 0;
   for (const Pose& p : poses) {
-    const DistanceResult r = distance(bodies.a, Pose::identity(), bodies.b, p, options, cache_or_null);
+    const DistanceResult r =
+        distance(bodies.a, Pose::identity(), bodies.b, p, options, cache_or_null);
     sum += r.signed_distance();
     overlapping += r.status == Status::intersecting ? 1 : 0;
   }
@@ -98,7 +100,8 @@ int main(int argc, char** argv) {
       double s = 0.0;
       cache.reset();
       for (const Pose& p : poses)
-        s += distance(bodies.a, Pose::identity(), bodies.b, p, options, cache_or_null).signed_distance();
+        s += distance(bodies.a, Pose::identity(), bodies.b, p, options, cache_or_null)
+                 .signed_distance();
       ns.push_back((thread_cpu_ns() - t0) / static_cast<double>(poses.size()));
       if (s != sum) std::printf("pass %d: the sum differs (%a)\n", k, s);
     }

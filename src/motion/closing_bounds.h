@@ -555,8 +555,8 @@ inline double edge_pair_step(const ConvexPolytope& a, const Pose& pa, const Vec3
     return std::max(margin * (1.0 - 0.5 * margin) * rho / wr,
                     edge_turn_span(rate0, growth, margin, rho, wr));
   };
-  span = std::min({span, edge_span(margin_a, seen_from_a, wr * nb),
-                   edge_span(margin_b, seen_from_b, wr * na)});
+  span = std::min(
+      {span, edge_span(margin_a, seen_from_a, wr * nb), edge_span(margin_b, seen_from_b, wr * na)});
   return std::min(step, span);
 }
 

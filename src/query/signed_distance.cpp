@@ -131,9 +131,9 @@ bool touching_certified(const ConvexPolytope& a, const Pose& pose_a, const Conve
 void refine_depth(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
                   const Pose& pose_b, const DistanceOptions& options, DistanceResult& result) {
   if (!options.extended_precision || result.status != Status::intersecting) return;
-  const double band = contact_band(
-      std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
-      options.absolute_tolerance);
+  const double band =
+      contact_band(std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
+                   options.absolute_tolerance);
   refine_depth_extended(a, pose_a, b, pose_b, band,
                         std::max(kStandardRelative, options.relative_tolerance), result);
 }

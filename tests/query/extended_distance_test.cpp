@@ -328,8 +328,9 @@ void check_extended_depth(const Points& a, const Points& b, DepthTally& tally,
   DistanceOptions options;
   options.extended_precision = true;
   for (const bool swapped : {false, true}) {
-    const DistanceResult r = swapped ? distance(pb, Pose::identity(), pa, Pose::identity(), options)
-                                     : distance(pa, Pose::identity(), pb, Pose::identity(), options);
+    const DistanceResult r = swapped
+                                 ? distance(pb, Pose::identity(), pa, Pose::identity(), options)
+                                 : distance(pa, Pose::identity(), pb, Pose::identity(), options);
     const std::string where = what + (swapped ? ", swapped" : "") + ", exact " + g(truth) +
                               ", answer " + g(r.depth) + " in [" + g(r.depth_lower_bound) + ", " +
                               g(r.depth_upper_bound) + "], without the option " + g(plain.depth);
@@ -366,8 +367,8 @@ TEST(ExtendedPrecision, DepthOfNearlyParallelFacesAtOneBillionth) {
     const Points a = transformed(box(Vec3(size, size, 0.5 * size)), turn, centre);
     const double angle = log_uniform(rng, 1e-5, 1e-2);
     const Mat3 tilt = Mat3(Eigen::AngleAxisd(angle, random_unit_vector(rng)));
-    const Points b_local = transformed(box(Vec3(0.3 * size, 0.4 * size, 0.2 * size)), turn * tilt,
-                                       Vec3::Zero());
+    const Points b_local =
+        transformed(box(Vec3(0.3 * size, 0.4 * size, 0.2 * size)), turn * tilt, Vec3::Zero());
     const double overlap = overlap_of(rng, size, centre.cwiseAbs().maxCoeff() + 2.0 * size);
     const Points b = place_along(a, translated(b_local, centre), turn.col(2), -overlap);
     check_extended_depth(a, b, tally, "trial " + std::to_string(trial) + ", angle " + g(angle));
