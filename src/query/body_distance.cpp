@@ -20,6 +20,7 @@
 #include "core/accuracy.h"
 #include "core/magnitude_limit.h"
 #include "proxima/query/distance.h"
+#include "query/extended_distance.h"
 
 namespace proxima {
 namespace {
@@ -112,6 +113,32 @@ Pose relative(const Pose& pose_a, const Pose& pose_b) {
   return checked_pose(pose_a.inverse() * pose_b, "distance: relative pose");
 }
 
+// The penetration query of two hulls at world poses (its answer in A's
+// frame), and with DistanceOptions::extended_precision its depth
+// recomputed in double-double along its face of A - B, as distance() does
+// for two polytopes (query/extended_distance.h).
+PenetrationResult depth_of(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
+                           const Pose& pose_b, PenetrationCache& cache,
+                           const DistanceOptions& options) {
+  PenetrationResult p = penetration_depth(a, b, relative(pose_a, pose_b), cache);
+  if (!options.extended_precision || p.status != PenetrationStatus::intersecting) return p;
+  DistanceResult r;
+  r.status = Status::intersecting;
+  r.depth = p.depth;
+  r.depth_lower_bound = p.lower_bound;
+  r.depth_upper_bound = p.upper_bound;
+  r.normal = p.normal;
+  r.feature_a = p.feature_a;
+  r.feature_b = p.feature_b;
+  if (detail::refine_depth_extended(a, pose_a, b, pose_b, options, r)) {
+    p.depth = r.depth;
+    p.lower_bound = r.depth_lower_bound;
+    p.normal = r.normal;
+  }
+  p.upper_bound = r.depth_upper_bound;
+  return p;
+}
+
 // The pieces (or convex bodies) that gave the answer, placed: the accuracy
 // standard's R is theirs, as for the compound query.
 struct Placed {
@@ -194,7 +221,7 @@ BodyResult convex_pair(const Body& a, const Pose& pose_a, const Body& b, const P
   if (!depth) {
     if (c.status == Status::intersecting) without_depth(c);
   } else if (needs_depth(c, a.radius() + b.radius())) {
-    take_depth(c, penetration_depth(ca, cb, relative(pose_a, pose_b), cache.penetration), pose_a);
+    take_depth(c, depth_of(ca, pose_a, cb, pose_b, cache.penetration, options), pose_a);
   }
   return offset(c, a, b, [&](double value) {
     return rounded_status(value, {&ca, pose_a}, a.radius(), {&cb, pose_b}, b.radius(), options);
@@ -274,10 +301,8 @@ class DeepestPair {
     if (r.status != Status::intersecting) return;
     CoreAnswer c = from_distance(r);
     PenetrationCache cold;
-    take_depth(
-        c,
-        penetration_depth(*piece_a.polytope, *piece_b.polytope, relative(place_a, place_b), cold),
-        place_a);
+    take_depth(c, depth_of(*piece_a.polytope, place_a, *piece_b.polytope, place_b, cold, options_),
+               place_a);
     c.piece_a = pa;
     c.piece_b = pb;
     if (!found_ || c.value < best_.value) best_ = c;
@@ -318,8 +343,8 @@ BodyResult compound_pair(const Body& a, const Pose& pose_a, const Body& b, const
     const Pose place_a = pose_a * piece_a.pose;
     PenetrationCache cold;
     take_depth(c,
-               penetration_depth(*piece_a.polytope, *piece_b.polytope,
-                                 relative(place_a, pose_b * piece_b.pose), cold),
+               depth_of(*piece_a.polytope, place_a, *piece_b.polytope, pose_b * piece_b.pose, cold,
+                        options),
                place_a);
   }
   const CompoundPiece& piece_a = ca.piece(c.piece_a);

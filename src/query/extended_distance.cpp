@@ -310,10 +310,14 @@ ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& po
 }
 
 bool refine_depth_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                           const Pose& pose_b, double band, double relative,
+                           const Pose& pose_b, const DistanceOptions& options,
                            DistanceResult& result) {
   const double magnitude = placed_bound(a, pose_a, b, pose_b);
   if (!(magnitude > 0.0) || !(result.depth > 0.0)) return false;
+  const double band = contact_band(
+      std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
+      options.absolute_tolerance);
+  const double relative = std::max(kStandardRelative, options.relative_tolerance);
   const detail::PowerOfTwoUnit unit = detail::power_of_two_unit(magnitude);
   const double s = unit.inverse;
   const PlacedFeature fa = place(a, pose_a, result.feature_a, s);

@@ -62,15 +62,17 @@ ExtendedOutcome refine_distance_extended(const ConvexPolytope& a, const Pose& po
 // computed to a few 2^-104 of the coordinates. When the two agree (the
 // features are the supports along N: a face of A - B), the face's offset
 // is its exact value within that error, and when it is within the double
-// answer's own tolerance (`band` the contact band of the query, relative
-// tolerance as options give) of the double depth, it replaces it:
+// answer's own tolerance (below) of the double depth, it replaces it:
 // `result.depth` the offset rounded, `depth_upper_bound` the overlap plus
 // its rounding bound, `normal` (A's frame) N. Otherwise only a tighter
 // upper bound along N is kept. The lower bound is the algorithm's: it is
 // certified over every face of A - B, which a recomputation of one face
-// cannot be. Returns whether the depth was replaced.
+// cannot be. Returns whether the depth was replaced. The tolerance is the
+// band of the poses' magnitude bound (wider than the exact one: it only
+// widens the window) and the larger of the standard's relative term and
+// options.relative_tolerance.
 bool refine_depth_extended(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
-                           const Pose& pose_b, double band, double relative,
+                           const Pose& pose_b, const DistanceOptions& options,
                            DistanceResult& result);
 
 }  // namespace proxima::detail

@@ -125,17 +125,11 @@ bool touching_certified(const ConvexPolytope& a, const Pose& pose_a, const Conve
 
 // With DistanceOptions::extended_precision, an intersecting answer's
 // depth recomputed in double-double along its face of A - B
-// (query/extended_distance.h), against the band of the magnitude bound
-// (the accept window is a bound on the double answer's error: the wider
-// band only widens it).
+// (query/extended_distance.h).
 void refine_depth(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolytope& b,
                   const Pose& pose_b, const DistanceOptions& options, DistanceResult& result) {
   if (!options.extended_precision || result.status != Status::intersecting) return;
-  const double band =
-      contact_band(std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
-                   options.absolute_tolerance);
-  refine_depth_extended(a, pose_a, b, pose_b, band,
-                        std::max(kStandardRelative, options.relative_tolerance), result);
+  refine_depth_extended(a, pose_a, b, pose_b, options, result);
 }
 
 }  // namespace

@@ -10,8 +10,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <memory>
 #include <string>
+#include <vector>
 
+#include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
 #include "support/exact_oracle.h"
 #include "support/generators.h"
@@ -344,6 +347,20 @@ void check_extended_depth(const Points& a, const Points& b, DepthTally& tally,
     EXPECT_LE(r.depth_lower_bound, r.depth) << where;
     EXPECT_LE(r.depth, r.depth_upper_bound) << where;
   }
+  // The same through Bodies (their own depth pipeline): a convex body, and
+  // the same hulls as one-piece compounds.
+  const Body body_a(pa), body_b(pb);
+  const BodyResult convex = distance(body_a, Pose::identity(), body_b, Pose::identity(), options);
+  EXPECT_TRUE(within_bound(convex.depth, exact.depth_squared, kExtendedRelative, 0.0))
+      << what << ", convex bodies: " << g(convex.depth) << ", exact " << g(truth);
+  const Body compound_a(
+      CompoundBody(std::vector<CompoundPiece>{{std::make_shared<ConvexPolytope>(pa), Pose{}}}));
+  const Body compound_b(
+      CompoundBody(std::vector<CompoundPiece>{{std::make_shared<ConvexPolytope>(pb), Pose{}}}));
+  const BodyResult compound =
+      distance(compound_a, Pose::identity(), compound_b, Pose::identity(), options);
+  EXPECT_TRUE(within_bound(compound.depth, exact.depth_squared, kExtendedRelative, 0.0))
+      << what << ", compounds: " << g(compound.depth) << ", exact " << g(truth);
 }
 
 // An overlap of 100 bands to 1e-7 of the size (log-uniform): above the
