@@ -314,9 +314,9 @@ bool refine_depth_extended(const ConvexPolytope& a, const Pose& pose_a, const Co
                            DistanceResult& result) {
   const double magnitude = placed_bound(a, pose_a, b, pose_b);
   if (!(magnitude > 0.0) || !(result.depth > 0.0)) return false;
-  const double band = contact_band(
-      std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
-      options.absolute_tolerance);
+  const double band =
+      contact_band(std::max(magnitude_bound(pose_a, a.scale()), magnitude_bound(pose_b, b.scale())),
+                   options.absolute_tolerance);
   const double relative = std::max(kStandardRelative, options.relative_tolerance);
   const detail::PowerOfTwoUnit unit = detail::power_of_two_unit(magnitude);
   const double s = unit.inverse;
