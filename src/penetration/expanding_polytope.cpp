@@ -50,6 +50,24 @@ struct Triangle {
   bool alive;
 };
 
+// triangle_plane's computation, inline in the expansion's loop (a call per
+// triangle added otherwise).
+inline TrianglePlane plane_of(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  const Vec3 e1 = p1 - p0;
+  const Vec3 e2 = p2 - p0;
+  const Vec3 c = e1.cross(e2);
+  const double length = c.norm();
+  TrianglePlane t;
+  if (length > 0.0 && std::isfinite(length)) {
+    t.normal = c / length;
+    t.offset = t.normal.dot(p0);
+    const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
+    t.normal_error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff;
+    t.error = t.normal_error * p0.lpNorm<1>();
+  }
+  return t;
+}
+
 // A triangle's key (its plane's offset less the offset's rounding bound)
 // in the min-heap of the triangles to expand. Ties go to the older
 // triangle (the lower index): the order std::greater gave the pairs
@@ -279,7 +297,7 @@ class Expansion {
   }
 
   int add_triangle(const std::array<int, 3>& v) {
-    const TrianglePlane plane = triangle_plane(vertices_[static_cast<std::size_t>(v[0])].p,
+    const TrianglePlane plane = plane_of(vertices_[static_cast<std::size_t>(v[0])].p,
                                                vertices_[static_cast<std::size_t>(v[1])].p,
                                                vertices_[static_cast<std::size_t>(v[2])].p);
     const int index = static_cast<int>(triangles_.size());
@@ -402,19 +420,7 @@ class Expansion {
 }  // namespace
 
 TrianglePlane triangle_plane(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
-  const Vec3 e1 = p1 - p0;
-  const Vec3 e2 = p2 - p0;
-  const Vec3 c = e1.cross(e2);
-  const double length = c.norm();
-  TrianglePlane t;
-  if (length > 0.0 && std::isfinite(length)) {
-    t.normal = c / length;
-    t.offset = t.normal.dot(p0);
-    const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
-    t.normal_error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff;
-    t.error = t.normal_error * p0.lpNorm<1>();
-  }
-  return t;
+  return plane_of(p0, p1, p2);
 }
 
 bool on_supporting_plane(const TrianglePlane& t, const Vec3& s) {
