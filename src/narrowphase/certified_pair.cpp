@@ -127,7 +127,8 @@ bool certified_tracked_distance(const ConvexPolytope& a, const ConvexPolytope& b
   bool has_direction = false;
   const auto decline = [&] {
     if (!moved_far(a, b, b_in_a, cache))
-      start = {fa.id, fb.id, fa.p, fb.p, fa.n, fb.n, loc, w, sa, sb, has_direction, true};
+      start = {fa.id,       fb.id,       fa.p, fb.p, fa.n, fb.n,          loc.distance_squared,
+               loc.point_a, loc.point_b, w,    sa,   sb,   has_direction, true};
     return false;
   };
 

@@ -505,7 +505,17 @@ template <bool kScaled, bool kMargin = false, bool kFromPair = false>
   // After a cold start small bodies are scanned (kColdLoopScanVertices).
   const bool scan_a = !warm && count_a <= kColdLoopScanVertices;
   const bool scan_b = !warm && count_b <= kColdLoopScanVertices;
-  Local loc = kFromPair ? start->local : local_distance(fa, fb, tol);
+  Local loc = [&]() -> Local {
+    if constexpr (kFromPair) {
+      Local from_pair;
+      from_pair.distance_squared = start->distance_squared;
+      from_pair.point_a = start->point_a;
+      from_pair.point_b = start->point_b;
+      return from_pair;
+    } else {
+      return local_distance(fa, fb, tol);
+    }
+  }();
   if constexpr (!kFromPair) {
     fa.reduce(loc.active_a);
     fb.reduce(loc.active_b);

@@ -13,7 +13,6 @@
 #include <cstdint>
 
 #include "proxima/core/types.h"
-#include "proxima/detail/geometry/closest_point_common.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima::detail {
@@ -43,20 +42,27 @@ inline constexpr double kCertifiedGapUlps = 32.0;
 // both supports along it, the loop's first pass. Filled only when the pair was
 // evaluated and B did not move far since the cache's pose (else the loop's
 // cold start is the better one).
+//
+// Its fields but `valid` are left uninitialized (written together when the
+// pair is declined): every tracked query builds one.
 struct TrackedPairStart {
   std::array<std::int32_t, 3> id_a;
   std::array<std::int32_t, 3> id_b;
   std::array<Vec3, 3> p_a;
   std::array<Vec3, 3> p_b;
-  int n_a = 0;
-  int n_b = 0;
-  ClosestPoints<double> local;
+  int n_a;
+  int n_b;
+  // The pair's closed-form answer: the closest points and their squared
+  // distance (the pair is already reduced to its active vertices).
+  double distance_squared;
+  Vec3 point_a;
+  Vec3 point_b;
   // With has_direction, the pair's search direction and the supports
   // along it; else the cache's hints.
-  Vec3 direction = Vec3::UnitX();
-  std::int32_t support_a = -1;
-  std::int32_t support_b = -1;
-  bool has_direction = false;
+  Vec3 direction;
+  std::int32_t support_a;
+  std::int32_t support_b;
+  bool has_direction;
   bool valid = false;
 };
 
