@@ -2,7 +2,7 @@
 #   make run   builds in release and runs the main job, the paper's experiments
 #              (bench/paper_experiments; PAPER_ARGS=--quick for the reduced run)
 #   make test  installs what is missing, builds, runs every test (unit tests under the
-#              sanitizers; long sweeps, peers, Python and packaging in release)
+#              sanitizers; peers, Python, packaging and the browser in release)
 JOBS ?= $(shell nproc)
 
 .PHONY: all run test test-release setup release asan dev bench fuzz clean results results-quick compare
@@ -20,10 +20,12 @@ release: setup
 # (-g1), enough for the sanitizers' stack traces. UBSan's alignment and null
 # checks are off: they made each test file about twice as slow to compile,
 # and ASan reports every null or wild dereference itself (x86-64 has no
-# alignment faults for what they check). It builds and runs every unit test; the
-# tests that link the peers (FCL, Bullet: PROXIMA_PEER_TESTS) and the three
-# longest random sweeps (the asan test preset's exclude filter; 50 s each
-# under ASan) run in the release build only.
+# alignment faults for what they check). The test files' own code is
+# compiled with ASan's heap checks only (tests/CMakeLists.txt,
+# PROXIMA_TEST_FILE_FLAGS): the code under test keeps every check. It builds
+# and runs every unit test, the random sweeps with fewer cases
+# (tests/support/sanitizers.h); the tests that link the peers (FCL, Bullet:
+# PROXIMA_PEER_TESTS) run in the release build only.
 asan: setup
 	cmake --preset asan >/dev/null
 	cmake --build --preset asan -j $(JOBS)
@@ -38,7 +40,7 @@ run: release
 
 # The tests need no micro-benchmark (bench/*_bench), and the unit tests run
 # in the sanitizer build: make test builds the release tree without either
-# (PROXIMA_UNIT_TESTS=OFF keeps the peers' tests and the long sweeps' files;
+# (PROXIMA_UNIT_TESTS=OFF keeps only the peers' tests;
 # a command-line -D overrides the preset's ON; `make release` and every
 # `cmake --preset release` turn them on again).
 test-release: setup
@@ -46,7 +48,7 @@ test-release: setup
 	cmake --build --preset release -j $(JOBS)
 
 test: test-release asan
-	@echo "== release build: long sweeps, peer tests, examples, Python, packaging, docs =="
+	@echo "== release build: peer tests, examples, Python, packaging, docs =="
 	ctest --preset release -j $(JOBS)
 	@echo "== unit tests, ASan + UBSan build (and the fuzz corpus replayed) =="
 	ctest --preset asan -j $(JOBS)

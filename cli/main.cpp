@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "demo.h"
+#include "exit_codes.h"
 #include "proxima/core/types.h"
 #include "query.h"
 #include "robot.h"
@@ -37,9 +38,10 @@
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitUsage = 2;
+using proxima::cli::kExitFailure;
+using proxima::cli::kExitOk;
+using proxima::cli::kExitUsage;
+
 // Upper end of --max-iterations: far above any real need (the default is
 // 64); it only keeps a typo from turning the cap off.
 constexpr int kMaxIterationsLimit = 1000000;

@@ -30,6 +30,7 @@
 #include <utility>
 #include <vector>
 
+#include "exit_codes.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
 #include "proxima/io.h"
@@ -38,10 +39,7 @@
 namespace proxima::cli {
 namespace {
 
-using Json = nlohmann::ordered_json;
-
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
+using OrderedJson = nlohmann::ordered_json;
 
 // A bad pose number or quaternion: bad input (exit 1), named by option.
 class BadArgument : public std::runtime_error {
@@ -64,7 +62,7 @@ std::string point_text(const Vec3& p) {
   return number(p.x()) + " " + number(p.y()) + " " + number(p.z());
 }
 
-Json point_json(const Vec3& p) { return Json::array({p.x(), p.y(), p.z()}); }
+OrderedJson point_json(const Vec3& p) { return OrderedJson::array({p.x(), p.y(), p.z()}); }
 
 struct LoadedFile {
   ConvexPolytope polytope;
@@ -114,11 +112,11 @@ std::string id_list(const std::vector<std::int32_t>& ids) {
   return s;
 }
 
-Json feature_json(const Feature& f, const ConvexPolytope& p) {
-  Json j;
+OrderedJson feature_json(const Feature& f, const ConvexPolytope& p) {
+  OrderedJson j;
   j["type"] = to_string(f.type);
   j["hull_vertices"] = hull_ids(f);
-  j["face"] = f.face >= 0 ? Json(f.face) : Json(nullptr);
+  j["face"] = f.face >= 0 ? OrderedJson(f.face) : OrderedJson(nullptr);
   j["input_indices"] = input_ids(f, p);
   return j;
 }
@@ -132,9 +130,9 @@ std::string feature_text(const Feature& f, const ConvexPolytope& p) {
 }
 
 // A file read as its hull: what was read and how convex it was.
-Json hull_report_json(const std::string& path, MeshFormat format, int input_points,
+OrderedJson hull_report_json(const std::string& path, MeshFormat format, int input_points,
                       const ConvexPolytope& hull, bool convex) {
-  Json j;
+  OrderedJson j;
   j["file"] = path;
   j["format"] = to_string(format);
   j["input_points"] = input_points;
@@ -221,8 +219,8 @@ LoadedBody load_body_as(const std::string& path, const std::string& as,
   return out;
 }
 
-Json loaded_json(const std::string& path, const LoadedBody& body) {
-  Json j;
+OrderedJson loaded_json(const std::string& path, const LoadedBody& body) {
+  OrderedJson j;
   j["file"] = path;
   j["format"] = to_string(body.format);
   j["as"] = body.as;
@@ -260,8 +258,8 @@ std::string loaded_text(const std::string& path, const LoadedBody& body) {
 
 // `proxima distance` between two hulls keeps its hull report (input
 // indices of the features), with how the file was read.
-Json hull_json(const std::string& path, const LoadedBody& body) {
-  Json j = hull_report_json(path, body.format, body.input_points, *body.hull, body.convex);
+OrderedJson hull_json(const std::string& path, const LoadedBody& body) {
+  OrderedJson j = hull_report_json(path, body.format, body.input_points, *body.hull, body.convex);
   j["as"] = body.as;
   return j;
 }
@@ -273,11 +271,11 @@ std::string hull_text(const std::string& path, const LoadedBody& body) {
 // A feature of a body's core: vertex ids in the core's terms (hull ids for
 // a hull or a piece, the file's vertex ids for a mesh), the face (hull face,
 // or the triangle for a mesh), the piece or triangle it is on.
-Json body_feature_json(const Feature& f, std::int32_t piece, std::int32_t triangle) {
-  Json j;
+OrderedJson body_feature_json(const Feature& f, std::int32_t piece, std::int32_t triangle) {
+  OrderedJson j;
   j["type"] = to_string(f.type);
   j["vertices"] = hull_ids(f);
-  j["face"] = f.face >= 0 ? Json(f.face) : Json(nullptr);
+  j["face"] = f.face >= 0 ? OrderedJson(f.face) : OrderedJson(nullptr);
   if (piece >= 0) j["piece"] = piece;
   if (triangle >= 0) j["triangle"] = triangle;
   return j;
@@ -298,8 +296,8 @@ std::string body_feature_text(const Feature& f, std::int32_t piece, std::int32_t
 // One line of JSON. File names are bytes, not necessarily UTF-8, and
 // nlohmann's dump throws on invalid UTF-8 (a name with byte 0xff lost the
 // whole answer): such bytes are written as U+FFFD instead.
-std::string json_line(const Json& j) {
-  return j.dump(-1, ' ', false, Json::error_handler_t::replace) + "\n";
+std::string json_line(const OrderedJson& j) {
+  return j.dump(-1, ' ', false, OrderedJson::error_handler_t::replace) + "\n";
 }
 
 void row(std::ostream& out, const std::string& name, const std::string& value) {
@@ -466,9 +464,9 @@ int print_body_distance(const DistanceCommand& command, const LoadedBody& a, con
            "arithmetic\n";
     return kExitFailure;
   }
-  const auto bound = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
+  const auto bound = [](double v) { return std::isfinite(v) ? OrderedJson(v) : OrderedJson(nullptr); };
   if (command.json) {
-    Json j;
+    OrderedJson j;
     j["a"] = loaded_json(command.file_a, a);
     j["b"] = loaded_json(command.file_b, b);
     j["status"] = to_string(r.status);
@@ -541,7 +539,7 @@ int run_distance(const DistanceCommand& command, std::ostream& out, std::ostream
   }
 
   if (command.json) {
-    Json j;
+    OrderedJson j;
     j["a"] = hull_json(command.file_a, *a);
     j["b"] = hull_json(command.file_b, *b);
     j["algorithm"] = to_string(command.options.algorithm);
@@ -593,7 +591,7 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
   const ConvexPolytope& p = body->polytope;
 
   if (command.json) {
-    Json j;
+    OrderedJson j;
     j["file"] = command.file;
     j["format"] = to_string(body->format);
     j["input_points"] = body->input_points;
@@ -608,12 +606,12 @@ int run_hull(const HullCommand& command, std::ostream& out, std::ostream& err) {
     j["convex"] = body->convex;
     j["memory_bytes"] = p.memory_bytes();
     if (exported) {
-      Json e;
+      OrderedJson e;
       e["file"] = command.out_file;
       e["format"] = export_format(command.out_file);
       e["vertices"] = exported->vertices;
       e["faces"] = exported->faces;
-      e["note"] = exported->note.empty() ? Json(nullptr) : Json(exported->note);
+      e["note"] = exported->note.empty() ? OrderedJson(nullptr) : OrderedJson(exported->note);
       j["export"] = e;
     }
     out << json_line(j);

@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "exit_codes.h"
 #include "json_errors.h"
 #include "proxima/query/body_distance.h"
 #include "proxima/query/distance.h"
@@ -35,9 +36,6 @@
 
 namespace proxima::cli {
 namespace {
-
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
 
 // Bad input to `proxima view`: the message names the file and line or the
 // option.

@@ -146,10 +146,10 @@ void bind_robot_model(py::class_<PyRobot>& robot) {
              }
              options.cylinder_tolerance = cylinder_tolerance;
              options.exclude_adjacent = exclude_adjacent;
-             auto robot = std::make_unique<PyRobot>();
-             robot->robot =
+             auto loaded = std::make_unique<PyRobot>();
+             loaded->robot =
                  std::make_shared<const Robot>(load_robot(urdf, srdf.value_or(""), options));
-             return robot;
+             return loaded;
            }),
            py::arg("urdf"), py::arg("srdf") = py::none(),
            py::arg("package_dirs") = std::vector<std::string>{}, py::arg("mesh_as") = "hull",

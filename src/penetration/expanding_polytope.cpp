@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <functional>
 #include <memory_resource>
 #include <utility>
 #include <vector>
@@ -49,6 +48,41 @@ struct Triangle {
   double error;  // bound on the offset's rounding
   double normal_error;  // bound on the normal's (TrianglePlane)
   bool alive;
+};
+
+// triangle_plane's computation, inline in the expansion's loop (a call per
+// triangle added otherwise).
+inline TrianglePlane plane_of(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
+  const Vec3 e1 = p1 - p0;
+  const Vec3 e2 = p2 - p0;
+  const Vec3 c = e1.cross(e2);
+  const double length = c.norm();
+  TrianglePlane t;
+  if (length > 0.0 && std::isfinite(length)) {
+    t.normal = c / length;
+    t.offset = t.normal.dot(p0);
+    const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
+    t.normal_error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff;
+    t.error = t.normal_error * p0.lpNorm<1>();
+  }
+  return t;
+}
+
+// A triangle's key (its plane's offset less the offset's rounding bound)
+// in the min-heap of the triangles to expand. Ties go to the older
+// triangle (the lower index): the order std::greater gave the pairs
+// (key, index), spelled out: the pair's synthesized three-way comparison
+// of doubles (a partial ordering) is several instructions per step of the
+// heap. Keys are never NaN (finite points, or -infinity for a
+// degenerate triangle).
+struct HeapEntry {
+  double key;
+  int index;
+};
+struct KeyAbove {
+  bool operator()(const HeapEntry& x, const HeapEntry& y) const {
+    return x.key > y.key || (x.key == y.key && x.index > y.index);
+  }
 };
 
 class Expansion {
@@ -263,22 +297,30 @@ class Expansion {
   }
 
   int add_triangle(const std::array<int, 3>& v) {
-    const TrianglePlane plane = triangle_plane(vertices_[static_cast<std::size_t>(v[0])].p,
+    const TrianglePlane plane = plane_of(vertices_[static_cast<std::size_t>(v[0])].p,
                                                vertices_[static_cast<std::size_t>(v[1])].p,
                                                vertices_[static_cast<std::size_t>(v[2])].p);
-    Triangle t{v, {-1, -1, -1}, plane.normal, plane.offset, plane.error, plane.normal_error, true};
     const int index = static_cast<int>(triangles_.size());
-    triangles_.push_back(t);
-    heap_.push_back({t.offset - t.error, index});
-    std::push_heap(heap_.begin(), heap_.end(), std::greater<>());
+    // Built in place (no copy of the triangle per call: a large share of
+    // an expansion's work is adding triangles).
+    Triangle& t = triangles_.emplace_back();
+    t.v = v;
+    t.adjacent = {-1, -1, -1};
+    t.normal = plane.normal;
+    t.offset = plane.offset;
+    t.error = plane.error;
+    t.normal_error = plane.normal_error;
+    t.alive = true;
+    heap_.push_back({plane.offset - plane.error, index});
+    std::push_heap(heap_.begin(), heap_.end(), KeyAbove{});
     return index;
   }
 
   // The live triangle of least key, or -1.
   int pop() {
     while (!heap_.empty()) {
-      std::pop_heap(heap_.begin(), heap_.end(), std::greater<>());
-      const int f = heap_.back().second;
+      std::pop_heap(heap_.begin(), heap_.end(), KeyAbove{});
+      const int f = heap_.back().index;
       heap_.pop_back();
       if (triangles_[static_cast<std::size_t>(f)].alive) return f;
     }
@@ -364,7 +406,7 @@ class Expansion {
   const MinkowskiSupport& m_;
   std::pmr::vector<Vertex> vertices_;
   std::pmr::vector<Triangle> triangles_;
-  std::pmr::vector<std::pair<double, int>> heap_;
+  std::pmr::vector<HeapEntry> heap_;
   // A boundary edge u -> w of a removed triangle, the kept triangle
   // across it and the edge's index there.
   struct Edge {
@@ -378,19 +420,7 @@ class Expansion {
 }  // namespace
 
 TrianglePlane triangle_plane(const Vec3& p0, const Vec3& p1, const Vec3& p2) {
-  const Vec3 e1 = p1 - p0;
-  const Vec3 e2 = p2 - p0;
-  const Vec3 c = e1.cross(e2);
-  const double length = c.norm();
-  TrianglePlane t;
-  if (length > 0.0 && std::isfinite(length)) {
-    t.normal = c / length;
-    t.offset = t.normal.dot(p0);
-    const double ratio = std::sqrt(e1.squaredNorm() * e2.squaredNorm()) / length;
-    t.normal_error = (kOffsetAngleUlps * ratio + kOffsetUlps) * kUnitRoundoff;
-    t.error = t.normal_error * p0.lpNorm<1>();
-  }
-  return t;
+  return plane_of(p0, p1, p2);
 }
 
 bool on_supporting_plane(const TrianglePlane& t, const Vec3& s) {

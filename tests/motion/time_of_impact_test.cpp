@@ -25,6 +25,7 @@
 #include "motion/sweep.h"
 #include "motion/time_of_impact.h"
 #include "support/penetration_oracle.h"
+#include "support/sanitizers.h"
 
 namespace proxima {
 namespace {
@@ -327,7 +328,8 @@ TEST(TimeOfImpact, TurningBarsCrossingEdgeOnNeverOvershoot) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int contacts = 0, edge_pairs = 0;
   long steps = 0, edge_steps = 0;
-  for (int trial = 0; trial < 120; ++trial) {
+  const int trials = test::sanitized_count(120, 4);
+  for (int trial = 0; trial < trials; ++trial) {
     const double length = 1.0 + 2.0 * u(rng);
     const ConvexPolytope a(box(Vec3(length, 0.05 + 0.1 * u(rng), 0.05 + 0.1 * u(rng))));
     // B: a thin box, or every other time a prism of many sides (its long
@@ -374,8 +376,8 @@ TEST(TimeOfImpact, TurningBarsCrossingEdgeOnNeverOvershoot) {
     }
     check_against_sampling(a, ma, b, mb, options, r, 4000);
   }
-  EXPECT_GT(contacts, 60);
-  EXPECT_GT(edge_pairs, 30);
+  EXPECT_GT(contacts, trials / 2);
+  EXPECT_GT(edge_pairs, trials / 4);
   EXPECT_LT(static_cast<double>(edge_steps) / edge_pairs, 13.0);
   std::printf("%d contacts, %.2f steps each; %d between two edges, %.2f steps each\n", contacts,
               static_cast<double>(steps) / contacts, edge_pairs,

@@ -17,6 +17,7 @@
 #include "support/generators.h"
 #include "support/penetration_oracle.h"
 #include "support/regression_clouds.h"
+#include "support/sanitizers.h"
 #include "support/same_bits.h"
 
 namespace proxima::test {
@@ -1060,7 +1061,7 @@ TEST(PenetrationTracking, ExpandedCacheMatchesBruteForceOnALongSweep) {
   const Mat3 rotation = random_rotation(rng);
   const Vec3 dir = random_unit_vector(rng);
   PenetrationCache cache;
-  const int steps = 400;
+  const int steps = test::sanitized_count(400, 4);
   int penetrating = 0;
   for (int i = 0; i < steps; ++i) {
     const double phase = static_cast<double>(i) / steps;

@@ -26,6 +26,7 @@
 # --no-browser (the ASan build) only writes the pages and checks their data;
 # --screenshots DIR keeps one screenshot per view kind there (docs/).
 import argparse
+import concurrent.futures
 import json
 import math
 import os
@@ -36,6 +37,8 @@ import sys
 
 WIDTH, HEIGHT = 1000, 700
 PANEL_BOTTOM = 190  # the text panel's height, left out of the blank-canvas check
+# Browsers open at once: each mostly waits, and four kept two cores busy.
+BROWSERS = 4
 
 
 def run(args, **kw):
@@ -58,7 +61,8 @@ def browse(chromium, page, work, name, fragment=""):
     png = os.path.join(work, name + ".png")
     if os.path.exists(png):
         os.remove(png)
-    profile = os.path.join(work, "chromium-profile")
+    # One profile per page: the pages are opened at the same time (browse_all).
+    profile = os.path.join(work, "chromium-profile-" + name)
     args = [chromium, "--headless", "--no-sandbox", "--no-first-run", "--user-data-dir=" + profile,
             # WebGL on the CPU (SwiftShader): the test machines have no GPU.
             "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
@@ -82,6 +86,17 @@ def browse(chromium, page, work, name, fragment=""):
             errors.group(1).strip() if errors else None, console, png)
 
 
+def browse_all(chromium, work, jobs):
+    """Opens every (name, page, fragment) of `jobs`, several at a time; returns
+    browse()'s answer by name. Most of a headless Chromium's time on a page is
+    spent waiting (its start, the virtual-time budget), not computing: one
+    page after the other took about 8 s each, most of the test's time."""
+    with concurrent.futures.ThreadPoolExecutor(max_workers=BROWSERS) as pool:
+        futures = {name: pool.submit(browse, chromium, page, work, name, fragment)
+                   for name, page, fragment in jobs}
+        return {name: future.result() for name, future in futures.items()}
+
+
 def canvas_variance(png):
     """Variance of the grey levels below the panel, and the share of pixels
     that differ from the most common one (the background)."""
@@ -96,10 +111,10 @@ def canvas_variance(png):
     return variance, drawn
 
 
-def check_rendered(chromium, page, work, name, expected_label=None, fragment=""):
-    """Returns what is wrong with the rendered page (empty: fine), the
-    screenshot and the share of the canvas drawn."""
-    state, label, errors, console, png = browse(chromium, page, work, name, fragment)
+def check_rendered(browsed, name, expected_label=None):
+    """Returns what is wrong with the page `name` as browse_all rendered it
+    (empty: fine), the screenshot and the share of the canvas drawn."""
+    state, label, errors, console, png = browsed[name]
     problems = []
     if state != "yes":
         problems.append(f"the page did not render (data-rendered={state!r}, errors: {errors!r})")
@@ -354,35 +369,40 @@ def main():
 
     if not opt.chromium or not os.path.exists(opt.chromium):
         sys.exit("FAILED: no chromium (scripts/setup installs Debian's chromium)")
-    failures = []
-    shots = {}
-    drawn = {}
-    for name, page, label in pages:
-        problems, png, drawn[name] = check_rendered(opt.chromium, page, opt.work, name, label)
-        failures += [f"{name}: {p}" for p in problems]
-        shots[name] = png
-
-    # The wireframe toggle (opened checked through #wireframe): the faces
-    # hidden, the edges and the witness still drawn, less canvas covered.
-    problems, _, wire = check_rendered(opt.chromium, w("compound.html"), opt.work, "wireframe",
-                                       {n: l for n, _, l in pages}["compound"], fragment="#wireframe")
-    failures += [f"wireframe: {p}" for p in problems]
-    if not wire < 0.7 * drawn["compound"]:
-        failures.append(f"wireframe: {100 * wire:.1f} % of the canvas drawn, with faces "
-                        f"{100 * drawn['compound']:.1f} %: the faces were not hidden")
-
     # The checks can fail: a page whose script throws, and one whose canvas
-    # is hidden, must each be caught.
+    # is hidden, must each be caught (the controls, checked below).
     html = open(w("pair.html"), encoding="utf-8").read()
     broken = html.replace("const data = JSON.parse(", "undefinedFunction(); const data = JSON.parse(", 1)
     hidden = html.replace("#view { position: absolute;", "#view { display: none; position: absolute;", 1)
     assert broken != html and hidden != html, "the page template changed: update the controls"
     open(w("broken.html"), "w", encoding="utf-8").write(broken)
     open(w("hidden.html"), "w", encoding="utf-8").write(hidden)
-    problems, _, _ = check_rendered(opt.chromium, w("broken.html"), opt.work, "broken", pages[0][2])
+
+    # Every page at once, the wireframe toggle opened checked through #wireframe.
+    browsed = browse_all(opt.chromium, opt.work,
+                         [(name, page, "") for name, page, _ in pages] +
+                         [("wireframe", w("compound.html"), "#wireframe"),
+                          ("broken", w("broken.html"), ""), ("hidden", w("hidden.html"), "")])
+    failures = []
+    shots = {}
+    drawn = {}
+    for name, page, label in pages:
+        problems, png, drawn[name] = check_rendered(browsed, name, label)
+        failures += [f"{name}: {p}" for p in problems]
+        shots[name] = png
+
+    # The wireframe toggle: the faces hidden, the edges and the witness still
+    # drawn, less canvas covered.
+    problems, _, wire = check_rendered(browsed, "wireframe", {n: l for n, _, l in pages}["compound"])
+    failures += [f"wireframe: {p}" for p in problems]
+    if not wire < 0.7 * drawn["compound"]:
+        failures.append(f"wireframe: {100 * wire:.1f} % of the canvas drawn, with faces "
+                        f"{100 * drawn['compound']:.1f} %: the faces were not hidden")
+
+    problems, _, _ = check_rendered(browsed, "broken", pages[0][2])
     if not any("console" in p for p in problems) or not any("did not render" in p for p in problems):
         failures.append(f"control: a script error went unnoticed ({problems})")
-    problems, _, _ = check_rendered(opt.chromium, w("hidden.html"), opt.work, "hidden", pages[0][2])
+    problems, _, _ = check_rendered(browsed, "hidden", pages[0][2])
     if not any("blank" in p for p in problems):
         failures.append(f"control: a hidden canvas went unnoticed ({problems})")
 
