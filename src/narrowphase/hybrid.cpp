@@ -32,6 +32,7 @@
 
 #include "core/accuracy.h"
 #include "core/power_of_two.h"
+#include "narrowphase/hybrid_rules.h"
 #include "narrowphase/witness_features.h"
 #include "proxima/detail/geometry/tetrahedron_coordinates.h"
 #include "proxima/detail/narrowphase/contact.h"
@@ -43,22 +44,12 @@ namespace {
 
 // The termination test's rounding slack (core/accuracy.h) is in units of
 // u * R: the support values w.a* and w.b* each carry an error of a few u |w| R.
+using detail::kMaxUnscaled;
+using detail::kMinUnscaled;
 using detail::kTerminationGapUlps;
-
-// Range of R (the largest coordinate magnitude in A's frame) in which the
-// algorithm runs on the given coordinates. Squared lengths overflow from
-// R ~ 1e154 on (inf - inf: NaN) and underflow to subnormals or 0 from
-// R ~ 1e-154 down (answers off by 1e-5, then distances of 0); the kernels'
-// length^4 and length^6 terms are only valid for extents within 1e-75 ..
-// 1e75 (closest_point.h). Outside this range every coordinate is
-// multiplied by the power of two that brings R into [1/2, 1): exact, so the
-// answer is the same one the unscaled algorithm would give in exact range.
-// 2^+-64 leaves a wide margin both ways and sends the paper's stress cases
-// (cubes at 1e39, tetrahedra of 1e-23) and the accuracy suite's 1e-20 ..
-// 1e20 scales through the scaled path too, where the tests compare them
-// with the oracle. DistanceRegression.ScalesFrom1eMinus300To1e300 pins it.
-constexpr double kMinUnscaled = 0x1p-64;
-constexpr double kMaxUnscaled = 0x1p64;
+using detail::kWitnessFarBands;
+using detail::minus_transpose_times;
+using detail::moved_far;
 
 // A squared distance below this has lost digits to subnormal squares (the
 // smallest subnormal 2^-1074 is 2^-114 of it): the distance and the normal
@@ -79,10 +70,6 @@ constexpr double kSquaresLoseDigits = 0x1p-960;
   result.normal = v.direction;
 }
 
-// A cache whose pose is further than this share of the bodies' size from
-// the query's is taken for stale (see moved_far).
-constexpr double kStaleMotion = 0.5;
-
 // Bodies of at most this many vertices are scanned (support_brute_force)
 // in the loop of a query that started cold, whose hints are the supports
 // along the line of centres: no better than a scan's start, and the climb's
@@ -101,20 +88,6 @@ constexpr int kColdLoopScanVertices = 16;
   if (scan) [[unlikely]]
     return support_brute_force(p.vertices(), dir);
   return support_hill_climb(p, dir, hint);
-}
-
-// -(R^T w): the direction of B's support search in B's frame. Entry j is
-// column j of R (contiguous) dotted with w, rounded as Eigen rounds
-// -(R^T w), (c0 w0 + c1 w1) + c2 w2, then negated (exact): the same bits
-// (2e6 random rotations and directions compared). Written out because
-// Eigen's transposed product takes more instructions for the same bits, on
-// every tracked query (bench/tracked_instructions under callgrind).
-[[gnu::always_inline]] inline Vec3 minus_transpose_times(const Mat3& r, const Vec3& w) {
-  const double* c = r.data();  // column-major: column j at c + 3 j
-  const auto dot = [&](const double* col) {
-    return -((col[0] * w[0] + col[1] * w[1]) + col[2] * w[2]);
-  };
-  return Vec3(dot(c), dot(c + 3), dot(c + 6));
 }
 
 // A feature of one body: up to three hull vertex ids (a fourth slot for the
@@ -238,71 +211,6 @@ bool valid_id(std::int32_t id, int count) {
   return static_cast<std::uint32_t>(id) < static_cast<std::uint32_t>(count);
 }
 
-// Unit direction from A towards B, as accurate as the features allow. The
-// difference XB - XA of two computed points carries an absolute error of a
-// few u R, so for nearly touching bodies (d << R) its direction is off by
-// u R / d: enough to pick wrong support points on a needle or a sliver. A
-// face normal or the cross product of two edges is accurate to a few u
-// whatever d is, so those are used where the pair is vertex-face or
-// edge-edge; XB - XA where it is exact (vertex-vertex).
-//
-// What matters for the support search is the error of the direction along
-// the bodies' long dimensions: tilted by e, a direction moves the support
-// value of a vertex a length L away by e L, and on a needle of thickness h
-// the wrong end of the needle wins once e L > h. Two such errors are removed
-// by projection, which is exact in theory (the true direction is orthogonal
-// to the edge or to the face's edges):
-//  * vertex-edge: XB - XA is orthogonal to the edge; its rounding is not.
-//    Removing its component along the edge leaves an error across the edge
-//    only, which a support value sees times the body's thickness.
-//  * vertex-face: the cross product of a sliver's edges is off by u / sin
-//    (sin: the face's smallest angle) in a direction that tilts it along the
-//    face; its component along the longest edge is removed, as in
-//    crossing_candidate (closest_point.h).
-// (DistanceRegression.PointOnTheSurfaceOfANeedle: a point on an edge of a
-// needle 1.6 long and 1e-9 thick stopped on the needle's inner diagonal at
-// 1.7e-9 with lower bound 0, the direction's 3e-7 tilt along the axis
-// making the diagonal's own ends the support points.)
-Vec3 across(const Vec3& x, const Vec3& edge) {
-  const double ee = edge.squaredNorm();
-  return ee > 0.0 ? Vec3(x - (x.dot(edge) / ee) * edge) : x;
-}
-
-// The normal of triangle t (unnormalized, either orientation), without its
-// rounding component along the longest edge (see search_direction).
-Vec3 face_direction(const std::array<Vec3, 4>& t) {
-  const Vec3 e0 = t[1] - t[0];
-  const Vec3 e1 = t[2] - t[0];
-  const Vec3 e2 = t[2] - t[1];
-  const double l0 = e0.squaredNorm();
-  const double l1 = e1.squaredNorm();
-  const double l2 = e2.squaredNorm();
-  const Vec3& longest = l0 >= l1 ? (l0 >= l2 ? e0 : e2) : (l1 >= l2 ? e1 : e2);
-  return across(e0.cross(e1), longest);
-}
-
-[[gnu::always_inline]] inline Vec3 search_direction(const FeatureSet& fa, const FeatureSet& fb,
-                                                    const Vec3& w, double d) {
-  Vec3 n;
-  if (fa.n == 1 && fb.n == 3) {
-    n = face_direction(fb.p);
-  } else if (fa.n == 3 && fb.n == 1) {
-    n = face_direction(fa.p);
-  } else if (fa.n == 2 && fb.n == 2) {
-    n = (fa.p[1] - fa.p[0]).cross(fb.p[1] - fb.p[0]);
-  } else if (fa.n + fb.n == 3) {
-    // Vertex-edge: the edge has length above the kernel's tolerance.
-    n = across(w, fa.n == 2 ? Vec3(fa.p[1] - fa.p[0]) : Vec3(fb.p[1] - fb.p[0]));
-  } else {
-    return w / d;
-  }
-  const double along = n.dot(w);
-  const double length = n.norm();
-  // Parallel edges (or a face seen edge-on): no better direction than w.
-  if (!(length > 0.0) || along == 0.0) return w / d;
-  return (along > 0.0 ? 1.0 : -1.0) / length * n;
-}
-
 // Loads a cached feature (ids range-checked, duplicates dropped). Returns
 // false when nothing usable is cached. Written out for the three slots: a
 // later id repeats an earlier one only if that one was valid and loaded.
@@ -336,50 +244,6 @@ bool load_feature(const std::array<std::int32_t, 4>& cached, int count, FeatureS
 // (FeatureSet keeps unused slots at -1).
 void store_feature(const FeatureSet& f, std::array<std::int32_t, 4>& out) {
   out = {f.id[0], f.id[1], f.id[2], -1};
-}
-
-// How far, in witness bands, the closest point x on a two-vertex feature
-// must be from both of its vertices in A's frame for rule 1 of the witness
-// rule (witness_features.h) to keep both in the hull's own frame too. There
-// the point is R^T (x - t) and the vertices y exact, while here they are
-// R y + t: the two distances differ by the rounding of both maps (about
-// 10 u R each) and by R's departure from orthonormality, |(I - R^T R) y|:
-// R = R_a^T R_b, two rotations within kOrthonormalUlps u of orthonormal
-// (pose.h) and a rounded product, so R^T R - I has entries below about
-// 70 u and that term stays below about 210 u R (R >= |y|, the algorithm's
-// bound). Against a band of 16 u R (witness_band), 64 bands (1024 u R)
-// leave all of it far behind, so the decision is the one the hull's frame
-// would make; nearer points take the general path, which makes it there.
-constexpr double kWitnessFarBands = 64.0;
-
-// Whether x is farther than `far` from both vertices of f (two of them),
-// at magnitudes where squaring does not underflow or overflow (the range in
-// which witness_feature's edge case runs).
-bool far_from_both_ends(const ConvexPolytope& poly, const FeatureSet& f, const Vec3& x,
-                        double far) {
-  const double far2 = far * far;
-  return detail::squares_are_safe(poly.scale()) && (f.p[0] - x).squaredNorm() > far2 &&
-         (f.p[1] - x).squaredNorm() > far2;
-}
-
-// Whether B moved so far relative to A since the cache's query that its
-// feature pair says nothing any more (a planner sampling unrelated
-// configurations with one cache per pair): a bound on how far any point of
-// B moved, |t - t'| + ||R - R'||_F max|y|, beyond a share of the bodies'
-// size. Such a warm start costs more iterations than a cold one
-// (bench/distance_bench WarmRandom), so the cold start is taken.
-// A cache without a pose (rotation zero: cold, or filled by GJK) moved
-// far. The test is paid by every query, so it is kept to a norm and a
-// Frobenius distance; a heuristic for speed only: any start ends in the
-// same certified answer.
-[[gnu::always_inline]] inline bool moved_far(const ConvexPolytope& a, const ConvexPolytope& b,
-                                             const Pose& b_in_a, const DistanceCache& cache) {
-  const double turn2 = (b_in_a.rotation - cache.rotation).squaredNorm();
-  const double shift = (b_in_a.translation - cache.translation).norm();
-  const double size = a.bounding_radius() + b.bounding_radius();
-  const double reach = std::sqrt(3.0) * b.scale();  // >= max |y| over B
-  // A quiet comparison: a garbage cache may hold NaN (moved far, then).
-  return !std::islessequal(shift + std::sqrt(turn2) * reach, kStaleMotion * size);
 }
 
 // The pair a query starts from: the cached features, unless B moved far
@@ -443,14 +307,20 @@ struct LoopEnd {
 // only when the local distance strictly decreases; it ends in contact, at
 // the termination test, at the cap, or when neither body improves (the
 // pair is optimal at machine precision).
-template <bool kMargin, class APoint, class BPoint>
+//
+// kResume: when `resume_direction` is given, the first pass takes it as its
+// search direction and the hints as the supports along it (what a declined
+// certified tracked pair computed, certified_pair.h), instead of computing
+// them again.
+template <bool kMargin, bool kResume = false, class APoint, class BPoint>
 [[gnu::always_inline]] inline LoopEnd iterate(const ConvexPolytope& a, const ConvexPolytope& b,
                                               const Mat3& rot, const DistanceOptions& options,
                                               const KernelTolerance<double>& tol,
                                               const LoopLimits& limits, bool scan_a, bool scan_b,
                                               const APoint& a_point, const BPoint& b_point,
                                               FeatureSet& fa, FeatureSet& fb, Local& loc,
-                                              std::int32_t& hint_a, std::int32_t& hint_b) {
+                                              std::int32_t& hint_a, std::int32_t& hint_b,
+                                              const Vec3* resume_direction = nullptr) {
   LoopEnd e;
   for (;;) {
     const double d = std::sqrt(loc.distance_squared);
@@ -461,11 +331,18 @@ template <bool kMargin, class APoint, class BPoint>
       e.contact = true;
       break;
     }
-    const Vec3 w =
-        search_direction(fa, fb, loc.point_b - loc.point_a, d);  // unit, from A towards B
+    const bool resumed = kResume && resume_direction != nullptr;
+    const Vec3 w = resumed ? *resume_direction
+                           : detail::search_direction(fa.p.data(), fa.n, fb.p.data(), fb.n,
+                                                      loc.point_b - loc.point_a,
+                                                      d);  // unit, from A towards B
     e.last_direction = w;
-    hint_a = support_point(a, w, hint_a, scan_a);
-    hint_b = support_point(b, minus_transpose_times(rot, w), hint_b, scan_b);
+    if (resumed) {
+      resume_direction = nullptr;
+    } else {
+      hint_a = support_point(a, w, hint_a, scan_a);
+      hint_b = support_point(b, minus_transpose_times(rot, w), hint_b, scan_b);
+    }
     const Vec3 pa = a_point(hint_a);
     const Vec3 pb = b_point(hint_b);
     const double wa = w.dot(pa);
@@ -532,7 +409,8 @@ template <bool kScaled>
     if constexpr (kScaled) {
       return false;
     } else {
-      return f.n == 2 && far_from_both_ends(poly, f, x, bands * witness_band) &&
+      return f.n == 2 &&
+             detail::far_from_both_ends(poly, f.p[0], f.p[1], x, bands * witness_band) &&
              detail::hull_edge(poly, f.id[0], f.id[1], out);
     }
   };
@@ -568,12 +446,17 @@ template <bool kScaled>
 // proof about `margin` instead of converging (see hybrid_within), and the
 // answer skips what only a distance answer needs (contact classification,
 // witness features, cross-check).
-template <bool kScaled, bool kMargin = false>
-[[gnu::always_inline]] inline DistanceResult run_hybrid(const ConvexPolytope& a,
-                                                        const ConvexPolytope& b, const Pose& b_in_a,
-                                                        const DistanceOptions& options, double band,
-                                                        DistanceCache& cache, double magnitude,
-                                                        double scale, double margin = 0.0) {
+//
+// kFromPair: the loop goes on from `*start`, the pair a declined certified
+// tracked pair evaluated (certified_pair.h), unscaled: its reduced pair,
+// closed-form answer and supports replace the cache's pair, the local
+// method's first call and the hints.
+template <bool kScaled, bool kMargin = false, bool kFromPair = false>
+[[gnu::always_inline]] inline DistanceResult run_hybrid(
+    const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
+    const DistanceOptions& options, double band, DistanceCache& cache, double magnitude,
+    double scale, double margin = 0.0, const detail::TrackedPairStart* start = nullptr) {
+  static_assert(!(kFromPair && (kScaled || kMargin)), "the pair is evaluated unscaled");
   const double contact_tolerance = kScaled ? band * scale : band;
   const double r_local = kScaled ? magnitude * scale : magnitude;
   const Mat3& rot = b_in_a.rotation;
@@ -608,20 +491,41 @@ template <bool kScaled, bool kMargin = false>
 
   FeatureSet fa;
   FeatureSet fb;
-  const bool warm = start_pair<kScaled>(a, b, b_in_a, cache, scale, a_point, b_point, fa, fb,
-                                        hint_a, hint_b);
+  if constexpr (kFromPair) {
+    for (int i = 0; i < start->n_a; ++i)
+      fa.push(start->id_a[static_cast<std::size_t>(i)], start->p_a[static_cast<std::size_t>(i)]);
+    for (int j = 0; j < start->n_b; ++j)
+      fb.push(start->id_b[static_cast<std::size_t>(j)], start->p_b[static_cast<std::size_t>(j)]);
+    hint_a = start->support_a;
+    hint_b = start->support_b;
+  }
+  const bool warm = kFromPair || start_pair<kScaled>(a, b, b_in_a, cache, scale, a_point, b_point,
+                                                     fa, fb, hint_a, hint_b);
 
   // After a cold start small bodies are scanned (kColdLoopScanVertices).
   const bool scan_a = !warm && count_a <= kColdLoopScanVertices;
   const bool scan_b = !warm && count_b <= kColdLoopScanVertices;
-  Local loc = local_distance(fa, fb, tol);
-  fa.reduce(loc.active_a);
-  fb.reduce(loc.active_b);
+  Local loc = [&]() -> Local {
+    if constexpr (kFromPair) {
+      Local from_pair;
+      from_pair.distance_squared = start->distance_squared;
+      from_pair.point_a = start->point_a;
+      from_pair.point_b = start->point_b;
+      return from_pair;
+    } else {
+      return local_distance(fa, fb, tol);
+    }
+  }();
+  if constexpr (!kFromPair) {
+    fa.reduce(loc.active_a);
+    fb.reduce(loc.active_b);
+  }
 
   DistanceResult result;
-  const LoopEnd end = iterate<kMargin>(
+  const LoopEnd end = iterate<kMargin, kFromPair>(
       a, b, rot, options, tol, LoopLimits{contact_tolerance, yes_at, no_above, ulp_r}, scan_a,
-      scan_b, a_point, b_point, fa, fb, loc, hint_a, hint_b);
+      scan_b, a_point, b_point, fa, fb, loc, hint_a, hint_b,
+      kFromPair && start->has_direction ? &start->direction : nullptr);
   const double lower = end.lower;
   const Vec3& last_direction = end.last_direction;
   const int iterations = end.iterations;
@@ -705,6 +609,15 @@ DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b,
     return run_hybrid<false>(a, b, b_in_a, options, contact_tolerance, cache, r_local, 1.0);
   }
   return run_scaled(a, b, b_in_a, options, contact_tolerance, cache, r_local);
+}
+
+DistanceResult hybrid_distance_from_pair(const ConvexPolytope& a, const ConvexPolytope& b,
+                                         const Pose& b_in_a, const DistanceOptions& options,
+                                         double contact_tolerance, DistanceCache& cache,
+                                         const detail::TrackedPairStart& start) {
+  const double r_local = std::max(a.scale(), magnitude_bound(b_in_a, b.scale()));
+  return run_hybrid<false, false, true>(a, b, b_in_a, options, contact_tolerance, cache, r_local,
+                                        1.0, 0.0, &start);
 }
 
 DistanceResult hybrid_within(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,

@@ -16,11 +16,12 @@
 #include <cstdio>
 #include <string>
 
+#include "core/accuracy.h"
 #include "core/magnitude_limit.h"
+#include "core/paired_pose.h"
+#include "proxima/detail/narrowphase/certified_pair.h"
 #include "proxima/detail/narrowphase/gjk.h"
 #include "proxima/detail/narrowphase/hybrid.h"
-#include "core/accuracy.h"
-#include "core/paired_pose.h"
 #include "query/extended_distance.h"
 #include "query/signed_distance.h"
 
@@ -215,16 +216,24 @@ double band_floor(const ConvexPolytope& a, const Pose& pose_a, const ConvexPolyt
   const Pose b_in_a = detail::relative_pose(pose_a, pose_b);
   const double band_bound = contact_band(r_bound, options.absolute_tolerance);
 
-  // One initialization from either call, not two returns: GCC 12 elides
-  // the copy of a named result only when every return names it. A pair
-  // whose last depth was not penetrating (one that overlapped once and
-  // separated since) takes the common path: the tracked depth would not be
-  // tried for it.
-  const bool penetrating = detail::overlap_trackable(options, c);
-  DistanceResult result =
-      penetrating ? penetrating_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c)
-                  : run(a, b, b_in_a, options, band_bound, c);
-  if (!penetrating) [[likely]] {
+  // One named result, returned from one place: GCC 12 elides the copy of
+  // a named result only when every return names it. A pair whose last
+  // depth was not penetrating (one that overlapped once and separated
+  // since) takes the common path: the tracked depth would not be tried for
+  // it. A tracked separated pair is answered by its certified cached pair
+  // (proxima/detail/narrowphase/certified_pair.h) when it certifies, far
+  // from the band: nothing of finish_query applies to such an answer.
+  DistanceResult result;
+  detail::TrackedPairStart start;
+  if (detail::overlap_trackable(options, c)) [[unlikely]] {
+    result = penetrating_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c);
+  } else if (detail::certified_tracked_distance(a, b, b_in_a, options, band_bound, c, result,
+                                                start)) [[likely]] {
+    to_world(pose_a, result);
+  } else {
+    // A declined pair's evaluation is not done again (certified_pair.h).
+    result = start.valid ? hybrid_distance_from_pair(a, b, b_in_a, options, band_bound, c, start)
+                         : run(a, b, b_in_a, options, band_bound, c);
     finish_query(a, pose_a, b, pose_b, b_in_a, options, band_bound, c, result);
   }
   return result;

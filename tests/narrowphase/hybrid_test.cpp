@@ -16,9 +16,14 @@
 #include <random>
 #include <vector>
 
+#include "core/accuracy.h"
 #include "proxima/detail/geometry/tetrahedron_coordinates.h"
+#include "proxima/detail/narrowphase/certified_pair.h"
 #include "proxima/geometry/closest_point.h"
 #include "proxima/query/distance.h"
+#include "support/exact_oracle.h"
+#include "support/generators.h"
+#include "support/same_bits.h"
 
 namespace proxima {
 namespace {
@@ -391,6 +396,213 @@ TEST(Hybrid, IterationCapIsReportedNotHidden) {
     EXPECT_LE(r.lower_bound, r.distance);
   } else {
     EXPECT_EQ(r.status, Status::separated);
+  }
+}
+
+// The certified tracked pair (certified_pair.h) against its slow twin, the
+// full hybrid from a copy of the same cache, on random walks of B in A's
+// frame. Where the pair certifies, the hybrid must stop at its first pass
+// with the same pair, so every field agrees bit for bit (the same kernel,
+// direction and supports) but the lower bound, the fast one being the gap
+// less its rounding slack: at most the hybrid's, and at most the exact
+// distance (every `kOracleEvery`-th step, exact oracle). Where it declines,
+// the cache is untouched. Counts the certified steps and the steps whose
+// cached pair changed (certified or not: the walk must cross many).
+struct TwinWalk {
+  int certified = 0;
+  int pair_changes = 0;
+  int oracle_checks = 0;
+  int cold_restarts = 0;
+  int handed_on = 0;
+};
+
+// One step of a twin walk at B's pose `pose` in A's frame (see above).
+void twin_step(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& pose, bool use_oracle,
+               test::ExactOracle& oracle, DistanceCache& cache, TwinWalk& out) {
+  using test::same_bits;
+  const DistanceOptions options;
+  const double r_local = std::max(a.scale(), magnitude_bound(pose, b.scale()));
+  const double band = contact_band(r_local);
+  const DistanceCache before = cache;
+  DistanceCache slow_cache = cache;
+  DistanceResult fast;
+  detail::TrackedPairStart start;
+  const bool hit =
+      detail::certified_tracked_distance(a, b, pose, options, band, cache, fast, start);
+  const DistanceResult slow = hybrid_distance(a, b, pose, options, band, slow_cache);
+  const bool pair_changed =
+      before.vertices_a != slow_cache.vertices_a || before.vertices_b != slow_cache.vertices_b;
+  out.pair_changes += pair_changed ? 1 : 0;
+  if (!hit) {
+    EXPECT_TRUE(cache.vertices_a == before.vertices_a && cache.vertices_b == before.vertices_b &&
+                cache.hint_a == before.hint_a && cache.hint_b == before.hint_b)
+        << "declined but wrote the cache";
+    if (start.valid) {
+      // The loop going on from the declined pair's evaluation gives the
+      // answer of the loop from the cache, bit for bit.
+      ++out.handed_on;
+      DistanceCache from_pair_cache = cache;
+      const DistanceResult from_pair =
+          hybrid_distance_from_pair(a, b, pose, options, band, from_pair_cache, start);
+      EXPECT_EQ(from_pair.status, slow.status);
+      EXPECT_EQ(from_pair.iterations, slow.iterations);
+      EXPECT_TRUE(same_bits(from_pair.distance, slow.distance));
+      EXPECT_TRUE(same_bits(from_pair.lower_bound, slow.lower_bound));
+      EXPECT_TRUE(same_bits(from_pair.point_a, slow.point_a));
+      EXPECT_TRUE(same_bits(from_pair.point_b, slow.point_b));
+      EXPECT_TRUE(test::same_feature(from_pair.feature_a, slow.feature_a));
+      EXPECT_TRUE(test::same_feature(from_pair.feature_b, slow.feature_b));
+    }
+    cache = slow_cache;
+    return;
+  }
+  ++out.certified;
+  EXPECT_EQ(slow.status, Status::separated);
+  EXPECT_EQ(fast.status, Status::separated);
+  if (slow.iterations > 0) {
+    // The hybrid took B for moved far since the cache's pose and started
+    // cold (hybrid.cpp, moved_far), where the pair, certified whatever the
+    // motion, does not look: the same distance within the standard, from
+    // other closest points where they are not unique (faces face to face).
+    ++out.cold_restarts;
+    EXPECT_NEAR(fast.distance, slow.distance, 1e-12 * slow.distance + 64 * kUnitRoundoff * r_local);
+    return;
+  }
+  EXPECT_TRUE(same_bits(fast.distance, slow.distance));
+  EXPECT_TRUE(same_bits(fast.point_a, slow.point_a));
+  EXPECT_TRUE(same_bits(fast.point_b, slow.point_b));
+  EXPECT_TRUE(same_bits(fast.normal, slow.normal));
+  EXPECT_TRUE(test::same_feature(fast.feature_a, slow.feature_a));
+  EXPECT_TRUE(test::same_feature(fast.feature_b, slow.feature_b));
+  EXPECT_LE(fast.lower_bound, slow.lower_bound);
+  EXPECT_GE(fast.lower_bound,
+            slow.lower_bound - detail::kCertifiedGapUlps * kUnitRoundoff * r_local * (1 + 1e-15));
+  EXPECT_TRUE(cache.vertices_a == slow_cache.vertices_a &&
+              cache.vertices_b == slow_cache.vertices_b && cache.hint_a == slow_cache.hint_a &&
+              cache.hint_b == slow_cache.hint_b && cache.face_a == slow_cache.face_a &&
+              cache.face_b == slow_cache.face_b)
+      << "the caches differ";
+  if (!use_oracle) return;
+  // B's vertices placed as both algorithms place them, R y + t.
+  test::Points placed;
+  for (const Vec3& y : b.vertices()) placed.push_back(pose.rotation * y + pose.translation);
+  const std::optional<test::ExactDistance> exact =
+      oracle.distance(test::Points(a.vertices().begin(), a.vertices().end()), placed);
+  if (!exact) {
+    ADD_FAILURE() << oracle.last_error();
+    return;
+  }
+  ++out.oracle_checks;
+  const mpq_class lower(fast.lower_bound);
+  EXPECT_LE(lower * lower, exact->distance_squared) << "lower bound above the exact distance";
+  EXPECT_TRUE(test::within_bound(fast.distance, exact->distance_squared, 1e-12,
+                                 64 * kUnitRoundoff * r_local));
+}
+
+// A random walk of B around A (both of radius 1 before `scale`): steps of
+// `step_length`, turns of `turn` radians about random axes, the centre kept
+// between 0.9 and 1.6 `reach` from A's.
+TwinWalk twin_walk(const test::Points& pa, const test::Points& pb, double scale, double reach,
+                   double step_length, double turn, int steps, std::uint64_t seed) {
+  test::Points sa = pa;
+  test::Points sb = pb;
+  for (Vec3& p : sa) p *= scale;
+  for (Vec3& p : sb) p *= scale;
+  const ConvexPolytope a(sa);
+  const ConvexPolytope b(sb);
+  test::Rng rng(seed);
+  test::ExactOracle oracle;
+  constexpr int kOracleEvery = 40;
+  DistanceCache cache;
+  Vec3 position = reach * scale * test::random_unit_vector(rng);
+  Quat turn_so_far = test::random_quaternion(rng);
+  TwinWalk out;
+  for (int step = 0; step < steps; ++step) {
+    SCOPED_TRACE(step);
+    const Vec3 next = position + step_length * scale * test::random_unit_vector(rng);
+    const double r = next.norm() / scale;
+    if (r > 0.9 * reach && r < 1.6 * reach) position = next;
+    turn_so_far =
+        (turn_so_far * Quat(Eigen::AngleAxisd(turn, test::random_unit_vector(rng)))).normalized();
+    twin_step(a, b, Pose(turn_so_far, position), step % kOracleEvery == 0, oracle, cache, out);
+  }
+  return out;
+}
+
+std::vector<Vec3> random_hull_points(int n, std::uint64_t seed) {
+  test::Rng rng(seed);
+  std::vector<Vec3> pts;
+  for (int i = 0; i < n; ++i) pts.push_back(test::random_unit_vector(rng));
+  return pts;
+}
+
+TEST(CertifiedPair, AgreesWithTheFullHybridOnRandomWalks) {
+  // Round bodies: the closest features change every few steps.
+  const TwinWalk round = twin_walk(random_hull_points(14, 1), random_hull_points(11, 2), 1.0, 2.6,
+                                   0.02, 0.03, 1500, 7);
+  EXPECT_GT(round.certified, 900);
+  EXPECT_GT(round.pair_changes, 50);
+  EXPECT_GT(round.handed_on, 20);
+  EXPECT_GE(round.oracle_checks, 20);
+  // Near touching: reach 2.02 on unit spheres leaves gaps down to ~1e-3,
+  // and large turns change the pair at most steps.
+  const TwinWalk close = twin_walk(random_hull_points(20, 3), random_hull_points(20, 4), 1.0, 2.02,
+                                   0.003, 0.1, 800, 8);
+  EXPECT_GT(close.certified, 100);
+  EXPECT_GT(close.pair_changes, 30);
+}
+
+TEST(CertifiedPair, AgreesWithTheFullHybridOnBoxes) {
+  // Boxes without turns: coplanar faces face to face and parallel edges,
+  // the certificate's ties (vertices of one face level along its normal).
+  const std::vector<Vec3> unit = box(Vec3(1, 1, 1));
+  const TwinWalk parallel = twin_walk(unit, box(Vec3(0.5, 0.7, 0.3)), 1.0, 2.4, 0.02, 0.0, 600, 9);
+  EXPECT_GT(parallel.certified, 300);
+  const TwinWalk turning = twin_walk(unit, unit, 1.0, 3.0, 0.02, 0.05, 600, 10);
+  EXPECT_GT(turning.certified, 300);
+  EXPECT_GT(turning.pair_changes, 20);
+}
+
+TEST(CertifiedPair, AgreesWithTheFullHybridNearTouching) {
+  // Boxes face to face at gaps from 1e-12 to 1e-2 of their size, sliding
+  // along the face, level (ties along the face normal on both sides, edges
+  // parallel) and then tilted by up to 6e-7 rad.
+  const ConvexPolytope a(box(Vec3(1, 1, 1)));
+  const ConvexPolytope b(box(Vec3(0.4, 0.6, 0.5)));
+  test::Rng rng(14);
+  test::ExactOracle oracle;
+  DistanceCache cache;
+  TwinWalk out;
+  Vec3 slide = Vec3::Zero();
+  for (int step = 0; step < 400; ++step) {
+    SCOPED_TRACE(step);
+    const double gap = test::log_uniform(rng, 1e-12, 1e-2);
+    // The tilt's axis turns slowly, so that B's lowest vertex changes now
+    // and then, not at every step.
+    const double tilt = step < 100 ? 0.0 : 1e-7 * (step % 7);
+    const Quat q(Eigen::AngleAxisd(tilt, Vec3(std::cos(0.01 * step), std::sin(0.01 * step), 0)));
+    slide += Vec3(test::uniform(rng, -0.05, 0.05), test::uniform(rng, -0.05, 0.05), 0.0);
+    slide = slide.cwiseMax(Vec3(-1.2, -1.2, 0)).cwiseMin(Vec3(1.2, 1.2, 0));
+    // B's lowest point along z is 0.5 below its centre (less for a tilt).
+    const Pose pose(q, slide + Vec3(0, 0, 1.5 + gap));
+    twin_step(a, b, pose, step % 20 == 0, oracle, cache, out);
+  }
+  EXPECT_GT(out.certified, 200);
+  EXPECT_GE(out.oracle_checks, 10);
+}
+
+TEST(CertifiedPair, ScalesFrom1eMinus300To1e300) {
+  // The unscaled range of the hybrid (2^-64 .. 2^64) is certified by the
+  // pair; beyond it the pair declines and the hybrid's scaled run answers.
+  for (const double scale : {1e-300, 1e-150, 1e-18, 1e-6, 1.0, 1e6, 1e18, 1e150, 1e300}) {
+    const bool unscaled = scale > 0x1p-64 && scale < 0x1p63;
+    const TwinWalk walk = twin_walk(random_hull_points(10, 11), random_hull_points(9, 12), scale,
+                                    2.5, 0.02, 0.03, 200, 13);
+    if (unscaled) {
+      EXPECT_GT(walk.certified, 100) << scale;
+    } else {
+      EXPECT_EQ(walk.certified, 0) << scale;
+    }
   }
 }
 

@@ -202,6 +202,17 @@ TEST(SignedDistanceOption, SeparatedAnswersAreBitForBitThoseWithoutTheDepth) {
   // same tracked sequences with and without it, every algorithm, every
   // field, while B circles A and dives through it (the overlapping steps
   // differ only in the depth's fields).
+  //
+  // Bit for bit holds while both caches went through the same states, that
+  // is up to the first overlap. From there on, the tracked depth answers
+  // the overlapping steps without running the algorithm (issue 28: a
+  // turning B too), so the algorithm resumes from an older warm state than
+  // without the depth and may end on another rounding of the same answer:
+  // on other seeds than this one, 1e-15 to 1e-13 relative apart, from the
+  // first separated step after an overlap or a later one. What still holds
+  // is the standard: the same status, distances within the contact band of
+  // each other, and each lower bound at most the other answer's distance
+  // plus the band.
   Rng rng(7);
   for (const Algorithm algorithm : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
     const ConvexPolytope a(points_on_sphere(rng, 40)), b(points_on_sphere(rng, 40, 0.5));
@@ -211,7 +222,7 @@ TEST(SignedDistanceOption, SeparatedAnswersAreBitForBitThoseWithoutTheDepth) {
     skip.penetration = false;
     DistanceCache cache_with, cache_skip;
     int separated = 0, overlapping = 0;
-    bool after_overlap = false;
+    bool overlapped = false;
     for (int i = 0; i < 400; ++i) {
       const double t = 2.0 * std::numbers::pi * i / 400;
       const Pose pb(Quat(Eigen::AngleAxisd(0.01 * i, Vec3(1, 2, 3).normalized())),
@@ -219,23 +230,19 @@ TEST(SignedDistanceOption, SeparatedAnswersAreBitForBitThoseWithoutTheDepth) {
       const DistanceResult x = distance(a, Pose::identity(), b, pb, with, &cache_with);
       const DistanceResult y = distance(a, Pose::identity(), b, pb, skip, &cache_skip);
       if (x.status != Status::intersecting) {
-        // The first separated step after an overlap: the tracked depth
-        // answered the overlapping steps without running the algorithm
-        // (issue 28: a turning B too), so the algorithm starts from an
-        // older warm state than without the depth and may take other
-        // iterations to the same answer; every other field is the same.
-        if (after_overlap) {
-          DistanceResult z = x;
-          z.iterations = y.iterations;
-          z.second_algorithm = y.second_algorithm;
-          ASSERT_TRUE(same_answer(z, y)) << to_string(algorithm) << " step " << i;
-        } else {
+        if (!overlapped) {
           ASSERT_TRUE(same_answer(x, y)) << to_string(algorithm) << " step " << i;
+        } else {
+          // |B's placed vertices| <= 2.3 + 0.5 and |A's| = 1: R < 3.
+          const double band = kContactBandUlps * kUnitRoundoff * 3.0;
+          ASSERT_EQ(x.status, y.status) << to_string(algorithm) << " step " << i;
+          ASSERT_NEAR(x.distance, y.distance, band) << to_string(algorithm) << " step " << i;
+          ASSERT_LE(x.lower_bound, y.distance + band) << to_string(algorithm) << " step " << i;
+          ASSERT_LE(y.lower_bound, x.distance + band) << to_string(algorithm) << " step " << i;
         }
-        after_overlap = false;
         ++separated;
       } else {
-        after_overlap = true;
+        overlapped = true;
         ASSERT_EQ(y.status, Status::intersecting);
         ASSERT_TRUE(same_bits(x.distance, y.distance) && same_bits(x.lower_bound, y.lower_bound));
         ++overlapping;

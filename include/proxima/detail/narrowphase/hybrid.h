@@ -7,6 +7,7 @@
 #pragma once
 
 #include "proxima/core/types.h"
+#include "proxima/detail/narrowphase/certified_pair.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima {
@@ -20,6 +21,17 @@ namespace proxima {
 DistanceResult hybrid_distance(const ConvexPolytope& a, const ConvexPolytope& b, const Pose& b_in_a,
                                const DistanceOptions& options, double contact_tolerance,
                                DistanceCache& cache);
+
+// hybrid_distance from a pair the certified tracked pair evaluated and
+// could not certify (`start.valid`; proxima/detail/narrowphase/certified_pair.h): the loop goes on
+// from that pair, its closed-form answer and its supports as hints, with
+// the answer hybrid_distance gives from the same cache when B did not move
+// far. Coordinates in the unscaled range only (where the pair is
+// evaluated).
+DistanceResult hybrid_distance_from_pair(const ConvexPolytope& a, const ConvexPolytope& b,
+                                         const Pose& b_in_a, const DistanceOptions& options,
+                                         double contact_tolerance, DistanceCache& cache,
+                                         const detail::TrackedPairStart& start);
 
 // The margin query's loop (proxima/query/margin.h): the same iterations, stopped
 // at the first proof about `margin` (>= 0): a feature pair whose closest
