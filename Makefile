@@ -18,10 +18,9 @@ release: setup
 
 # The sanitizer build (ASan + UBSan) compiles at -O1 with line tables only
 # (-g1), enough for the sanitizers' stack traces. UBSan's alignment, null,
-# object-size and pointer-overflow checks are off: the first two made each
-# test file about twice as slow to compile, the last two each file of the
-# library about a tenth slower (src/scene/scene.cpp 11.3 -> 10.0 s of CPU
-# without them), and ASan reports every null, wild or out-of-bounds
+# object-size and pointer-overflow checks are off: they made each file
+# slower to compile (the first two about twice as slow, figures in
+# CHANGELOG.md), and ASan reports every null, wild or out-of-bounds
 # dereference itself (x86-64 has no alignment faults for what they check). The test files' own code is
 # compiled with ASan's heap checks only (tests/CMakeLists.txt,
 # PROXIMA_TEST_FILE_FLAGS): the code under test keeps every check. It builds

@@ -89,8 +89,8 @@ def browse(chromium, page, work, name, fragment=""):
 def browse_all(chromium, work, jobs):
     """Opens every (name, page, fragment) of `jobs`, several at a time; returns
     browse()'s answer by name. Most of a headless Chromium's time on a page is
-    spent waiting (its start, the virtual-time budget), not computing: one
-    page after the other took about 8 s each, most of the test's time."""
+    spent waiting (its start, the virtual-time budget), not computing, and
+    one page after the other was most of the test's time."""
     with concurrent.futures.ThreadPoolExecutor(max_workers=BROWSERS) as pool:
         futures = {name: pool.submit(browse, chromium, page, work, name, fragment)
                    for name, page, fragment in jobs}
