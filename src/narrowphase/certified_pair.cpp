@@ -151,34 +151,13 @@ bool certified_tracked_distance(const ConvexPolytope& a, const ConvexPolytope& b
   result.point_b = loc.point_b;
   result.normal = (loc.point_b - loc.point_a) / d;
 
-  // The witness features by the shared rule, as the hybrid's witness_pair
-  // applies it on unscaled coordinates.
-  const double band = witness_band(r_local);
-  if (!(fa.n == 2 && far_from_both_ends(a, fa.p[0], fa.p[1], loc.point_a, band) &&
-        hull_edge(a, fa.id[0], fa.id[1], result.feature_a))) {
-    result.feature_a = witness_feature(a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)),
-                                       band, cache.face_a, [&] {
-                                         return WitnessPoint{loc.point_a, result.normal};
-                                       });
-  }
-  if (!(fb.n == 2 &&
-        far_from_both_ends(b, fb.p[0], fb.p[1], loc.point_b, kWitnessFarBands * band) &&
-        hull_edge(b, fb.id[0], fb.id[1], result.feature_b))) {
-    result.feature_b = witness_feature(
-        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), band, cache.face_b, [&] {
-          // The outward side only matters on a polygon.
-          return WitnessPoint{
-              Vec3(rot.transpose() * (loc.point_b - tr)),
-              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-        });
-  }
+  // The witness features by the hybrid's own rule, on unscaled coordinates.
+  witness_pair<false>(a, b, b_in_a, fa, fb, loc, r_local, 1.0, true, cache, result);
 
   cache.vertices_a = stored(fa);
   cache.vertices_b = stored(fb);
   cache.hint_a = sa;
   cache.hint_b = sb;
-  cache.face_a = result.feature_a.face;
-  cache.face_b = result.feature_b.face;
   cache.rotation = rot;
   cache.translation = tr;
   return true;

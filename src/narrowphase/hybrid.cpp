@@ -386,57 +386,6 @@ template <bool kMargin, bool kResume = false, class APoint, class BPoint>
   return e;
 }
 
-// The witness features of the answer (witness_features.h) from the final
-// pair (fa, fb) and its closest points `loc` (local units; `unit` maps them
-// back), and the faces the cache keeps for the next query.
-template <bool kScaled>
-[[gnu::always_inline]] inline void witness_pair(const ConvexPolytope& a, const ConvexPolytope& b,
-                                                const Pose& b_in_a, const FeatureSet& fa,
-                                                const FeatureSet& fb, const Local& loc,
-                                                double r_local, double unit, bool locate,
-                                                DistanceCache& cache, DistanceResult& result) {
-  const Mat3& rot = b_in_a.rotation;
-  const Vec3& tr = b_in_a.translation;
-  const double witness_band = detail::witness_band(r_local * unit);
-  // The tracked edge: rule 1 keeps both vertices when the closest point is
-  // farther than the band from each of them, and rule 2 needs their ids
-  // only. A's frame is A's own (unscaled: the same arithmetic as
-  // witness_feature's); B's point is tested in A's frame, with the margin
-  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
-  // and the whole rule applied there.
-  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const FeatureSet& f,
-                                      const Vec3& x, double bands, Feature& out) {
-    if constexpr (kScaled) {
-      return false;
-    } else {
-      return f.n == 2 &&
-             detail::far_from_both_ends(poly, f.p[0], f.p[1], x, bands * witness_band) &&
-             detail::hull_edge(poly, f.id[0], f.id[1], out);
-    }
-  };
-  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
-    result.feature_a = detail::witness_feature(
-        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
-        [&] {
-          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
-        },
-        locate);
-  }
-  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
-    result.feature_b = detail::witness_feature(
-        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
-        [&] {
-          // The outward side only matters on a polygon.
-          return detail::WitnessPoint{
-              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
-              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
-        },
-        locate);
-  }
-  cache.face_a = result.feature_a.face;
-  cache.face_b = result.feature_b.face;
-}
-
 // The algorithm on coordinates multiplied by `scale`, a power of two, when
 // kScaled (see hybrid_distance); `band` and `magnitude` (R in A's frame) are
 // in the caller's units, like the result returned. The unscaled instance is
@@ -580,7 +529,7 @@ template <bool kScaled, bool kMargin = false, bool kFromPair = false>
 
   // The witness features by the rule all algorithms share
   // (witness_features.h), in each hull's own frame and units.
-  witness_pair<kScaled>(a, b, b_in_a, fa, fb, loc, r_local, unit, locate, cache, result);
+  detail::witness_pair<kScaled>(a, b, b_in_a, fa, fb, loc, r_local, unit, locate, cache, result);
 
   // An answer the hybrid could not certify is cross-checked (contact.h).
   if (needs_cross_check(result, options, magnitude)) [[unlikely]]

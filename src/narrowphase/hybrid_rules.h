@@ -13,6 +13,7 @@
 
 #include "narrowphase/witness_features.h"
 #include "proxima/core/types.h"
+#include "proxima/geometry/closest_point.h"
 #include "proxima/shape/polytope.h"
 
 namespace proxima::detail {
@@ -159,6 +160,60 @@ inline constexpr double kStaleMotion = 0.5;
   const double reach = std::sqrt(3.0) * b.scale();  // >= max |y| over B
   // A quiet comparison: a garbage cache may hold NaN (moved far, then).
   return !std::islessequal(shift + std::sqrt(turn2) * reach, kStaleMotion * size);
+}
+
+// The witness features of the answer (witness_features.h) from the final
+// pair (fa, fb) and its closest points `loc` (local units; `unit` maps them
+// back), and the faces the cache keeps for the next query. One rule for the
+// hybrid's loop and the certified tracked pair (certified_pair.cpp, unscaled,
+// unit 1): Features is either's feature set (ids, points in A's frame, n).
+template <bool kScaled, class Features>
+[[gnu::always_inline]] inline void witness_pair(const ConvexPolytope& a, const ConvexPolytope& b,
+                                                const Pose& b_in_a, const Features& fa,
+                                                const Features& fb,
+                                                const ClosestPoints<double>& loc,
+                                                double r_local, double unit, bool locate,
+                                                DistanceCache& cache, DistanceResult& result) {
+  const Mat3& rot = b_in_a.rotation;
+  const Vec3& tr = b_in_a.translation;
+  const double witness_band = detail::witness_band(r_local * unit);
+  // The tracked edge: rule 1 keeps both vertices when the closest point is
+  // farther than the band from each of them, and rule 2 needs their ids
+  // only. A's frame is A's own (unscaled: the same arithmetic as
+  // witness_feature's); B's point is tested in A's frame, with the margin
+  // of kWitnessFarBands. Otherwise the point is mapped into its hull's frame
+  // and the whole rule applied there.
+  const auto edge_far_from_ends = [&](const ConvexPolytope& poly, const Features& f,
+                                      const Vec3& x, double bands, Feature& out) {
+    if constexpr (kScaled) {
+      return false;
+    } else {
+      return f.n == 2 &&
+             detail::far_from_both_ends(poly, f.p[0], f.p[1], x, bands * witness_band) &&
+             detail::hull_edge(poly, f.id[0], f.id[1], out);
+    }
+  };
+  if (!edge_far_from_ends(a, fa, loc.point_a, 1.0, result.feature_a)) {
+    result.feature_a = detail::witness_feature(
+        a, std::span(fa.id.data(), static_cast<std::size_t>(fa.n)), witness_band, cache.face_a,
+        [&] {
+          return detail::WitnessPoint{Vec3(loc.point_a * unit), result.normal};
+        },
+        locate);
+  }
+  if (!edge_far_from_ends(b, fb, loc.point_b, kWitnessFarBands, result.feature_b)) {
+    result.feature_b = detail::witness_feature(
+        b, std::span(fb.id.data(), static_cast<std::size_t>(fb.n)), witness_band, cache.face_b,
+        [&] {
+          // The outward side only matters on a polygon.
+          return detail::WitnessPoint{
+              Vec3(rot.transpose() * (loc.point_b * unit - tr)),
+              b.dimension() == 2 ? Vec3(-(rot.transpose() * result.normal)) : Vec3::UnitX()};
+        },
+        locate);
+  }
+  cache.face_a = result.feature_a.face;
+  cache.face_b = result.feature_b.face;
 }
 
 }  // namespace proxima::detail
