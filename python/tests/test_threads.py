@@ -155,6 +155,13 @@ COMPOUND_RACE = """
                 refused[k] += 1
             except Exception as e:
                 unexpected.append(repr(e))
+            # Hand the GIL over. The cache is marked in use from before a query
+            # releases the GIL until after it takes it back, so the only moment
+            # it is free is while this thread runs Python between two calls;
+            # without a pause there the main thread found it busy on every try
+            # and this thread never met a query of the main thread (a CI run:
+            # refused [2617912, 0] in 60 s).
+            time.sleep(0.0002)
 
     worker = threading.Thread(target=query, args=(1,))
     worker.start()
