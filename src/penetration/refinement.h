@@ -37,6 +37,26 @@ constexpr double kRefineBands = 4.0;
 // value is the least, has a rounded value within it of the least rounded.
 constexpr double kRefineWindow = 2.0 * kValueSlackUlps;
 
+// The refined value is exact for B's vertices as placed in A's frame in
+// double (or A's supports as mapped into B's frame, for a face of B), not
+// for the bodies the world poses place: those differ by the rounding of
+// B's pose relative to A and of its application, and by the rotations'
+// distance from orthonormal that the pose contract accepts (kOrthonormalUlps
+// u per entry of R^T R - I, proxima/core/pose.h), which makes R^T differ
+// from R^-1. The signed distance moves by at most the points' displacement
+// (docs/accuracy.md, "The refined depth's certificate", derives both
+// terms, in u of the magnitude bound M of A's frame): at most
+// kPlacementRoundingUlps u M for the rounding (76 for a face of B, 19
+// for the others) and kSkewLeverUlps times the contract's tolerance, plus
+// a relative kSkewLeverRelative times it for the change of frame, which
+// is not rigid. Pinned by
+// SignedDistanceOracle.CertificatesNearTheBandHoldUnderRotatedPoses.
+constexpr double kPlacementRoundingUlps = 80.0;
+constexpr double kSkewLeverUlps = 5.2;  // 3 sqrt(3), rounded up
+constexpr double kSkewLeverRelative = 2.0;
+constexpr double kRefinedPlacementUlps =
+    kPlacementRoundingUlps + kSkewLeverUlps * kOrthonormalUlps;
+
 // Whether a value (scaled units) is within kRefineBands bands of zero.
 bool near_band(const Query& q, double value) {
   return std::abs(value) <= kRefineBands * kValueSlackUlps * kUnitRoundoff * q.magnitude * q.inverse;
@@ -173,12 +193,16 @@ PenetrationResult refine(const Query& q, std::span<const Candidate> candidates,
   refined.value = least;
   PenetrationResult out = finish(q, refined, least, count, false);
   if (out.status == PenetrationStatus::separated) return out;
-  // The exact value is within 4 u of `least`; the bounds say so.
+  // The exact value of the placed doubles is within 4 u of `least`; the
+  // bodies the poses place are within kRefinedPlacementUlps u M and the
+  // frame's relative distortion of it (see kRefinedPlacementUlps).
   const double depth = std::max(least, 0.0) * q.unit;
+  const double relative = 8.0 * kUnitRoundoff + kSkewLeverRelative * kOrthonormalUlps * kUnitRoundoff;
+  const double placement = kRefinedPlacementUlps * kUnitRoundoff * q.magnitude;
   out.status = touching ? PenetrationStatus::touching : PenetrationStatus::intersecting;
   out.depth = depth;
-  out.upper_bound = depth * (1.0 + 8.0 * kUnitRoundoff);
-  out.lower_bound = depth * (1.0 - 8.0 * kUnitRoundoff);
+  out.upper_bound = depth * (1.0 + relative) + placement;
+  out.lower_bound = std::max(depth * (1.0 - relative) - placement, 0.0);
   return out;
 }
 

@@ -44,6 +44,30 @@ struct ExactDepth {
 // The exact depth* of conv(a) - conv(b) (see above).
 ExactDepth exact_depth(const Points& a, const Points& b);
 
+// The exact signed distance of conv(a) placed at pose_a and conv(b) placed
+// at pose_b, the poses as the library's rigid-pose contract takes them
+// (checked_pose: a rotation orthonormal to kOrthonormalUlps u as given,
+// one within kRotationTolerance re-orthonormalized): the world points
+// R a_i + t exactly (products and sums of doubles, exact in Epeck), M the
+// exact hull of their differences, and
+//   origin inside M:          sd* = -depth*  (the least facet offset),
+//   origin on M's boundary:   sd* = 0,
+//   origin outside M:         sd* = +distance from the origin to M (the
+//                             least exact distance to M's facet triangles).
+// Solid M only (`flat` set otherwise, sd* not computed).
+struct ExactSignedDistance {
+  bool flat = false;
+  OriginInM origin = OriginInM::outside;
+  mpq_class squared = 0;  // sd*^2, exact; the sign is the origin's side
+  int exponent = 0;       // as ExactDepth::exponent
+  // sd* rounded (through squared / 4^exponent, as ExactDepth::depth).
+  double value() const;
+  // Exactly: lower <= sd* <= upper.
+  bool within(double lower, double upper) const;
+};
+ExactSignedDistance exact_signed_distance(const Points& a, const Pose& pose_a, const Points& b,
+                                          const Pose& pose_b);
+
 // The exact first time of contact of the hull of `a` (fixed) and the hull of
 // `b` translated by t u, t in [0, 1]: the ray t u entering M = A - B (the
 // exact hull of the differences of the given doubles), or nothing when it
