@@ -19,6 +19,7 @@
 #include <boost/multiprecision/gmp.hpp>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -587,17 +588,67 @@ TEST(MeshDistanceTraversal, TrackedNeverTestsMorePairsThanCold) {
 }
 
 TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
-  Rng rng(22);
+  Rng rng(test::test_seed(22));
   const MeshData a = random_soup(rng, 400, 6.0, 0.5);
   const MeshData b = random_soup(rng, 200, 2.0, 0.5);
   const TriangleMesh ma = a.build(), mb = b.build();
   MeshCache cache;
   int tracked = 0, separated = 0;
   const Quat q0 = test::random_quaternion(rng);
+  // B descends along -y while it swings along x and turns about z: at
+  // parameter s (0 to 3) its pose is path(s, place). The scenario is B
+  // among A's triangles (the hulls overlapping, where tracking keeps its
+  // candidate lists; a pair whose hulls are apart is tracked only when its
+  // last pair reaches the hulls' bound) but apart from them (a gap of a
+  // fraction of a triangle). A fixed path left some seeds' B above A's
+  // hull and others deep among its triangles, so the path is placed from
+  // the soups drawn: for each of kLanes places of the swing, the lowest
+  // height (in steps of kHeightStep below one where B's bounding ball
+  // clears A's highest vertex) at which the cold distance at every
+  // kSampled parameter is at least kLeastGap; the first lane where the
+  // hulls then overlap at every sampled parameter from 0.5 on is taken.
+  struct Place {
+    double height;
+    Vec3 lane;  // x and z: where the swing is centred
+  };
+  const auto path = [&](double s, Place place) {
+    return Pose(Quat(Eigen::AngleAxisd(0.3 * s, Vec3(0, 0, 1))) * q0,
+                place.lane + Vec3(2.0 * std::sin(s), place.height - 0.3 * s, 0.0));
+  };
+  constexpr int kHeights = 60;
+  constexpr double kHeightStep = 0.1, kLeastGap = 0.05;
+  constexpr double kSampled[] = {0.0, 0.5, 1.0, 1.2, 1.4, 1.75, 2.0, 2.5, 2.99};
+  const Vec3 kLanes[] = {{0.0, 0.0, 0.2},  {0.0, 0.0, -1.3}, {0.0, 0.0, 1.7}, {-3.0, 0.0, 0.2},
+                         {-3.0, 0.0, -2.5}, {1.5, 0.0, -2.8}, {-1.5, 0.0, 3.0}, {2.0, 0.0, 2.5}};
+  double top = -std::numeric_limits<double>::infinity(), reach = 0.0;
+  for (const Vec3& v : a.vertices) top = std::max(top, v.y());
+  for (const Vec3& v : b.vertices) reach = std::max(reach, v.norm());
+  // B descends by 0.3 * 3 over the path: from `clear` on it never meets A.
+  const double clear = top + reach + 0.9;
+  const ConvexPolytope hull_a(a.vertices), hull_b(b.vertices);
+  Place place{clear, kLanes[0]};
+  for (const Vec3& lane : kLanes) {
+    Place lowest{clear, lane};
+    for (int k = kHeights; k >= 0; --k) {
+      const Place candidate{clear - kHeightStep * k, lane};
+      bool apart = true;
+      for (const double s : kSampled)
+        apart = apart && distance(ma, Pose(), mb, path(s, candidate)).distance >= kLeastGap;
+      if (apart) {
+        lowest = candidate;
+        break;
+      }
+    }
+    bool among = true;
+    for (const double s : kSampled)
+      among = among && (s < 0.5 || distance(hull_a, Pose(), hull_b, path(s, lowest)).status ==
+                                       Status::intersecting);
+    place = lowest;
+    if (among) break;
+  }
   for (int step = 0; step < 300; ++step) {
     const double s = 0.01 * step;
-    const Pose pb(Quat(Eigen::AngleAxisd(0.3 * s, Vec3(0, 0, 1))) * q0,
-                  Vec3(2.0 * std::sin(s), 9.2 - 0.3 * s, 0.2));
+    const Pose pb = path(s, place);
     const MeshResult warm = distance(ma, Pose(), mb, pb, {}, &cache);
     const MeshResult cold = distance(ma, Pose(), mb, pb);
     ASSERT_EQ(warm.status, cold.status) << step;
@@ -625,8 +676,8 @@ TEST(MeshDistanceTraversal, TrackingGivesTheColdAnswer) {
     // hulls are apart is tracked by the hulls' bound, not by the lists.
     for (int step = kBigFirstStep; step < kBigFirstStep + 40; ++step) {
       const double s = 0.01 * step;
-      const Pose pb(Quat(Eigen::AngleAxisd(0.3 * s, Vec3(0, 0, 1))) * q0,
-                    0x1p990 * Vec3(2.0 * std::sin(s), 9.2 - 0.3 * s, 0.2));
+      Pose pb = path(s, place);
+      pb.translation *= 0x1p990;
       const MeshResult warm = distance(ba, Pose(), bb, pb, {}, &big_cache);
       const MeshResult cold = distance(ba, Pose(), bb, pb);
       ASSERT_EQ(warm.status, cold.status) << step;

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <random>
 #include <string>
@@ -27,6 +28,23 @@ namespace proxima::test {
 
 using Rng = std::mt19937_64;
 using Points = std::vector<Vec3>;
+
+// The seed of a test's Rng: `fixed`, the one its cases were chosen on, or
+// the value of the environment variable PROXIMA_TEST_SEED when set (a
+// decimal integer), so that a test whose scenario must reach a count can
+// be run on other seeds without editing it:
+//   for s in $(seq 1 20); do PROXIMA_TEST_SEED=$s ./mesh_test --gtest_filter=...; done
+inline std::uint64_t test_seed(std::uint64_t fixed) {
+  const char* text = std::getenv("PROXIMA_TEST_SEED");
+  if (text == nullptr || *text == '\0') return fixed;
+  char* end = nullptr;
+  const unsigned long long value = std::strtoull(text, &end, 10);
+  if (*end != '\0') {
+    std::fprintf(stderr, "PROXIMA_TEST_SEED=%s is not a decimal integer\n", text);
+    std::abort();
+  }
+  return value;
+}
 
 // Uniform double in [0, 1) with 53 random bits: portable, unlike
 // std::uniform_real_distribution whose algorithm the standard leaves open.
