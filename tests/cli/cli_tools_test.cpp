@@ -25,9 +25,10 @@
 #include <string>
 #include <vector>
 
-#include "proxima/query/distance.h"
 #include "proxima/io.h"
+#include "proxima/query/distance.h"
 #include "proxima/shape/polytope.h"
+#include "support/generators.h"
 #include "support/run_cli.h"
 
 namespace {
@@ -37,6 +38,7 @@ using proxima::ConvexPolytope;
 using proxima::kUnitRoundoff;
 using proxima::Vec3;
 using proxima::test::CliRun;
+using proxima::test::drawn;
 using proxima::test::run_cli;
 using proxima::test::shell_quote;
 using proxima::test::TempPath;
@@ -193,7 +195,7 @@ TEST(CliDistance, PoseFlagsMatchTheLibrary) {
   std::uniform_real_distribution<double> uniform(-3.0, 3.0);
   auto cloud = [&](int n) {
     std::vector<Vec3> points;
-    for (int i = 0; i < n; ++i) points.emplace_back(gauss(rng), gauss(rng), gauss(rng));
+    for (int i = 0; i < n; ++i) points.push_back(drawn([&] { return gauss(rng); }));
     return points;
   };
   const std::vector<Vec3> pa = cloud(40);
@@ -398,7 +400,7 @@ TEST(CliHull, ExportRoundTrip) {
   std::normal_distribution<double> gauss;
   std::vector<Vec3> points;
   for (int i = 0; i < 300; ++i) {
-    Vec3 p(gauss(rng), gauss(rng), gauss(rng));
+    Vec3 p = drawn([&] { return gauss(rng); });
     // Half on a sphere (hull vertices), half inside.
     points.push_back(i % 2 == 0 ? Vec3(p.normalized() * 3.0) : Vec3(p.normalized() * 1.5));
   }

@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include "support/generators.h"
+
 namespace proxima {
 namespace {
 
@@ -30,6 +32,7 @@ using detail::collinear3d;
 using detail::exact_triangle_normal;
 using detail::orient2d;
 using detail::side3d;
+using test::drawn;
 
 using Rng = std::mt19937_64;
 double uniform01(Rng& rng) { return static_cast<double>(rng() >> 11) * 0x1p-53; }
@@ -167,8 +170,7 @@ TEST(ExactPredicates, ExponentsMixedFrom1eMinus300To1e300) {
            spread_double(rng, -996, 996)};
     check(p[0], p[1], p[2], p[3], "mixed exponents");
     // The same with a huge common part: differences cancel.
-    const Vec3 big(spread_double(rng, 900, 1000), spread_double(rng, 900, 1000),
-                   spread_double(rng, 900, 1000));
+    const Vec3 big = drawn([&] { return spread_double(rng, 900, 1000); });
     check(big + p[0] * 0x1p-900, big, big + p[2] * 0x1p-900, big + p[3] * 0x1p-900,
           "huge base, spread offsets");
   }
@@ -189,10 +191,7 @@ TEST(ExactPredicates, SubnormalAndTinyCoordinates) {
     }
     check(p[0], p[1], p[2], p[3], "subnormal and tiny");
     // Exactly the smallest steps: subnormal integer multiples.
-    const auto tiny = [&] {
-      return Vec3(uniform_int(rng, -3, 3) * DBL_TRUE_MIN, uniform_int(rng, -3, 3) * DBL_TRUE_MIN,
-                  uniform_int(rng, -3, 3) * DBL_TRUE_MIN);
-    };
+    const auto tiny = [&] { return drawn([&] { return uniform_int(rng, -3, 3) * DBL_TRUE_MIN; }); };
     check(tiny(), tiny(), tiny(), tiny(), "multiples of the smallest subnormal");
   }
 }

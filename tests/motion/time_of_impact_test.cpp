@@ -30,6 +30,9 @@
 namespace proxima {
 namespace {
 
+using test::drawn;
+using test::drawn_quaternion;
+
 std::vector<Vec3> box(const Vec3& half) {
   std::vector<Vec3> pts;
   for (int i = 0; i < 8; ++i) {
@@ -43,7 +46,7 @@ std::vector<Vec3> sphere_points(int n, std::uint32_t seed, double radius) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> g;
   std::vector<Vec3> pts;
-  for (int i = 0; i < n; ++i) pts.push_back(radius * Vec3(g(rng), g(rng), g(rng)).normalized());
+  for (int i = 0; i < n; ++i) pts.push_back(radius * drawn([&] { return g(rng); }).normalized());
   return pts;
 }
 
@@ -181,16 +184,18 @@ TEST(TimeOfImpact, RandomMotionsNeverReportContactLate) {
   for (int trial = 0; trial < 60; ++trial) {
     const ConvexPolytope a(sphere_points(12 + trial % 20, 100 + trial, 0.5 + u(rng)));
     const ConvexPolytope b(sphere_points(6 + trial % 30, 200 + trial, 0.2 + u(rng)));
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
     const auto random_pose = [&](double spread) {
-      return Pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(),
-                  Vec3(spread * g(rng), spread * g(rng), spread * g(rng)));
+      const Vec3 at = drawn([&] { return spread * g(rng); });
+      return Pose(drawn_quaternion([&] { return g(rng); }).normalized(), at);
     };
     const Pose a0 = random_pose(1.0);
-    const Motion ma = Motion::from_velocity(a0, Vec3(g(rng), g(rng), g(rng)),
-                                            M_PI / 2 * Vec3(g(rng), g(rng), g(rng)).normalized());
+    const Vec3 a_axis = drawn([&] { return g(rng); }).normalized();
+    const Motion ma = Motion::from_velocity(a0, drawn([&] { return g(rng); }), M_PI / 2 * a_axis);
     const Pose b0 = random_pose(4.0);
+    const Vec3 b_shift = drawn([&] { return g(rng); });
     const Motion mb{b0, Pose(b0.rotation * Eigen::AngleAxisd(3.0 * u(rng), Vec3::UnitX()),
-                             Vec3(-b0.translation + 0.5 * Vec3(g(rng), g(rng), g(rng))))};
+                             Vec3(-b0.translation + 0.5 * b_shift))};
     ImpactOptions options;
     options.target_separation = trial % 3 == 0 ? 0.2 * u(rng) : 0.0;
     options.tolerance = 1e-7;
@@ -244,22 +249,26 @@ TEST(TimeOfImpact, FastTurnsOfFewVertexHullsNeverOvershoot) {
   for (int trial = 0; trial < 150; ++trial) {
     const auto hull = [&](int n, double radius, double off) {
       std::vector<Vec3> pts;
-      const Vec3 shift = off * Vec3(g(rng), g(rng), g(rng)).normalized();
+      const Vec3 shift = off * drawn([&] { return g(rng); }).normalized();
       for (int i = 0; i < n; ++i) {
-        pts.push_back(radius * Vec3(g(rng), g(rng), g(rng)).normalized() + shift);
+        pts.push_back(radius * drawn([&] { return g(rng); }).normalized() + shift);
       }
       return ConvexPolytope(pts);
     };
     const ConvexPolytope a = hull(4 + trial % 7, 0.5 + u(rng), trial % 3 == 0 ? u(rng) : 0.0);
     const ConvexPolytope b = hull(4 + trial % 5, 0.3 + u(rng), trial % 4 == 0 ? u(rng) : 0.0);
-    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
-    const Pose a0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3::Zero());
-    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), (2.5 + u(rng)) * dir);
+    const Vec3 dir = drawn([&] { return g(rng); }).normalized();
+    const Pose a0(drawn_quaternion([&] { return g(rng); }).normalized(), Vec3::Zero());
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
+    const double b_distance = 2.5 + u(rng);
+    const Pose b0(drawn_quaternion([&] { return g(rng); }).normalized(), b_distance * dir);
+    const Vec3 a_axis = drawn([&] { return g(rng); }).normalized();
+    const double a_turn = M_PI * u(rng);
     const Motion ma =
-        Motion::from_velocity(a0, 0.3 * Vec3(g(rng), g(rng), g(rng)),
-                              M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
-    const Motion mb = Motion::from_velocity(
-        b0, -(1.0 + 2.0 * u(rng)) * dir, M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+        Motion::from_velocity(a0, 0.3 * drawn([&] { return g(rng); }), a_turn * a_axis);
+    const Vec3 b_axis = drawn([&] { return g(rng); }).normalized();
+    const double b_turn = M_PI * u(rng);
+    const Motion mb = Motion::from_velocity(b0, -(1.0 + 2.0 * u(rng)) * dir, b_turn * b_axis);
     ImpactOptions options;
     options.target_separation = trial % 5 == 0 ? 0.1 * u(rng) : 0.0;
     options.tolerance = 1e-9;
@@ -331,7 +340,8 @@ TEST(TimeOfImpact, TurningBarsCrossingEdgeOnNeverOvershoot) {
   const int trials = test::sanitized_count(120, 4);
   for (int trial = 0; trial < trials; ++trial) {
     const double length = 1.0 + 2.0 * u(rng);
-    const ConvexPolytope a(box(Vec3(length, 0.05 + 0.1 * u(rng), 0.05 + 0.1 * u(rng))));
+    const ConvexPolytope a(box(drawn([&] { return length; }, [&] { return 0.05 + 0.1 * u(rng); },
+                                     [&] { return 0.05 + 0.1 * u(rng); })));
     // B: a thin box, or every other time a prism of many sides (its long
     // edges between nearly coplanar faces: turning about its axis hands
     // the support from edge to edge quickly, where the bound's span ends).
@@ -345,17 +355,25 @@ TEST(TimeOfImpact, TurningBarsCrossingEdgeOnNeverOvershoot) {
         prism.emplace_back(radius * std::cos(angle), y, radius * std::sin(angle));
     }
     const ConvexPolytope b(
-        trial % 2 == 0 ? box(Vec3(0.05 + 0.1 * u(rng), half, 0.05 + 0.1 * u(rng))) : prism);
-    const Pose a0(Quat(1.0, 0.2 * g(rng), 0.2 * g(rng), 0.2 * g(rng)).normalized(),
-                  Vec3(0.3 * g(rng), 0.3 * g(rng), 0.0));
-    const Pose b0(Quat(1.0, 0.2 * g(rng), 0.2 * g(rng), 0.2 * g(rng)).normalized(),
-                  Vec3(0.3 * g(rng), 0.3 * g(rng), 2.0 + u(rng)));
+        trial % 2 == 0 ? box(drawn([&] { return 0.05 + 0.1 * u(rng); }, [&] { return half; },
+                                   [&] { return 0.05 + 0.1 * u(rng); }))
+                       : prism);
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
+    const auto small = [&] { return 0.2 * g(rng); };
+    const auto offset = [&] { return 0.3 * g(rng); };
+    const Vec3 a_at = drawn(offset, offset, [] { return 0.0; });
+    const Pose a0(drawn_quaternion([] { return 1.0; }, small, small, small).normalized(), a_at);
+    const Vec3 b_at = drawn(offset, offset, [&] { return 2.0 + u(rng); });
+    const Pose b0(drawn_quaternion([] { return 1.0; }, small, small, small).normalized(), b_at);
+    const Vec3 a_axis = drawn([&] { return g(rng); }).normalized();
+    const double a_turn = 2.0 * u(rng);
     const Motion ma =
-        Motion::from_velocity(a0, 0.3 * Vec3(g(rng), g(rng), g(rng)),
-                              2.0 * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
-    const Motion mb =
-        Motion::from_velocity(b0, Vec3(0.5 * g(rng), 0.5 * g(rng), -(2.5 + 2.0 * u(rng))),
-                              3.0 * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+        Motion::from_velocity(a0, 0.3 * drawn([&] { return g(rng); }), a_turn * a_axis);
+    const Vec3 b_axis = drawn([&] { return g(rng); }).normalized();
+    const double b_turn = 3.0 * u(rng);
+    const auto lateral = [&] { return 0.5 * g(rng); };
+    const Motion mb = Motion::from_velocity(
+        b0, drawn(lateral, lateral, [&] { return -(2.5 + 2.0 * u(rng)); }), b_turn * b_axis);
     ImpactOptions options;
     options.target_separation = trial % 4 == 0 ? 0.05 * u(rng) : 0.0;
     options.tolerance = 1e-9;
@@ -439,10 +457,12 @@ TEST(TimeOfImpact, MotionAtIsTheAngleAxisTurnAndStaysRigid) {
   std::normal_distribution<double> g;
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int trial = 0; trial < 200; ++trial) {
-    const Pose p(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3(g(rng), g(rng), g(rng)));
-    const Vec3 axis = Vec3(g(rng), g(rng), g(rng)).normalized();
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
+    const Vec3 start = drawn([&] { return g(rng); });
+    const Pose p(drawn_quaternion([&] { return g(rng); }).normalized(), start);
+    const Vec3 axis = drawn([&] { return g(rng); }).normalized();
     const double angle = trial % 4 == 0 ? 1e-9 * u(rng) : M_PI * u(rng);
-    const Motion m = Motion::from_velocity(p, Vec3(g(rng), g(rng), g(rng)), angle * axis);
+    const Motion m = Motion::from_velocity(p, drawn([&] { return g(rng); }), angle * axis);
     for (int i = 1; i < 16; ++i) {
       const double t = i / 16.0;
       const Pose at = m.at(t);
@@ -467,9 +487,9 @@ TEST(TimeOfImpact, PureTranslationAgreesWithTheExactRayAgainstTheMinkowskiHull) 
   for (int trial = 0; trial < 80; ++trial) {
     std::vector<Vec3> pa = sphere_points(8 + trial % 40, 300 + trial, 0.5 + u01(rng));
     std::vector<Vec3> pb = sphere_points(5 + trial % 25, 400 + trial, 0.3 + u01(rng));
-    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
+    const Vec3 dir = drawn([&] { return g(rng); }).normalized();
     for (Vec3& y : pb) y += (3.0 + u01(rng)) * dir;  // B starts about 3 to 4 away
-    const Vec3 aim = 0.6 * Vec3(g(rng), g(rng), g(rng));
+    const Vec3 aim = 0.6 * drawn([&] { return g(rng); });
     const Vec3 move = (aim - (pb[0] - 0.0 * dir)).normalized() * (4.0 + 4.0 * u01(rng));
     const std::optional<double> t_star = test::exact_translation_toi(pa, pb, move);
     for (const int e : {0, -996, 996}) {
@@ -638,9 +658,9 @@ CompoundBody random_compound(std::mt19937& rng, int count, double spread, double
   for (int i = 0; i < count; ++i) {
     auto hull = std::make_shared<const ConvexPolytope>(
         sphere_points(5 + i % 6, 900 + static_cast<std::uint32_t>(rng() % 1000), size));
-    const Vec3 at(spread * u(rng), spread * u(rng), spread * u(rng));
+    const Vec3 at = drawn([&] { return spread * u(rng); });
     const Pose pose = i % 2 == 0 ? Pose::from_translation(at)
-                                 : Pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), at);
+                                 : Pose(drawn_quaternion([&] { return g(rng); }).normalized(), at);
     pieces.push_back({hull, pose});
   }
   return CompoundBody(std::move(pieces));
@@ -663,15 +683,22 @@ TEST(TimeOfImpact, CompoundsPrunedAnswerIsTheEarliestOfEveryPiecePair) {
     const Body a(random_compound(rng, 2 + trial % 11, 1.5, 0.4), radius_a);
     const Body b = trial % 2 == 0 ? Body(ConvexPolytope(sphere_points(12, 50 + trial, 0.5)), 0.0)
                                   : Body(random_compound(rng, 2 + trial % 5, 0.8, 0.3), 0.02);
-    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
-    const Motion ma =
-        Motion::from_velocity(Pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3::Zero()),
-                              0.3 * Vec3(g(rng), g(rng), g(rng)),
-                              M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
-    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), (4.0 + u(rng)) * dir);
+    const Vec3 dir = drawn([&] { return g(rng); }).normalized();
+    // Drawn last argument (and right operand) first, the order gcc gives a
+    // call (see drawn()).
+    const Vec3 a_axis = drawn([&] { return g(rng); }).normalized();
+    const double a_turn = M_PI * u(rng);
+    const Vec3 a_velocity = 0.3 * drawn([&] { return g(rng); });
+    const Motion ma = Motion::from_velocity(
+        Pose(drawn_quaternion([&] { return g(rng); }).normalized(), Vec3::Zero()), a_velocity,
+        a_turn * a_axis);
+    const double b_distance = 4.0 + u(rng);
+    const Pose b0(drawn_quaternion([&] { return g(rng); }).normalized(), b_distance * dir);
+    const Vec3 b_axis = drawn([&] { return g(rng); }).normalized();
+    const double b_turn = 2.0 * M_PI * u(rng);
+    const Vec3 b_wobble = 0.5 * drawn([&] { return g(rng); });
     const Motion mb =
-        Motion::from_velocity(b0, -(8.0 + 2.0 * u(rng)) * dir + 0.5 * Vec3(g(rng), g(rng), g(rng)),
-                              2.0 * M_PI * u(rng) * Vec3(g(rng), g(rng), g(rng)).normalized());
+        Motion::from_velocity(b0, -(8.0 + 2.0 * u(rng)) * dir + b_wobble, b_turn * b_axis);
     ImpactOptions options;
     options.tolerance = 1e-9;
     options.target_separation = trial % 4 == 1 ? 0.05 : 0.0;
@@ -1134,14 +1161,20 @@ TEST(TimeOfImpact, MeshPrunedAnswerIsTheEarliestOfEveryTriangle) {
     const Body body(rock);
     // The ground turning a little about a tilted axis; the rock thrown
     // across it, spinning.
-    const Motion ma =
-        Motion::from_velocity(Pose::from_translation(Vec3(0.1 * g(rng), 0.1 * g(rng), 0.0)),
-                              0.2 * Vec3(g(rng), g(rng), 0), 0.3 * Vec3(g(rng), g(rng), g(rng)));
-    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(),
-                  Vec3(2.0 * g(rng), 2.0 * g(rng), 1.5 + u(rng)));
-    const Motion mb =
-        Motion::from_velocity(b0, Vec3(1.5 * g(rng), 1.5 * g(rng), -(2.0 + 2.0 * u(rng))),
-                              4.0 * Vec3(g(rng), g(rng), g(rng)));
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
+    const auto normal = [&] { return g(rng); };
+    const Vec3 a_spin = 0.3 * drawn(normal);
+    const Vec3 a_velocity = 0.2 * drawn(normal, normal, [] { return 0.0; });
+    const auto tenth = [&] { return 0.1 * g(rng); };
+    const Motion ma = Motion::from_velocity(
+        Pose::from_translation(drawn(tenth, tenth, [] { return 0.0; })), a_velocity, a_spin);
+    const auto twice = [&] { return 2.0 * g(rng); };
+    const Vec3 b_at = drawn(twice, twice, [&] { return 1.5 + u(rng); });
+    const Pose b0(drawn_quaternion(normal).normalized(), b_at);
+    const Vec3 b_spin = 4.0 * drawn(normal);
+    const auto lateral = [&] { return 1.5 * g(rng); };
+    const Motion mb = Motion::from_velocity(
+        b0, drawn(lateral, lateral, [&] { return -(2.0 + 2.0 * u(rng)); }), b_spin);
     ImpactOptions options;
     options.tolerance = 1e-9;
     options.target_separation = trial % 3 == 0 ? 0.05 : 0.0;
@@ -1198,11 +1231,14 @@ TEST(TimeOfImpact, MeshAgainstMeshIsTheEarliestOfEveryTrianglePair) {
   int contacts = 0;
   for (int trial = 0; trial < 5; ++trial) {
     const Motion ma =
-        Motion::from_velocity(Pose::identity(), Vec3::Zero(), 0.3 * Vec3(g(rng), g(rng), g(rng)));
-    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(),
-                  Vec3(g(rng), g(rng), 1.5 + u(rng)));
-    const Motion mb = Motion::from_velocity(b0, Vec3(g(rng), g(rng), -(2.0 + 2.0 * u(rng))),
-                                            3.0 * Vec3(g(rng), g(rng), g(rng)));
+        Motion::from_velocity(Pose::identity(), Vec3::Zero(), 0.3 * drawn([&] { return g(rng); }));
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
+    const auto normal = [&] { return g(rng); };
+    const Vec3 b_at = drawn(normal, normal, [&] { return 1.5 + u(rng); });
+    const Pose b0(drawn_quaternion(normal).normalized(), b_at);
+    const Vec3 b_spin = 3.0 * drawn(normal);
+    const Motion mb = Motion::from_velocity(
+        b0, drawn(normal, normal, [&] { return -(2.0 + 2.0 * u(rng)); }), b_spin);
     ImpactOptions options;
     options.tolerance = 1e-9;
     const ImpactResult r = time_of_impact(Body(ground), ma, Body(stone), mb, options);
@@ -1242,10 +1278,14 @@ TEST(TimeOfImpact, AMeshPrunesTrianglesThatCannotBeHitFirst) {
   std::normal_distribution<double> g;
   int most = 0;
   for (int trial = 0; trial < 8; ++trial) {
-    const Pose b0(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(),
-                  Vec3(5.0 * g(rng), 5.0 * g(rng), 2.0));
+    // Drawn last argument first, the order gcc gives a call (see drawn()).
+    const auto normal = [&] { return g(rng); };
+    const auto wide = [&] { return 5.0 * g(rng); };
+    const Vec3 b_at = drawn(wide, wide, [] { return 2.0; });
+    const Pose b0(drawn_quaternion(normal).normalized(), b_at);
+    const Vec3 b_spin = 5.0 * drawn(normal);
     const Motion fall =
-        Motion::from_velocity(b0, Vec3(g(rng), g(rng), -4.0), 5.0 * Vec3(g(rng), g(rng), g(rng)));
+        Motion::from_velocity(b0, drawn(normal, normal, [] { return -4.0; }), b_spin);
     const ImpactResult r = time_of_impact(ground, still, pebble, fall);
     ASSERT_EQ(r.status, ImpactStatus::contact);
     EXPECT_GE(r.pairs_advanced, 1);

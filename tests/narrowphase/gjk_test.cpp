@@ -31,10 +31,14 @@
 #include "narrowphase/gjk_contact.h"
 #include "proxima/query/distance.h"
 #include "support/exact_oracle.h"
+#include "support/generators.h"
 #include "support/sanitizers.h"
 
 namespace proxima {
 namespace {
+
+using test::drawn;
+using test::drawn_quaternion;
 
 using Rng = std::mt19937_64;
 
@@ -48,14 +52,14 @@ int uniform_int(Rng& rng, int lo, int hi) {
 }
 Vec3 random_unit(Rng& rng) {
   for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Vec3 p = drawn([&] { return uniform(rng, -1, 1); });
     const double n2 = p.squaredNorm();
     if (n2 > 1e-4 && n2 <= 1.0) return p / std::sqrt(n2);
   }
 }
 Mat3 random_rotation(Rng& rng) {
   for (;;) {
-    const Quat q(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Quat q = drawn_quaternion([&] { return uniform(rng, -1, 1); });
     if (q.squaredNorm() > 1e-4 && q.squaredNorm() <= 1.0) return q.normalized().toRotationMatrix();
   }
 }

@@ -28,6 +28,9 @@
 namespace proxima {
 namespace {
 
+using test::drawn;
+using test::drawn_quaternion;
+
 std::vector<Vec3> box(const Vec3& half) {
   std::vector<Vec3> pts;
   for (int i = 0; i < 8; ++i) {
@@ -42,7 +45,7 @@ std::vector<Vec3> sphere_points(int n, std::uint32_t seed, double radius = 1.0) 
   std::normal_distribution<double> g;
   std::vector<Vec3> pts;
   for (int i = 0; i < n; ++i) {
-    Vec3 p(g(rng), g(rng), g(rng));
+    Vec3 p = drawn([&] { return g(rng); });
     pts.push_back(radius * p.normalized());
   }
   return pts;
@@ -79,8 +82,8 @@ double brute_force_distance(const ConvexPolytope& a, const Pose& pa, const Conve
 
 Pose random_pose(std::mt19937& rng, double spread) {
   std::normal_distribution<double> g;
-  const Quat q(g(rng), g(rng), g(rng), g(rng));
-  return Pose(q, Vec3(spread * g(rng), spread * g(rng), spread * g(rng)));
+  const Quat q = drawn_quaternion([&] { return g(rng); });
+  return Pose(q, drawn([&] { return spread * g(rng); }));
 }
 
 // Regression (issue 24): the hybrid's inside test of a four-vertex feature
@@ -373,8 +376,8 @@ TEST(Hybrid, AWarmCacheOnUnrelatedPosesCostsNoMoreThanCold) {
   long warm_iterations = 0;
   long cold_iterations = 0;
   for (int i = 0; i < 500; ++i) {
-    const Vec3 dir = Vec3(g(rng), g(rng), g(rng)).normalized();
-    const Pose pose(Quat(g(rng), g(rng), g(rng), g(rng)).normalized(), Vec3(3.0 * dir));
+    const Vec3 dir = drawn([&] { return g(rng); }).normalized();
+    const Pose pose(drawn_quaternion([&] { return g(rng); }).normalized(), Vec3(3.0 * dir));
     const DistanceResult w = distance(a, Pose::identity(), b, pose, {}, &warm);
     const DistanceResult c = distance(a, Pose::identity(), b, pose);
     EXPECT_NEAR(w.distance, c.distance, 1e-12);
@@ -581,7 +584,8 @@ TEST(CertifiedPair, AgreesWithTheFullHybridNearTouching) {
     // and then, not at every step.
     const double tilt = step < 100 ? 0.0 : 1e-7 * (step % 7);
     const Quat q(Eigen::AngleAxisd(tilt, Vec3(std::cos(0.01 * step), std::sin(0.01 * step), 0)));
-    slide += Vec3(test::uniform(rng, -0.05, 0.05), test::uniform(rng, -0.05, 0.05), 0.0);
+    slide += test::drawn([&] { return test::uniform(rng, -0.05, 0.05); },
+                         [&] { return test::uniform(rng, -0.05, 0.05); }, [&] { return 0.0; });
     slide = slide.cwiseMax(Vec3(-1.2, -1.2, 0)).cwiseMin(Vec3(1.2, 1.2, 0));
     // B's lowest point along z is 0.5 below its centre (less for a tilt).
     const Pose pose(q, slide + Vec3(0, 0, 1.5 + gap));

@@ -19,9 +19,12 @@
 #include <vector>
 
 #include "proxima/shape/polytope.h"
+#include "support/generators.h"
 
 namespace proxima {
 namespace {
+
+using test::drawn;
 
 using Rng = std::mt19937_64;
 
@@ -31,7 +34,7 @@ double uniform(Rng& rng, double lo, double hi) {
 
 Vec3 random_unit(Rng& rng) {
   for (;;) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Vec3 p = drawn([&] { return uniform(rng, -1, 1); });
     const double n2 = p.squaredNorm();
     if (n2 > 1e-4 && n2 <= 1.0) return p / std::sqrt(n2);
   }

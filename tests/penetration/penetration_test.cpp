@@ -184,13 +184,15 @@ TEST(PenetrationOracle, RandomOverlapsFromGrazingToContainment) {
     if (mode == 4) {
       // Two polygons in one plane, overlapping: M flat, touching.
       a = flat_polygon(rng, uniform_int(rng, 3, 8));
-      b = translated(flat_polygon(rng, uniform_int(rng, 3, 8)),
-                     Vec3(uniform(rng, -0.5, 0.5), uniform(rng, -0.5, 0.5), 0));
+      // The shift first, the order gcc gives the call (see drawn()).
+      const auto shift = [&] { return uniform(rng, -0.5, 0.5); };
+      const Vec3 at = drawn(shift, shift, [] { return 0.0; });
+      b = translated(flat_polygon(rng, uniform_int(rng, 3, 8)), at);
     } else if (mode == 0) {
       // Containment: a small B near A's centre.
-      b = translated(
-          scaled(b, uniform(rng, 0.01, 0.3)),
-          Vec3(uniform(rng, -0.1, 0.1), uniform(rng, -0.1, 0.1), uniform(rng, -0.1, 0.1)));
+      // The shift first, the order gcc gives the call (see drawn()).
+      const Vec3 at = drawn([&] { return uniform(rng, -0.1, 0.1); });
+      b = translated(scaled(b, uniform(rng, 0.01, 0.3)), at);
     } else {
       // Separated along a random direction, then moved back along the
       // closest points' direction by the contact distance plus an overlap
@@ -695,9 +697,7 @@ TEST(PenetrationTwins, GridsWithCoplanarFacesAndRotationSweep) {
     const Points b_local = grid_points(rng, 30, uniform_int(rng, 1, 3));
     const Pose pose =
         trial % 2 == 0
-            ? Pose::from_translation(
-                  Vec3(uniform_int(rng, -2, 2), uniform_int(rng, -2, 2), uniform_int(rng, -2, 2)) /
-                  4.0)
+            ? Pose::from_translation(drawn([&] { return uniform_int(rng, -2, 2); }) / 4.0)
             : Pose(random_quaternion(rng), 0.5 * random_unit_vector(rng));
     const ConvexPolytope pa(a), pb(b_local);
     PenetrationCache cache;
@@ -928,9 +928,8 @@ TEST(PenetrationTracking, WitnessFeaturesOfBoxesTranslatedAndTurned) {
   Rng rng(5);
   int penetrating = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    const Points a = box(Vec3(uniform(rng, 0.2, 1), uniform(rng, 0.2, 1), uniform(rng, 0.2, 1)));
-    const Points b_local =
-        box(Vec3(uniform(rng, 0.1, 0.6), uniform(rng, 0.1, 0.6), uniform(rng, 0.1, 0.6)));
+    const Points a = box(drawn([&] { return uniform(rng, 0.2, 1); }));
+    const Points b_local = box(drawn([&] { return uniform(rng, 0.1, 0.6); }));
     const ConvexPolytope pa(a), pb(b_local);
     PenetrationCache cache;
     Vec3 t = 0.5 * random_unit_vector(rng);
@@ -977,10 +976,14 @@ TEST(PenetrationTracking, WitnessesReadFromTheCacheAreTheColdOnesBitForBit) {
   for (const int n : {8, 20, 64, 0}) {
     for (int trial = 0; trial < 3; ++trial) {
       Rng rng(static_cast<std::uint64_t>(n * 53 + trial + 7));
-      const Points a = n > 0 ? points_on_sphere(rng, n)
-                             : box(Vec3(uniform(rng, 0.3, 1), uniform(rng, 0.3, 1), 0.5));
-      const Points b_local = n > 0 ? points_on_sphere(rng, n, 0.8)
-                                   : box(Vec3(uniform(rng, 0.1, 0.4), 0.3, uniform(rng, 0.1, 0.4)));
+      const Points a = n > 0
+                           ? points_on_sphere(rng, n)
+                           : box(drawn([&] { return uniform(rng, 0.3, 1); },
+                                       [&] { return uniform(rng, 0.3, 1); }, [&] { return 0.5; }));
+      const Points b_local =
+          n > 0 ? points_on_sphere(rng, n, 0.8)
+                : box(drawn([&] { return uniform(rng, 0.1, 0.4); }, [&] { return 0.3; },
+                            [&] { return uniform(rng, 0.1, 0.4); }));
       const ConvexPolytope pa(a), pb(b_local);
       const Mat3 rotation = n > 0 ? random_rotation(rng) : Mat3::Identity();
       const Vec3 dir = random_unit_vector(rng);

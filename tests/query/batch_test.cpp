@@ -52,8 +52,7 @@ struct Scene {
 
 Pose random_pose(Rng& rng, double spread) {
   return {test::random_quaternion(rng),
-          Vec3(test::uniform(rng, -spread, spread), test::uniform(rng, -spread, spread),
-               test::uniform(rng, -spread, spread))};
+          test::drawn([&] { return test::uniform(rng, -spread, spread); })};
 }
 
 Scene make_scene(Rng& rng, int n, int pool_size = 12) {

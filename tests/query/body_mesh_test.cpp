@@ -71,8 +71,7 @@ TriangleMesh l_mesh() {
 
 Pose random_pose(Rng& rng, double spread) {
   return {test::random_quaternion(rng),
-          Vec3(test::uniform(rng, -spread, spread), test::uniform(rng, -spread, spread),
-               test::uniform(rng, -spread, spread))};
+          test::drawn([&] { return test::uniform(rng, -spread, spread); })};
 }
 
 TEST(BodyMesh, TheTestMeshesAreWhatTheySay) {
@@ -214,8 +213,9 @@ TEST(BodyMesh, NonConvexMeshAgainstARoundedPointEqualsTheTwin) {
   const TriangleMesh point(center, one);
   Rng rng(7);
   for (int k = 0; k < 100; ++k) {
-    const Pose pb(Mat3::Identity(), Vec3(test::uniform(rng, 1.2, 3), test::uniform(rng, 1.2, 3),
-                                         test::uniform(rng, -0.5, 1.5)));
+    const Pose pb(Mat3::Identity(), test::drawn([&] { return test::uniform(rng, 1.2, 3); },
+                                                [&] { return test::uniform(rng, 1.2, 3); },
+                                                [&] { return test::uniform(rng, -0.5, 1.5); }));
     const BodyResult got = distance(body, Pose::identity(), ball, pb);
     const MeshResult twin = distance_all_pairs(*l, Pose::identity(), point, pb);
     if (twin.status == Status::intersecting) continue;

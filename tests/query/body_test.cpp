@@ -65,8 +65,8 @@ TEST(BodyClosedForm, SphereSphere) {
   for (int i = 0; i < count(200); ++i) {
     const double ra = test::log_uniform(rng, 1e-3, 10.0);
     const double rb = test::log_uniform(rng, 1e-3, 10.0);
-    const Vec3 ca(test::uniform(rng, -5, 5), test::uniform(rng, -5, 5), test::uniform(rng, -5, 5));
-    const Vec3 cb(test::uniform(rng, -5, 5), test::uniform(rng, -5, 5), test::uniform(rng, -5, 5));
+    const Vec3 ca = test::drawn([&] { return test::uniform(rng, -5, 5); });
+    const Vec3 cb = test::drawn([&] { return test::uniform(rng, -5, 5); });
     const Body a = make_sphere(ra);
     const Body b = make_sphere(rb);
     // A rotation of a sphere changes nothing.
@@ -125,10 +125,12 @@ TEST(BodyClosedForm, CapsuleCapsuleIsSegmentsMinusRadii) {
   for (int i = 0; i < count(300); ++i) {
     const double ha = test::uniform(rng, 0.1, 2.0), hb = test::uniform(rng, 0.1, 2.0);
     const double ra = test::uniform(rng, 0.01, 0.8), rb = test::uniform(rng, 0.01, 0.8);
-    const Pose pa(test::random_quaternion(rng),
-                  Vec3(test::uniform(rng, -2, 2), test::uniform(rng, -2, 2), 0.0));
-    const Pose pb(test::random_quaternion(rng),
-                  Vec3(test::uniform(rng, -2, 2), test::uniform(rng, -2, 2), 1.0));
+    // Each translation first, the order gcc gives the call (see drawn()).
+    const auto spread = [&] { return test::uniform(rng, -2, 2); };
+    const Vec3 at_a = test::drawn(spread, spread, [] { return 0.0; });
+    const Pose pa(test::random_quaternion(rng), at_a);
+    const Vec3 at_b = test::drawn(spread, spread, [] { return 1.0; });
+    const Pose pb(test::random_quaternion(rng), at_b);
     const Vec3 a0 = pa.apply(Vec3(0, 0, -ha)), a1 = pa.apply(Vec3(0, 0, ha));
     const Vec3 b0 = pb.apply(Vec3(0, 0, -hb)), b1 = pb.apply(Vec3(0, 0, hb));
     const double core = segment_segment(a0, a1 - a0, b0, b1 - b0);
@@ -148,11 +150,11 @@ TEST(BodyClosedForm, CapsuleCapsuleIsSegmentsMinusRadii) {
 TEST(BodyClosedForm, AxisAlignedBoxes) {
   Rng rng(13);
   for (int i = 0; i < count(300); ++i) {
-    const Vec3 ha(test::uniform(rng, 0, 2), test::uniform(rng, 0, 2), test::uniform(rng, 0, 2));
-    const Vec3 hb(test::uniform(rng, 0, 2), test::uniform(rng, 0, 2), test::uniform(rng, 0, 2));
+    const Vec3 ha = test::drawn([&] { return test::uniform(rng, 0, 2); });
+    const Vec3 hb = test::drawn([&] { return test::uniform(rng, 0, 2); });
     const double ra = i % 2 ? test::uniform(rng, 0, 0.5) : 0.0;
     const double rb = i % 3 ? test::uniform(rng, 0, 0.5) : 0.0;
-    const Vec3 c(test::uniform(rng, -6, 6), test::uniform(rng, -6, 6), test::uniform(rng, -6, 6));
+    const Vec3 c = test::drawn([&] { return test::uniform(rng, -6, 6); });
     // Per axis the gap between the intervals [-ha, ha] and c + [-hb, hb].
     Vec3 gap;
     for (int k = 0; k < 3; ++k) gap[k] = std::max(0.0, std::abs(c[k]) - ha[k] - hb[k]);
@@ -261,10 +263,8 @@ TEST(BodyOracle, TouchingCoresTakeTheNormalOfTheirContact) {
   Rng rng(21);
   int cases = 0;
   for (int i = 0; i < count(40); ++i) {
-    const Vec3 ha(test::uniform(rng, 0.5, 1.5), test::uniform(rng, 0.5, 1.5),
-                  test::uniform(rng, 0.5, 1.5));
-    const Vec3 hb(test::uniform(rng, 0.5, 1.5), test::uniform(rng, 0.5, 1.5),
-                  test::uniform(rng, 0.5, 1.5));
+    const Vec3 ha = test::drawn([&] { return test::uniform(rng, 0.5, 1.5); });
+    const Vec3 hb = test::drawn([&] { return test::uniform(rng, 0.5, 1.5); });
     const int axis = i % 3;
     // Face to face along `axis`, offset sideways by a quarter: the contact
     // is a rectangle.
@@ -392,11 +392,12 @@ TEST(BodyCompound, DeepestPairIsTheAllPairsTwins) {
     const auto random_compound = [&](int pieces) {
       std::vector<CompoundPiece> list;
       for (int p = 0; p < pieces; ++p) {
-        list.push_back({hull(test::points_on_sphere(rng, test::uniform_int(rng, 4, 12),
-                                                    test::uniform(rng, 0.3, 1.0))),
-                        Pose(test::random_quaternion(rng),
-                             2.0 * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
-                                        test::uniform(rng, -1, 1)))});
+        // The braces are evaluated in order; in the calls, the last
+        // argument first (gcc's order, see drawn()).
+        const double radius = test::uniform(rng, 0.3, 1.0);
+        const auto piece = hull(test::points_on_sphere(rng, test::uniform_int(rng, 4, 12), radius));
+        const Vec3 at = 2.0 * test::drawn([&] { return test::uniform(rng, -1, 1); });
+        list.push_back({piece, Pose(test::random_quaternion(rng), at)});
       }
       return std::make_shared<const CompoundBody>(std::move(list));
     };

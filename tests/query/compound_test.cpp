@@ -51,8 +51,7 @@ Points random_piece_points(Rng& rng) {
 
 Pose random_pose(Rng& rng, double spread) {
   return {test::random_quaternion(rng),
-          Vec3(test::uniform(rng, -spread, spread), test::uniform(rng, -spread, spread),
-               test::uniform(rng, -spread, spread))};
+          test::drawn([&] { return test::uniform(rng, -spread, spread); })};
 }
 
 // `n` pieces of size `size` spread over a cube of half-width `spread` (small

@@ -531,8 +531,8 @@ TEST(DistanceAccuracy, ParallelFeatures) {
   Rng rng(3);
   for (int i = 0; i < count(150); ++i) {
     const int kind = i % 3;
-    const Vec3 ha(uniform(rng, 0.1, 2), uniform(rng, 0.1, 2), uniform(rng, 0.1, 2));
-    const Vec3 hb(uniform(rng, 0.1, 2), uniform(rng, 0.1, 2), uniform(rng, 0.1, 2));
+    const Vec3 ha = drawn([&] { return uniform(rng, 0.1, 2); });
+    const Vec3 hb = drawn([&] { return uniform(rng, 0.1, 2); });
     const double gap = (rng() & 1) ? log_uniform(rng, 1e-12, 1e-6) : log_uniform(rng, 1e-3, 3);
     Points a = box(ha), b = box(hb);
     if (kind == 1) {  // edge-edge: both turned 45 degrees about z
@@ -542,7 +542,8 @@ TEST(DistanceAccuracy, ParallelFeatures) {
     }
     // Side by side along x, offset laterally so the faces overlap partly.
     const double dx = support_value(a, Vec3::UnitX()) + support_value(b, -Vec3::UnitX()) + gap;
-    b = translated(b, Vec3(dx, uniform(rng, -0.5, 0.5) * hb.y(), uniform(rng, -0.5, 0.5) * hb.z()));
+    b = translated(b, drawn([&] { return dx; }, [&] { return uniform(rng, -0.5, 0.5) * hb.y(); },
+                            [&] { return uniform(rng, -0.5, 0.5) * hb.z(); }));
     if (kind == 2) {
       const Mat3 r = random_rotation(rng);
       a = transformed(a, r, Vec3::Zero());

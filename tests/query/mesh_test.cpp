@@ -99,11 +99,9 @@ MeshData uv_sphere(const Vec3& c, double r, int rings, int segments) {
 MeshData random_soup(Rng& rng, int n, double extent, double size) {
   MeshData m;
   for (int t = 0; t < n; ++t) {
-    const Vec3 c(test::uniform(rng, -extent, extent), test::uniform(rng, -extent, extent),
-                 test::uniform(rng, -extent, extent));
+    const Vec3 c = test::drawn([&] { return test::uniform(rng, -extent, extent); });
     for (int k = 0; k < 3; ++k)
-      m.vertices.push_back(c + size * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
-                                           test::uniform(rng, -1, 1)));
+      m.vertices.push_back(c + size * test::drawn([&] { return test::uniform(rng, -1, 1); }));
     const auto b = static_cast<std::uint32_t>(3 * t);
     m.triangles.push_back({b, b + 1, b + 2});
   }
@@ -111,9 +109,9 @@ MeshData random_soup(Rng& rng, int n, double extent, double size) {
 }
 
 Pose random_pose(Rng& rng, double extent) {
-  return Pose(test::random_quaternion(rng),
-              Vec3(test::uniform(rng, -extent, extent), test::uniform(rng, -extent, extent),
-                   test::uniform(rng, -extent, extent)));
+  // The translation first, the order gcc gives the call (see drawn()).
+  const Vec3 at = test::drawn([&] { return test::uniform(rng, -extent, extent); });
+  return Pose(test::random_quaternion(rng), at);
 }
 
 // The exact squared distance between the triangle sets (vertices as given,
@@ -341,8 +339,7 @@ TEST(MeshDistanceExact, BruteForceMatchesRationalReferee) {
   for (int trial = 0; trial < 40; ++trial) {
     const MeshData a = random_soup(rng, 6, 2.0, 1.0);
     MeshData b = random_soup(rng, 6, 2.0, 1.0);
-    const Vec3 shift(test::uniform(rng, -3, 3), test::uniform(rng, -3, 3),
-                     test::uniform(rng, -3, 3));
+    const Vec3 shift = test::drawn([&] { return test::uniform(rng, -3, 3); });
     for (Vec3& v : b.vertices) v += shift;
     const MeshResult r = distance_all_pairs(a.build(), Pose(), b.build(), Pose());
     const double exact = exact_sqrt(exact_distance_squared(a, b), 0);
@@ -440,10 +437,7 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
   const auto q = [](const Vec3& v) {
     return Vec3q(Rational(v.x()), Rational(v.y()), Rational(v.z()));
   };
-  const auto grid = [&] {
-    return Vec3(test::uniform_int(rng, -2, 2), test::uniform_int(rng, -2, 2),
-                test::uniform_int(rng, -2, 2));
-  };
+  const auto grid = [&] { return test::drawn([&] { return test::uniform_int(rng, -2, 2); }); };
   const KernelTolerance<double> tol = kernel_tolerance(4.0);
   int zero = 0, degenerate = 0;
   for (int trial = 0; trial < 2000; ++trial) {
@@ -451,9 +445,7 @@ TEST(MeshKernel, FastTriangleDistanceMatchesTheExactKernel) {
     // Half the pairs on a small integer grid: coplanar, parallel, touching,
     // shared and repeated vertices are frequent there.
     for (Vec3& v : p)
-      v = trial % 2 == 0 ? grid()
-                         : Vec3(test::uniform(rng, -2, 2), test::uniform(rng, -2, 2),
-                                test::uniform(rng, -2, 2));
+      v = trial % 2 == 0 ? grid() : test::drawn([&] { return test::uniform(rng, -2, 2); });
     const detail::FastTriangle a(p[0], p[1], p[2], tol.min_sin_squared);
     const detail::FastTriangle b(p[3], p[4], p[5], tol.min_sin_squared);
     const double fast = std::sqrt(detail::triangle_distance_squared(a, b, tol));
@@ -829,8 +821,7 @@ TEST(MeshStatus, ContainsAgreesWithTheBoxOnRaysThroughEdges) {
   const TriangleMesh box = box_mesh(Vec3(-1, -1, -1), Vec3(1, 1, 1)).build();
   Rng rng(3);
   for (int k = 0; k < 2000; ++k) {
-    const Vec3 p(0.25 * test::uniform_int(rng, -6, 6), 0.25 * test::uniform_int(rng, -6, 6),
-                 0.25 * test::uniform_int(rng, -6, 6));
+    const Vec3 p = test::drawn([&] { return 0.25 * test::uniform_int(rng, -6, 6); });
     const bool inside = (p.cwiseAbs().array() < 1.0).all();
     EXPECT_EQ(box.contains(p), inside) << p.transpose();
   }
@@ -841,8 +832,7 @@ TEST(MeshStatus, ContainsAgreesWithTheBoxOnRaysThroughEdges) {
 std::vector<Vec3> random_cloud(Rng& rng, int n, double size) {
   std::vector<Vec3> p;
   for (int k = 0; k < n; ++k)
-    p.emplace_back(test::uniform(rng, -size, size), test::uniform(rng, -size, size),
-                   test::uniform(rng, -size, size));
+    p.push_back(test::drawn([&] { return test::uniform(rng, -size, size); }));
   return p;
 }
 
@@ -955,9 +945,7 @@ TEST(TrianglePolytope, IsTheHullOfItsTriangle) {
   for (int trial = 0; trial < 300; ++trial) {
     const double scale = std::ldexp(1.0, test::uniform_int(rng, -990, 990));
     std::array<Vec3, 3> v;
-    for (Vec3& p : v)
-      p = scale * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
-                       test::uniform(rng, -1, 1));
+    for (Vec3& p : v) p = scale * test::drawn([&] { return test::uniform(rng, -1, 1); });
     if (trial % 5 == 0) v[2] = v[0] + 1e-9 * (v[1] - v[0]).cross(Vec3(0.3, 0.2, 1.0));  // sliver
     ASSERT_TRUE(scratch.assign(v[0], v[1], v[2])) << trial;
     const ConvexPolytope& p = scratch.polytope();
@@ -1014,8 +1002,7 @@ TEST(TrianglePolytope, ConvexQueryMatchesTheBuiltTriangleAndTheExactDistance) {
     const int kind = (trial / 4) % 5;
     std::array<Vec3, 3> v;
     const auto random_point = [&](double extent) {
-      return Vec3(test::uniform(rng, -extent, extent), test::uniform(rng, -extent, extent),
-                  test::uniform(rng, -extent, extent));
+      return test::drawn([&] { return test::uniform(rng, -extent, extent); });
     };
     Pose pose_b = random_pose(rng, 0.3);
     if (kind == 0) {  // at random near the body
@@ -1028,7 +1015,8 @@ TEST(TrianglePolytope, ConvexQueryMatchesTheBuiltTriangleAndTheExactDistance) {
       const double top = 0.2 + pose_b.translation.z();
       const double reach = kind == 1 ? 0.2 : 0.9;
       for (Vec3& p : v)
-        p = Vec3(test::uniform(rng, -reach, reach), test::uniform(rng, -reach, reach), top);
+        p = test::drawn([&] { return test::uniform(rng, -reach, reach); },
+                        [&] { return test::uniform(rng, -reach, reach); }, [&] { return top; });
     } else if (kind == 3) {  // crossing the body
       const Vec3 c = pose_b.translation;
       const Vec3 n = random_point(1.0).normalized();

@@ -266,11 +266,15 @@ TEST(SignedDistanceOracle, RandomOverlapsAreMinusTheExactDepth) {
     const int mode = uniform_int(rng, 0, 3);
     if (mode == 3) {
       a = flat_polygon(rng, uniform_int(rng, 3, 8));
-      b = translated(flat_polygon(rng, uniform_int(rng, 3, 8)),
-                     Vec3(uniform(rng, -0.3, 0.3), uniform(rng, -0.3, 0.3), 0));
+      // The shift first, the order gcc gives the call (see drawn()).
+      const auto shift = [&] { return uniform(rng, -0.3, 0.3); };
+      const Vec3 at = drawn(shift, shift, [] { return 0.0; });
+      b = translated(flat_polygon(rng, uniform_int(rng, 3, 8)), at);
     } else if (mode == 0) {
-      b = translated(scaled(b, uniform(rng, 0.01, 0.3)),
-                     Vec3(uniform(rng, -0.1, 0.1), uniform(rng, -0.1, 0.1), 0));
+      // The shift first, the order gcc gives the call (see drawn()).
+      const auto shift = [&] { return uniform(rng, -0.1, 0.1); };
+      const Vec3 at = drawn(shift, shift, [] { return 0.0; });
+      b = translated(scaled(b, uniform(rng, 0.01, 0.3)), at);
     } else {
       b = place_along(a, b, random_unit_vector(rng), 0.25);
       const std::optional<ExactDistance> d = oracle.distance(a, b);
@@ -822,7 +826,10 @@ TEST(SignedDistanceGradient, RandomPairsWithAUniqueWitnessMatchFiniteDifferences
   for (int trial = 0; trial < 80; ++trial) {
     const ConvexPolytope a(points_on_sphere(rng, uniform_int(rng, 8, 30)));
     const ConvexPolytope b(points_on_sphere(rng, uniform_int(rng, 8, 30), 0.6));
-    const Pose pa(random_quaternion(rng), Vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), 0));
+    // The translation first, the order gcc gives the call (see drawn()).
+    const auto spread = [&] { return uniform(rng, -1, 1); };
+    const Vec3 at = drawn(spread, spread, [] { return 0.0; });
+    const Pose pa(random_quaternion(rng), at);
     const double reach = trial % 2 == 0 ? uniform(rng, 1.8, 3.0) : uniform(rng, 0.1, 1.0);
     const Pose pb(random_quaternion(rng), pa.translation + reach * random_unit_vector(rng));
     const DistanceResult r = distance(a, pa, b, pb);
@@ -863,8 +870,11 @@ TEST(SignedDistanceCompound, DeepestPiecePairIsReportedAndMatchesTheTwin) {
   Rng rng(5);
   int overlapping = 0;
   for (int trial = 0; trial < 40; ++trial) {
-    const Pose pb(Quat(Eigen::AngleAxisd(uniform(rng, -0.2, 0.2), Vec3::UnitZ())),
-                  Vec3(uniform(rng, -0.4, 0.4), uniform(rng, -0.2, 0.2), uniform(rng, 0.3, 1.2)));
+    // The translation first, the order gcc gives the call (see drawn()).
+    const Vec3 at =
+        drawn([&] { return uniform(rng, -0.4, 0.4); }, [&] { return uniform(rng, -0.2, 0.2); },
+              [&] { return uniform(rng, 0.3, 1.2); });
+    const Pose pb(Quat(Eigen::AngleAxisd(uniform(rng, -0.2, 0.2), Vec3::UnitZ())), at);
     CompoundCache cache;
     const CompoundResult r = distance(a, Pose::identity(), b, pb, {}, &cache);
     const CompoundResult twin = distance_all_pairs(a, Pose::identity(), b, pb);

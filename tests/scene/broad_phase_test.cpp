@@ -20,6 +20,8 @@
 namespace proxima {
 namespace {
 
+using test::drawn;
+
 using detail::Aabb;
 using test::Rng;
 
@@ -42,10 +44,10 @@ double grid(Rng& rng, int lo, int hi) { return test::uniform_int(rng, 8 * lo, 8 
 // A box on the 1/8 grid: half-extents 0 to 1 on each axis, so some boxes
 // are flat or points.
 Aabb random_box(Rng& rng, const Vec3& extent) {
-  const Vec3 c(grid(rng, 0, static_cast<int>(extent.x())),
-               grid(rng, 0, static_cast<int>(extent.y())),
-               grid(rng, 0, static_cast<int>(extent.z())));
-  const Vec3 h(grid(rng, 0, 1), grid(rng, 0, 1), grid(rng, 0, 1));
+  const Vec3 c = drawn([&] { return grid(rng, 0, static_cast<int>(extent.x())); },
+                       [&] { return grid(rng, 0, static_cast<int>(extent.y())); },
+                       [&] { return grid(rng, 0, static_cast<int>(extent.z())); });
+  const Vec3 h = drawn([&] { return grid(rng, 0, 1); });
   return {c - h, c + h};
 }
 
@@ -93,7 +95,7 @@ TEST_P(PairFinderTest, MatchesAllPairsWhileBoxesMoveAndMembersChange) {
     // joining, or leaving and joining again before the next call.
     for (int i = 0; i < kIds; ++i) {
       Aabb& b = boxes[static_cast<std::size_t>(i)];
-      const Vec3 d(grid(rng, -1, 1) / 8, grid(rng, -1, 1) / 8, grid(rng, -1, 1) / 8);
+      const Vec3 d = drawn([&] { return grid(rng, -1, 1) / 8; });
       b.lo += d;
       b.hi += d;
       if (test::uniform_int(rng, 0, 99) == 0) b = random_box(rng, extent);
@@ -173,7 +175,7 @@ TEST_P(PairFinderTest, TwoThreadsGiveTheSamePairsOnALargeSet) {
     // ids leave and come back.
     for (int i = 0; i < kIds; ++i) {
       Aabb& b = boxes[static_cast<std::size_t>(i)];
-      const Vec3 d(grid(rng, -1, 1) / 4, grid(rng, -1, 1) / 4, grid(rng, -1, 1) / 4);
+      const Vec3 d = drawn([&] { return grid(rng, -1, 1) / 4; });
       b.lo += d;
       b.hi += d;
     }

@@ -82,8 +82,7 @@ std::vector<Entry> random_entries(Rng& rng, int n, double side) {
   std::vector<Entry> out;
   for (int i = 0; i < n; ++i) {
     const Pose pose{test::random_quaternion(rng),
-                    Vec3(test::uniform(rng, 0, side), test::uniform(rng, 0, side),
-                         test::uniform(rng, 0, side))};
+                    test::drawn([&] { return test::uniform(rng, 0, side); })};
     const double pad = test::uniform(rng, 0.0, 0.25);
     switch (i % 9) {
       case 0:

@@ -68,8 +68,7 @@ std::vector<Entry> random_entries(Rng& rng, int n, double side, bool plain_only)
   std::vector<Entry> out;
   for (int i = 0; i < n; ++i) {
     const Pose pose{test::random_quaternion(rng),
-                    Vec3(test::uniform(rng, 0, side), test::uniform(rng, 0, side),
-                         test::uniform(rng, 0, side))};
+                    test::drawn([&] { return test::uniform(rng, 0, side); })};
     const int kind = plain_only ? i % 3 : i % 7;
     switch (kind) {
       case 0:

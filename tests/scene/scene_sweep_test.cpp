@@ -334,8 +334,9 @@ TEST(SceneSweep, RandomTurnstilesAreCaughtWhereTheBoxesAtBothEndsMissThem) {
         test::points_in_cube(rng, 12, test::uniform(rng, 0.02, 0.1)));
     const Mat3 r0 = test::random_rotation(rng);
     // An axis across the bar (its x axis in its own frame).
-    const Vec3 across = r0 * Vec3(0, std::cos(test::uniform(rng, 0, 2 * M_PI)),
-                                  std::sin(test::uniform(rng, 0, 2 * M_PI)))
+    const Vec3 across = r0 * test::drawn([&] { return 0; },
+                                         [&] { return std::cos(test::uniform(rng, 0, 2 * M_PI)); },
+                                         [&] { return std::sin(test::uniform(rng, 0, 2 * M_PI)); })
                                  .normalized();
     const double angle = test::uniform(rng, 0.5, 0.98) * M_PI;
     const Pose start{r0, site};

@@ -80,8 +80,7 @@ std::shared_ptr<const CompoundBody> random_compound(Rng& rng) {
 
 Pose random_pose(Rng& rng, double side, const Vec3& offset) {
   return {test::random_quaternion(rng),
-          Vec3(offset + Vec3(test::uniform(rng, 0, side), test::uniform(rng, 0, side),
-                             test::uniform(rng, 0, side)))};
+          Vec3(offset + test::drawn([&] { return test::uniform(rng, 0, side); }))};
 }
 
 // The next frame of a slow simulation.

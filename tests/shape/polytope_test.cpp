@@ -32,10 +32,14 @@
 #include <utility>
 #include <vector>
 
+#include "support/generators.h"
 #include "support/regression_clouds.h"
 
 namespace proxima {
 namespace {
+
+using test::drawn;
+using test::drawn_quaternion;
 
 // ---------------------------------------------------------------------------
 // Seeded, portable inputs (integer draws only: the std distributions are
@@ -54,7 +58,7 @@ int uniform_int(Rng& rng, int lo, int hi) {
 Points sphere_points(Rng& rng, int n, double radius = 1.0) {
   Points pts;
   while (static_cast<int>(pts.size()) < n) {
-    const Vec3 p(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Vec3 p = drawn([&] { return uniform(rng, -1, 1); });
     const double r = p.norm();
     if (r > 0.1 && r <= 1.0) pts.push_back(radius * (p / r));
   }
@@ -63,15 +67,13 @@ Points sphere_points(Rng& rng, int n, double radius = 1.0) {
 
 Points cube_points(Rng& rng, int n) {
   Points pts;
-  for (int i = 0; i < n; ++i)
-    pts.emplace_back(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+  for (int i = 0; i < n; ++i) pts.push_back(drawn([&] { return uniform(rng, -1, 1); }));
   return pts;
 }
 
 Points grid_points(Rng& rng, int n, int g) {
   Points pts;
-  for (int i = 0; i < n; ++i)
-    pts.emplace_back(uniform_int(rng, -g, g), uniform_int(rng, -g, g), uniform_int(rng, -g, g));
+  for (int i = 0; i < n; ++i) pts.push_back(drawn([&] { return uniform_int(rng, -g, g); }));
   return pts;
 }
 
@@ -501,8 +503,7 @@ TEST(Polytope, CubeWithFaceEdgeAndInteriorPoints) {
         pts.emplace_back(x / 2.0, y / 2.0, z / 2.0);  // grid: faces, edges, inside
     }
   }
-  for (int i = 0; i < 50; ++i)
-    pts.emplace_back(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+  for (int i = 0; i < 50; ++i) pts.push_back(drawn([&] { return uniform(rng, -1, 1); }));
   std::shuffle(pts.begin(), pts.end(), rng);
   const ConvexPolytope p(pts);
   EXPECT_EQ(p.dimension(), 3);
@@ -676,9 +677,7 @@ TEST(Polytope, CylinderWithLargeCoplanarFaces) {
 TEST(Polytope, RotatedGridCubeWithinRoundoff) {
   Rng rng(47);
   for (int rep = 0; rep < 5; ++rep) {
-    const Quat q =
-        Quat(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))
-            .normalized();
+    const Quat q = drawn_quaternion([&] { return uniform(rng, -1, 1); }).normalized();
     Points pts;
     for (int x = 0; x < 4; ++x) {
       for (int y = 0; y < 4; ++y) {
@@ -805,17 +804,16 @@ TEST(Polytope, MovedFlatPolygonKeepsItsHull) {
 TEST(Polytope, NearlyFlatCloudsFarFromTheOriginAreExact) {
   Rng rng(53);
   for (int rep = 0; rep < 24; ++rep) {
-    const Quat q =
-        Quat(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))
-            .normalized();
+    const Quat q = drawn_quaternion([&] { return uniform(rng, -1, 1); }).normalized();
     const double thickness = rep % 3 == 0 ? 0.0 : std::pow(10.0, -uniform(rng, 9, 16));
     const double distance = std::pow(10.0, uniform(rng, 0, 13));
-    const Vec3 offset =
-        distance * Vec3(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Vec3 offset = distance * drawn([&] { return uniform(rng, -1, 1); });
     const int n = uniform_int(rng, 10, 80);
     Points pts;
     for (int i = 0; i < n; ++i) {
-      const Vec3 local(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, 0, thickness));
+      const Vec3 local =
+          drawn([&] { return uniform(rng, -1, 1); }, [&] { return uniform(rng, -1, 1); },
+                [&] { return uniform(rng, 0, thickness); });
       pts.push_back(Vec3(q * local) + offset);
     }
     SCOPED_TRACE("rep " + std::to_string(rep));
@@ -837,9 +835,7 @@ TEST(Polytope, NearlyFlatCloudsFarFromTheOriginAreExact) {
 // face planar and strictly convex, every vertex extreme).
 TEST(Polytope, LargeRoundedThinCylinderFarAwayIsExact) {
   Rng rng(9);
-  const Quat q =
-      Quat(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))
-          .normalized();
+  const Quat q = drawn_quaternion([&] { return uniform(rng, -1, 1); }).normalized();
   const Vec3 offset(300, -400, 0);  // distance 500
   Points pts;
   for (int cap = 0; cap < 2; ++cap) {
@@ -867,9 +863,7 @@ TEST(Polytope, SliverFacePlanesHoldTheirOwnVertices) {
   for (int seed = 0; seed < 200; ++seed) {
     Rng rng(static_cast<std::uint64_t>(seed));
     const double c = std::pow(10.0, -uniform(rng, 12, 15));
-    const Quat q =
-        Quat(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1))
-            .normalized();
+    const Quat q = drawn_quaternion([&] { return uniform(rng, -1, 1); }).normalized();
     const double length = 1e4;
     Points pts;
     for (int i = 0; i < 10 + seed % 30; ++i) {
@@ -1057,7 +1051,9 @@ TEST(Polytope, TwoPointsAndVerticalLine) {
 TEST(Polytope, ThousandPointsOnPlaneZ) {
   Rng rng(29);
   Points pts;
-  for (int i = 0; i < 1000; ++i) pts.emplace_back(uniform(rng, -1, 1), uniform(rng, -1, 1), 0.1);
+  for (int i = 0; i < 1000; ++i)
+    pts.push_back(drawn([&] { return uniform(rng, -1, 1); }, [&] { return uniform(rng, -1, 1); },
+                        [&] { return 0.1; }));
   const ConvexPolytope p(pts);
   ASSERT_EQ(p.dimension(), 2);
   EXPECT_GE(p.vertex_count(), 3);
@@ -1073,8 +1069,8 @@ TEST(Polytope, PointsOnTiltedPlanesExactly) {
   Rng rng(31);
   for (int rep = 0; rep < 6; ++rep) {
     SCOPED_TRACE("tilted rep=" + std::to_string(rep));
-    const Vec3 u(uniform_int(rng, -9, 9), uniform_int(rng, -9, 9), uniform_int(rng, -9, 9));
-    Vec3 w(uniform_int(rng, -9, 9), uniform_int(rng, -9, 9), uniform_int(rng, -9, 9));
+    const Vec3 u = drawn([&] { return uniform_int(rng, -9, 9); });
+    Vec3 w = drawn([&] { return uniform_int(rng, -9, 9); });
     if (u.cross(w).squaredNorm() == 0) w += Vec3(1, 3, 7);
     const Vec3 origin = rep % 2 ? Vec3(0.1, 0.2, 0.3) : Vec3(5, -3, 11);
     Points pts;
@@ -1135,7 +1131,8 @@ TEST(Polytope, TinyAndHugeScales) {
 
     Points plane;
     for (int i = 0; i < 300; ++i)
-      plane.emplace_back(uniform(rng, -s, s), uniform(rng, -s, s), 0.1 * s);
+      plane.push_back(drawn([&] { return uniform(rng, -s, s); },
+                            [&] { return uniform(rng, -s, s); }, [&] { return 0.1 * s; }));
     const ConvexPolytope q(plane);
     EXPECT_EQ(q.dimension(), 2);
     check_polytope(q, plane);
@@ -1298,6 +1295,9 @@ TEST(Polytope, BadInputThrowsNamingTheIndex) {
 
 namespace proxima {
 namespace {
+
+using test::drawn;
+using test::drawn_quaternion;
 
 // Regression (found by the reader fuzzer from the OBJ line `v 5.25 -1e308
 // -0.6`): the centroid and radius were scaled back by 2^exponent, which is

@@ -39,6 +39,8 @@
 namespace proxima {
 namespace {
 
+using test::drawn;
+
 using Rng = std::mt19937_64;
 using Points = std::vector<Vec3>;
 
@@ -54,7 +56,7 @@ int uniform_int(Rng& rng, int lo, int hi) {
 
 Vec3 random_direction(Rng& rng) {
   for (;;) {
-    const Vec3 d(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    const Vec3 d = drawn([&] { return uniform(rng, -1, 1); });
     if (d.squaredNorm() > 1e-4 && d.squaredNorm() <= 1.0) return d;
   }
 }
@@ -335,8 +337,7 @@ TEST(Support, RandomCubeClouds) {
   for (const int n : {10, 100, 1000, 10000}) {
     SCOPED_TRACE("cube cloud n=" + std::to_string(n));
     Points pts;
-    for (int i = 0; i < n; ++i)
-      pts.emplace_back(uniform(rng, -1, 1), uniform(rng, -1, 1), uniform(rng, -1, 1));
+    for (int i = 0; i < n; ++i) pts.push_back(drawn([&] { return uniform(rng, -1, 1); }));
     const ConvexPolytope p(pts);
     compare_random_directions(p, rng, 2000, tally);
     compare_face_normals(p, false, tally);
@@ -352,13 +353,12 @@ TEST(Support, IntegerGridPolytopesExactPlateaus) {
   for (const int g : {1, 2, 4, 10}) {
     for (int rep = 0; rep < 3; ++rep) {
       Points pts;
-      for (int i = 0; i < 300; ++i)
-        pts.emplace_back(uniform_int(rng, -g, g), uniform_int(rng, -g, g), uniform_int(rng, -g, g));
+      for (int i = 0; i < 300; ++i) pts.push_back(drawn([&] { return uniform_int(rng, -g, g); }));
       const ConvexPolytope p(pts);
       ASSERT_EQ(p.dimension(), 3);
       compare_face_normals(p, true, tally);
       for (int i = 0; i < 200; ++i) {
-        const Vec3 dir(uniform_int(rng, -2, 2), uniform_int(rng, -2, 2), uniform_int(rng, -2, 2));
+        const Vec3 dir = drawn([&] { return uniform_int(rng, -2, 2); });
         for (int hint = 0; hint < p.vertex_count(); ++hint) compare(p, dir, hint, true, tally);
       }
       compare_random_directions(p, rng, 200, tally);
@@ -404,7 +404,8 @@ TEST(Support, PrismWithLargePlateaus) {
     compare(p, Vec3(0, 0, -1), hint, true, tally);
   }
   for (int i = 0; i < 300; ++i) {
-    const Vec3 dir(uniform(rng, -1e-3, 1e-3), uniform(rng, -1e-3, 1e-3), 1.0);
+    const Vec3 dir = drawn([&] { return uniform(rng, -1e-3, 1e-3); },
+                           [&] { return uniform(rng, -1e-3, 1e-3); }, [&] { return 1.0; });
     compare(p, dir, uniform_int(rng, 0, p.vertex_count() - 1), true, tally);
   }
   compare_face_normals(p, true, tally);
@@ -467,8 +468,10 @@ TEST(Support, PolygonsSegmentsAndPoints) {
     }
     compare_random_directions(p, rng, 500, tally);
     for (int i = 0; i < 200; ++i)
-      compare(p, Vec3(uniform_int(rng, -3, 3), uniform_int(rng, -3, 3), 1), i % p.vertex_count(),
-              true, tally);
+      compare(p,
+              drawn([&] { return uniform_int(rng, -3, 3); },
+                    [&] { return uniform_int(rng, -3, 3); }, [&] { return 1; }),
+              i % p.vertex_count(), true, tally);
   }
   {
     // An exactly tilted polygon: integer combinations of integer vectors.

@@ -78,6 +78,21 @@ Vec3 drawn(F&& f) {
   return drawn(f, f, f);
 }
 
+// A quaternion (w, x, y, z) from four draws in the order gcc gives
+// Quat(fw(), fx(), fy(), fz()): fz, fy, fx, then fw (see drawn()). Not
+// normalized.
+template <class Fw, class Fx, class Fy, class Fz>
+Quat drawn_quaternion(Fw&& fw, Fx&& fx, Fy&& fy, Fz&& fz) {
+  const double z = fz();
+  const double y = fy();
+  const double x = fx();
+  return Quat(fw(), x, y, z);
+}
+template <class F>
+Quat drawn_quaternion(F&& f) {
+  return drawn_quaternion(f, f, f, f);
+}
+
 // Uniform on the unit sphere: normalize a point drawn in the cube and kept
 // only inside the ball (rejection keeps the distribution uniform without a
 // normal deviate).
