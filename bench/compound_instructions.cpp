@@ -25,7 +25,9 @@
 // normal, piece ids) printed to the last bit (%a), and a hash of every
 // field of every answer in order: two builds answer bit for bit alike
 // exactly when their lines are equal (a sum alone could hide two changes
-// that cancel).
+// that cancel). A third argument `print` also prints every answer (status,
+// pieces, signed distance and its bounds, to the last bit), one a line, for
+// a diff of two builds' answers.
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -94,7 +96,15 @@ std::shared_ptr<const CompoundBody> make_compound(int n, std::uint64_t seed) {
 // The hash and the sums of the answers' fields.
 class Checksum {
  public:
+  explicit Checksum(bool print) : print_(print) {}
+
   void add(const DistanceResult& r, std::int32_t piece_a, std::int32_t piece_b) {
+    if (print_) {
+      std::printf("%d: status %d pieces %d %d signed %a [%a, %a] normal %a %a %a\n", queries_,
+                  static_cast<int>(r.status), piece_a, piece_b, r.signed_distance(),
+                  r.signed_lower_bound(), r.signed_upper_bound(), r.normal.x(), r.normal.y(),
+                  r.normal.z());
+    }
     ++queries_;
     overlapping_ += r.status == Status::intersecting ? 1 : 0;
     status_ += static_cast<int>(r.status);
@@ -136,6 +146,7 @@ class Checksum {
     }
   }
 
+  bool print_ = false;
   int queries_ = 0;
   int overlapping_ = 0;
   long long status_ = 0;
@@ -220,15 +231,16 @@ int main(int argc, char** argv) {
   const std::string mode = argc >= 2 ? argv[1] : "";
   const bool known = mode == "body" || mode == "body_tracked" || mode == "compound" ||
                      mode == "compound_tracked";
-  const int n = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (argc != 3 || !known || n < 1) {
+  const bool print = argc == 4 && std::strcmp(argv[3], "print") == 0;
+  const int n = argc >= 3 ? std::atoi(argv[2]) : 0;
+  if ((argc != 3 && !print) || !known || n < 1) {
     std::fprintf(stderr,
                  "usage: compound_instructions body|body_tracked|compound|compound_tracked N "
-                 "(N >= 1 pieces per body)\n");
+                 "[print] (N >= 1 pieces per body)\n");
     return 2;
   }
   const Work w = mode.ends_with("_tracked") ? path_work(n) : cold_work(n);
-  Checksum sum;
+  Checksum sum(print);
   run_queries(mode, w, sum);
   std::printf("%s N = %d: ", mode.c_str(), n);
   sum.print();

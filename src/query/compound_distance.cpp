@@ -74,6 +74,31 @@ void take(CompoundResult& best, const DistanceResult& r, std::int32_t pa, std::i
   best.piece_b = pb;
 }
 
+// The certificate of a search's answer `best` over every tested pair, not
+// the best pair's alone: the lower bounds are the least over the tested
+// pairs' (`lower`, `signed_lower`), since a tested pair that ended with a
+// loose bound (an iteration cap, an uncertified depth) may hold a closer
+// pair than the best reported value
+// (CompoundRegression.LowerBoundCoversALooselyCertifiedPair). Pruned node
+// pairs need no term: a key prunes only above the best signed distance at
+// that time, which the final best's does not exceed, and that is at least
+// the final best's lower bounds. Node pairs left unvisited by an early end
+// (an intersection without the depth) need none either: the answer's
+// bounds are then 0 and -infinity, below any key. The signed distance of
+// the compounds is the least over pairs, so each tested pair's signed
+// upper bound bounds it too: the upper bound is the least of them
+// (`signed_upper`), tighter than the best pair's own when that pair's
+// depth is loosely bounded below. It never goes below the reported value:
+// each pair's upper bound is at least its value, at least the best's.
+void certify_over_pairs(CompoundResult& best, double lower, double signed_lower,
+                        double signed_upper) {
+  best.lower_bound = std::min(best.lower_bound, lower);
+  const double own_lower = best.signed_lower_bound();
+  if (signed_lower < own_lower) best.depth_upper_bound += own_lower - signed_lower;
+  if (signed_upper < best.signed_upper_bound() && signed_upper >= best.signed_distance())
+    best.depth_lower_bound = best.distance - signed_upper;
+}
+
 struct NearEntry {
   CompoundCache::Entry entry;
   double distance;
@@ -262,6 +287,7 @@ class Search {
     t.distance = r.signed_distance();
     lowest_lower_ = std::min(lowest_lower_, r.lower_bound);
     lowest_signed_lower_ = std::min(lowest_signed_lower_, r.signed_lower_bound());
+    lowest_signed_upper_ = std::min(lowest_signed_upper_, r.signed_upper_bound());
     if (!have_best_ || better(r, pa, pb, best_)) {
       take(best_, r, pa, pb);
       have_best_ = true;
@@ -270,21 +296,10 @@ class Search {
   }
 
   // The answer's certificate over the whole search, not the best pair's
-  // alone: a tested pair that ended with a loose bound (an iteration cap,
-  // an uncertified depth) may hold a closer pair than the best reported
-  // value, so the lower bounds are the minimum over every tested pair's.
-  // Pruned node pairs need no term: a key prunes only above the best
-  // signed distance at that time, which the final best's does not exceed,
-  // and that is at least the final best's lower bounds. Node pairs left on
-  // the stack by an early end (an intersection without the depth) need none
-  // either: the answer's bounds are then 0 and -infinity, below any key.
-  // (CompoundRegression.LowerBoundCoversALooselyCertifiedPair.)
+  // alone (certify_over_pairs, shared with the twin).
   void certify() {
-    if (!have_best_) return;
-    best_.lower_bound = std::min(best_.lower_bound, lowest_lower_);
-    const double signed_lower = best_.signed_lower_bound();
-    if (lowest_signed_lower_ < signed_lower)
-      best_.depth_upper_bound += signed_lower - lowest_signed_lower_;
+    if (have_best_)
+      certify_over_pairs(best_, lowest_lower_, lowest_signed_lower_, lowest_signed_upper_);
   }
 
   // The next query's warm start: the best pair, and the feature caches of
@@ -318,9 +333,11 @@ class Search {
   std::int32_t hint_b_ = -1;
   bool have_best_ = false;
   CompoundResult best_;
-  // The least lower bound and signed lower bound of the tested pairs.
+  // The least lower bound, signed lower bound and signed upper bound of
+  // the tested pairs.
   double lowest_lower_ = std::numeric_limits<double>::infinity();
   double lowest_signed_lower_ = std::numeric_limits<double>::infinity();
+  double lowest_signed_upper_ = std::numeric_limits<double>::infinity();
   std::vector<NearEntry> tested_;
   std::vector<StackEntry> stack_;
 };
@@ -538,22 +555,22 @@ CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, con
   bool have_best = false;
   double lowest_lower = std::numeric_limits<double>::infinity();
   double lowest_signed_lower = std::numeric_limits<double>::infinity();
+  double lowest_signed_upper = std::numeric_limits<double>::infinity();
   for (std::int32_t pa = 0; pa < a.piece_count(); ++pa) {
     for (std::int32_t pb = 0; pb < b.piece_count(); ++pb) {
       const DistanceResult r = distance(*a.piece(pa).polytope, pose_a * a.piece(pa).pose,
                                         *b.piece(pb).polytope, pose_b * b.piece(pb).pose, options);
       lowest_lower = std::min(lowest_lower, r.lower_bound);
       lowest_signed_lower = std::min(lowest_signed_lower, r.signed_lower_bound());
+      lowest_signed_upper = std::min(lowest_signed_upper, r.signed_upper_bound());
       if (!have_best || better(r, pa, pb, best)) {
         take(best, r, pa, pb);
         have_best = true;
       }
     }
   }
-  // The certificate over every pair, as the search's (Search::certify).
-  best.lower_bound = std::min(best.lower_bound, lowest_lower);
-  if (lowest_signed_lower < best.signed_lower_bound())
-    best.depth_upper_bound += best.signed_lower_bound() - lowest_signed_lower;
+  // The certificate over every pair, as the search's.
+  certify_over_pairs(best, lowest_lower, lowest_signed_lower, lowest_signed_upper);
   // Saturated: the product of two piece counts can exceed an int.
   best.pairs_tested = static_cast<int>(std::min<std::int64_t>(
       std::int64_t{a.piece_count()} * b.piece_count(), std::numeric_limits<int>::max()));
