@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -118,12 +119,19 @@ PenetrationResult depth_of(const ConvexPolytope& a, const Pose& pose_a, const Co
   return p;
 }
 
-// The pieces (or convex bodies) that gave the answer, placed: the accuracy
-// standard's R is theirs, as for the compound query.
+// The pieces (convex bodies, compound pieces or meshes) that gave the
+// answer, placed: the accuracy standard's R is theirs, as for the compound
+// and mesh queries. `scale` is the largest coordinate magnitude of
+// `vertices` (ConvexPolytope::scale, TriangleMesh::scale).
 struct Placed {
-  const ConvexPolytope* polytope;
+  std::span<const Vec3> vertices;
+  double scale;
   Pose pose;
 };
+template <class Shape>
+Placed placed(const Shape& shape, const Pose& pose) {
+  return {shape.vertices(), shape.scale(), pose};
+}
 
 // The status of the rounded bodies from their signed value s: the contact
 // band of the rounded pieces (core R plus radius; the largest coordinate of
@@ -132,12 +140,12 @@ struct Placed {
 // contact).
 Status rounded_status(double s, const Placed& a, double ra, const Placed& b, double rb,
                       const DistanceOptions& options) {
-  const double bound = std::max(magnitude_bound(a.pose, a.polytope->scale()) + ra,
-                                magnitude_bound(b.pose, b.polytope->scale()) + rb);
+  const double bound =
+      std::max(magnitude_bound(a.pose, a.scale) + ra, magnitude_bound(b.pose, b.scale) + rb);
   double band = contact_band(bound, options.absolute_tolerance);
   if (std::abs(s) <= band) {
-    band = contact_band(std::max(detail::placed_magnitude(a.polytope->vertices(), a.pose) + ra,
-                                 detail::placed_magnitude(b.polytope->vertices(), b.pose) + rb),
+    band = contact_band(std::max(detail::placed_magnitude(a.vertices, a.pose) + ra,
+                                 detail::placed_magnitude(b.vertices, b.pose) + rb),
                         options.absolute_tolerance);
   }
   return s > band ? Status::separated : s >= -band ? Status::touching : Status::intersecting;
@@ -228,7 +236,8 @@ BodyResult convex_pair(const Body& a, const Pose& pose_a, const Body& b, const P
   if (options.penetration && needs_contact_normal(c, a.radius() + b.radius()))
     take_contact_depth(c, depth_of(ca, pose_a, cb, pose_b, cache.penetration, options), pose_a);
   return offset(c, a, b, [&](double value) {
-    return rounded_status(value, {&ca, pose_a}, a.radius(), {&cb, pose_b}, b.radius(), options);
+    return rounded_status(value, placed(ca, pose_a), a.radius(), placed(cb, pose_b), b.radius(),
+                          options);
   });
 }
 
@@ -238,7 +247,8 @@ BodyResult convex_pair(const Body& a, const Pose& pose_a, const Body& b, const P
 // and bound on the pieces' spheres, each pair's convex query taking its
 // own depth and tracked through the near list of BodyCache::compound).
 // Rounded bodies whose best pieces touch take that pair's contact normal
-// (needs_contact_normal), cold.
+// (needs_contact_normal), tracked through BodyCache::penetration as a
+// convex pair's.
 BodyResult compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                          const DistanceOptions& options, BodyCache& cache) {
   const std::shared_ptr<const CompoundBody> hold_a = a.compound();
@@ -252,17 +262,18 @@ BodyResult compound_pair(const Body& a, const Pose& pose_a, const Body& b, const
   const CompoundPiece& piece_a = ca.piece(c.piece_a);
   const CompoundPiece& piece_b = cb.piece(c.piece_b);
   if (options.penetration && needs_contact_normal(c, a.radius() + b.radius())) {
+    // The penetration cache keeps the pair of polytopes it was filled for
+    // and starts over for another: the best pieces may change.
     const Pose place_a = pose_a * piece_a.pose;
-    PenetrationCache cold;
     take_contact_depth(c,
                        depth_of(*piece_a.polytope, place_a, *piece_b.polytope,
-                                pose_b * piece_b.pose, cold, options),
+                                pose_b * piece_b.pose, cache.penetration, options),
                        place_a);
   }
   // The pieces are placed only for a radius (offset calls this only then).
   BodyResult r = offset(c, a, b, [&](double value) {
-    return rounded_status(value, {piece_a.polytope.get(), pose_a * piece_a.pose}, a.radius(),
-                          {piece_b.polytope.get(), pose_b * piece_b.pose}, b.radius(), options);
+    return rounded_status(value, placed(*piece_a.polytope, pose_a * piece_a.pose), a.radius(),
+                          placed(*piece_b.polytope, pose_b * piece_b.pose), b.radius(), options);
   });
   // A convex body met a compound as its one-piece wrapper: it has no pieces.
   if (a.kind() == Body::Kind::convex) r.piece_a = -1;
@@ -365,12 +376,8 @@ BodyResult mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pos
   const Pose place_a = pose_a * ma[best_i].pose;
   const Pose place_b = pose_b * mb[best_j].pose;
   BodyResult r = offset(c, a, b, [&](double value) {
-    const double reach = std::max(detail::placed_magnitude(ma[best_i].mesh->vertices(), place_a) + a.radius(),
-                                  detail::placed_magnitude(mb[best_j].mesh->vertices(), place_b) + b.radius());
-    const double band = contact_band(reach, options.absolute_tolerance);
-    return value > band     ? Status::separated
-           : value >= -band ? Status::touching
-                            : Status::intersecting;
+    return rounded_status(value, placed(*ma[best_i].mesh, place_a), a.radius(),
+                          placed(*mb[best_j].mesh, place_b), b.radius(), options);
   });
   if (a.kind() == Body::Kind::mesh) r.triangle_a = best.triangle_a;
   if (b.kind() == Body::Kind::mesh) r.triangle_b = best.triangle_b;
