@@ -20,6 +20,9 @@
 //                    and out, turning), one BodyCache per radius
 //   compound         distance(CompoundBody, ...) with the depth, cold
 //   compound_tracked the same along the path, one CompoundCache
+//   margin           within_margin(CompoundBody, ...) at margins 0.05,
+//                    0.3 and 1 in turn, cold
+//   margin_tracked   the same along the path, one CompoundCache per margin
 // The output is the number of queries and overlapping answers, the sums of
 // the answers' fields (status, signed distance and its bounds, points,
 // normal, piece ids) printed to the last bit (%a), and a hash of every
@@ -42,6 +45,7 @@
 
 #include "proxima/query/body_distance.h"
 #include "proxima/query/compound_distance.h"
+#include "proxima/query/margin.h"
 
 namespace {
 
@@ -54,6 +58,7 @@ using proxima::CompoundPiece;
 using proxima::CompoundResult;
 using proxima::ConvexPolytope;
 using proxima::DistanceResult;
+using proxima::MarginResult;
 using proxima::Pose;
 using proxima::Quat;
 using proxima::Status;
@@ -127,6 +132,20 @@ class Checksum {
       for (const std::int32_t id : f->vertices) mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(id)));
       mix(static_cast<std::uint64_t>(static_cast<std::uint32_t>(f->face)));
     }
+  }
+
+  // A margin answer: its status in place of the distance status, its
+  // bounds in place of the signed bounds.
+  void add(const MarginResult& r) {
+    DistanceResult d;
+    d.status = r.status == proxima::MarginStatus::within ? Status::intersecting
+               : r.status == proxima::MarginStatus::beyond ? Status::separated
+                                                           : Status::iteration_cap;
+    d.lower_bound = r.lower_bound;
+    d.distance = r.upper_bound;
+    d.point_a = r.point_a;
+    d.point_b = r.point_b;
+    add(d, r.piece_a, r.piece_b);
   }
 
   void print() const {
@@ -217,6 +236,16 @@ Work path_work(int n) {
     }
     return;
   }
+  if (mode.starts_with("margin")) {
+    for (const double margin : {0.05, 0.3, 1.0}) {
+      CompoundCache cache;
+      for (std::size_t i = 0; i < count; ++i) {
+        sum.add(proxima::within_margin(*w.a, w.poses_a[i], *w.b, w.poses_b[i], margin, {},
+                                       tracked ? &cache : nullptr));
+      }
+    }
+    return;
+  }
   CompoundCache cache;
   for (std::size_t i = 0; i < count; ++i) {
     const CompoundResult r = proxima::distance(*w.a, w.poses_a[i], *w.b, w.poses_b[i], {},
@@ -230,12 +259,13 @@ Work path_work(int n) {
 int main(int argc, char** argv) {
   const std::string mode = argc >= 2 ? argv[1] : "";
   const bool known = mode == "body" || mode == "body_tracked" || mode == "compound" ||
-                     mode == "compound_tracked";
+                     mode == "compound_tracked" || mode == "margin" || mode == "margin_tracked";
   const bool print = argc == 4 && std::strcmp(argv[3], "print") == 0;
   const int n = argc >= 3 ? std::atoi(argv[2]) : 0;
   if ((argc != 3 && !print) || !known || n < 1) {
     std::fprintf(stderr,
-                 "usage: compound_instructions body|body_tracked|compound|compound_tracked N "
+                 "usage: compound_instructions body|body_tracked|compound|compound_tracked|margin|"
+                 "margin_tracked N "
                  "[print] (N >= 1 pieces per body)\n");
     return 2;
   }
