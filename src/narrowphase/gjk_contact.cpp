@@ -139,12 +139,28 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
     p[idx(n++)] = s.p[idx(k)].w;
   }
 
+  // The side searched off an edge. A support along d that lands on the
+  // edge's line (the segment's own end, when C is a segment, or a point
+  // collinear with it by rounding) adds no dimension; with d.w above tol by
+  // rounding (the edge passes within about tol of the origin, on d's side)
+  // the same d would find the same point until the cap. The other side
+  // then decides it: on the line, -d.w is about minus that, at most tol,
+  // which certifies touching; or a point off the line on that side adds
+  // the dimension. A segment against a point in the band ran to the cap
+  // (GjkRegression.SegmentAgainstAPointInTheBand).
+  bool other_side = false;
+  int flat_edges = 0;
   while (n < 4) {
     Vec3 d = Vec3::UnitX();
     if (n == 3) {
       d = (p[1] - p[0]).cross(p[2] - p[0]);
       if (!(d.squaredNorm() > 0.0)) {  // collinear: an edge is all there is
         --n;
+        // Both sides found nothing off the line: C is that line as far as
+        // rounding tells, within about tol of the origin (no interior to
+        // certify a depth in), which counts as touching like a flat P below.
+        if (++flat_edges == 2) return Status::touching;
+        other_side = !other_side;
         continue;
       }
     } else if (n == 2) {
@@ -156,6 +172,7 @@ Status classify_contact(const Simplex& s, double tol, Support& support, int& ite
       int axis = 0;
       e.cwiseAbs().minCoeff(&axis);
       d = e.cross(Vec3::Unit(axis));  // |d| >= |e| sqrt(2/3) > 0
+      if (other_side) d = -d;
     }
     d.normalize();
     if (iterations >= max_iterations) return Status::iteration_cap;

@@ -3,15 +3,17 @@
 //
 // Bodies of any kind (a convex, compound or mesh core plus a radius) and the
 // one distance call between two of them: the cores' query (convex, compound
-// or mesh), their penetration depth where convex cores overlap, and the
-// offset by the radii along the normal (proxima/query/body_distance.h says why that is
-// exact).
+// or mesh, the convex query taking the depth of overlapping cores or
+// pieces itself), the contact normal of rounded bodies whose cores touch,
+// and the offset by the radii along the normal
+// (proxima/query/body_distance.h says why that is exact).
 #include "proxima/query/body_distance.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -45,30 +47,16 @@ struct CoreAnswer {
   std::int32_t piece_b = -1;
 };
 
-CoreAnswer from_distance(const DistanceResult& r) {
-  CoreAnswer c;
-  c.status = r.status;
-  c.value = r.distance;
-  c.lower = r.lower_bound;
-  c.upper = r.distance;
-  c.point_a = r.point_a;
-  c.point_b = r.point_b;
-  c.normal = r.normal;
-  c.feature_a = r.feature_a;
-  c.feature_b = r.feature_b;
-  c.iterations = r.iterations;
-  c.second_algorithm = r.second_algorithm;
-  return c;
-}
-
-// Whether the cores' answer needs their penetration query: when they
-// overlap (its depth is the signed value), and, for rounded bodies, when
-// they touch without a certified gap: the normal of a distance answer is
-// trusted only when the support gap along it, the lower bound, is above 0
-// (the cores are then apart along it, and the offset points are the rounded
-// bodies' closest points); below that it is a direction of a few roundings.
-bool needs_depth(const CoreAnswer& c, double radii) {
-  if (c.status == Status::intersecting) return true;
+// Whether rounded bodies need their cores' penetration query on top of
+// the cores' signed answer: when the cores touch without a certified gap.
+// The normal of a distance answer is trusted only when the support gap
+// along it, the lower bound, is above 0 (the cores are then apart along
+// it, and the offset points are the rounded bodies' closest points); below
+// that it is a direction of a few roundings, and the penetration query's
+// normal (the direction of least overlap, or of contact) is taken.
+// Overlapping cores need nothing more: the convex query took their depth
+// itself (DistanceOptions::penetration, src/query/signed_distance.cpp).
+bool needs_contact_normal(const CoreAnswer& c, double radii) {
   return c.status == Status::touching && radii > 0.0 && !(c.lower > 0.0);
 }
 
@@ -83,19 +71,12 @@ void without_depth(CoreAnswer& c) {
   c.overlap = true;
 }
 
-// Replaces the answer's value, bounds, points, normal and features by the
-// penetration query's (in the frame `frame_a`), unless it found the cores
-// apart (a disagreement of the two queries at the band's edge): then the
-// distance query's answer stands, with a depth of 0 if it called them
-// intersecting.
-void take_depth(CoreAnswer& c, const PenetrationResult& p, const Pose& frame_a) {
-  if (p.status == PenetrationStatus::separated) {
-    if (c.status == Status::intersecting) {
-      c.value = c.lower = c.upper = 0.0;
-      c.overlap = true;
-    }
-    return;
-  }
+// Replaces a touching answer's value, bounds, points, normal and features
+// by the penetration query's (in the frame `frame_a`), unless it found the
+// cores apart (the two queries disagree within rounding at the band's
+// edge): then the distance query's answer stands.
+void take_contact_depth(CoreAnswer& c, const PenetrationResult& p, const Pose& frame_a) {
+  if (p.status == PenetrationStatus::separated) return;
   c.value = -p.depth;
   c.lower = -p.upper_bound;
   c.upper = -p.lower_bound;
@@ -104,7 +85,6 @@ void take_depth(CoreAnswer& c, const PenetrationResult& p, const Pose& frame_a) 
   c.normal = frame_a.rotation * p.normal;
   c.feature_a = p.feature_a;
   c.feature_b = p.feature_b;
-  c.overlap = c.status == Status::intersecting;
 }
 
 // B's pose in A's frame under the pose contract (the product of two rigid
@@ -139,12 +119,19 @@ PenetrationResult depth_of(const ConvexPolytope& a, const Pose& pose_a, const Co
   return p;
 }
 
-// The pieces (or convex bodies) that gave the answer, placed: the accuracy
-// standard's R is theirs, as for the compound query.
+// The pieces (convex bodies, compound pieces or meshes) that gave the
+// answer, placed: the accuracy standard's R is theirs, as for the compound
+// and mesh queries. `scale` is the largest coordinate magnitude of
+// `vertices` (ConvexPolytope::scale, TriangleMesh::scale).
 struct Placed {
-  const ConvexPolytope* polytope;
+  std::span<const Vec3> vertices;
+  double scale;
   Pose pose;
 };
+template <class Shape>
+Placed placed(const Shape& shape, const Pose& pose) {
+  return {shape.vertices(), shape.scale(), pose};
+}
 
 // The status of the rounded bodies from their signed value s: the contact
 // band of the rounded pieces (core R plus radius; the largest coordinate of
@@ -153,12 +140,12 @@ struct Placed {
 // contact).
 Status rounded_status(double s, const Placed& a, double ra, const Placed& b, double rb,
                       const DistanceOptions& options) {
-  const double bound = std::max(magnitude_bound(a.pose, a.polytope->scale()) + ra,
-                                magnitude_bound(b.pose, b.polytope->scale()) + rb);
+  const double bound =
+      std::max(magnitude_bound(a.pose, a.scale) + ra, magnitude_bound(b.pose, b.scale) + rb);
   double band = contact_band(bound, options.absolute_tolerance);
   if (std::abs(s) <= band) {
-    band = contact_band(std::max(detail::placed_magnitude(a.polytope->vertices(), a.pose) + ra,
-                                 detail::placed_magnitude(b.polytope->vertices(), b.pose) + rb),
+    band = contact_band(std::max(detail::placed_magnitude(a.vertices, a.pose) + ra,
+                                 detail::placed_magnitude(b.vertices, b.pose) + rb),
                         options.absolute_tolerance);
   }
   return s > band ? Status::separated : s >= -band ? Status::touching : Status::intersecting;
@@ -210,148 +197,83 @@ BodyResult offset(const CoreAnswer& c, const Body& a, const Body& b, RoundedStat
   return r;
 }
 
-// `depth`: the caller's DistanceOptions::penetration (`options` are the
-// cores' options, without it).
+// The cores' answer from the signed answer of a convex query, or of a
+// compound search (the least over piece pairs of the convex query's): the
+// signed distance and its certificate (DistanceResult::signed_lower_bound
+// and signed_upper_bound). An overlap's depth was taken by the convex
+// query itself (DistanceOptions::penetration, src/query/signed_distance.cpp:
+// tracked through its DistanceCache, a touching answer checked for an
+// overlap that the contact classification could not certify); without the
+// depth the certificate is [-infinity, 0] (as without_depth's), and an
+// iteration cap's lower bound leaves room for an overlap as deep as the
+// bounding balls allow.
+CoreAnswer from_signed(const DistanceResult& r) {
+  CoreAnswer c;
+  c.status = r.status;
+  c.value = r.signed_distance();
+  c.lower = r.signed_lower_bound();
+  c.upper = r.signed_upper_bound();
+  c.point_a = r.point_a;
+  c.point_b = r.point_b;
+  c.normal = r.normal;
+  c.feature_a = r.feature_a;
+  c.feature_b = r.feature_b;
+  c.iterations = r.iterations;
+  c.second_algorithm = r.second_algorithm;
+  c.overlap = r.status == Status::intersecting;
+  return c;
+}
+
+// Two convex cores: the convex query with its own depth, and for rounded
+// bodies whose cores touch, the contact normal (needs_contact_normal),
+// tracked through BodyCache::penetration.
 BodyResult convex_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
-                         const DistanceOptions& options, bool depth, BodyCache& cache) {
+                       const DistanceOptions& options, BodyCache& cache) {
   const ConvexPolytope& ca = *a.convex();
   const ConvexPolytope& cb = *b.convex();
-  CoreAnswer c = from_distance(
+  CoreAnswer c = from_signed(
       detail::distance_of_rigid_poses(ca, pose_a, cb, pose_b, options, &cache.convex));
-  if (!depth) {
-    if (c.status == Status::intersecting) without_depth(c);
-  } else if (needs_depth(c, a.radius() + b.radius())) {
-    take_depth(c, depth_of(ca, pose_a, cb, pose_b, cache.penetration, options), pose_a);
-  }
+  if (options.penetration && needs_contact_normal(c, a.radius() + b.radius()))
+    take_contact_depth(c, depth_of(ca, pose_a, cb, pose_b, cache.penetration, options), pose_a);
   return offset(c, a, b, [&](double value) {
-    return rounded_status(value, {&ca, pose_a}, a.radius(), {&cb, pose_b}, b.radius(), options);
+    return rounded_status(value, placed(ca, pose_a), a.radius(), placed(cb, pose_b), b.radius(),
+                          options);
   });
 }
 
-// The deepest overlapping piece pair of two compounds whose cores overlap:
-// every piece pair whose bounding spheres meet, by a traversal of both
-// hierarchies, gets a cold convex query and, if it overlaps, a cold
-// penetration query. The signed value is the smallest over pairs of the
-// pair's (minus the largest depth); its bounds are the smallest of the
-// pairs' bounds.
-class DeepestPair {
- public:
-  DeepestPair(const CompoundBody& a, const Pose& pose_a, const CompoundBody& b, const Pose& pose_b,
-              const DistanceOptions& options)
-      : a_(a), b_(b), pose_a_(pose_a), pose_b_(pose_b), options_(options) {}
-
-  // Updates `c` (the compound query's intersecting answer) to the deepest pair.
-  void run(CoreAnswer& c) {
-    std::vector<std::pair<std::int32_t, std::int32_t>> stack = {{0, 0}};
-    while (!stack.empty()) {
-      const auto [ia, ib] = stack.back();
-      stack.pop_back();
-      const CompoundBody::Node& na = a_.nodes()[static_cast<std::size_t>(ia)];
-      const CompoundBody::Node& nb = b_.nodes()[static_cast<std::size_t>(ib)];
-      if (!spheres_meet(na.center, na.radius, nb.center, nb.radius)) continue;
-      const bool leaf_a = na.left < 0;
-      const bool leaf_b = nb.left < 0;
-      if (leaf_a && leaf_b) {
-        for (std::int32_t i = 0; i < na.count; ++i) {
-          for (std::int32_t j = 0; j < nb.count; ++j) {
-            test(a_.piece_order()[static_cast<std::size_t>(na.first + i)],
-                 b_.piece_order()[static_cast<std::size_t>(nb.first + j)]);
-          }
-        }
-      } else if (!leaf_a && (leaf_b || na.radius >= nb.radius)) {
-        stack.push_back({na.left, ib});
-        stack.push_back({na.right, ib});
-      } else {
-        stack.push_back({ia, nb.left});
-        stack.push_back({ia, nb.right});
-      }
-    }
-    if (!found_) return;  // the compound query's pair stands (depth 0)
-    const int iterations = c.iterations;
-    const bool second = c.second_algorithm;
-    c = best_;
-    c.iterations = iterations;
-    c.second_algorithm = second;
-    c.lower = lower_;
-    c.upper = upper_;
-  }
-
- private:
-  // Whether two spheres (body frames) may meet, with the prune slack
-  // (core/accuracy.h) of the placed centers' and the radii's magnitudes for
-  // the rounding of the centers and of the norm: a pair tested more is only
-  // slower (BodyCompound.DeepestPairIsTheAllPairsTwins).
-  bool spheres_meet(const Vec3& center_a, double radius_a, const Vec3& center_b,
-                    double radius_b) const {
-    const Vec3 ca = pose_a_.apply(center_a);
-    const Vec3 cb = pose_b_.apply(center_b);
-    const double reach = radius_a + radius_b;
-    const double slack =
-        detail::prune_slack(ca.cwiseAbs().maxCoeff() + cb.cwiseAbs().maxCoeff() + reach);
-    return !((ca - cb).norm() > reach + slack);
-  }
-
-  void test(std::int32_t pa, std::int32_t pb) {
-    const CompoundPiece& piece_a = a_.piece(pa);
-    const CompoundPiece& piece_b = b_.piece(pb);
-    const Pose place_a = pose_a_ * piece_a.pose;
-    const Pose place_b = pose_b_ * piece_b.pose;
-    const DistanceResult r = detail::distance_of_rigid_poses(
-        *piece_a.polytope, place_a, *piece_b.polytope, place_b, options_, nullptr);
-    if (r.status != Status::intersecting) return;
-    CoreAnswer c = from_distance(r);
-    PenetrationCache cold;
-    take_depth(c, depth_of(*piece_a.polytope, place_a, *piece_b.polytope, place_b, cold, options_),
-               place_a);
-    c.piece_a = pa;
-    c.piece_b = pb;
-    if (!found_ || c.value < best_.value) best_ = c;
-    lower_ = found_ ? std::min(lower_, c.lower) : c.lower;
-    upper_ = found_ ? std::min(upper_, c.upper) : c.upper;
-    found_ = true;
-  }
-
-  const CompoundBody& a_;
-  const CompoundBody& b_;
-  const Pose& pose_a_;
-  const Pose& pose_b_;
-  const DistanceOptions& options_;
-  bool found_ = false;
-  CoreAnswer best_;
-  double lower_ = 0.0;
-  double upper_ = 0.0;
-};
-
+// Two compounds (or a compound and a convex body, its one-piece wrapper):
+// the compound search, which with the depth finds the deepest overlapping
+// piece pair itself (the least signed distance over piece pairs, by branch
+// and bound on the pieces' spheres, each pair's convex query taking its
+// own depth and tracked through the near list of BodyCache::compound).
+// Rounded bodies whose best pieces touch take that pair's contact normal
+// (needs_contact_normal), tracked through BodyCache::penetration as a
+// convex pair's.
 BodyResult compound_pair(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
-                           const DistanceOptions& options, bool depth, BodyCache& cache) {
+                         const DistanceOptions& options, BodyCache& cache) {
   const std::shared_ptr<const CompoundBody> hold_a = a.compound();
   const std::shared_ptr<const CompoundBody> hold_b = b.compound();
   const CompoundBody& ca = *hold_a;
   const CompoundBody& cb = *hold_b;
   const CompoundResult cr = distance(ca, pose_a, cb, pose_b, options, &cache.compound);
-  CoreAnswer c = from_distance(cr);
+  CoreAnswer c = from_signed(cr);
   c.piece_a = cr.piece_a;
   c.piece_b = cr.piece_b;
-  if (c.status == Status::intersecting && !depth) {
-    without_depth(c);
-  } else if (c.status == Status::intersecting) {
-    c.overlap = true;
-    DeepestPair(ca, pose_a, cb, pose_b, options).run(c);
-  } else if (depth && needs_depth(c, a.radius() + b.radius())) {
-    const CompoundPiece& piece_a = ca.piece(c.piece_a);
-    const CompoundPiece& piece_b = cb.piece(c.piece_b);
-    const Pose place_a = pose_a * piece_a.pose;
-    PenetrationCache cold;
-    take_depth(c,
-               depth_of(*piece_a.polytope, place_a, *piece_b.polytope, pose_b * piece_b.pose, cold,
-                        options),
-               place_a);
-  }
   const CompoundPiece& piece_a = ca.piece(c.piece_a);
   const CompoundPiece& piece_b = cb.piece(c.piece_b);
+  if (options.penetration && needs_contact_normal(c, a.radius() + b.radius())) {
+    // The penetration cache keeps the pair of polytopes it was filled for
+    // and starts over for another: the best pieces may change.
+    const Pose place_a = pose_a * piece_a.pose;
+    take_contact_depth(c,
+                       depth_of(*piece_a.polytope, place_a, *piece_b.polytope,
+                                pose_b * piece_b.pose, cache.penetration, options),
+                       place_a);
+  }
+  // The pieces are placed only for a radius (offset calls this only then).
   BodyResult r = offset(c, a, b, [&](double value) {
-    return rounded_status(value, {piece_a.polytope.get(), pose_a * piece_a.pose}, a.radius(),
-                          {piece_b.polytope.get(), pose_b * piece_b.pose}, b.radius(), options);
+    return rounded_status(value, placed(*piece_a.polytope, pose_a * piece_a.pose), a.radius(),
+                          placed(*piece_b.polytope, pose_b * piece_b.pose), b.radius(), options);
   });
   // A convex body met a compound as its one-piece wrapper: it has no pieces.
   if (a.kind() == Body::Kind::convex) r.piece_a = -1;
@@ -436,10 +358,7 @@ BodyResult mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pos
   c.feature_b = best.feature_b;
   c.iterations = best.iterations;
   if (best.status == Status::intersecting) {
-    c.value = 0.0;
-    c.lower = -std::numeric_limits<double>::infinity();
-    c.upper = 0.0;
-    c.overlap = true;
+    without_depth(c);
   } else {
     c.value = best.distance;
     c.lower = best.lower_bound;
@@ -457,12 +376,8 @@ BodyResult mesh_pair(const Body& a, const Pose& pose_a, const Body& b, const Pos
   const Pose place_a = pose_a * ma[best_i].pose;
   const Pose place_b = pose_b * mb[best_j].pose;
   BodyResult r = offset(c, a, b, [&](double value) {
-    const double reach = std::max(detail::placed_magnitude(ma[best_i].mesh->vertices(), place_a) + a.radius(),
-                                  detail::placed_magnitude(mb[best_j].mesh->vertices(), place_b) + b.radius());
-    const double band = contact_band(reach, options.absolute_tolerance);
-    return value > band     ? Status::separated
-           : value >= -band ? Status::touching
-                            : Status::intersecting;
+    return rounded_status(value, placed(*ma[best_i].mesh, place_a), a.radius(),
+                          placed(*mb[best_j].mesh, place_b), b.radius(), options);
   });
   if (a.kind() == Body::Kind::mesh) r.triangle_a = best.triangle_a;
   if (b.kind() == Body::Kind::mesh) r.triangle_b = best.triangle_b;
@@ -507,17 +422,16 @@ BodyResult distance_of_rigid_poses(const Body& a, const Pose& pa, const Body& b,
                                                   std::string("with its radius ") + radius));
     }
   }
-  // The cores' queries without their own depth: the depth of overlapping
-  // cores is taken here (take_depth, DeepestPair), once.
-  DistanceOptions cores = options;
-  cores.penetration = false;
+  // The depth (DistanceOptions::penetration) is the cores' queries' own:
+  // the convex query takes it for a convex pair and for each piece pair of
+  // a compound search; a mesh query has none and ignores the option.
   if (a.kind() == Body::Kind::convex && b.kind() == Body::Kind::convex) {
-    return convex_pair(a, pa, b, pb, cores, options.penetration, c);
+    return convex_pair(a, pa, b, pb, options, c);
   }
   if (a.kind() == Body::Kind::mesh || b.kind() == Body::Kind::mesh) {
-    return mesh_pair(a, pa, b, pb, cores, c);
+    return mesh_pair(a, pa, b, pb, options, c);
   }
-  return compound_pair(a, pa, b, pb, cores, options.penetration, c);
+  return compound_pair(a, pa, b, pb, options, c);
 }
 
 }  // namespace detail

@@ -25,6 +25,7 @@
 #include "core/power_of_two.h"
 #include "proxima/query/distance.h"
 #include "proxima/query/margin.h"
+#include "query/branch_and_bound.h"
 
 namespace proxima {
 
@@ -72,6 +73,31 @@ void take(CompoundResult& best, const DistanceResult& r, std::int32_t pa, std::i
   static_cast<DistanceResult&>(best) = r;
   best.piece_a = pa;
   best.piece_b = pb;
+}
+
+// The certificate of a search's answer `best` over every tested pair, not
+// the best pair's alone: the lower bounds are the least over the tested
+// pairs' (`lower`, `signed_lower`), since a tested pair that ended with a
+// loose bound (an iteration cap, an uncertified depth) may hold a closer
+// pair than the best reported value
+// (CompoundRegression.LowerBoundCoversALooselyCertifiedPair). Pruned node
+// pairs need no term: a key prunes only above the best signed distance at
+// that time, which the final best's does not exceed, and that is at least
+// the final best's lower bounds. Node pairs left unvisited by an early end
+// (an intersection without the depth) need none either: the answer's
+// bounds are then 0 and -infinity, below any key. The signed distance of
+// the compounds is the least over pairs, so each tested pair's signed
+// upper bound bounds it too: the upper bound is the least of them
+// (`signed_upper`), tighter than the best pair's own when that pair's
+// depth is loosely bounded below. It never goes below the reported value:
+// each pair's upper bound is at least its value, at least the best's.
+void certify_over_pairs(CompoundResult& best, double lower, double signed_lower,
+                        double signed_upper) {
+  best.lower_bound = std::min(best.lower_bound, lower);
+  const double own_lower = best.signed_lower_bound();
+  if (signed_lower < own_lower) best.depth_upper_bound += own_lower - signed_lower;
+  if (signed_upper < best.signed_upper_bound() && signed_upper >= best.signed_distance())
+    best.depth_lower_bound = best.distance - signed_upper;
 }
 
 struct NearEntry {
@@ -127,6 +153,72 @@ class SphereBounds {
   double slack_ = 0.0;   // scaled
 };
 
+// A pair of nodes of the two hierarchies and its pruning key (scaled:
+// SphereBounds::key).
+struct NodePair {
+  std::int32_t node_a;
+  std::int32_t node_b;
+  double key;
+};
+
+// The node pairs of two compounds for detail::branch_and_bound: the roots'
+// pair, and the split of the larger sphere (a leaf cannot be split: it
+// shrinks the bound the most per level), the nearer child pair first (a tie
+// to the right child: the order the searches were measured with).
+class NodePairs {
+ public:
+  NodePairs(const CompoundBody& a, const CompoundBody& b, const SphereBounds& bounds)
+      : a_(a), b_(b), bounds_(bounds) {}
+
+  NodePair root() const {
+    const CompoundBody::Node& na = a_.nodes()[0];
+    const CompoundBody::Node& nb = b_.nodes()[0];
+    return {0, 0, bounds_.key(na.center, na.radius, bounds_.b_center_in_a(nb.center), nb.radius)};
+  }
+  bool leaves(const NodePair& e) const {
+    return node_a(e).left < 0 && node_b(e).left < 0;
+  }
+  const CompoundBody::Node& node_a(const NodePair& e) const {
+    return a_.nodes()[static_cast<std::size_t>(e.node_a)];
+  }
+  const CompoundBody::Node& node_b(const NodePair& e) const {
+    return b_.nodes()[static_cast<std::size_t>(e.node_b)];
+  }
+
+  std::pair<NodePair, NodePair> split(const NodePair& e) const {
+    const auto& nodes_a = a_.nodes();
+    const auto& nodes_b = b_.nodes();
+    const CompoundBody::Node& na = node_a(e);
+    const CompoundBody::Node& nb = node_b(e);
+    const bool leaf_a = na.left < 0;
+    const bool leaf_b = nb.left < 0;
+    const bool split_a = !leaf_a && (leaf_b || na.radius >= nb.radius);
+    NodePair first{};
+    NodePair second{};
+    if (split_a) {
+      const Vec3 cb = bounds_.b_center_in_a(nb.center);
+      const CompoundBody::Node& l = nodes_a[static_cast<std::size_t>(na.left)];
+      const CompoundBody::Node& r = nodes_a[static_cast<std::size_t>(na.right)];
+      first = {na.left, e.node_b, bounds_.key(l.center, l.radius, cb, nb.radius)};
+      second = {na.right, e.node_b, bounds_.key(r.center, r.radius, cb, nb.radius)};
+    } else {
+      const CompoundBody::Node& l = nodes_b[static_cast<std::size_t>(nb.left)];
+      const CompoundBody::Node& r = nodes_b[static_cast<std::size_t>(nb.right)];
+      first = {e.node_a, nb.left,
+               bounds_.key(na.center, na.radius, bounds_.b_center_in_a(l.center), l.radius)};
+      second = {e.node_a, nb.right,
+                bounds_.key(na.center, na.radius, bounds_.b_center_in_a(r.center), r.radius)};
+    }
+    if (first.key < second.key) std::swap(first, second);
+    return {second, first};
+  }
+
+ private:
+  const CompoundBody& a_;
+  const CompoundBody& b_;
+  const SphereBounds& bounds_;
+};
+
 // One branch-and-bound query.
 class Search {
  public:
@@ -138,7 +230,8 @@ class Search {
         pose_b_(pose_b),
         options_(options),
         cache_(cache),
-        bounds_(a, pose_a, b, pose_b) {
+        bounds_(a, pose_a, b, pose_b),
+        pairs_(a, b, bounds_) {
     // A near list the caller did not keep sorted is ignored (a binary search
     // on it could miss entries): slower, never wrong.
     if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
@@ -161,21 +254,6 @@ class Search {
   }
 
  private:
-  struct StackEntry {
-    std::int32_t node_a;
-    std::int32_t node_b;
-    double key;  // lower bound minus slack, in scaled units
-  };
-
-  // An overlap ends the search only when the depth is not asked for: with
-  // it, a deeper piece pair may still come (the pruning keys below are
-  // lower bounds on the signed distance too: a piece pair inside two
-  // spheres is at most as deep as the spheres, whose depth is
-  // r_a + r_b - |c_a - c_b|, depth being monotone under inclusion).
-  bool done() const {
-    return have_best_ && best_.status == Status::intersecting && !options_.penetration;
-  }
-
   double key(const Vec3& center_a, double radius_a, const Vec3& center_b_in_a_scaled,
              double radius_b) const {
     return bounds_.key(center_a, radius_a, center_b_in_a_scaled, radius_b);
@@ -184,46 +262,31 @@ class Search {
   bool pruned(double k) const { return have_best_ && k > best_scaled_; }
 
   void traverse() {
-    const auto& nodes_a = a_.nodes();
-    const auto& nodes_b = b_.nodes();
-    stack_.push_back({0, 0, -std::numeric_limits<double>::infinity()});
-    while (!stack_.empty() && !done()) {
-      const StackEntry e = stack_.back();
-      stack_.pop_back();
-      if (pruned(e.key)) continue;
-      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(e.node_a)];
-      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(e.node_b)];
-      const bool leaf_a = na.left < 0;
-      const bool leaf_b = nb.left < 0;
-      if (leaf_a && leaf_b) {
-        test_leaves(na, nb);
-        continue;
-      }
-      // Descend the larger sphere (a leaf cannot be split): it shrinks the
-      // bound the most per level.
-      const bool split_a = !leaf_a && (leaf_b || na.radius >= nb.radius);
-      StackEntry first{};
-      StackEntry second{};
-      if (split_a) {
-        const Vec3 cb = b_center_in_a(nb.center);
-        const CompoundBody::Node& l = nodes_a[static_cast<std::size_t>(na.left)];
-        const CompoundBody::Node& r = nodes_a[static_cast<std::size_t>(na.right)];
-        first = {na.left, e.node_b, key(l.center, l.radius, cb, nb.radius)};
-        second = {na.right, e.node_b, key(r.center, r.radius, cb, nb.radius)};
-      } else {
-        const CompoundBody::Node& l = nodes_b[static_cast<std::size_t>(nb.left)];
-        const CompoundBody::Node& r = nodes_b[static_cast<std::size_t>(nb.right)];
-        first = {e.node_a, nb.left, key(na.center, na.radius, b_center_in_a(l.center), l.radius)};
-        second = {e.node_a, nb.right, key(na.center, na.radius, b_center_in_a(r.center), r.radius)};
-      }
-      // The nearer child pair on top: visited first, it is the likelier to
-      // lower the best distance before its sibling is looked at.
-      if (first.key < second.key) std::swap(first, second);
-      if (!pruned(first.key)) stack_.push_back(first);
-      if (!pruned(second.key)) stack_.push_back(second);
-    }
+    detail::DepthFirst<NodePair> frontier(stack_);
+    detail::branch_and_bound(*this, frontier);
   }
 
+ public:
+  // The search as detail::branch_and_bound takes it (branch_and_bound.h).
+  // An overlap ends the search only when the depth is not asked for: with
+  // it, a deeper piece pair may still come (the pruning keys are lower
+  // bounds on the signed distance too: a piece pair inside two spheres is
+  // at most as deep as the spheres, whose depth is r_a + r_b - |c_a - c_b|,
+  // depth being monotone under inclusion).
+  bool done() const {
+    return have_best_ && best_.status == Status::intersecting && !options_.penetration;
+  }
+  // The roots' pair is never pruned (a key of -infinity): its key would
+  // bound nothing its children's do not. A waiting pair is looked at again
+  // when taken out: the best may have come below its key since.
+  NodePair root() const { return {0, 0, -std::numeric_limits<double>::infinity()}; }
+  bool stale(const NodePair& e) const { return pruned(e.key); }
+  bool prune(const NodePair& e) const { return pruned(e.key); }
+  bool leaves(const NodePair& e) const { return pairs_.leaves(e); }
+  std::pair<NodePair, NodePair> split(const NodePair& e) const { return pairs_.split(e); }
+  void test_leaves(const NodePair& e) { test_leaves(pairs_.node_a(e), pairs_.node_b(e)); }
+
+ private:
   void test_leaves(const CompoundBody::Node& na, const CompoundBody::Node& nb) {
     const auto order_a = a_.piece_order();
     const auto order_b = b_.piece_order();
@@ -262,6 +325,7 @@ class Search {
     t.distance = r.signed_distance();
     lowest_lower_ = std::min(lowest_lower_, r.lower_bound);
     lowest_signed_lower_ = std::min(lowest_signed_lower_, r.signed_lower_bound());
+    lowest_signed_upper_ = std::min(lowest_signed_upper_, r.signed_upper_bound());
     if (!have_best_ || better(r, pa, pb, best_)) {
       take(best_, r, pa, pb);
       have_best_ = true;
@@ -270,21 +334,10 @@ class Search {
   }
 
   // The answer's certificate over the whole search, not the best pair's
-  // alone: a tested pair that ended with a loose bound (an iteration cap,
-  // an uncertified depth) may hold a closer pair than the best reported
-  // value, so the lower bounds are the minimum over every tested pair's.
-  // Pruned node pairs need no term: a key prunes only above the best
-  // signed distance at that time, which the final best's does not exceed,
-  // and that is at least the final best's lower bounds. Node pairs left on
-  // the stack by an early end (an intersection without the depth) need none
-  // either: the answer's bounds are then 0 and -infinity, below any key.
-  // (CompoundRegression.LowerBoundCoversALooselyCertifiedPair.)
+  // alone (certify_over_pairs, shared with the twin).
   void certify() {
-    if (!have_best_) return;
-    best_.lower_bound = std::min(best_.lower_bound, lowest_lower_);
-    const double signed_lower = best_.signed_lower_bound();
-    if (lowest_signed_lower_ < signed_lower)
-      best_.depth_upper_bound += signed_lower - lowest_signed_lower_;
+    if (have_best_)
+      certify_over_pairs(best_, lowest_lower_, lowest_signed_lower_, lowest_signed_upper_);
   }
 
   // The next query's warm start: the best pair, and the feature caches of
@@ -312,17 +365,20 @@ class Search {
   const DistanceOptions& options_;
   CompoundCache* cache_;
   SphereBounds bounds_;
+  NodePairs pairs_;
   std::span<CompoundCache::Entry> old_near_;
   double best_scaled_ = 0.0;  // best_.signed_distance() * bounds_.factor()
   std::int32_t hint_a_ = -1;
   std::int32_t hint_b_ = -1;
   bool have_best_ = false;
   CompoundResult best_;
-  // The least lower bound and signed lower bound of the tested pairs.
+  // The least lower bound, signed lower bound and signed upper bound of
+  // the tested pairs.
   double lowest_lower_ = std::numeric_limits<double>::infinity();
   double lowest_signed_lower_ = std::numeric_limits<double>::infinity();
+  double lowest_signed_upper_ = std::numeric_limits<double>::infinity();
   std::vector<NearEntry> tested_;
-  std::vector<StackEntry> stack_;
+  std::vector<NodePair> stack_;
 };
 
 // The margin query (proxima/query/margin.h): the same hierarchies, depth first
@@ -344,6 +400,7 @@ class MarginSearch {
         options_(options),
         cache_(cache),
         bounds_(a, pose_a, b, pose_b),
+        pairs_(a, b, bounds_),
         margin_scaled_(bounds_.factor() * margin) {
     if (cache_ != nullptr && std::is_sorted(cache_->near.begin(), cache_->near.end(), pair_less)) {
       old_near_ = std::span<CompoundCache::Entry>(cache_->near);
@@ -380,44 +437,24 @@ class MarginSearch {
   }
 
   void traverse() {
-    const auto& nodes_a = a_.nodes();
-    const auto& nodes_b = b_.nodes();
-    const auto node_key = [&](std::int32_t ia, std::int32_t ib) {
-      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(ia)];
-      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(ib)];
-      return bounds_.key(na.center, na.radius, bounds_.b_center_in_a(nb.center), nb.radius);
-    };
-    std::vector<std::pair<std::int32_t, std::int32_t>> stack;
-    if (!prune(node_key(0, 0))) stack.emplace_back(0, 0);
-    while (!stack.empty() && !found_) {
-      const auto [ia, ib] = stack.back();
-      stack.pop_back();
-      const CompoundBody::Node& na = nodes_a[static_cast<std::size_t>(ia)];
-      const CompoundBody::Node& nb = nodes_b[static_cast<std::size_t>(ib)];
-      const bool leaf_a = na.left < 0;
-      const bool leaf_b = nb.left < 0;
-      if (leaf_a && leaf_b) {
-        test_leaves(na, nb);
-        continue;
-      }
-      // Descend the larger sphere (as Search).
-      const bool split_a = !leaf_a && (leaf_b || na.radius >= nb.radius);
-      std::pair<std::int32_t, std::int32_t> first =
-          split_a ? std::pair(na.left, ib) : std::pair(ia, nb.left);
-      std::pair<std::int32_t, std::int32_t> second =
-          split_a ? std::pair(na.right, ib) : std::pair(ia, nb.right);
-      double first_key = node_key(first.first, first.second);
-      double second_key = node_key(second.first, second.second);
-      // The nearer child pair on top: the likelier to prove within first.
-      if (first_key < second_key) {
-        std::swap(first, second);
-        std::swap(first_key, second_key);
-      }
-      if (!prune(first_key)) stack.push_back(first);
-      if (!prune(second_key)) stack.push_back(second);
-    }
+    std::vector<NodePair> stack;
+    detail::DepthFirst<NodePair> frontier(stack);
+    detail::branch_and_bound(*this, frontier);
   }
 
+ public:
+  // The search as detail::branch_and_bound takes it (branch_and_bound.h):
+  // the margin does not move, so a pair is pruned (and its key lowers the
+  // reported bound) when first met, never again when taken out.
+  bool done() const { return found_; }
+  NodePair root() const { return pairs_.root(); }
+  bool stale(const NodePair&) const { return false; }
+  bool prune(const NodePair& e) { return prune(e.key); }
+  bool leaves(const NodePair& e) const { return pairs_.leaves(e); }
+  std::pair<NodePair, NodePair> split(const NodePair& e) const { return pairs_.split(e); }
+  void test_leaves(const NodePair& e) { test_leaves(pairs_.node_a(e), pairs_.node_b(e)); }
+
+ private:
   void test_leaves(const CompoundBody::Node& na, const CompoundBody::Node& nb) {
     const auto order_a = a_.piece_order();
     const auto order_b = b_.piece_order();
@@ -499,6 +536,7 @@ class MarginSearch {
   const DistanceOptions& options_;
   CompoundCache* cache_;
   SphereBounds bounds_;
+  NodePairs pairs_;
   double margin_scaled_;
   std::span<CompoundCache::Entry> old_near_;
   std::vector<bool> moved_;  // per old_near_ entry: its cache moved to a tested pair
@@ -538,22 +576,22 @@ CompoundResult distance_all_pairs(const CompoundBody& a, const Pose& pose_a, con
   bool have_best = false;
   double lowest_lower = std::numeric_limits<double>::infinity();
   double lowest_signed_lower = std::numeric_limits<double>::infinity();
+  double lowest_signed_upper = std::numeric_limits<double>::infinity();
   for (std::int32_t pa = 0; pa < a.piece_count(); ++pa) {
     for (std::int32_t pb = 0; pb < b.piece_count(); ++pb) {
       const DistanceResult r = distance(*a.piece(pa).polytope, pose_a * a.piece(pa).pose,
                                         *b.piece(pb).polytope, pose_b * b.piece(pb).pose, options);
       lowest_lower = std::min(lowest_lower, r.lower_bound);
       lowest_signed_lower = std::min(lowest_signed_lower, r.signed_lower_bound());
+      lowest_signed_upper = std::min(lowest_signed_upper, r.signed_upper_bound());
       if (!have_best || better(r, pa, pb, best)) {
         take(best, r, pa, pb);
         have_best = true;
       }
     }
   }
-  // The certificate over every pair, as the search's (Search::certify).
-  best.lower_bound = std::min(best.lower_bound, lowest_lower);
-  if (lowest_signed_lower < best.signed_lower_bound())
-    best.depth_upper_bound += best.signed_lower_bound() - lowest_signed_lower;
+  // The certificate over every pair, as the search's.
+  certify_over_pairs(best, lowest_lower, lowest_signed_lower, lowest_signed_upper);
   // Saturated: the product of two piece counts can exceed an int.
   best.pairs_tested = static_cast<int>(std::min<std::int64_t>(
       std::int64_t{a.piece_count()} * b.piece_count(), std::numeric_limits<int>::max()));

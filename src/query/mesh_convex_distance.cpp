@@ -20,6 +20,7 @@
 #include "core/accuracy.h"
 #include "proxima/query/distance.h"
 #include "proxima/query/mesh_distance.h"
+#include "query/branch_and_bound.h"
 #include "query/mesh_pair.h"
 #include "shape/triangle_polytope.h"
 
@@ -197,6 +198,80 @@ MeshResult finish(const ConvexQuery& q, const Best& best, int tested, int nodes,
   return r;
 }
 
+// The search of distance() as detail::branch_and_bound takes it: the
+// mesh's nodes (one hierarchy against B's box, so an entry is one node and
+// its box gap), depth first, the nearer child on top (a tie to the first),
+// a node pruned when its gap is above the best distance plus the slack;
+// at a leaf each triangle is pruned by its own box, then queried. It ends
+// at an intersecting triangle, or at one within the hull's stop.
+class MeshSearch {
+ public:
+  struct Entry {
+    std::int32_t node;
+    double lb;
+  };
+
+  MeshSearch(ConvexQuery& q, const HullStop& hull, Best& best, int& tested, int& nodes)
+      : q_(q), hull_(hull), best_(best), tested_(tested), nodes_(nodes) {}
+
+  bool stopped() const { return stopped_; }
+
+  bool done() const { return best_.result.status == Status::intersecting || stopped_; }
+  Entry root() const { return {0, 0.0}; }
+  bool stale(const Entry& e) const { return e.lb > bound(); }
+  bool prune(const Entry& e) const { return e.lb > bound(); }
+  bool leaves(const Entry& e) const {
+    return q_.a.nodes()[static_cast<std::size_t>(e.node)].is_leaf();
+  }
+
+  void test_leaves(const Entry& e) {
+    const TriangleMesh& a = q_.a;
+    const TriangleMesh::Node& n = a.nodes()[static_cast<std::size_t>(e.node)];
+    const auto order = a.triangle_order();
+    for (std::int32_t k = 0; k < n.count; ++k) {
+      const std::int32_t t = order[static_cast<std::size_t>(n.first_or_right + k)];
+      if (best_.have && t == best_.triangle) continue;
+      const auto& tri = a.triangle(t);
+      const Vec3& p0 = a.vertex(static_cast<int>(tri[0]));
+      const Vec3& p1 = a.vertex(static_cast<int>(tri[1]));
+      const Vec3& p2 = a.vertex(static_cast<int>(tri[2]));
+      if (gap(q_, p0.cwiseMin(p1).cwiseMin(p2), p0.cwiseMax(p1).cwiseMax(p2)) > bound()) continue;
+      test_triangle(q_, t, best_, tested_);
+      if (best_.result.status == Status::intersecting) break;
+      if (best_.have && best_.result.distance <= hull_.stop) {
+        stopped_ = true;
+        break;
+      }
+    }
+  }
+
+  std::pair<Entry, Entry> split(const Entry& e) {
+    const TriangleMesh::Node& n = q_.a.nodes()[static_cast<std::size_t>(e.node)];
+    const std::int32_t children[2] = {e.node + 1, n.first_or_right};
+    double lbs[2];
+    for (int c = 0; c < 2; ++c) {
+      Vec3 lo, hi;
+      q_.a.box(children[c], lo, hi);
+      lbs[c] = gap(q_, lo, hi);
+    }
+    nodes_ += 2;
+    const int near = lbs[0] <= lbs[1] ? 0 : 1;
+    return {{children[near], lbs[near]}, {children[1 - near], lbs[1 - near]}};
+  }
+
+ private:
+  double bound() const {
+    return best_.have ? best_.result.distance + q_.slack : std::numeric_limits<double>::infinity();
+  }
+
+  ConvexQuery& q_;
+  const HullStop& hull_;
+  Best& best_;
+  int& tested_;
+  int& nodes_;
+  bool stopped_ = false;
+};
+
 }  // namespace
 
 MeshResult distance_all_pairs(const TriangleMesh& a, const Pose& pose_a, const ConvexPolytope& b,
@@ -235,50 +310,12 @@ MeshResult distance(const TriangleMesh& a, const Pose& pose_a, const ConvexPolyt
     test_triangle(q, cache->triangle_a, best, tested);
     if (reached_hull()) return answer(true);
   }
-  const auto bound = [&] {
-    return best.have ? best.result.distance + q.slack : std::numeric_limits<double>::infinity();
-  };
-  std::vector<std::pair<std::int32_t, double>> stack;
+  MeshSearch search(q, hull, best, tested, nodes);
+  std::vector<MeshSearch::Entry> stack;
   stack.reserve(64);
-  stack.emplace_back(0, 0.0);
-  const auto nodes_a = a.nodes();
-  const auto order = a.triangle_order();
-  bool stopped = false;
-  while (!stack.empty() && best.result.status != Status::intersecting && !stopped) {
-    const auto [id, lb] = stack.back();
-    stack.pop_back();
-    if (lb > bound()) continue;
-    const TriangleMesh::Node& n = nodes_a[static_cast<std::size_t>(id)];
-    if (n.is_leaf()) {
-      for (std::int32_t k = 0; k < n.count; ++k) {
-        const std::int32_t t = order[static_cast<std::size_t>(n.first_or_right + k)];
-        if (best.have && t == best.triangle) continue;
-        const auto& tri = a.triangle(t);
-        const Vec3& p0 = a.vertex(static_cast<int>(tri[0]));
-        const Vec3& p1 = a.vertex(static_cast<int>(tri[1]));
-        const Vec3& p2 = a.vertex(static_cast<int>(tri[2]));
-        if (gap(q, p0.cwiseMin(p1).cwiseMin(p2), p0.cwiseMax(p1).cwiseMax(p2)) > bound()) continue;
-        test_triangle(q, t, best, tested);
-        if (best.result.status == Status::intersecting) break;
-        if (reached_hull()) {
-          stopped = true;
-          break;
-        }
-      }
-      continue;
-    }
-    const std::int32_t children[2] = {id + 1, n.first_or_right};
-    double lbs[2];
-    for (int c = 0; c < 2; ++c) {
-      Vec3 lo, hi;
-      a.box(children[c], lo, hi);
-      lbs[c] = gap(q, lo, hi);
-    }
-    nodes += 2;
-    const int near = lbs[0] <= lbs[1] ? 0 : 1;
-    if (lbs[1 - near] <= bound()) stack.emplace_back(children[1 - near], lbs[1 - near]);
-    if (lbs[near] <= bound()) stack.emplace_back(children[near], lbs[near]);
-  }
+  detail::DepthFirst<MeshSearch::Entry> frontier(stack);
+  detail::branch_and_bound(search, frontier);
+  const bool stopped = search.stopped();
   return answer(stopped);
 }
 

@@ -9,10 +9,13 @@
 #include "proxima/query/mesh_distance.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
+#include "query/branch_and_bound.h"
 #include "query/mesh_pair.h"
 
 namespace proxima {
@@ -27,166 +30,225 @@ struct Candidate {
   double d2;
 };
 
-// The branch and bound of distance(): from `best` (the last pair, or
-// none), every node pair whose bound is below best + 2 margin + slack_s
-// (scaled), collecting the tested pairs within that into `candidates`
-// (while margin > 0; `overflow` past 4 kNearCapacity). Returns whether it
-// stopped because the best pair reached stop2 (the hulls' bound, -1 for
-// none): the pairs left are then no closer.
-bool best_first_search(const Query& q, double margin, double slack_s, double stop2, Best& best,
-                       int& tested, int& nodes_tested, std::vector<Candidate>& candidates,
-                       bool& overflow) {
-  struct Entry {
-    std::int32_t na, nb;
-    double lb2;
-    double center2;  // squared distance of the boxes' centers: ties of lb2
-  };
-  // Best first (a binary heap of node pairs, the smallest lower bound on
-  // top, ties to the nearer centers), each pop followed by a dive to a leaf
-  // pair along the nearer child: the first leaves reached are near the
-  // closest pair, so the upper bound is tight early and prunes most of the
-  // rest: far fewer triangle pairs than a depth-first stack, cold and along
-  // a motion (bench/mesh_bench, env/rob). A plain heap without the dive
-  // tests about as few pairs but pays heap work for every node pair (slower
-  // when the meshes are apart); a depth-first stack with the same tie rule
-  // stays slower than this.
-  const auto later = [](const Entry& x, const Entry& y) {
+// A node pair waiting: its squared box bound and, for ties of it, the
+// squared distance of the boxes' centers.
+struct NodePair {
+  std::int32_t na, nb;
+  double lb2;
+  double center2;
+};
+
+// Best first (a binary heap of node pairs, the smallest lower bound on
+// top, ties to the nearer centers), each pair taken out followed by a dive
+// to a leaf pair along the nearer child (detail::branch_and_bound): the
+// first leaves reached are near the closest pair, so the upper bound is
+// tight early and prunes most of the rest: far fewer triangle pairs than a
+// depth-first stack, cold and along a motion (bench/mesh_bench, env/rob).
+// A plain heap without the dive tests about as few pairs but pays heap
+// work for every node pair (slower when the meshes are apart); a
+// depth-first stack with the same tie rule stays slower than this.
+struct Later {
+  bool operator()(const NodePair& x, const NodePair& y) const {
     return x.lb2 > y.lb2 || (x.lb2 == y.lb2 && x.center2 > y.center2);
-  };
-  std::vector<Entry> heap;
-  heap.reserve(256);
-  const auto nodes_a = q.a.nodes();
-  const auto nodes_b = q.b.nodes();
-  const auto order_a = q.a.triangle_order();
-  const auto order_b = q.b.triangle_order();
-  const auto threshold2 = [&]() {
-    const double t = std::sqrt(best.d2) + 2.0 * margin + slack_s;
-    return t * t;
-  };
-  double prune2 = threshold2();
-  heap.push_back({0, 0, 0.0, 0.0});
+  }
+};
+
+// The branch and bound of distance() as detail::branch_and_bound takes it:
+// from `best` (the last pair, or none), every node pair whose bound is
+// below best + 2 margin + slack_s (scaled), collecting the tested pairs
+// within that into `candidates` (while margin > 0; `overflow` past 4
+// kNearCapacity). It stops when the best pair reaches stop2 (the hulls'
+// bound, -1 for none; reached_hull()): the pairs left are then no closer.
+class DistanceSearch {
+ public:
+  DistanceSearch(const Query& q, double margin, double slack_s, double stop2, Best& best,
+                 int& tested, int& nodes_tested, std::vector<Candidate>& candidates,
+                 bool& overflow)
+      : q_(q),
+        margin_(margin),
+        slack_s_(slack_s),
+        stop2_(stop2),
+        best_(best),
+        tested_(tested),
+        nodes_tested_(nodes_tested),
+        candidates_(candidates),
+        overflow_(overflow),
+        nodes_a_(q.a.nodes()),
+        nodes_b_(q.b.nodes()),
+        order_a_(q.a.triangle_order()),
+        order_b_(q.b.triangle_order()),
+        stamp_(++query_stamp()) {
+    prune2_ = threshold2();
+    reached_hull_ = best_.d2 <= stop2_;
+  }
+
+  bool reached_hull() const { return reached_hull_; }
+
+  bool done() const { return best_.crossing || reached_hull_; }
+  NodePair root() const { return {0, 0, 0.0, 0.0}; }
+  // The pair taken out has the least bound: past the threshold, every
+  // other pair's bound is as large.
+  bool stale(const NodePair& e) const { return e.lb2 > prune2_; }
+  bool prune(const NodePair& e) const { return e.lb2 > prune2_; }
+  bool leaves(const NodePair& e) const {
+    return nodes_a_[static_cast<std::size_t>(e.na)].is_leaf() &&
+           nodes_b_[static_cast<std::size_t>(e.nb)].is_leaf();
+  }
+
+  void test_leaves(const NodePair& e) {
+    const TriangleMesh::Node& na = nodes_a_[static_cast<std::size_t>(e.na)];
+    const TriangleMesh::Node& nb = nodes_b_[static_cast<std::size_t>(e.nb)];
+    const LeafSlot& leaf_a = leaf(slots_a(), e.na, na, true);
+    const LeafSlot& leaf_b = leaf(slots_b(), e.nb, nb, false);
+    // Each triangle against the other leaf's box first (both in the
+    // query frame): a triangle farther than the limit from every
+    // triangle of the other leaf skips its row or column of pairs.
+    const double box_limit = std::sqrt(prune2_) + kBoxSlackUlps * kUnitRoundoff;
+    unsigned columns = 0;
+    for (std::int32_t j = 0; j < nb.count; ++j) {
+      const Triangles& tj = leaf_b.t[static_cast<std::size_t>(j)];
+      if (box_gap_squared(tj.lo, tj.hi, leaf_a.lo, leaf_a.hi) <= box_limit * box_limit)
+        columns |= 1u << j;
+    }
+    for (std::int32_t i = 0; i < na.count && columns != 0 && !best_.crossing; ++i) {
+      const Triangles& ti = leaf_a.t[static_cast<std::size_t>(i)];
+      if (box_gap_squared(ti.lo, ti.hi, leaf_b.lo, leaf_b.hi) > box_limit * box_limit) continue;
+      for (std::int32_t j = 0; j < nb.count; ++j) {
+        if ((columns >> j & 1u) == 0) continue;
+        const Triangles& tj = leaf_b.t[static_cast<std::size_t>(j)];
+        const double before = best_.d2;
+        const double d2 = test_pair(q_, ti, tj, best_, tested_, std::sqrt(prune2_));
+        if (best_.d2 < before) prune2_ = threshold2();
+        if (best_.crossing) break;
+        if (margin_ > 0.0 && !overflow_ && d2 <= prune2_) {
+          // Every tested pair that may end within the margin; filtered
+          // against the final best at the end.
+          candidates_.push_back({ti.id, tj.id, d2});
+          overflow_ = candidates_.size() > 4 * kNearCapacity;
+        }
+      }
+    }
+    prune2_ = threshold2();
+    reached_hull_ = best_.d2 <= stop2_;
+  }
+
+  // The children of the larger box (by the sum of half extents; an inner
+  // node against a leaf: the inner one), the nearer first (Later).
+  std::pair<NodePair, NodePair> split(const NodePair& e) {
+    const TriangleMesh::Node& na = nodes_a_[static_cast<std::size_t>(e.na)];
+    const TriangleMesh::Node& nb = nodes_b_[static_cast<std::size_t>(e.nb)];
+    const Box ba = node_box(na, q_.box_unit_a);
+    const Box bb = node_box(nb, q_.box_unit_b);
+    const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
+    NodePair c0, c1;
+    if (split_a) {
+      // B's box in A's frame, shared by both children.
+      const Vec3 cb = q_.rotation * bb.center + q_.translation_s;
+      const Vec3 extent_b = q_.abs_rotation * bb.half;
+      const std::int32_t l = e.na + 1, r = na.first_or_right;
+      const Box b0 = node_box(nodes_a_[static_cast<std::size_t>(l)], q_.box_unit_a);
+      const Box b1 = node_box(nodes_a_[static_cast<std::size_t>(r)], q_.box_unit_a);
+      c0 = {l, e.nb, lower_bound_on_a_axes(q_, b0, bb, cb, extent_b, prune2_),
+            (b0.center - cb).squaredNorm()};
+      c1 = {r, e.nb, lower_bound_on_a_axes(q_, b1, bb, cb, extent_b, prune2_),
+            (b1.center - cb).squaredNorm()};
+    } else {
+      // A's box in B's frame, shared by both children.
+      const Vec3 ca = q_.rotation.transpose() * (ba.center - q_.translation_s);
+      const Vec3 extent_a = q_.abs_rotation.transpose() * ba.half;
+      const std::int32_t l = e.nb + 1, r = nb.first_or_right;
+      const Box b0 = node_box(nodes_b_[static_cast<std::size_t>(l)], q_.box_unit_b);
+      const Box b1 = node_box(nodes_b_[static_cast<std::size_t>(r)], q_.box_unit_b);
+      c0 = {e.na, l, lower_bound_on_b_axes(q_, ba, b0, ca, extent_a, prune2_),
+            (b0.center - ca).squaredNorm()};
+      c1 = {e.na, r, lower_bound_on_b_axes(q_, ba, b1, ca, extent_a, prune2_),
+            (b1.center - ca).squaredNorm()};
+    }
+    nodes_tested_ += 2;
+    if (Later{}(c0, c1)) std::swap(c0, c1);
+    return {c0, c1};
+  }
+
+ private:
   // Prepared leaves, direct-mapped by node id: a dive meets the same leaf
-  // against several leaves of the other mesh in a row.
-  // Per thread (the query is reentrant), stamped with this query so that no
-  // leaf placed at another query's pose is used. 128 slots a side (a few
-  // hundred KB per thread); with the best-first traversal fewer or more
-  // slots measure the same (bench/mesh_bench, env/rob): the size is not
-  // critical.
+  // against several leaves of the other mesh in a row. Per thread (the
+  // query is reentrant), stamped with this query so that no leaf placed at
+  // another query's pose is used. 128 slots a side (a few hundred KB per
+  // thread); with the best-first traversal fewer or more slots measure the
+  // same (bench/mesh_bench, env/rob): the size is not critical.
   struct LeafSlot {
     std::uint64_t stamp = 0;
     std::int32_t node = -1;
     std::array<Triangles, TriangleMesh::kLeafSize> t;
     Vec3 lo, hi;  // the union of the triangles' boxes (query frame)
   };
-  constexpr std::size_t kSlots = 128;
-  thread_local std::array<LeafSlot, kSlots> slots_a, slots_b;
-  thread_local std::uint64_t query_stamp = 0;
-  const std::uint64_t stamp = ++query_stamp;
-  const auto leaf = [&](std::array<LeafSlot, kSlots> & slots, std::int32_t node,
-                        const TriangleMesh::Node& n, bool side_a) -> const auto& {
+  static constexpr std::size_t kSlots = 128;
+  using Slots = std::array<LeafSlot, kSlots>;
+  static Slots& slots_a() {
+    thread_local Slots slots;
+    return slots;
+  }
+  static Slots& slots_b() {
+    thread_local Slots slots;
+    return slots;
+  }
+  static std::uint64_t& query_stamp() {
+    thread_local std::uint64_t stamp = 0;
+    return stamp;
+  }
+
+  const LeafSlot& leaf(Slots& slots, std::int32_t node, const TriangleMesh::Node& n,
+                       bool side_a) const {
     LeafSlot& slot = slots[static_cast<std::size_t>(node) % kSlots];
-    if (slot.stamp != stamp || slot.node != node) {
-      slot.stamp = stamp;
+    if (slot.stamp != stamp_ || slot.node != node) {
+      slot.stamp = stamp_;
       slot.node = node;
       slot.lo = Vec3::Constant(std::numeric_limits<double>::infinity());
       slot.hi = -slot.lo;
       for (std::int32_t i = 0; i < n.count; ++i) {
         const auto k = static_cast<std::size_t>(n.first_or_right + i);
         Triangles& t = slot.t[static_cast<std::size_t>(i)];
-        t = side_a ? a_triangle(q, order_a[k]) : b_triangle(q, order_b[k]);
+        t = side_a ? a_triangle(q_, order_a_[k]) : b_triangle(q_, order_b_[k]);
         slot.lo = slot.lo.cwiseMin(t.lo);
         slot.hi = slot.hi.cwiseMax(t.hi);
       }
     }
     return slot;
-  };
-  // Stopped when the best pair reaches the hulls' lower bound: every pair
-  // left is at least as far as that bound.
-  bool reached_hull = best.d2 <= stop2;
-  while (!heap.empty() && !best.crossing && !reached_hull) {
-    std::pop_heap(heap.begin(), heap.end(), later);
-    Entry e = heap.back();
-    heap.pop_back();
-    if (e.lb2 > prune2) break;  // every other pair's bound is as large
-    // Dive: follow the nearer child down to a leaf pair, the other child
-    // waits in the heap.
-    while (true) {
-      const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.na)];
-      const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.nb)];
-      if (na.is_leaf() && nb.is_leaf()) {
-        const LeafSlot& leaf_a = leaf(slots_a, e.na, na, true);
-        const LeafSlot& leaf_b = leaf(slots_b, e.nb, nb, false);
-        // Each triangle against the other leaf's box first (both in the
-        // query frame): a triangle farther than the limit from every
-        // triangle of the other leaf skips its row or column of pairs.
-        const double box_limit = std::sqrt(prune2) + kBoxSlackUlps * kUnitRoundoff;
-        unsigned columns = 0;
-        for (std::int32_t j = 0; j < nb.count; ++j) {
-          const Triangles& tj = leaf_b.t[static_cast<std::size_t>(j)];
-          if (box_gap_squared(tj.lo, tj.hi, leaf_a.lo, leaf_a.hi) <= box_limit * box_limit)
-            columns |= 1u << j;
-        }
-        for (std::int32_t i = 0; i < na.count && columns != 0 && !best.crossing; ++i) {
-          const Triangles& ti = leaf_a.t[static_cast<std::size_t>(i)];
-          if (box_gap_squared(ti.lo, ti.hi, leaf_b.lo, leaf_b.hi) > box_limit * box_limit) continue;
-          for (std::int32_t j = 0; j < nb.count; ++j) {
-            if ((columns >> j & 1u) == 0) continue;
-            const Triangles& tj = leaf_b.t[static_cast<std::size_t>(j)];
-            const double before = best.d2;
-            const double d2 = test_pair(q, ti, tj, best, tested, std::sqrt(prune2));
-            if (best.d2 < before) prune2 = threshold2();
-            if (best.crossing) break;
-            if (margin > 0.0 && !overflow && d2 <= prune2) {
-              // Every tested pair that may end within the margin; filtered
-              // against the final best at the end.
-              candidates.push_back({ti.id, tj.id, d2});
-              overflow = candidates.size() > 4 * kNearCapacity;
-            }
-          }
-        }
-        prune2 = threshold2();
-        reached_hull = best.d2 <= stop2;
-        break;
-      }
-      // Split the larger node (an inner node against a leaf: the inner one).
-      const Box ba = node_box(na, q.box_unit_a);
-      const Box bb = node_box(nb, q.box_unit_b);
-      const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
-      Entry c0, c1;
-      if (split_a) {
-        // B's box in A's frame, shared by both children.
-        const Vec3 cb = q.rotation * bb.center + q.translation_s;
-        const Vec3 extent_b = q.abs_rotation * bb.half;
-        const std::int32_t l = e.na + 1, r = na.first_or_right;
-        const Box b0 = node_box(nodes_a[static_cast<std::size_t>(l)], q.box_unit_a);
-        const Box b1 = node_box(nodes_a[static_cast<std::size_t>(r)], q.box_unit_a);
-        c0 = {l, e.nb, lower_bound_on_a_axes(q, b0, bb, cb, extent_b, prune2),
-              (b0.center - cb).squaredNorm()};
-        c1 = {r, e.nb, lower_bound_on_a_axes(q, b1, bb, cb, extent_b, prune2),
-              (b1.center - cb).squaredNorm()};
-      } else {
-        // A's box in B's frame, shared by both children.
-        const Vec3 ca = q.rotation.transpose() * (ba.center - q.translation_s);
-        const Vec3 extent_a = q.abs_rotation.transpose() * ba.half;
-        const std::int32_t l = e.nb + 1, r = nb.first_or_right;
-        const Box b0 = node_box(nodes_b[static_cast<std::size_t>(l)], q.box_unit_b);
-        const Box b1 = node_box(nodes_b[static_cast<std::size_t>(r)], q.box_unit_b);
-        c0 = {e.na, l, lower_bound_on_b_axes(q, ba, b0, ca, extent_a, prune2),
-              (b0.center - ca).squaredNorm()};
-        c1 = {e.na, r, lower_bound_on_b_axes(q, ba, b1, ca, extent_a, prune2),
-              (b1.center - ca).squaredNorm()};
-      }
-      nodes_tested += 2;
-      if (later(c0, c1)) std::swap(c0, c1);
-      if (c1.lb2 <= prune2) {
-        heap.push_back(c1);
-        std::push_heap(heap.begin(), heap.end(), later);
-      }
-      if (c0.lb2 > prune2) break;
-      e = c0;
-    }
   }
-  return reached_hull;
+
+  double threshold2() const {
+    const double t = std::sqrt(best_.d2) + 2.0 * margin_ + slack_s_;
+    return t * t;
+  }
+
+  const Query& q_;
+  double margin_;
+  double slack_s_;
+  double stop2_;
+  Best& best_;
+  int& tested_;
+  int& nodes_tested_;
+  std::vector<Candidate>& candidates_;
+  bool& overflow_;
+  std::span<const TriangleMesh::Node> nodes_a_, nodes_b_;
+  std::span<const std::int32_t> order_a_, order_b_;
+  std::uint64_t stamp_;
+  double prune2_ = 0.0;
+  bool reached_hull_ = false;
+};
+
+// The search of distance() (DistanceSearch); returns whether it stopped
+// because the best pair reached stop2.
+bool best_first_search(const Query& q, double margin, double slack_s, double stop2, Best& best,
+                       int& tested, int& nodes_tested, std::vector<Candidate>& candidates,
+                       bool& overflow) {
+  DistanceSearch search(q, margin, slack_s, stop2, best, tested, nodes_tested, candidates,
+                        overflow);
+  std::vector<NodePair> heap;
+  heap.reserve(256);
+  detail::BestFirst<NodePair, Later> frontier(heap, Later{});
+  detail::branch_and_bound(search, frontier);
+  return search.reached_hull();
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "proxima/query/margin.h"
+#include "query/branch_and_bound.h"
 #include "query/mesh_pair.h"
 
 namespace proxima {
@@ -70,67 +71,91 @@ class MarginSearch {
   }
 
   bool traverse() {
-    const auto nodes_a = q_.a.nodes();
-    const auto nodes_b = q_.b.nodes();
+    found_ = false;
+    detail::DepthFirst<NodePair> frontier(stack_);
+    detail::branch_and_bound(*this, frontier);
+    return found_;
+  }
+
+  // A pair of nodes and its squared box bound (scaled).
+  struct NodePair {
+    std::int32_t ia, ib;
+    double lb2;
+  };
+
+  // The search as detail::branch_and_bound takes it (branch_and_bound.h):
+  // the margin does not move, so a pair is pruned (and its bound lowers
+  // the reported one) when first met, never again when taken out.
+  bool done() const { return found_; }
+  NodePair root() const { return {0, 0, 0.0}; }
+  bool stale(const NodePair&) const { return false; }
+  bool prune(const NodePair& e) {
+    const double prune2 = prune_s_ * prune_s_;
+    if (!(e.lb2 > prune2)) return false;
+    lower_s_ = std::min(lower_s_, std::sqrt(e.lb2) - slack_s_);
+    return true;
+  }
+  bool leaves(const NodePair& e) const {
+    return q_.a.nodes()[static_cast<std::size_t>(e.ia)].is_leaf() &&
+           q_.b.nodes()[static_cast<std::size_t>(e.ib)].is_leaf();
+  }
+
+  void test_leaves(const NodePair& e) {
+    const TriangleMesh::Node& na = q_.a.nodes()[static_cast<std::size_t>(e.ia)];
+    const TriangleMesh::Node& nb = q_.b.nodes()[static_cast<std::size_t>(e.ib)];
     const auto order_a = q_.a.triangle_order();
     const auto order_b = q_.b.triangle_order();
-    const double prune2 = prune_s_ * prune_s_;
-    std::array<Triangles, TriangleMesh::kLeafSize> leaf_a, leaf_b;
-    stack_.clear();
-    stack_.push_back({0, 0});
-    while (!stack_.empty()) {
-      const auto [ia, ib] = stack_.back();
-      stack_.pop_back();
-      const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(ia)];
-      const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(ib)];
-      if (na.is_leaf() && nb.is_leaf()) {
-        for (std::int32_t i = 0; i < na.count; ++i)
-          leaf_a[static_cast<std::size_t>(i)] =
-              a_triangle(q_, order_a[static_cast<std::size_t>(na.first_or_right + i)]);
-        for (std::int32_t j = 0; j < nb.count; ++j)
-          leaf_b[static_cast<std::size_t>(j)] =
-              b_triangle(q_, order_b[static_cast<std::size_t>(nb.first_or_right + j)]);
-        for (std::int32_t i = 0; i < na.count; ++i)
-          for (std::int32_t j = 0; j < nb.count; ++j)
-            if (test(leaf_a[static_cast<std::size_t>(i)], leaf_b[static_cast<std::size_t>(j)]))
-              return true;
-        continue;
-      }
-      const Box ba = node_box(na, q_.box_unit_a);
-      const Box bb = node_box(nb, q_.box_unit_b);
-      const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
-      std::array<std::int32_t, 2> child_a = {ia, ia};
-      std::array<std::int32_t, 2> child_b = {ib, ib};
-      std::array<double, 2> lb2;
-      if (split_a) {
-        const Vec3 cb = q_.rotation * bb.center + q_.translation_s;
-        const Vec3 extent_b = q_.abs_rotation * bb.half;
-        child_a = {ia + 1, na.first_or_right};
-        for (int c = 0; c < 2; ++c) {
-          const Box box = node_box(nodes_a[static_cast<std::size_t>(child_a[c])], q_.box_unit_a);
-          lb2[c] = lower_bound_on_a_axes(q_, box, bb, cb, extent_b, prune2);
-        }
-      } else {
-        const Vec3 ca = q_.rotation.transpose() * (ba.center - q_.translation_s);
-        const Vec3 extent_a = q_.abs_rotation.transpose() * ba.half;
-        child_b = {ib + 1, nb.first_or_right};
-        for (int c = 0; c < 2; ++c) {
-          const Box box = node_box(nodes_b[static_cast<std::size_t>(child_b[c])], q_.box_unit_b);
-          lb2[c] = lower_bound_on_b_axes(q_, ba, box, ca, extent_a, prune2);
-        }
-      }
-      nodes_tested_ += 2;
-      // The nearer child on top (pushed last).
-      const int near = lb2[0] <= lb2[1] ? 0 : 1;
-      for (const int c : {1 - near, near}) {
-        if (lb2[c] > prune2) {
-          lower_s_ = std::min(lower_s_, std::sqrt(lb2[c]) - slack_s_);
-        } else {
-          stack_.push_back({child_a[c], child_b[c]});
+    for (std::int32_t i = 0; i < na.count; ++i)
+      leaf_a_[static_cast<std::size_t>(i)] =
+          a_triangle(q_, order_a[static_cast<std::size_t>(na.first_or_right + i)]);
+    for (std::int32_t j = 0; j < nb.count; ++j)
+      leaf_b_[static_cast<std::size_t>(j)] =
+          b_triangle(q_, order_b[static_cast<std::size_t>(nb.first_or_right + j)]);
+    for (std::int32_t i = 0; i < na.count; ++i) {
+      for (std::int32_t j = 0; j < nb.count; ++j) {
+        if (test(leaf_a_[static_cast<std::size_t>(i)], leaf_b_[static_cast<std::size_t>(j)])) {
+          found_ = true;
+          return;
         }
       }
     }
-    return false;
+  }
+
+  // The children of the larger box (by the sum of half extents; an inner
+  // node against a leaf: the inner one), the nearer first (a tie to the
+  // first child).
+  std::pair<NodePair, NodePair> split(const NodePair& e) {
+    const auto nodes_a = q_.a.nodes();
+    const auto nodes_b = q_.b.nodes();
+    const double prune2 = prune_s_ * prune_s_;
+    const TriangleMesh::Node& na = nodes_a[static_cast<std::size_t>(e.ia)];
+    const TriangleMesh::Node& nb = nodes_b[static_cast<std::size_t>(e.ib)];
+    const Box ba = node_box(na, q_.box_unit_a);
+    const Box bb = node_box(nb, q_.box_unit_b);
+    const bool split_a = !na.is_leaf() && (nb.is_leaf() || ba.half.sum() >= bb.half.sum());
+    std::array<NodePair, 2> child = {NodePair{e.ia, e.ib, 0.0}, NodePair{e.ia, e.ib, 0.0}};
+    if (split_a) {
+      const Vec3 cb = q_.rotation * bb.center + q_.translation_s;
+      const Vec3 extent_b = q_.abs_rotation * bb.half;
+      child[0].ia = e.ia + 1;
+      child[1].ia = na.first_or_right;
+      for (NodePair& c : child) {
+        const Box box = node_box(nodes_a[static_cast<std::size_t>(c.ia)], q_.box_unit_a);
+        c.lb2 = lower_bound_on_a_axes(q_, box, bb, cb, extent_b, prune2);
+      }
+    } else {
+      const Vec3 ca = q_.rotation.transpose() * (ba.center - q_.translation_s);
+      const Vec3 extent_a = q_.abs_rotation.transpose() * ba.half;
+      child[0].ib = e.ib + 1;
+      child[1].ib = nb.first_or_right;
+      for (NodePair& c : child) {
+        const Box box = node_box(nodes_b[static_cast<std::size_t>(c.ib)], q_.box_unit_b);
+        c.lb2 = lower_bound_on_b_axes(q_, ba, box, ca, extent_a, prune2);
+      }
+    }
+    nodes_tested_ += 2;
+    const int near = child[0].lb2 <= child[1].lb2 ? 0 : 1;
+    return {child[static_cast<std::size_t>(near)], child[static_cast<std::size_t>(1 - near)]};
   }
 
   double margin() const { return margin_; }
@@ -147,7 +172,9 @@ class MarginSearch {
   int tested_ = 0;
   int nodes_tested_ = 0;
   std::int32_t witness_a_ = -1, witness_b_ = -1;
-  std::vector<std::array<std::int32_t, 2>> stack_;
+  bool found_ = false;
+  std::array<Triangles, TriangleMesh::kLeafSize> leaf_a_, leaf_b_;
+  std::vector<NodePair> stack_;
 };
 
 }  // namespace

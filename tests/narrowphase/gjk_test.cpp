@@ -1114,6 +1114,41 @@ TEST(GjkRegression, FlatFaceAboveATouchingApexReachesIt) {
   EXPECT_GT(queries, 100);
 }
 
+// Regression (issue 25, the 10^7-query soak: seed 15, episode 18168): a
+// segment (two vertices) against a point whose exact distance, about
+// 2.2e-14, is inside the band (4.7e-13), poses as the soak drew them.
+// Plain GJK ran to its cap of 64 iterations and answered `iteration_cap`;
+// Enhanced GJK and the hybrid answered `touching`.
+TEST(GjkRegression, SegmentAgainstAPointInTheBand) {
+  const ConvexPolytope segment(std::vector<Vec3>{
+      Vec3(-2.1957053245359854, -0.20772433606387436, -3.1749476909626524),
+      Vec3(0.80635862618445708, 0.60743791173750117, 3.5526115208256339)});
+  const ConvexPolytope point(
+      std::vector<Vec3>{Vec3(-0.037849993504155861, -66.588346848257814, -34.010020936431658)});
+  Mat3 rot_a;
+  rot_a << 0.32527856930103372, -0.58752728268295551, -0.74094908357906419,
+           0.09160406957269987, 0.79945318910817087, -0.59370303423723136,
+           0.94117083826008585, 0.12524492216436442, 0.31386487965500331;
+  Mat3 rot_b;
+  rot_b << 0.62195251239646476, -0.30954734634362957, -0.71927429586725988,
+           0.67831406792236282, -0.24595579376443497, 0.69238412227052371,
+           -0.3912353480736907, -0.91852391797128752, 0.056997495842662935;
+  const Pose pose_a(rot_a, Vec3::Zero());
+  const Pose pose_b(rot_b, Vec3(-43.290936617042682, 8.7136576244506863, -62.328366280845387));
+  for (const Algorithm alg : {Algorithm::gjk, Algorithm::enhanced_gjk, Algorithm::hybrid}) {
+    DistanceOptions options;
+    options.algorithm = alg;
+    for (const bool segment_first : {true, false}) {
+      SCOPED_TRACE(std::string(to_string(alg)) + (segment_first ? ", segment first" : ", point first"));
+      const DistanceResult r = segment_first ? distance(segment, pose_a, point, pose_b, options)
+                                             : distance(point, pose_b, segment, pose_a, options);
+      EXPECT_EQ(r.status, Status::touching) << r.iterations << " iterations, distance " << r.distance;
+      EXPECT_LE(r.lower_bound, r.distance);
+      EXPECT_LT(r.iterations, options.max_iterations);
+    }
+  }
+}
+
 TEST(Gjk, IterationCapIsReportedWithValidBounds) {
   Rng rng(8);
   const ConvexPolytope a(sphere_points(rng, 500, 1.0));

@@ -454,6 +454,136 @@ TEST(BodyCompound, MixedKindsAgreeWithTheirOnePieceCompounds) {
   }
 }
 
+// Bitwise equality of two answers' signed distance, certificate, points,
+// normal and features.
+void expect_same_bits(const DistanceResult& body, double radii, const DistanceResult& core,
+                      int i) {
+  EXPECT_EQ(body.status, core.status) << i;
+  EXPECT_EQ(body.signed_distance(), core.signed_distance() - radii) << i;
+  EXPECT_EQ(body.signed_lower_bound(), core.signed_lower_bound() - radii) << i;
+  EXPECT_EQ(body.signed_upper_bound(), core.signed_upper_bound() - radii) << i;
+  EXPECT_EQ(body.normal, core.normal) << i;
+  EXPECT_EQ(body.feature_a.vertices, core.feature_a.vertices) << i;
+  EXPECT_EQ(body.feature_b.vertices, core.feature_b.vertices) << i;
+}
+
+TEST(BodyDepth, OverlappingCoresAreTheirQuerysOwnAnswerBitForBit) {
+  // Story: a Body pair took the depth of overlapping cores through a
+  // pipeline of its own (the cores' query without the depth, then a
+  // penetration query per pair; for compounds a second, cold traversal of
+  // both hierarchies after the compound search stopped at its first
+  // overlapping pair), which answered a few ulps away from the convex and
+  // compound queries on the same cores (another relative pose, another
+  // seed). Now the cores' own query takes the depth: overlapping cores
+  // give its answer offset by the radii, bit for bit, cold and tracked.
+  Rng rng(23);
+  const auto random_compound = [&](int pieces) {
+    std::vector<CompoundPiece> list;
+    for (int p = 0; p < pieces; ++p) {
+      list.push_back({hull(test::points_on_sphere(rng, test::uniform_int(rng, 4, 12),
+                                                  test::uniform(rng, 0.3, 1.0))),
+                      Pose(test::random_quaternion(rng),
+                           1.5 * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
+                                      test::uniform(rng, -1, 1)))});
+    }
+    return std::make_shared<const CompoundBody>(std::move(list));
+  };
+  const auto ca = random_compound(6);
+  const auto cb = random_compound(5);
+  const auto hull_a = ca->piece(0).polytope;
+  const auto hull_b = cb->piece(0).polytope;
+  BodyCache tracked_bodies, tracked_hulls;
+  CompoundCache tracked_compounds;
+  DistanceCache tracked_convex;
+  int overlapping = 0;
+  for (int i = 0; i < count(40); ++i) {
+    const double ra = i % 3 == 0 ? 0.0 : 0.1, rb = i % 2 == 0 ? 0.0 : 0.2;
+    // B passes through A, turning.
+    const Pose pa = Pose::identity();
+    const Pose pb(Quat(Eigen::AngleAxisd(0.05 * i, Vec3(1, 2, 3).normalized())),
+                  Vec3(-2.0 + 4.0 * i / count(40), 0.3, 0.1));
+    const CompoundResult compound = distance(*ca, pa, *cb, pb);
+    const CompoundResult compound_tracked = distance(*ca, pa, *cb, pb, {}, &tracked_compounds);
+    const DistanceResult convex = distance(*hull_a, pa, *hull_b, pb);
+    const DistanceResult convex_tracked = distance(*hull_a, pa, *hull_b, pb, {}, &tracked_convex);
+    if (compound.status == Status::intersecting) {
+      ++overlapping;
+      const BodyResult r = distance(Body(ca, ra), pa, Body(cb, rb), pb);
+      expect_same_bits(r, ra + rb, compound, i);
+      EXPECT_EQ(r.piece_a, compound.piece_a) << i;
+      EXPECT_EQ(r.piece_b, compound.piece_b) << i;
+    }
+    if (compound_tracked.status == Status::intersecting) {
+      const BodyResult r = distance(Body(ca, ra), pa, Body(cb, rb), pb, {}, &tracked_bodies);
+      expect_same_bits(r, ra + rb, compound_tracked, i);
+    } else {
+      distance(Body(ca, ra), pa, Body(cb, rb), pb, {}, &tracked_bodies);
+    }
+    if (convex.status == Status::intersecting) {
+      expect_same_bits(distance(Body(hull_a, ra), pa, Body(hull_b, rb), pb), ra + rb, convex, i);
+    }
+    const BodyResult r = distance(Body(hull_a, ra), pa, Body(hull_b, rb), pb, {}, &tracked_hulls);
+    if (convex_tracked.status == Status::intersecting)
+      expect_same_bits(r, ra + rb, convex_tracked, i);
+  }
+  EXPECT_GT(overlapping, count(40) / 4);
+}
+
+TEST(BodyRegression, CoplanarOverlapOfBoxesIsIntersecting) {
+  // Story: unit cubes with B at (0.8, 0, 0) overlap by 0.2, but the
+  // contact classification answers touching (the origin on planes of A -
+  // B's vertex differences; SignedDistanceHand.CoplanarOverlapCalledTouching
+  // GetsItsDepth). The convex query checks a touching answer's depth; a
+  // Body pair asked its cores' query without the depth and took one only
+  // for an intersecting answer or a rounded touching one, so unrounded
+  // boxes came out touching with signed distance 0, and rounded ones
+  // overlapping by the right amount but with intersecting false.
+  for (const double r : {0.0, 0.1}) {
+    const Body box = make_box(Vec3(0.5, 0.5, 0.5), r);
+    const Body compound(box.compound(), r);
+    for (const Algorithm algorithm : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
+      DistanceOptions options;
+      options.algorithm = algorithm;
+      for (int step = 0; step < 3; ++step) {
+        const Pose pb = Pose::from_translation(Vec3(0.8 - 0.1 * step, 0, 0));
+        for (const BodyResult& a : {distance(box, Pose::identity(), box, pb, options),
+                                    distance(compound, Pose::identity(), box, pb, options)}) {
+          EXPECT_EQ(a.status, Status::intersecting) << r << " " << step;
+          EXPECT_TRUE(a.intersecting) << r << " " << step;
+          EXPECT_NEAR(a.signed_distance(), -0.2 - 0.1 * step - 2 * r, 1e-15) << r << " " << step;
+          expect_consistent(a, 2.0);
+        }
+      }
+    }
+  }
+}
+
+TEST(BodyRegression, IterationCapLeavesRoomForTheOverlap) {
+  // Story: the cores' query stopped at DistanceOptions::max_iterations
+  // with a lower bound <= 0 does not certify separation: the convex query
+  // bounds the possible depth by the bounding balls' (its
+  // depth_upper_bound), but a Body pair read only its lower bound, so two
+  // rounded balls of 64 points overlapping by 1.76 reported a signed lower
+  // bound of -0.2 (minus the radii), above the signed distance.
+  Rng rng(24);
+  const auto ball = hull(test::points_on_sphere(rng, 64));
+  const Pose pb(Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized())), Vec3(0.3, 0.2, 0.1));
+  const double depth = penetration_depth_brute_force(*ball, *ball, pb).depth;
+  for (const Algorithm algorithm : {Algorithm::hybrid, Algorithm::gjk, Algorithm::enhanced_gjk}) {
+    DistanceOptions capped;
+    capped.algorithm = algorithm;
+    capped.max_iterations = 1;
+    const Body a(ball, 0.1);
+    const Body compound(a.compound(), 0.1);
+    for (const BodyResult& r : {distance(a, Pose::identity(), a, pb, capped),
+                                distance(compound, Pose::identity(), a, pb, capped)}) {
+      ASSERT_EQ(r.status, Status::iteration_cap) << to_string(algorithm);
+      EXPECT_LE(r.signed_lower_bound(), -depth - 0.2) << to_string(algorithm);
+      EXPECT_GE(r.signed_upper_bound(), -depth - 0.2) << to_string(algorithm);
+    }
+  }
+}
+
 // --- Tracking -----------------------------------------------------------------
 
 TEST(BodyTracking, TrackedAnswersAreTheColdAnswers) {

@@ -2,8 +2,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 //
 // One distance call for any two bodies (proxima/shape/body.h): the cores'
-// query (convex, compound or mesh), their penetration depth where convex cores
-// overlap, and the offset by the radii along the normal.
+// query (convex, compound or mesh; the convex query takes the penetration
+// depth of overlapping convex cores or pieces), and the offset by the radii
+// along the normal.
 #pragma once
 
 #include <cstdint>
@@ -19,9 +20,11 @@ namespace proxima {
 
 // Coherence between queries of one pair of Bodies, owned by the caller;
 // default-constructed means cold. It holds the cache of whichever query the
-// pair's kinds need (convex pair, or compound as soon as one side is one)
-// and the penetration cache used while convex cores overlap. A cache of
-// another pair is at worst slower, never wrong.
+// pair's kinds need (convex pair, whose DistanceCache tracks the depth of
+// overlapping cores too, or compound as soon as one side is one) and the
+// penetration cache of rounded convex bodies whose cores touch (their
+// contact normal). A cache of another pair is at worst slower, never
+// wrong.
 struct BodyCache {
   DistanceCache convex;
   CompoundCache compound;
@@ -100,15 +103,18 @@ struct BodyResult : DistanceResult {
 // DistanceOptions): a non-default algorithm, relative_tolerance or
 // max_iterations is refused with InvalidInput naming the field.
 //
-// Compound bodies: the signed distance is the smallest over piece pairs of
-// the pair's signed distance (the deepest overlapping pair when cores
-// overlap: every piece pair whose bounding spheres meet is then tested,
-// cold). Convex cores that overlap cost a penetration query (tracked
-// through the cache) on top of the distance query. With
-// options.penetration false that depth is skipped: overlapping cores then
-// have the signed value 0 with certificate [-infinity, 0] (as a mesh
-// overlap), status intersecting, and the distance query's points and normal
-// (which do not separate them).
+// Convex and compound cores: their answer is the convex query's
+// (proxima/query/distance.h) or the compound query's
+// (proxima/query/compound_distance.h: the smallest signed distance over
+// piece pairs, the deepest overlapping pair when cores overlap) on the same
+// cores and options, offset by the radii, with that query's depth and
+// certificate: overlapping cores give the same bits as that query less
+// r_a + r_b. Rounded bodies whose cores touch without a certified gap take
+// the cores' penetration query for their normal. With options.penetration
+// false the depth is skipped: overlapping cores then have the signed value
+// 0 with certificate [-infinity, 0] (as a mesh overlap), status
+// intersecting, and the distance query's points and normal (which do not
+// separate them).
 BodyResult distance(const Body& a, const Pose& pose_a, const Body& b, const Pose& pose_b,
                       const DistanceOptions& options = {}, BodyCache* cache = nullptr);
 

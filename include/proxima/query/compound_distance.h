@@ -53,8 +53,11 @@ struct CompoundResult : DistanceResult {
 // Signed distance: the minimum over piece pairs of the convex signed
 // distance (the piecewise definition FCL and Coal use for unions). When
 // pieces overlap it is minus the depth of the deepest overlapping piece
-// pair, reported with that pair's deepest points, normal, features and
-// certificate (which brackets that pair's signed distance). It is NOT the
+// pair, reported with that pair's deepest points, normal and features. The
+// certificate is the whole search's: the lower bounds are the least over
+// the tested pairs' (a pruned pair's sphere bound lies above them), the
+// signed upper bound the least of the tested pairs' signed upper bounds;
+// the twin's is the same over every pair. It is NOT the
 // penetration depth of the two unions: moving B by that pair's depth along
 // its normal separates that pair but may leave other pieces overlapping
 // (the union's depth is at least every pair's depth). With the depth
