@@ -480,11 +480,12 @@ TEST(BodyDepth, OverlappingCoresAreTheirQuerysOwnAnswerBitForBit) {
   const auto random_compound = [&](int pieces) {
     std::vector<CompoundPiece> list;
     for (int p = 0; p < pieces; ++p) {
-      list.push_back({hull(test::points_on_sphere(rng, test::uniform_int(rng, 4, 12),
-                                                  test::uniform(rng, 0.3, 1.0))),
-                      Pose(test::random_quaternion(rng),
-                           1.5 * Vec3(test::uniform(rng, -1, 1), test::uniform(rng, -1, 1),
-                                      test::uniform(rng, -1, 1)))});
+      // The braces are evaluated in order; in the calls, the last
+      // argument first (gcc's order, see drawn()).
+      const double radius = test::uniform(rng, 0.3, 1.0);
+      const auto piece = hull(test::points_on_sphere(rng, test::uniform_int(rng, 4, 12), radius));
+      const Vec3 at = 1.5 * test::drawn([&] { return test::uniform(rng, -1, 1); });
+      list.push_back({piece, Pose(test::random_quaternion(rng), at)});
     }
     return std::make_shared<const CompoundBody>(std::move(list));
   };
