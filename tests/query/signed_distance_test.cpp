@@ -460,15 +460,18 @@ TEST(SignedDistanceOracle, CertificatesNearTheBandHoldUnderRotatedPoses) {
   int inside = 0, outside = 0, near = 0, strict = 0;
   for (int trial = 0; trial < 80; ++trial) {
     const double s = log_uniform(rng, 1e-100, 1e100);
-    const auto offset = [&] {
-      return uniform_int(rng, 0, 2) == 0 ? Vec3::Zero().eval()
-                                         : Vec3(log_uniform(rng, 1.0, 1e3) * s *
-                                                random_unit_vector(rng));
+    // Each draw in its own statement (a call's arguments and an operator's
+    // operands are evaluated in an order the compiler chooses).
+    const auto offset = [&]() -> Vec3 {
+      if (uniform_int(rng, 0, 2) == 0) return Vec3::Zero();
+      const Vec3 direction = random_unit_vector(rng);
+      return log_uniform(rng, 1.0, 1e3) * s * direction;
     };
     const Vec3 at_a = 0.5 * s * random_unit_vector(rng), at_b = 0.5 * s * random_unit_vector(rng);
     const Points a = translated(scaled(near_band_body(rng), s), at_a);
     const Points b = translated(scaled(near_band_body(rng), s), at_b);
-    const Pose pose_a(given_rotation(rng), offset());
+    const Vec3 placed_at = offset();
+    const Pose pose_a(given_rotation(rng), placed_at);
     Pose pose_b(given_rotation(rng), Vec3::Zero());
     const Pose rigid_a = checked_pose(pose_a, "pose_a");
     // B's centre 4 sizes from A's along a random direction, then moved back
