@@ -10,6 +10,7 @@
 #include <CGAL/squared_distance_3.h>
 
 #include <algorithm>
+#include <array>
 #include <sstream>
 #include <type_traits>
 
@@ -59,22 +60,32 @@ struct FacetPlane {
   ExactFT offset;
 };
 
-// The facets of the exact hull of m, as CGAL's convex_hull_3 builds it.
-std::vector<FacetPlane> facet_planes(const std::vector<ExactPoint>& m) {
+// The facets of the exact hull of m as CGAL's convex_hull_3 builds them
+// (triangles), each its first three vertices in CGAL's outward order.
+std::vector<std::array<ExactPoint, 3>> facet_triangles(const std::vector<ExactPoint>& m) {
   CGAL::Polyhedron_3<ExactKernel> hull;
   CGAL::convex_hull_3(m.begin(), m.end(), hull);
-  const ExactPoint origin(0, 0, 0);
-  std::vector<FacetPlane> planes;
+  std::vector<std::array<ExactPoint, 3>> triangles;
   for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
     auto h = f->facet_begin();
     const ExactPoint& p0 = h->vertex()->point();
     ++h;
     const ExactPoint& p1 = h->vertex()->point();
     ++h;
-    const ExactPoint& p2 = h->vertex()->point();
-    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);
-    planes.push_back({n, n * (p0 - origin)});
+    triangles.push_back({p0, p1, h->vertex()->point()});
   }
+  return triangles;
+}
+
+// A facet's plane: N = (p1 - p0) x (p2 - p0), offset N . p0.
+FacetPlane facet_plane(const std::array<ExactPoint, 3>& t) {
+  const auto n = CGAL::cross_product(t[1] - t[0], t[2] - t[0]);
+  return {n, n * (t[0] - ExactPoint(0, 0, 0))};
+}
+
+std::vector<FacetPlane> facet_planes(const std::vector<ExactPoint>& m) {
+  std::vector<FacetPlane> planes;
+  for (const auto& t : facet_triangles(m)) planes.push_back(facet_plane(t));
   return planes;
 }
 
@@ -202,24 +213,15 @@ ExactSignedDistance exact_signed_distance(const Points& a, const Pose& pose_a, c
     r.flat = true;
     return r;
   }
-  CGAL::Polyhedron_3<ExactKernel> hull;
-  CGAL::convex_hull_3(m.begin(), m.end(), hull);
   const ExactPoint origin(0, 0, 0);
   bool outside = false, boundary = false, first = true;
   ExactFT least_offset = 0, least_distance = 0;
-  for (auto f = hull.facets_begin(); f != hull.facets_end(); ++f) {
-    auto h = f->facet_begin();
-    const ExactPoint& p0 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p1 = h->vertex()->point();
-    ++h;
-    const ExactPoint& p2 = h->vertex()->point();
-    const auto n = CGAL::cross_product(p1 - p0, p2 - p0);
-    const ExactFT offset = n * (p0 - origin);
+  for (const auto& t : facet_triangles(m)) {
+    const auto [n, offset] = facet_plane(t);
     if (offset < 0) outside = true;
     if (offset == 0) boundary = true;
     const ExactFT d2 = offset * offset / n.squared_length();
-    const ExactFT e2 = CGAL::squared_distance(origin, ExactKernel::Triangle_3(p0, p1, p2));
+    const ExactFT e2 = CGAL::squared_distance(origin, ExactKernel::Triangle_3(t[0], t[1], t[2]));
     if (first || d2 < least_offset) least_offset = d2;
     if (first || e2 < least_distance) least_distance = e2;
     first = false;
